@@ -1,0 +1,47 @@
+"""Perspective camera and transform helpers (pyrr builds the matrices; column-vector convention).
+
+Matrices here are numpy (4, 4) arrays acting on column vectors (``p' = M @ p``). GLSL wants them
+column-major, which is ``M.T`` in numpy's row-major memory: use :func:`gl_bytes`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pyrr
+
+
+def gl_bytes(matrix: np.ndarray) -> bytes:
+    """Bytes of a column-vector matrix in the column-major order GLSL expects."""
+    return np.ascontiguousarray(np.asarray(matrix, dtype=np.float32).T).tobytes()
+
+
+def model_matrix(position, rotation_degrees, scale) -> np.ndarray:
+    """Translation @ Rz @ Ry @ Rx @ Scale: rotations are applied X first, then Y, then Z."""
+    rx, ry, rz = np.radians(np.asarray(rotation_degrees, dtype=np.float64))
+    rot = (pyrr.matrix44.create_from_z_rotation(-rz).T
+           @ pyrr.matrix44.create_from_y_rotation(-ry).T
+           @ pyrr.matrix44.create_from_x_rotation(-rx).T)
+    scale = np.broadcast_to(np.asarray(scale, dtype=np.float64), (3,))
+    translation = pyrr.matrix44.create_from_translation(np.asarray(position, dtype=np.float64)).T
+    return translation @ rot @ np.diag([*scale, 1.0])
+
+
+@dataclass(frozen=True)
+class Camera:
+    position: tuple[float, float, float] = (0.0, 1.0, 4.0)
+    target: tuple[float, float, float] = (0.0, 0.5, 0.0)
+    up: tuple[float, float, float] = (0.0, 1.0, 0.0)
+    fov: float = 45.0  # vertical, degrees
+    near: float = 0.05
+    far: float = 100.0
+
+    def view(self) -> np.ndarray:
+        return pyrr.matrix44.create_look_at(np.array(self.position, dtype=np.float64),
+                                            np.array(self.target, dtype=np.float64),
+                                            np.array(self.up, dtype=np.float64)).T
+
+    def projection(self, aspect: float) -> np.ndarray:
+        return pyrr.matrix44.create_perspective_projection(
+            self.fov, aspect, self.near, self.far, dtype=np.float64).T

@@ -1,0 +1,88 @@
+"""Headless GL context creation and capability detection.
+
+The framework needs GL 3.3 core. GL 4.3 features (shader storage buffers, compute shaders) are
+detected and switched on only where the driver reports them; everything has a 3.3 path.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+
+import moderngl
+
+from .errors import RenderError
+
+MIN_GL_VERSION = 330
+
+
+@dataclass(frozen=True)
+class Features:
+    """Optional GL features in use, decided once per context."""
+
+    storage_buffers: bool = False  # GL 4.3: lights in an SSBO instead of a float texture
+    compute_shaders: bool = False  # GL 4.3
+    depth_clamp: bool = True  # GL 3.2 core: light volumes are never cut by the far plane
+
+    def glsl_version(self) -> int:
+        return 430 if self.storage_buffers or self.compute_shaders else 330
+
+    def names(self) -> dict[str, bool]:
+        return {
+            "storage_buffers": self.storage_buffers,
+            "compute_shaders": self.compute_shaders,
+            "depth_clamp": self.depth_clamp,
+        }
+
+
+@dataclass
+class GLContext:
+    """A moderngl context plus the features the framework decided to use on it."""
+
+    ctx: moderngl.Context
+    features: Features = field(default_factory=Features)
+
+    @property
+    def info(self) -> dict[str, str]:
+        return {
+            "vendor": self.ctx.info["GL_VENDOR"],
+            "renderer": self.ctx.info["GL_RENDERER"],
+            "version": self.ctx.info["GL_VERSION"],
+            "glsl": str(self.features.glsl_version()),
+        }
+
+    _parking: moderngl.Framebuffer | None = None
+
+    def park(self) -> None:
+        """Bind a framebuffer this context keeps for good.
+
+        moderngl re-binds the last used framebuffer after creating another one; if that one was
+        released, the next creation is a GL error. Renderers park before releasing theirs.
+        """
+        if self._parking is None:
+            self._parking = self.ctx.framebuffer(self.ctx.renderbuffer((1, 1), 4))
+        self._parking.use()
+
+    def release(self) -> None:
+        self.ctx.release()
+
+
+def detect_features(ctx: moderngl.Context, allow_gl43: bool = True) -> Features:
+    has_43 = allow_gl43 and ctx.version_code >= 430
+    return Features(storage_buffers=has_43, compute_shaders=has_43, depth_clamp=True)
+
+
+def create_context(backend: str | None = None, allow_gl43: bool | None = None) -> GLContext:
+    """Create a headless context: EGL by default (Mesa llvmpipe on CI machines).
+
+    ``DEFERRED_GL_BACKEND`` overrides the backend; ``DEFERRED_GL33=1`` forces the GL 3.3 paths.
+    """
+    backend = backend or os.environ.get("DEFERRED_GL_BACKEND", "egl")
+    if allow_gl43 is None:
+        allow_gl43 = os.environ.get("DEFERRED_GL33", "") not in ("1", "true", "yes")
+    try:
+        ctx = moderngl.create_standalone_context(backend=backend, require=MIN_GL_VERSION)
+    except Exception as exc:  # noqa: BLE001 - moderngl raises plain Exception for missing drivers
+        raise RenderError("cannot create a GL 3.3 core context "
+                          f"(backend {backend}): {exc}") from exc
+    return GLContext(ctx, detect_features(ctx, allow_gl43))

@@ -1,0 +1,28 @@
+"""Error types the command line maps to exit codes (DESIGN.md, "Command line")."""
+
+from __future__ import annotations
+
+
+class DeferredError(Exception):
+    """Base class of the framework's own errors."""
+
+
+class InputError(DeferredError):
+    """Bad input: a scene, mesh, parameter or option. Exit code 2, one line on stderr.
+
+    ``where`` names the file and key (``scene.toml: object[0].params.shells``) so the message says
+    exactly what to fix.
+    """
+
+    def __init__(self, message: str, where: str | None = None):
+        self.where = where
+        self.message = message
+        super().__init__(f"{where}: {message}" if where else message)
+
+
+class ShaderError(DeferredError):
+    """A GLSL compile or link error, mapped back to the shader file and line."""
+
+
+class RenderError(DeferredError):
+    """A failure while rendering (GL error, missing feature). Exit code 1."""

@@ -1,0 +1,78 @@
+"""The G-buffer: the one interface between light-receiving materials and lights (Revie 2.1).
+
+| target               | format  | channels                                                         |
+|----------------------|---------|------------------------------------------------------------------|
+| ``albedo_specular``  | RGBA8   | albedo.rgb (linear), specular intensity [0, 1]                   |
+| ``normal_exponent_id``| RGBA16F | view-space normal, octahedral (2 ch.), specular exponent, material id (0 = background) |
+| ``linear_depth``     | R32F    | linear view depth (-z_view, 0 = background); fur samples it to reject occluded samples |
+| ``depth``            | DEPTH24 | hardware depth (light volumes depth-test against it)             |
+
+4 + 8 + 4 + 4 = 20 bytes per pixel (Killzone 2's budget). View-space position is never stored: it
+is reconstructed from the linear depth and the pixel's view ray (``gbuffer/layout.glsl``).
+
+Normals are octahedral-encoded [Cigolle et al. 2014] so a view-space unit vector fits two half
+floats. Material ids are the registry's ``type_id`` of the material that wrote the pixel.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .targets_spec import TargetSpec
+
+ALBEDO_SPECULAR = "albedo_specular"
+NORMAL_EXPONENT_ID = "normal_exponent_id"
+LINEAR_DEPTH = "linear_depth"
+DEPTH = "depth"
+
+GBUFFER_COLOR_TARGETS = (ALBEDO_SPECULAR, NORMAL_EXPONENT_ID, LINEAR_DEPTH)
+
+GBUFFER_TARGETS: dict[str, TargetSpec] = {
+    ALBEDO_SPECULAR: TargetSpec(4, "f1", "albedo.rgb, specular intensity"),
+    NORMAL_EXPONENT_ID: TargetSpec(4, "f2", "octahedral view normal (2), specular exponent, "
+                                            "material id"),
+    LINEAR_DEPTH: TargetSpec(1, "f4", "linear view depth (0 = background)"),
+    DEPTH: TargetSpec(1, "f4", "hardware depth", depth=True),
+}
+
+
+def bytes_per_pixel() -> int:
+    return sum(spec.bytes_per_pixel for spec in GBUFFER_TARGETS.values())
+
+
+def octahedral_encode(n: np.ndarray) -> np.ndarray:
+    """numpy twin of ``octahedral_encode`` in ``gbuffer/layout.glsl``."""
+    n = np.asarray(n, dtype=np.float64)
+    n = n / np.sum(np.abs(n), axis=-1, keepdims=True)
+    xy = n[..., :2].copy()
+    neg = n[..., 2] < 0.0
+    sign = np.where(xy >= 0.0, 1.0, -1.0)
+    folded = (1.0 - np.abs(xy[..., ::-1])) * sign
+    xy[neg] = folded[neg]
+    return xy
+
+
+def octahedral_decode(e: np.ndarray) -> np.ndarray:
+    """numpy twin of ``octahedral_decode`` in ``gbuffer/layout.glsl``."""
+    e = np.asarray(e, dtype=np.float64)
+    z = 1.0 - np.abs(e[..., 0]) - np.abs(e[..., 1])
+    xy = e.copy()
+    neg = z < 0.0
+    sign = np.where(e >= 0.0, 1.0, -1.0)
+    folded = (1.0 - np.abs(e[..., ::-1])) * sign
+    xy[neg] = folded[neg]
+    n = np.concatenate([xy, z[..., None]], axis=-1)
+    return n / np.linalg.norm(n, axis=-1, keepdims=True)
+
+
+def decode(albedo_specular: np.ndarray, normal_exponent_id: np.ndarray,
+           linear_depth: np.ndarray) -> dict[str, np.ndarray]:
+    """Decode read-back G-buffer targets to named arrays (albedo, normal, depth, ...)."""
+    return {
+        "albedo": albedo_specular[..., :3],
+        "specular_intensity": albedo_specular[..., 3],
+        "normal": octahedral_decode(normal_exponent_id[..., :2]).astype(np.float32),
+        "specular_exponent": normal_exponent_id[..., 2],
+        "material_id": normal_exponent_id[..., 3],
+        "linear_depth": linear_depth[..., 0],
+    }

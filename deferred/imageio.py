@@ -1,0 +1,125 @@
+"""Image files through OpenImageIO: PNG/EXR out (atomically), any OIIO format in."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from .errors import InputError, RenderError
+
+OUTPUT_SUFFIXES = (".png", ".exr")
+
+
+def srgb_encode(linear: np.ndarray) -> np.ndarray:
+    linear = np.clip(linear, 0.0, 1.0)
+    return np.where(linear <= 0.0031308, linear * 12.92,
+                    1.055 * np.power(linear, 1.0 / 2.4) - 0.055)
+
+
+def srgb_decode(encoded: np.ndarray) -> np.ndarray:
+    encoded = np.asarray(encoded, dtype=np.float64)
+    return np.where(encoded <= 0.04045, encoded / 12.92, np.power((encoded + 0.055) / 1.055, 2.4))
+
+
+def check_output_path(path: str | Path, where: str = "-o") -> Path:
+    path = Path(path)
+    if path.suffix.lower() not in OUTPUT_SUFFIXES:
+        raise InputError(f"output must end in {' or '.join(OUTPUT_SUFFIXES)}: {path}", where)
+    if path.parent and not path.parent.exists():
+        raise InputError(f"output folder does not exist: {path.parent}", where)
+    return path
+
+
+def write_image(path: str | Path, pixels: np.ndarray, channels: Sequence[str] | None = None,
+                attributes: dict[str, object] | None = None, half: bool = False) -> Path:
+    """Write ``pixels`` (H, W, C), top row first, atomically (temporary file, then rename).
+
+    uint8 data is written as 8-bit; float data as float (or half) EXR with ``channels`` names.
+    """
+    import OpenImageIO as oiio
+
+    path = Path(path)
+    pixels = np.ascontiguousarray(pixels)
+    if pixels.ndim == 2:
+        pixels = pixels[..., None]
+    height, width, count = pixels.shape
+    if pixels.dtype == np.uint8:
+        fmt = oiio.UINT8
+    else:
+        pixels = pixels.astype(np.float16 if half else np.float32)
+        fmt = oiio.HALF if half else oiio.FLOAT
+    spec = oiio.ImageSpec(width, height, count, fmt)
+    if channels is not None:
+        if len(channels) != count:
+            raise ValueError(f"{len(channels)} channel names for {count} channels")
+        spec.channelnames = tuple(channels)
+    for key, value in (attributes or {}).items():
+        spec.attribute(key, value)
+    directory = path.parent if str(path.parent) else Path(".")
+    handle, temporary = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix,
+                                         dir=directory)
+    os.close(handle)
+    try:
+        output = oiio.ImageOutput.create(temporary)
+        if output is None or not output.open(temporary, spec):
+            raise RenderError(f"cannot write {path}: {oiio.geterror()}")
+        ok = output.write_image(pixels)
+        output.close()
+        if not ok:
+            raise RenderError(f"cannot write {path}: {oiio.geterror()}")
+        os.replace(temporary, path)
+    finally:
+        if os.path.exists(temporary):
+            os.unlink(temporary)
+    return path
+
+
+def read_image(path: str | Path, srgb_to_linear: bool = False) -> np.ndarray:
+    """Read an image as float32 RGBA (H, W, 4), top row first."""
+    import OpenImageIO as oiio
+
+    path = Path(path)
+    image = oiio.ImageInput.open(str(path))
+    if image is None:
+        raise InputError(f"cannot read image: {oiio.geterror() or 'unknown format'}", str(path))
+    try:
+        pixels = np.asarray(image.read_image(format=oiio.FLOAT), dtype=np.float32)
+        spec = image.spec()
+    finally:
+        image.close()
+    if pixels.ndim == 2:
+        pixels = pixels[..., None]
+    count = pixels.shape[2]
+    if count < 3:
+        pixels = np.concatenate([np.repeat(pixels[..., :1], 3, axis=2),
+                                 pixels[..., 1:2] if count == 2 else
+                                 np.ones(pixels.shape[:2] + (1,), np.float32)], axis=2)
+    elif count == 3:
+        pixels = np.concatenate([pixels, np.ones(pixels.shape[:2] + (1,), np.float32)], axis=2)
+    pixels = pixels[..., :4]
+    if srgb_to_linear and spec.format.basetype != oiio.FLOAT and spec.format.basetype != oiio.HALF:
+        pixels[..., :3] = srgb_decode(pixels[..., :3])
+    return pixels
+
+
+def read_channels(path: str | Path) -> tuple[np.ndarray, list[str], dict[str, object]]:
+    """Read every channel of an image (EXR dumps): pixels (H, W, C), names, a few attributes."""
+    import OpenImageIO as oiio
+
+    image = oiio.ImageInput.open(str(path))
+    if image is None:
+        raise InputError(f"cannot read image: {oiio.geterror()}", str(path))
+    try:
+        spec = image.spec()
+        pixels = np.asarray(image.read_image(format=oiio.FLOAT), dtype=np.float32)
+        names = list(spec.channelnames)
+        attributes = {"z_channel": spec.z_channel, "alpha_channel": spec.alpha_channel}
+    finally:
+        image.close()
+    if pixels.ndim == 2:
+        pixels = pixels[..., None]
+    return pixels, names, attributes

@@ -1,0 +1,143 @@
+"""The light interface, and the deferred pass that draws all lights of one type.
+
+A light type is a class with a unique ``name`` (the scene file's ``type``), a pydantic ``Params``
+model, a GLSL file defining ``vec3 <glsl_function>(LightRecord light, Surface s, vec3 P, vec3 V)``
+and a ``record(view)`` method packing the light into four vec4s in view space
+(``common/lighting.glsl`` documents the layout). The same record feeds both pipelines: the deferred
+pass reads it per instance, the forward pass loops over all records per fragment.
+
+``volume`` says how the deferred pass bounds a light: ``"fullscreen"`` (directional, ambient) or
+``"sphere"`` (the record's ``position.xyz`` is the centre and ``position.w`` the radius), so that
+cost follows the pixels a light touches.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+from importlib.resources.abc import Traversable
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, ClassVar, Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
+
+from .errors import InputError
+from .gbuffer import DEPTH, GBUFFER_COLOR_TARGETS
+from .mesh import MeshData, build_mesh
+from .passes import Phase, RenderPass
+from .targets import LIGHT_ACCUMULATION
+from .validation import format_validation_error
+
+if TYPE_CHECKING:
+    from .frame import Frame
+
+Vec3 = tuple[float, float, float]
+DISPATCH_FILE = "generated/lights.glsl"
+
+
+class LightParams(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    color: Vec3 = Field((1.0, 1.0, 1.0), description="linear RGB colour")
+    intensity: float = Field(1.0, ge=0.0, description="multiplier of color")
+
+
+class Light:
+    name: ClassVar[str]
+    Params: ClassVar[type[LightParams]] = LightParams
+    glsl_file: ClassVar[str] = ""
+    glsl_function: ClassVar[str] = ""
+    volume: ClassVar[Literal["fullscreen", "sphere"]] = "fullscreen"
+    shader_root: ClassVar[Traversable | Path | None] = None
+    type_id: ClassVar[int] = 0  # set by the registry
+
+    def __init__(self, params: LightParams | None = None):
+        self.params = params if params is not None else self.Params()
+
+    @classmethod
+    def from_dict(cls, values: dict[str, Any], where: str | None = None) -> Light:
+        try:
+            return cls(cls.Params(**values))
+        except ValidationError as exc:
+            raise InputError(*format_validation_error(exc, where)) from None
+
+    def radiance(self) -> np.ndarray:
+        return np.asarray(self.params.color, dtype=np.float64) * self.params.intensity
+
+    def record(self, view: np.ndarray) -> np.ndarray:
+        """(4, 4) float32: color, position, direction, extra (view space). See lighting.glsl."""
+        raise NotImplementedError
+
+
+def view_point(view: np.ndarray, point) -> np.ndarray:
+    return (view @ np.append(np.asarray(point, dtype=np.float64), 1.0))[:3]
+
+
+def view_direction(view: np.ndarray, direction) -> np.ndarray:
+    d = view[:3, :3] @ np.asarray(direction, dtype=np.float64)
+    return d / max(np.linalg.norm(d), 1e-12)
+
+
+def light_dispatch_glsl(light_types: list[type[Light]]) -> str:
+    """GLSL of ``evaluate_light``: include every light type and switch on its type id."""
+    lines = [f'#include "{cls.glsl_file}"' for cls in light_types]
+    lines.append("vec3 evaluate_light(LightRecord light, Surface s, vec3 P, vec3 V) {")
+    lines.append("    int kind = int(light.color.w + 0.5);")
+    lines += [f"    if (kind == {cls.type_id}) return {cls.glsl_function}(light, s, P, V);"
+              for cls in light_types]
+    lines += ["    return vec3(0.0);", "}"]
+    return "\n".join(lines) + "\n"
+
+
+@lru_cache(maxsize=1)
+def light_volume_mesh() -> tuple[MeshData, float]:
+    """An icosphere and the scale that makes it enclose the unit sphere (faces sit inside it)."""
+    import trimesh
+
+    sphere = trimesh.creation.icosphere(subdivisions=2, radius=1.0)
+    faces = np.asarray(sphere.faces)
+    vertices = np.asarray(sphere.vertices)
+    normals = np.asarray(sphere.face_normals)
+    inscribed = np.min(np.abs(np.sum(normals * vertices[faces[:, 0]], axis=1)))
+    mesh = build_mesh("light-volume", vertices, faces, vertices,
+                      uvs=np.zeros((len(vertices), 2)))
+    return mesh, 1.0 / float(inscribed)
+
+
+class LightTypePass(RenderPass):
+    """Deferred lighting of every light of one type, instanced, added into light accumulation."""
+
+    phase = Phase.LIGHTING
+    reads = (*GBUFFER_COLOR_TARGETS, DEPTH)
+    writes = (LIGHT_ACCUMULATION,)
+
+    def __init__(self, light_type: type[Light]):
+        self.light_type = light_type
+        self.name = f"lighting.{light_type.name}"
+
+    def execute(self, frame: Frame) -> None:
+        offset, count = frame.light_buffer.range(self.light_type)
+        if count == 0:
+            return
+        sphere = self.light_type.volume == "sphere"
+        vertex = "lights/volume.vert" if sphere else "lights/fullscreen.vert"
+        program = frame.shaders.program(vertex, "lights/accumulate.frag")
+        frame.use_framebuffer((LIGHT_ACCUMULATION,), DEPTH, depth_write=False)
+        textures = {f"u_{name}": frame.targets[name] for name in GBUFFER_COLOR_TARGETS}
+        uniforms = {**frame.camera_uniforms(), "u_light_offset": offset}
+        if sphere:
+            # Back faces of the bounding sphere, kept where the surface lies in front of them:
+            # works with the camera inside the volume; depth clamp stops the far plane cutting it.
+            mesh, scale = light_volume_mesh()
+            frame.set_state(depth_test=True, depth_func="gequal", cull="front", blend="add")
+            frame.bind(program, {**uniforms, "u_volume_scale": scale}, textures)
+            frame.ctx.enable_direct(GL_DEPTH_CLAMP)
+            frame.draw_mesh(mesh, program, instances=count)
+            frame.ctx.disable_direct(GL_DEPTH_CLAMP)
+        else:
+            frame.set_state(blend="add")
+            frame.bind(program, uniforms, textures)
+            frame.draw_fullscreen(program, instances=count)
+
+
+GL_DEPTH_CLAMP = 0x864F

@@ -1,0 +1,178 @@
+"""Passes: the pipeline is an ordered list of these (Revie section 2.1, Figure 2.3).
+
+Each pass has a unique name, the phase it belongs to, and the targets it reads and writes; dumps
+capture a pass's ``writes`` after it runs and benchmarks time it. Passes set all the GL state they
+need (``Frame.set_state``), so their order is the only coupling between them.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Callable
+from enum import Enum
+from typing import TYPE_CHECKING, Any
+
+import moderngl
+
+if TYPE_CHECKING:
+    from .frame import Frame
+    from .scene import SceneObject
+
+
+class Phase(str, Enum):
+    GEOMETRY = "geometry"  # opaque G-buffer passes
+    SCREEN = "screen"  # effects needing a clean G-buffer (SSAO, edges), before stipple
+    STIPPLE = "stipple"  # stippled G-buffer passes
+    LIGHTING = "lighting"  # lights add into the light accumulation
+    MATERIAL = "material"  # materials re-render meshes over the composition buffer
+    FORWARD = "forward"  # the forward pipeline's lit passes and forward shells
+    POST = "post"  # tone mapping etc.; knows no light and no object
+    OUTPUT = "output"
+
+
+PHASE_ORDER = (Phase.GEOMETRY, Phase.SCREEN, Phase.STIPPLE, Phase.LIGHTING, Phase.MATERIAL,
+               Phase.FORWARD, Phase.POST, Phase.OUTPUT)
+
+
+class RenderPass(ABC):
+    """One step of a frame."""
+
+    name: str
+    phase: Phase
+    reads: tuple[str, ...] = ()
+    writes: tuple[str, ...] = ()
+
+    def prepare(self, frame: Frame) -> None:  # noqa: B027 - optional hook
+        """Declare extra targets, upload data; called once per frame before any pass runs."""
+
+    @abstractmethod
+    def execute(self, frame: Frame) -> None:
+        """Issue the GL work of this pass."""
+
+    def describe(self) -> dict[str, Any]:
+        return {"name": self.name, "phase": self.phase.value, "reads": list(self.reads),
+                "writes": list(self.writes)}
+
+    def __repr__(self) -> str:
+        return f"<{type(self).__name__} {self.name} ({self.phase.value})>"
+
+
+class ClearPass(RenderPass):
+    """Clear colour targets to given values and optionally the depth target to 1."""
+
+    def __init__(self, name: str, phase: Phase, colors: dict[str, tuple[float, ...]],
+                 depth: str | None = None):
+        self.name = name
+        self.phase = phase
+        self.colors = colors
+        self.depth = depth
+        self.writes = tuple(colors) + ((depth,) if depth else ())
+
+    def execute(self, frame: Frame) -> None:
+        for target, value in self.colors.items():
+            frame.use_framebuffer([target]).clear(*value)
+        if self.depth:
+            frame.use_framebuffer([], self.depth).clear(depth=1.0)
+
+
+class FullscreenPass(RenderPass):
+    """Run a fragment shader over every pixel (``post/fullscreen.vert``)."""
+
+    def __init__(self, name: str, phase: Phase, fragment: str, inputs: dict[str, str],
+                 outputs: tuple[str, ...], blend: str | None = None,
+                 defines: dict[str, str] | None = None,
+                 uniforms: Callable[[Frame], dict[str, Any]] | None = None,
+                 depth: str | None = None, depth_test: bool = False, depth_func: str = "less",
+                 depth_write: bool = False, instances: Callable[[Frame], int] | None = None,
+                 vertex: str = "post/fullscreen.vert"):
+        self.name = name
+        self.phase = phase
+        self.fragment = fragment
+        self.vertex = vertex
+        self.inputs = inputs  # sampler uniform -> target name
+        self.outputs = outputs
+        self.blend = blend
+        self.defines = defines or {}
+        self.uniforms = uniforms
+        self.depth = depth
+        self.depth_test = depth_test
+        self.depth_func = depth_func
+        self.depth_write = depth_write
+        self.instances = instances
+        self.reads = tuple(dict.fromkeys(inputs.values()))
+        self.writes = outputs + ((depth,) if depth and depth_write else ())
+
+    def execute(self, frame: Frame) -> None:
+        program = frame.shaders.program(self.vertex, self.fragment, defines=self.defines)
+        frame.use_framebuffer(self.outputs, self.depth, depth_write=self.depth_write)
+        frame.set_state(depth_test=self.depth_test, depth_func=self.depth_func, blend=self.blend)
+        uniforms = frame.camera_uniforms()
+        if self.uniforms:
+            uniforms.update(self.uniforms(frame))
+        frame.bind(program, uniforms, {u: frame.targets[t] for u, t in self.inputs.items()})
+        count = self.instances(frame) if self.instances else 1
+        if count > 0:
+            frame.draw_fullscreen(program, instances=count)
+
+
+class ObjectPass(RenderPass):
+    """Draw one scene object's mesh with a program; materials build their passes on this.
+
+    Subclasses (or callers) give the shader files, defines, the targets and state, and a
+    ``uniforms`` hook for per-draw values. ``draws`` > 1 renders the mesh that many times with
+    ``u_draw_index`` set (e.g. one shell per draw).
+    """
+
+    vertex: str = "common/mesh.vert"
+    fragment: str = ""
+    colors: tuple[str, ...] = ()
+    depth: str | None = "depth"
+    depth_test: bool = True
+    depth_func: str = "less"
+    depth_write: bool = True
+    cull: str | None = "back"
+    blend: str | None = None
+    extra_reads: tuple[str, ...] = ()
+
+    def __init__(self, name: str, phase: Phase, obj: SceneObject, **options: Any):
+        self.name = name
+        self.phase = phase
+        self.obj = obj
+        for key, value in options.items():
+            if not hasattr(type(self), key):
+                raise TypeError(f"{type(self).__name__} has no option '{key}'")
+            setattr(self, key, value)
+        self.reads = tuple(self.extra_reads)
+        self.writes = tuple(self.colors) + ((self.depth,) if self.depth and self.depth_write
+                                            else ())
+
+    def defines(self, frame: Frame) -> dict[str, str]:
+        return self.obj.material.defines()
+
+    def uniforms(self, frame: Frame) -> dict[str, Any]:
+        return {}
+
+    def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
+        return {}
+
+    def draws(self, frame: Frame) -> int:
+        return 1
+
+    def program(self, frame: Frame) -> moderngl.Program:
+        return frame.shaders.program(self.vertex, self.fragment, defines=self.defines(frame))
+
+    def execute(self, frame: Frame) -> None:
+        program = self.program(frame)
+        frame.use_framebuffer(self.colors, self.depth, depth_write=self.depth_write)
+        frame.set_state(depth_test=self.depth_test, depth_func=self.depth_func, cull=self.cull,
+                        blend=self.blend)
+        material = self.obj.material
+        uniforms = {**frame.object_uniforms(self.obj), **material.uniforms(frame)}
+        uniforms.update(self.uniforms(frame))
+        textures = {**material.textures(frame), **self.textures(frame)}
+        count = self.draws(frame)
+        for index in range(count):
+            uniforms["u_draw_index"] = index
+            uniforms["u_draw_count"] = count
+            frame.bind(program, uniforms, textures)
+            frame.draw_mesh(self.obj.mesh, program)

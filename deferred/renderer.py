@@ -1,0 +1,109 @@
+"""The renderer: owns GL resources for a scene at a size and runs a pipeline's passes."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import registry
+from .context import GLContext, create_context
+from .errors import InputError, RenderError
+from .frame import Frame, Resources
+from .light import DISPATCH_FILE, light_dispatch_glsl
+from .lightbuffer import LightBuffer
+from .passes import RenderPass
+from .pipeline import PIPELINES
+from .scene import Scene, check_size
+from .shaderlib import ShaderLibrary
+from .targets import COMPOSITE, FINAL, FrameTargets
+
+PassCallback = Callable[[RenderPass, Frame], None]
+
+
+@dataclass
+class RenderResult:
+    image: np.ndarray  # (H, W, 4) uint8, sRGB, top row first
+    hdr: np.ndarray  # (H, W, 4) float32, linear composite, top row first
+    draw_calls: int
+    draws_by_pass: dict[str, int]
+
+
+class Renderer:
+    """Renders one scene with one pipeline; reuse it for many frames, then ``release()``."""
+
+    def __init__(self, scene: Scene, pipeline: str = "deferred",
+                 size: tuple[int, int] | None = None, gl: GLContext | None = None):
+        if pipeline not in PIPELINES:
+            raise InputError(f"unknown pipeline '{pipeline}' (choose from "
+                             f"{', '.join(PIPELINES)})", "--pipeline")
+        self.scene = scene
+        self.pipeline_name = pipeline
+        self.size = check_size(size or scene.size, "size")
+        self._owns_context = gl is None
+        self.gl = gl or create_context()
+        ctx = self.gl.ctx
+        features = self.gl.features
+        defines = {"DEFERRED_STORAGE_BUFFERS": "1"} if features.storage_buffers else {}
+        self.shaders = ShaderLibrary(ctx, features.glsl_version(), defines)
+        light_types = [cls for _, cls in registry.lights.items()]
+        for cls in [type(obj.material) for obj in scene.objects] + light_types:
+            if cls.shader_root is not None:
+                self.shaders.add_root(cls.shader_root)
+        self.shaders.set_virtual_file(DISPATCH_FILE, light_dispatch_glsl(light_types))
+        self.targets = FrameTargets(ctx, *self.size)
+        self.resources = Resources(ctx)
+        self.light_buffer = LightBuffer(ctx, features)
+        self.passes = PIPELINES[pipeline]().passes(scene)
+        self.last_frame: Frame | None = None
+
+    def render(self, on_pass: PassCallback | None = None,
+               before_pass: PassCallback | None = None) -> RenderResult:
+        frame = Frame(self.gl, self.shaders, self.targets, self.resources, self.scene,
+                      self.light_buffer)
+        self.light_buffer.upload(self.scene.lights, frame.view)
+        for render_pass in self.passes:
+            render_pass.prepare(frame)
+        ctx = self.gl.ctx
+        for render_pass in self.passes:
+            frame.current_pass = render_pass.name
+            if before_pass:
+                before_pass(render_pass, frame)
+            render_pass.execute(frame)
+            error = ctx.error
+            if error != "GL_NO_ERROR":
+                raise RenderError(f"pass {render_pass.name}: {error}")
+            if on_pass:
+                on_pass(render_pass, frame)
+        self.last_frame = frame
+        return RenderResult(self.read_final(), self.read_hdr(), frame.stats.draw_calls,
+                            dict(frame.stats.draws_by_pass))
+
+    def read_final(self) -> np.ndarray:
+        data = np.frombuffer(self.targets[FINAL].read(alignment=1), dtype=np.uint8)
+        return data.reshape(self.size[1], self.size[0], 4)[::-1].copy()
+
+    def read_hdr(self) -> np.ndarray:
+        return self.targets.read(COMPOSITE)[::-1].copy()
+
+    def release(self) -> None:
+        self.gl.park()
+        self.light_buffer.release()
+        self.resources.release()
+        self.targets.release()
+        self.shaders.release()
+        if self._owns_context:
+            self.gl.release()
+
+    def __enter__(self) -> Renderer:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.release()
+
+
+def render_scene(scene: Scene, pipeline: str = "deferred", size: tuple[int, int] | None = None,
+                 gl: GLContext | None = None) -> RenderResult:
+    with Renderer(scene, pipeline, size, gl) as renderer:
+        return renderer.render()

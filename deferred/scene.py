@@ -1,0 +1,200 @@
+"""Scenes: camera, objects (mesh + transform + material), lights; loaded from TOML files.
+
+The file format is DESIGN.md's. Validation names the file, the key and the problem in one line
+(``demo.toml: object[1].params.shells: Input should be greater than or equal to 0 (got -3)``).
+"""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from . import registry
+from .camera import Camera, model_matrix
+from .errors import InputError
+from .light import Light
+from .material import Material
+from .mesh import MeshData, load_mesh
+from .validation import format_validation_error
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+Vec3 = tuple[float, float, float]
+MAX_SIZE = 16384
+DEMO_SCENE = "demo.toml"
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+class CameraModel(_Strict):
+    position: Vec3 = (0.0, 1.0, 4.0)
+    target: Vec3 = (0.0, 0.5, 0.0)
+    up: Vec3 = (0.0, 1.0, 0.0)
+    fov: float = Field(45.0, gt=1.0, lt=179.0, description="vertical field of view, degrees")
+    near: float = Field(0.05, gt=0.0)
+    far: float = Field(100.0, gt=0.0)
+
+    @model_validator(mode="after")
+    def _check(self) -> CameraModel:
+        if self.far <= self.near:
+            raise ValueError("far must be greater than near")
+        if np.allclose(self.position, self.target):
+            raise ValueError("position and target are the same point")
+        return self
+
+
+class ObjectModel(_Strict):
+    name: str | None = None
+    mesh: str
+    material: str = "standard"
+    position: Vec3 = (0.0, 0.0, 0.0)
+    rotation: Vec3 = Field((0.0, 0.0, 0.0), description="degrees, applied X, then Y, then Z")
+    scale: float | Vec3 = 1.0
+    params: dict[str, Any] = Field(default_factory=dict)
+
+    @model_validator(mode="after")
+    def _check_scale(self) -> ObjectModel:
+        scale = np.broadcast_to(np.asarray(self.scale, dtype=float), (3,))
+        if np.any(scale == 0.0):
+            raise ValueError("scale must not be zero")
+        return self
+
+
+class LightModel(BaseModel):
+    model_config = ConfigDict(extra="allow")
+    type: str
+
+
+class SceneModel(_Strict):
+    size: tuple[int, int] = (1280, 720)
+    background: Vec3 = Field((0.02, 0.02, 0.025), description="linear RGB behind everything")
+    exposure: float = Field(1.0, gt=0.0)
+    tonemap: Literal["reinhard", "aces", "none"] = "aces"
+    camera: CameraModel = Field(default_factory=CameraModel)
+    object: list[ObjectModel] = Field(default_factory=list)
+    light: list[LightModel] = Field(default_factory=list)
+
+
+@dataclass
+class SceneObject:
+    label: str
+    mesh: MeshData
+    material: Material
+    model: np.ndarray
+
+
+@dataclass
+class Scene:
+    """A scene ready to render (meshes loaded, materials and lights validated)."""
+
+    camera: Camera
+    objects: list[SceneObject] = field(default_factory=list)
+    lights: list[Light] = field(default_factory=list)
+    size: tuple[int, int] = (1280, 720)
+    background: tuple[float, float, float] = (0.02, 0.02, 0.025)
+    exposure: float = 1.0
+    tonemap: str = "aces"
+    source: str = "<memory>"
+
+    def add(self, mesh: MeshData | str, material: Material | str = "standard",
+            position=(0.0, 0.0, 0.0), rotation=(0.0, 0.0, 0.0), scale=1.0,
+            label: str | None = None, params: dict[str, Any] | None = None) -> SceneObject:
+        """Add an object from Python (scene files go through :func:`load_scene`)."""
+        if isinstance(mesh, str):
+            mesh = load_mesh(mesh)
+        if isinstance(material, str):
+            material = registry.materials.get(material).from_dict(params or {})
+        obj = SceneObject(label or _unique_label(self, mesh.name), mesh, material,
+                          model_matrix(position, rotation, scale))
+        self.objects.append(obj)
+        return obj
+
+
+def _unique_label(scene: Scene, mesh_name: str) -> str:
+    stem = mesh_name.removeprefix("builtin:").rsplit(".", 1)[0] or "object"
+    taken = {obj.label for obj in scene.objects}
+    index = 0
+    while f"{stem}{index}" in taken:
+        index += 1
+    return f"{stem}{index}"
+
+
+def parse_size(text: str, where: str = "--size") -> tuple[int, int]:
+    parts = text.lower().split("x")
+    try:
+        width, height = (int(p) for p in parts)
+    except ValueError:
+        raise InputError(f"expected WIDTHxHEIGHT such as 1280x720, got '{text}'", where) from None
+    return check_size((width, height), where)
+
+
+def check_size(size: tuple[int, int], where: str) -> tuple[int, int]:
+    width, height = size
+    if not (1 <= width <= MAX_SIZE and 1 <= height <= MAX_SIZE):
+        raise InputError(f"size {width}x{height} is impossible (each side 1..{MAX_SIZE})", where)
+    return width, height
+
+
+def load_scene(path: str | Path | None = None) -> Scene:
+    """Load a scene file; ``None`` loads the built-in demo scene."""
+    if path is None:
+        text = resources.files("deferred").joinpath("scenes", DEMO_SCENE).read_text("utf-8")
+        return scene_from_toml(text, name=f"builtin:{DEMO_SCENE}", base_dir=None)
+    path = Path(path)
+    if not path.is_file():
+        raise InputError("scene file not found", str(path))
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"cannot read scene file: {exc}", str(path)) from None
+    return scene_from_toml(text, name=path.name, base_dir=path.parent)
+
+
+def scene_from_toml(text: str, name: str = "<string>", base_dir: Path | None = None) -> Scene:
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"malformed TOML: {exc}", name) from None
+    return scene_from_dict(data, name, base_dir)
+
+
+def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
+                    base_dir: Path | None = None) -> Scene:
+    try:
+        model = SceneModel(**data)
+    except ValidationError as exc:
+        raise InputError(*format_validation_error(exc, name)) from None
+    check_size(model.size, f"{name}: size")
+    c = model.camera
+    scene = Scene(camera=Camera(c.position, c.target, c.up, c.fov, c.near, c.far),
+                  size=model.size, background=model.background, exposure=model.exposure,
+                  tonemap=model.tonemap, source=name)
+    meshes: dict[str, MeshData] = {}
+    for index, obj in enumerate(model.object):
+        where = f"{name}: object[{index}]"
+        material_cls = registry.materials.get(obj.material, f"{where}.material")
+        material = material_cls.from_dict(obj.params, base_dir, f"{where}.params")
+        if obj.mesh not in meshes:
+            meshes[obj.mesh] = load_mesh(obj.mesh, base_dir, f"{where}.mesh")
+        mesh = meshes[obj.mesh]
+        label = obj.name or _unique_label(scene, mesh.name)
+        if any(o.label == label for o in scene.objects):
+            raise InputError(f"duplicate object name '{label}'", f"{where}.name")
+        scene.objects.append(SceneObject(label, mesh, material,
+                                         model_matrix(obj.position, obj.rotation, obj.scale)))
+    for index, light in enumerate(model.light):
+        where = f"{name}: light[{index}]"
+        light_cls = registry.lights.get(light.type, f"{where}.type")
+        scene.lights.append(light_cls.from_dict(light.model_extra or {}, where))
+    return scene

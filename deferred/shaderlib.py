@@ -1,0 +1,180 @@
+"""The shader library: GLSL files with ``#include``, injected defines, cached programs.
+
+GLSL lives in ``.glsl`` files under the ``shaders`` package (found with ``importlib.resources``) or
+under extra roots a plugin adds. A file may ``#include "path/from/a/root.glsl"``; the argument may
+also be the name of an injected define whose value is a quoted path (``#include SURFACE_FILE``),
+which is how a generic pass pulls in a material's surface function. Each file is included once per
+program (include-once), nesting is limited to ``MAX_INCLUDE_DEPTH``, and a cycle is an error.
+
+The assembled source keeps a line map, so a compile error reported by the driver as ``0:57(3)``
+(Mesa) or ``0(57)`` (NVIDIA) is reported as ``materials/standard/surface.glsl:12``.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from importlib import resources
+from importlib.resources.abc import Traversable
+from pathlib import Path
+
+import moderngl
+
+from .errors import ShaderError
+
+MAX_INCLUDE_DEPTH = 16
+
+_INCLUDE = re.compile(r'^\s*#\s*include\s+(?:"([^"]+)"|<([^>]+)>|([A-Za-z_]\w*))\s*$')
+_ERROR_LOCATION = re.compile(r"\b(\d+)(?::(\d+)\((\d+)\)|\((\d+)\))")
+
+
+@dataclass
+class Source:
+    """Assembled GLSL text and, per output line, the (file, line) it came from."""
+
+    text: str
+    line_map: list[tuple[str, int]]
+
+    def locate(self, line: int) -> tuple[str, int]:
+        """File and line (1-based) of assembled line ``line`` (1-based)."""
+        if 1 <= line <= len(self.line_map):
+            return self.line_map[line - 1]
+        return ("<generated>", line)
+
+
+class ShaderLibrary:
+    """Resolves, assembles, compiles and caches GLSL programs for one context."""
+
+    def __init__(self, ctx: moderngl.Context, glsl_version: int = 330,
+                 defines: dict[str, str] | None = None):
+        self.ctx = ctx
+        self.glsl_version = glsl_version
+        self.global_defines = dict(defines or {})
+        self.roots: list[Traversable | Path] = [resources.files("shaders")]
+        self.virtual_files: dict[str, str] = {}
+        self._programs: dict[tuple, moderngl.Program] = {}
+
+    # -- files -------------------------------------------------------------------------------
+    def add_root(self, root: Traversable | Path) -> None:
+        """Search ``root`` for shader files too (plugins ship their GLSL this way)."""
+        if root not in self.roots:
+            self.roots.append(root)
+
+    def set_virtual_file(self, name: str, text: str) -> None:
+        """Provide generated GLSL under ``name`` (e.g. the light dispatch built from the registry)."""
+        if self.virtual_files.get(name) != text:
+            self.virtual_files[name] = text
+            self._programs = {k: v for k, v in self._programs.items() if name not in k[-1]}
+
+    def read(self, name: str) -> str:
+        if name in self.virtual_files:
+            return self.virtual_files[name]
+        for root in self.roots:
+            candidate = root.joinpath(*name.split("/"))
+            if candidate.is_file():
+                return candidate.read_text(encoding="utf-8")
+        raise ShaderError(f"shader file not found: {name} (searched {len(self.roots)} roots)")
+
+    def assemble(self, name: str, defines: dict[str, str] | None = None) -> Source:
+        """Resolve includes of ``name`` and inject ``#version`` and defines."""
+        defines = {**self.global_defines, **(defines or {})}
+        lines: list[str] = [f"#version {self.glsl_version} core"]
+        line_map: list[tuple[str, int]] = [("<version>", 0)]
+        for key, value in defines.items():
+            lines.append(f"#define {key} {value}".rstrip())
+            line_map.append(("<defines>", 0))
+        included: set[str] = set()
+        self._expand(name, defines, lines, line_map, included, stack=[])
+        return Source("\n".join(lines) + "\n", line_map)
+
+    def _expand(self, name: str, defines: dict[str, str], lines: list[str],
+                line_map: list[tuple[str, int]], included: set[str], stack: list[str]) -> None:
+        if name in stack:
+            raise ShaderError(f"{stack[-1]}: include cycle: {' -> '.join(stack + [name])}")
+        if len(stack) >= MAX_INCLUDE_DEPTH:
+            raise ShaderError(f"{stack[-1]}: includes nested deeper than {MAX_INCLUDE_DEPTH}")
+        included.add(name)
+        text = self.read(name)
+        for number, line in enumerate(text.splitlines(), start=1):
+            match = _INCLUDE.match(line)
+            if not match:
+                if line.lstrip().startswith("#version"):
+                    continue  # the library owns the version line
+                lines.append(line)
+                line_map.append((name, number))
+                continue
+            target = match.group(1) or match.group(2)
+            if match.group(3):
+                value = defines.get(match.group(3))
+                if value is None:
+                    raise ShaderError(f"{name}:{number}: #include {match.group(3)}: "
+                                      "no such define was injected")
+                target = value.strip().strip('"')
+            if target in included:
+                continue
+            self._expand(target, defines, lines, line_map, included, stack + [name])
+
+    # -- programs ----------------------------------------------------------------------------
+    def program(self, vertex: str, fragment: str | None = None, geometry: str | None = None,
+                defines: dict[str, str] | None = None) -> moderngl.Program:
+        """Compile (or return the cached) program of these files with these defines."""
+        defines = dict(defines or {})
+        key = (vertex, fragment, geometry, tuple(sorted(defines.items())),
+               tuple(sorted(self.virtual_files)))
+        cached = self._programs.get(key)
+        if cached is not None:
+            return cached
+        stages = {"vertex_shader": vertex, "fragment_shader": fragment,
+                  "geometry_shader": geometry}
+        sources = {stage: self.assemble(name, defines)
+                   for stage, name in stages.items() if name is not None}
+        try:
+            program = self.ctx.program(**{stage: src.text for stage, src in sources.items()})
+        except moderngl.Error as exc:
+            raise ShaderError(self._map_error(str(exc), sources, stages)) from None
+        self._programs[key] = program
+        return program
+
+    def compute(self, name: str, defines: dict[str, str] | None = None) -> moderngl.ComputeShader:
+        source = self.assemble(name, defines)
+        try:
+            return self.ctx.compute_shader(source.text)
+        except moderngl.Error as exc:
+            raise ShaderError(self._map_error(str(exc), {"compute_shader": source},
+                                              {"compute_shader": name})) from None
+
+    @staticmethod
+    def _map_error(message: str, sources: dict[str, Source], stages: dict[str, str | None]) -> str:
+        """Rewrite driver line references to ``file:line`` of the stage that failed."""
+        headers = {line.strip() for line in message.splitlines()}
+        stage = next((s for s in sources if s in headers), None)
+        if stage is None and len(sources) == 1:
+            stage = next(iter(sources))
+        lines_out: list[str] = []
+        first_location = None
+        for raw in message.splitlines():
+            raw = raw.strip()
+            if not raw or set(raw) <= {"=", "-"} or raw in sources:
+                continue
+            if stage is not None:
+                source = sources[stage]
+
+                def replace(m: re.Match, source: Source = source) -> str:
+                    nonlocal first_location
+                    line = int(m.group(2) or m.group(4))
+                    file, file_line = source.locate(line)
+                    if first_location is None:
+                        first_location = f"{file}:{file_line}"
+                    return f"{file}:{file_line}"
+
+                raw = _ERROR_LOCATION.sub(replace, raw, count=1)
+            lines_out.append(raw)
+        head = first_location or (stages.get(stage) if stage else None) or "shader"
+        detail = "; ".join(line for line in lines_out if "error" in line.lower()) or \
+            "; ".join(lines_out)
+        return f"{head}: {detail}" if not detail.startswith(head) else detail
+
+    def release(self) -> None:
+        for program in self._programs.values():
+            program.release()
+        self._programs.clear()

@@ -1,0 +1,99 @@
+"""Named render targets of a frame, and framebuffers assembled from them.
+
+Passes declare what they read and write by target name; the dump and the benchmark use the same
+names. Core targets are the G-buffer (see :mod:`deferred.gbuffer`), the light accumulation, the
+composition buffer and the final image; a material or screen pass may declare more.
+"""
+
+from __future__ import annotations
+
+import moderngl
+import numpy as np
+
+from .gbuffer import GBUFFER_TARGETS
+from .targets_spec import TargetSpec
+
+
+LIGHT_ACCUMULATION = "light_accumulation"
+COMPOSITE = "composite"
+FINAL = "final"
+
+CORE_TARGETS: dict[str, TargetSpec] = {
+    **GBUFFER_TARGETS,
+    LIGHT_ACCUMULATION: TargetSpec(4, "f2", "linear HDR light accumulated by every light"),
+    COMPOSITE: TargetSpec(4, "f2", "composition buffer: light accumulation + material phase"),
+    FINAL: TargetSpec(4, "f1", "tone mapped, sRGB encoded"),
+}
+
+
+class FrameTargets:
+    """Owns the textures of every named target at one size, and framebuffers over them."""
+
+    def __init__(self, ctx: moderngl.Context, width: int, height: int):
+        self.ctx = ctx
+        self.width = width
+        self.height = height
+        self.specs: dict[str, TargetSpec] = {}
+        self.textures: dict[str, moderngl.Texture] = {}
+        self._framebuffers: dict[tuple, moderngl.Framebuffer] = {}
+        for name, spec in CORE_TARGETS.items():
+            self.declare(name, spec)
+
+    def declare(self, name: str, spec: TargetSpec) -> moderngl.Texture:
+        """Create target ``name`` (or return it if it exists with the same format)."""
+        if name in self.textures:
+            old = self.specs[name]
+            if (old.components, old.dtype, old.depth) != (spec.components, spec.dtype, spec.depth):
+                raise ValueError(f"target '{name}' already declared as {self.specs[name]}")
+            return self.textures[name]
+        size = (self.width, self.height)
+        if spec.depth:
+            texture = self.ctx.depth_texture(size)
+        else:
+            texture = self.ctx.texture(size, spec.components, dtype=spec.dtype)
+        texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        texture.repeat_x = texture.repeat_y = False
+        self.specs[name] = spec
+        self.textures[name] = texture
+        return texture
+
+    def __getitem__(self, name: str) -> moderngl.Texture:
+        return self.textures[name]
+
+    def __contains__(self, name: str) -> bool:
+        return name in self.textures
+
+    def framebuffer(self, colors: tuple[str, ...] | list[str],
+                    depth: str | None = None) -> moderngl.Framebuffer:
+        key = (tuple(colors), depth)
+        fbo = self._framebuffers.get(key)
+        if fbo is None:
+            fbo = self.ctx.framebuffer(
+                color_attachments=[self.textures[c] for c in colors],
+                depth_attachment=self.textures[depth] if depth else None)
+            self._framebuffers[key] = fbo
+        return fbo
+
+    def read(self, name: str) -> np.ndarray:
+        """Target contents as float32 (H, W, C), bottom row first (GL order)."""
+        spec = self.specs[name]
+        texture = self.textures[name]
+        if spec.depth:
+            data = np.frombuffer(texture.read(alignment=1), dtype=np.float32)
+            return data.reshape(self.height, self.width, 1).copy()
+        if spec.dtype == "f1":
+            data = np.frombuffer(texture.read(alignment=1), dtype=np.uint8)
+            data = data.astype(np.float32) / 255.0
+        elif spec.dtype == "f2":
+            data = np.frombuffer(texture.read(alignment=1), dtype=np.float16).astype(np.float32)
+        else:
+            data = np.frombuffer(texture.read(alignment=1), dtype=np.float32).copy()
+        return data.reshape(self.height, self.width, spec.components)
+
+    def release(self) -> None:
+        for fbo in self._framebuffers.values():
+            fbo.release()
+        self._framebuffers.clear()
+        for texture in self.textures.values():
+            texture.release()
+        self.textures.clear()

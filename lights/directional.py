@@ -1,0 +1,36 @@
+"""Directional light: parallel rays, no falloff (full-screen in the deferred pipeline)."""
+
+from __future__ import annotations
+
+import numpy as np
+from pydantic import Field, field_validator
+
+from deferred.light import Light, LightParams, view_direction
+from deferred.registry import lights
+
+
+class DirectionalParams(LightParams):
+    direction: tuple[float, float, float] = Field((-0.4, -1.0, -0.6),
+                                                  description="direction the light travels")
+
+    @field_validator("direction")
+    @classmethod
+    def _nonzero(cls, value):
+        if np.linalg.norm(value) == 0.0:
+            raise ValueError("direction must not be the zero vector")
+        return value
+
+
+@lights.register
+class DirectionalLight(Light):
+    name = "directional"
+    Params = DirectionalParams
+    glsl_file = "lights/directional.glsl"
+    glsl_function = "directional_light"
+    volume = "fullscreen"
+
+    def record(self, view: np.ndarray) -> np.ndarray:
+        record = np.zeros((4, 4), dtype=np.float32)
+        record[0, :3] = self.radiance()
+        record[2, :3] = view_direction(view, self.params.direction)
+        return record

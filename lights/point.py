@@ -1,0 +1,36 @@
+"""Point light: windowed inverse-square falloff reaching 0 at ``radius`` (a sphere volume)."""
+
+from __future__ import annotations
+
+import numpy as np
+from pydantic import Field
+
+from deferred.light import Light, LightParams, view_point
+from deferred.registry import lights
+
+
+class PointParams(LightParams):
+    position: tuple[float, float, float] = Field((0.0, 2.0, 2.0), description="world position")
+    radius: float = Field(10.0, gt=0.0, description="distance at which the light reaches 0")
+
+
+def distance_falloff(d: np.ndarray, radius: float) -> np.ndarray:
+    """numpy twin of ``distance_falloff`` in common/lighting.glsl."""
+    window = np.clip(1.0 - (d / radius) ** 4, 0.0, 1.0)
+    return window * window / (d * d + 1.0)
+
+
+@lights.register
+class PointLight(Light):
+    name = "point"
+    Params = PointParams
+    glsl_file = "lights/point.glsl"
+    glsl_function = "point_light"
+    volume = "sphere"
+
+    def record(self, view: np.ndarray) -> np.ndarray:
+        record = np.zeros((4, 4), dtype=np.float32)
+        record[0, :3] = self.radiance()
+        record[1, :3] = view_point(view, self.params.position)
+        record[1, 3] = self.params.radius
+        return record

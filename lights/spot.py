@@ -1,0 +1,54 @@
+"""Spot light: a point light inside a cone (smooth between inner and outer angles)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from pydantic import Field, model_validator
+
+from deferred.light import Light, view_direction, view_point
+from deferred.registry import lights
+
+from .point import PointParams
+
+
+class SpotParams(PointParams):
+    direction: tuple[float, float, float] = Field((0.0, -1.0, 0.0),
+                                                  description="axis of the cone")
+    inner_angle: float = Field(20.0, ge=0.0, le=89.0, description="full intensity, degrees")
+    outer_angle: float = Field(30.0, gt=0.0, le=90.0, description="zero beyond, degrees")
+
+    @model_validator(mode="after")
+    def _check(self) -> SpotParams:
+        if np.linalg.norm(self.direction) == 0.0:
+            raise ValueError("direction must not be the zero vector")
+        if self.outer_angle <= self.inner_angle:
+            raise ValueError("outer_angle must be greater than inner_angle")
+        return self
+
+
+def cone_falloff(cos_angle: np.ndarray, cos_outer: float, cos_inner: float) -> np.ndarray:
+    """numpy twin of ``cone_falloff`` in common/lighting.glsl (GLSL smoothstep)."""
+    t = np.clip((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0)
+    return t * t * (3.0 - 2.0 * t)
+
+
+@lights.register
+class SpotLight(Light):
+    name = "spot"
+    Params = SpotParams
+    glsl_file = "lights/spot.glsl"
+    glsl_function = "spot_light"
+    volume = "sphere"
+
+    def record(self, view: np.ndarray) -> np.ndarray:
+        p = self.params
+        record = np.zeros((4, 4), dtype=np.float32)
+        record[0, :3] = self.radiance()
+        record[1, :3] = view_point(view, p.position)
+        record[1, 3] = p.radius
+        record[2, :3] = view_direction(view, p.direction)
+        record[2, 3] = math.cos(math.radians(p.outer_angle))
+        record[3, 0] = math.cos(math.radians(p.inner_angle))
+        return record

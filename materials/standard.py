@@ -1,0 +1,51 @@
+"""The standard material: Blinn-Phong, colour or texture, specular intensity and exponent."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import moderngl
+from pydantic import Field
+
+from deferred.errors import InputError
+from deferred.material import Material, MaterialParams
+from deferred.registry import materials
+
+if TYPE_CHECKING:
+    from deferred.frame import Frame
+
+
+class StandardParams(MaterialParams):
+    color: tuple[float, float, float] = Field((0.8, 0.8, 0.8), description="linear RGB albedo")
+    texture: str | None = Field(None, description="albedo image (sRGB), multiplied by color")
+    specular_intensity: float = Field(0.5, ge=0.0, le=1.0, description="Blinn-Phong intensity")
+    specular_exponent: float = Field(32.0, ge=1.0, le=2048.0, description="Blinn-Phong exponent")
+
+
+@materials.register
+class StandardMaterial(Material):
+    name = "standard"
+    Params = StandardParams
+    surface_shader = "materials/standard/surface.glsl"
+
+    def check_files(self, where: str | None) -> None:
+        if self.params.texture is not None and not self.resolve_path(self.params.texture).is_file():
+            raise InputError(f"texture file not found: {self.resolve_path(self.params.texture)}",
+                             f"{where}.texture" if where else "texture")
+
+    def defines(self) -> dict[str, str]:
+        defines = super().defines()
+        if self.params.texture is not None:
+            defines["HAS_ALBEDO_TEXTURE"] = "1"
+        return defines
+
+    def uniforms(self, frame: Frame) -> dict[str, Any]:
+        return {"u_color": self.params.color,
+                "u_specular_intensity": self.params.specular_intensity,
+                "u_specular_exponent": self.params.specular_exponent}
+
+    def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
+        if self.params.texture is None:
+            return {}
+        return {"u_albedo_texture": frame.resources.image_texture(
+            self.resolve_path(self.params.texture))}

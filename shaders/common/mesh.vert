@@ -1,0 +1,32 @@
+// Vertex shader of every mesh pass: transforms the framework's vertex format to view space.
+in vec3 in_position;
+in vec3 in_normal;
+in vec2 in_uv;
+in vec3 in_tangent;
+in vec3 in_binormal;
+in vec4 in_comb;
+
+uniform mat4 u_model_view;
+uniform mat4 u_projection;
+uniform mat3 u_normal_matrix;
+
+out vec3 v_position;
+out vec3 v_normal;
+out vec3 v_tangent;
+out vec3 v_binormal;
+out vec2 v_uv;
+out vec4 v_comb;
+
+// Passes that draw the same mesh twice and compare depths need bit-identical positions.
+invariant gl_Position;
+
+void main() {
+    vec4 position = u_model_view * vec4(in_position, 1.0);
+    v_position = position.xyz;
+    v_normal = normalize(u_normal_matrix * in_normal);
+    v_tangent = normalize(mat3(u_model_view) * in_tangent);
+    v_binormal = normalize(mat3(u_model_view) * in_binormal);
+    v_uv = in_uv;
+    v_comb = in_comb;
+    gl_Position = u_projection * position;
+}

@@ -1,0 +1,11 @@
+// Geometry phase: a material's surface into the G-buffer (the material is SURFACE_FILE).
+#include "common/surface_input.glsl"
+#include "gbuffer/write.glsl"
+#include SURFACE_FILE
+
+uniform float u_material_id;
+
+void main() {
+    SurfaceInput i = surface_input();
+    gbuffer_write(material_surface(i), i.position, u_material_id);
+}

@@ -1,0 +1,18 @@
+// Lighting phase (Revie 2.4.3): one light, read from the G-buffer alone, added to light accumulation.
+#include "gbuffer/fetch.glsl"
+#include "common/light_buffer.glsl"
+#include "generated/lights.glsl"
+
+uniform vec2 u_resolution;
+uniform mat4 u_inverse_projection;
+
+flat in int v_light_index;
+out vec4 out_light;
+
+void main() {
+    GBufferSample g = gbuffer_fetch(ivec2(gl_FragCoord.xy));
+    if (g.material_id <= 0.0) discard;
+    vec3 P = view_position(gl_FragCoord.xy, g.linear_depth, u_resolution, u_inverse_projection);
+    vec3 V = normalize(-P);
+    out_light = vec4(evaluate_light(fetch_light(v_light_index), g.surface, P, V), 0.0);
+}

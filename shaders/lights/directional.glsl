@@ -1,0 +1,6 @@
+// Directional light: parallel rays along direction.xyz, no falloff.
+#include "common/lighting.glsl"
+
+vec3 directional_light(LightRecord light, Surface s, vec3 P, vec3 V) {
+    return blinn_phong(s, -light.direction.xyz, V, light.color.rgb);
+}
