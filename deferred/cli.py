@@ -86,8 +86,9 @@ def materials() -> None:
     console = Console()
     for name, cls in registry.materials.items():
         table = Table(title=f"{name}  (id {cls.type_id}, {cls.__module__})", title_justify="left")
-        for column in ("parameter", "type", "default", "range", "description"):
-            table.add_column(column)
+        for column in ("parameter", "type", "default", "range"):
+            table.add_column(column, no_wrap=True)
+        table.add_column("description")
         for row in cls.describe_params():
             table.add_row(row["name"], row["type"], repr(row["default"]), row["range"],
                           row["doc"])

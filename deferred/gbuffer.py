@@ -1,11 +1,12 @@
 """The G-buffer: the one interface between light-receiving materials and lights (Revie 2.1).
 
-| target               | format  | channels                                                         |
-|----------------------|---------|------------------------------------------------------------------|
-| ``albedo_specular``  | RGBA8   | albedo.rgb (linear), specular intensity [0, 1]                   |
-| ``normal_exponent_id``| RGBA16F | view-space normal, octahedral (2 ch.), specular exponent, material id (0 = background) |
-| ``linear_depth``     | R32F    | linear view depth (-z_view, 0 = background); fur samples it to reject occluded samples |
-| ``depth``            | DEPTH24 | hardware depth (light volumes depth-test against it)             |
+| target             | format  | channels                                                |
+|--------------------|---------|---------------------------------------------------------|
+| albedo_specular    | RGBA8   | albedo.rgb (linear), specular intensity [0, 1]          |
+| normal_exponent_id | RGBA16F | view normal (octahedral, 2 ch.), specular exponent,     |
+|                    |         | material id (0 = background)                            |
+| linear_depth       | R32F    | linear view depth -z_view (0 = background)              |
+| depth              | DEPTH24 | hardware depth (light volumes depth-test against it)    |
 
 4 + 8 + 4 + 4 = 20 bytes per pixel (Killzone 2's budget). View-space position is never stored: it
 is reconstructed from the linear depth and the pixel's view ray (``gbuffer/layout.glsl``).

@@ -61,7 +61,7 @@ class ShaderLibrary:
             self.roots.append(root)
 
     def set_virtual_file(self, name: str, text: str) -> None:
-        """Provide generated GLSL under ``name`` (e.g. the light dispatch built from the registry)."""
+        """Provide generated GLSL under ``name`` (e.g. the light dispatch of the registry)."""
         if self.virtual_files.get(name) != text:
             self.virtual_files[name] = text
             self._programs = {k: v for k, v in self._programs.items() if name not in k[-1]}

@@ -13,7 +13,6 @@ import numpy as np
 from .gbuffer import GBUFFER_TARGETS
 from .targets_spec import TargetSpec
 
-
 LIGHT_ACCUMULATION = "light_accumulation"
 COMPOSITE = "composite"
 FINAL = "final"

@@ -1,0 +1,52 @@
+"""Shared fixtures: one headless GL context for the session, helpers to render small scenes."""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+TESTS = Path(__file__).parent
+sys.path.insert(0, str(TESTS / "fixtures"))
+
+
+@pytest.fixture(scope="session")
+def gl():
+    from deferred.context import create_context
+    from deferred.errors import RenderError
+
+    try:
+        context = create_context()
+    except RenderError as exc:
+        pytest.skip(f"no headless GL context: {exc}")
+    yield context
+    context.release()
+
+
+@pytest.fixture
+def render(gl):
+    """render(scene, pipeline='deferred', size=None) -> (RenderResult, Renderer) released later."""
+    from deferred.renderer import Renderer
+
+    made = []
+
+    def _render(scene, pipeline="deferred", size=None, **kwargs):
+        renderer = Renderer(scene, pipeline, size, gl=gl)
+        made.append(renderer)
+        return renderer.render(**kwargs), renderer
+
+    yield _render
+    for renderer in made:
+        renderer.release()
+
+
+def psnr(a: np.ndarray, b: np.ndarray, peak: float = 1.0) -> float:
+    mse = float(np.mean((np.asarray(a, np.float64) - np.asarray(b, np.float64)) ** 2))
+    return float("inf") if mse == 0.0 else 10.0 * np.log10(peak * peak / mse)
+
+
+def pytest_configure(config):
+    os.environ.setdefault("DEFERRED_GL_BACKEND", "egl")

@@ -1,0 +1,79 @@
+"""The command line: outputs, exit codes, one-line errors, no partial files."""
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from deferred.cli import main
+from deferred.imageio import read_channels, read_image
+
+
+def run(capsys, *args):
+    code = main(list(args))
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
+
+
+def test_render_demo_png(tmp_path, capsys):
+    out = tmp_path / "demo.png"
+    code, stdout, err = run(capsys, "render", "-o", str(out), "--size", "160x90")
+    assert code == 0, err
+    assert stdout == ""
+    image = read_image(out)
+    assert image.shape == (90, 160, 4)
+    assert image[..., :3].std() > 0.05  # not a blank frame
+    assert [p.name for p in tmp_path.iterdir()] == ["demo.png"]  # no temporary left behind
+
+
+def test_render_forward_exr_is_linear_float(tmp_path, capsys):
+    out = tmp_path / "demo.exr"
+    code, _, err = run(capsys, "render", "-o", str(out), "--size", "64x36", "--pipeline",
+                       "forward")
+    assert code == 0, err
+    pixels, names, _ = read_channels(out)
+    assert names == ["R", "G", "B", "A"] and pixels.shape == (36, 64, 4)
+    assert pixels.dtype == np.float32 and pixels[..., 3].max() == 1.0
+
+
+@pytest.mark.parametrize("args, fragment", [
+    (["render", "missing.toml"], "missing.toml: scene file not found"),
+    (["render", "--size", "0x10"], "--size: size 0x10 is impossible"),
+    (["render", "--size", "big"], "--size: expected WIDTHxHEIGHT"),
+    (["render", "-o", "x.jpg"], "-o: output must end in .png or .exr"),
+    (["render", "--pipeline", "raytrace"], "Invalid value for '--pipeline'"),
+    (["render", "--frames", "0"], "Invalid value for '--frames'"),
+])
+def test_bad_input_exits_2_with_one_line(tmp_path, capsys, monkeypatch, args, fragment):
+    monkeypatch.chdir(tmp_path)
+    code, _, err = run(capsys, *args)
+    assert code == 2
+    assert fragment in err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_bad_scene_leaves_no_output(tmp_path, capsys):
+    scene = tmp_path / "bad.toml"
+    scene.write_text('[[object]]\nmesh = "builtin:sphere"\nmaterial = "standard"\n'
+                     '[object.params]\nspecular_exponent = -4\n')
+    out = tmp_path / "out.png"
+    code, _, err = run(capsys, "render", str(scene), "-o", str(out))
+    assert code == 2
+    assert err.startswith("error: bad.toml: object[0].params.specular_exponent:")
+    assert not out.exists()
+
+
+def test_materials_and_info(capsys):
+    code, out, _ = run(capsys, "materials")
+    assert code == 0 and "standard" in out and "specular_exponent" in out
+    code, out, _ = run(capsys, "info")
+    assert code == 0 and "renderer" in out and "20 bytes per pixel" in out
+
+
+def test_console_script_exit_code(tmp_path):
+    result = subprocess.run([sys.executable, "-m", "deferred.cli", "render", "nope.toml"],
+                            capture_output=True, text=True, cwd=tmp_path)
+    assert result.returncode == 2
+    assert result.stderr.strip() == "error: nope.toml: scene file not found"

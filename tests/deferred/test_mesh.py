@@ -1,0 +1,113 @@
+import numpy as np
+import pytest
+import trimesh
+
+from deferred.errors import InputError
+from deferred.mesh import BUILTIN_MESHES, comb_to_tangent_space, load_mesh
+
+
+def listing_2_7_reference(color, normal, tangent, binormal):
+    """Revie Listing 2.7, transcribed literally for one vertex."""
+    tangent_space = np.eye(4)
+    tangent_space[:3, 0] = tangent
+    tangent_space[:3, 1] = binormal
+    tangent_space[:3, 2] = normal
+    tangent_space = tangent_space.T
+    direction = np.array(color[:3]) * 2.0 - 1.0
+    direction = direction - np.dot(direction, normal) * normal
+    direction = direction / np.linalg.norm(direction)
+    direction = (tangent_space @ np.append(direction, 0.0))[:3]
+    return np.append((direction + 1.0) * 0.5, color[3])
+
+
+def test_comb_conversion_matches_listing_2_7():
+    rng = np.random.default_rng(7)
+    n = 200
+    normals = rng.normal(size=(n, 3))
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    helper = rng.normal(size=(n, 3))
+    tangents = helper - np.sum(helper * normals, axis=1, keepdims=True) * normals
+    tangents /= np.linalg.norm(tangents, axis=1, keepdims=True)
+    binormals = np.cross(normals, tangents)
+    colors = rng.uniform(size=(n, 4))
+    got = comb_to_tangent_space(colors, normals, tangents, binormals)
+    want = np.array([listing_2_7_reference(c, nn, t, b)
+                     for c, nn, t, b in zip(colors, normals, tangents, binormals, strict=True)])
+    np.testing.assert_allclose(got, want, atol=1e-6)
+    # tangential after conversion: no component along the normal (z = 0 -> packed 0.5)
+    np.testing.assert_allclose(got[:, 2], 0.5, atol=1e-6)
+
+
+@pytest.mark.parametrize("name", BUILTIN_MESHES)
+def test_builtin_meshes_have_orthonormal_frames_and_outward_winding(name):
+    mesh = load_mesh(f"builtin:{name}")
+    n, t, b = mesh.normals, mesh.tangents, mesh.binormals
+    np.testing.assert_allclose(np.linalg.norm(n, axis=1), 1.0, atol=1e-5)
+    assert np.abs(np.sum(n * t, axis=1)).max() < 1e-4
+    assert np.abs(np.sum(n * b, axis=1)).max() < 1e-4
+    p, i = mesh.positions, mesh.indices
+    face = np.cross(p[i[:, 1]] - p[i[:, 0]], p[i[:, 2]] - p[i[:, 0]])
+    area = np.linalg.norm(face, axis=1)
+    facing = np.sum(face * n[i].mean(axis=1), axis=1)
+    assert np.all(facing[area > 1e-9] > 0.0)
+
+
+def test_obj_with_positions_only_gets_normals_uvs_and_tangents(tmp_path):
+    sphere = trimesh.creation.icosphere(subdivisions=2)
+    path = tmp_path / "scan.obj"
+    lines = [f"v {x} {y} {z}" for x, y, z in sphere.vertices]
+    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in sphere.faces]
+    path.write_text("\n".join(lines) + "\n")
+    mesh = load_mesh(path.name, tmp_path)
+    assert mesh.generated_uvs and not mesh.has_comb
+    assert np.isfinite(mesh.uvs).all() and mesh.uvs.min() >= 0.0 and mesh.uvs.max() <= 1.0
+    # computed normals point outward on a sphere centred at the origin
+    assert np.all(np.sum(mesh.normals * mesh.positions, axis=1) > 0.0)
+    assert np.abs(np.sum(mesh.normals * mesh.tangents, axis=1)).max() < 1e-4
+
+
+def test_ply_vertex_colours_become_tangent_space_comb(tmp_path):
+    sphere = trimesh.creation.icosphere(subdivisions=2)
+    down = np.tile([0.5, 0.0, 0.5, 0.6], (len(sphere.vertices), 1))  # object-space -Y, length .6
+    sphere.visual.vertex_colors = (down * 255).round().astype(np.uint8)
+    path = tmp_path / "combed.ply"
+    sphere.export(path)
+    mesh = load_mesh(str(path))
+    assert mesh.has_comb
+    np.testing.assert_allclose(mesh.comb[:, 3], 153 / 255, atol=1e-6)
+    # back to object space: the comb must be the tangential part of -Y
+    d = mesh.comb[:, :3] * 2.0 - 1.0
+    obj = d[:, :1] * mesh.tangents + d[:, 1:2] * mesh.binormals + d[:, 2:3] * mesh.normals
+    want = np.array([0.0, -1.0, 0.0]) - mesh.normals[:, 1:2] * -1.0 * mesh.normals
+    lengths = np.linalg.norm(want, axis=1)
+    ok = lengths > 0.2  # away from the poles, where -Y has no tangential part
+    want = want[ok] / lengths[ok, None]
+    np.testing.assert_allclose(obj[ok], want, atol=0.02)
+
+
+@pytest.mark.parametrize("suffix", [".stl", ".off", ".glb"])
+def test_other_formats_load(tmp_path, suffix):
+    box = trimesh.creation.box()
+    path = tmp_path / f"box{suffix}"
+    box.export(path)
+    mesh = load_mesh(str(path))
+    assert len(mesh.indices) >= 12
+
+
+def test_bad_meshes_are_input_errors(tmp_path):
+    with pytest.raises(InputError, match="not found"):
+        load_mesh("missing.obj", tmp_path, where="scene.toml: object[0].mesh")
+    broken = tmp_path / "broken.obj"
+    broken.write_text("v 0 0 0\nv 1 0 0\nf 1 2 9\n")
+    with pytest.raises(InputError) as info:
+        load_mesh(str(broken), where="scene.toml: object[0].mesh")
+    assert str(info.value).startswith("scene.toml: object[0].mesh:")
+    empty = tmp_path / "empty.obj"
+    empty.write_text("# nothing\n")
+    with pytest.raises(InputError):
+        load_mesh(str(empty))
+    with pytest.raises(InputError, match="unknown built-in"):
+        load_mesh("builtin:teapot")
+    with pytest.raises(InputError, match="unsupported"):
+        (tmp_path / "x.fbx").write_text("")
+        load_mesh(str(tmp_path / "x.fbx"))

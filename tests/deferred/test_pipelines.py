@@ -1,0 +1,181 @@
+"""The pipelines: forward == deferred, determinism, resource release, the plugin seam."""
+
+import moderngl
+import numpy as np
+import pytest
+from conftest import psnr
+
+from deferred import registry
+from deferred.context import Features, GLContext
+from deferred.gbuffer import decode
+from deferred.passes import Phase
+from deferred.renderer import Renderer
+from deferred.scene import load_scene, scene_from_dict
+
+ALL_LIGHTS = [
+    {"type": "ambient", "color": [0.2, 0.22, 0.3], "ground": [0.1, 0.05, 0.02]},
+    {"type": "directional", "direction": [-0.5, -1.0, -0.3], "intensity": 0.7},
+    {"type": "point", "position": [1.2, 1.2, 1.0], "color": [1.0, 0.6, 0.3], "intensity": 4.0,
+     "radius": 4.0},
+    {"type": "spot", "position": [-1.0, 2.0, 1.0], "direction": [0.4, -1.0, -0.4],
+     "color": [0.3, 0.5, 1.0], "intensity": 6.0, "radius": 5.0, "inner_angle": 12.0,
+     "outer_angle": 25.0},
+]
+
+
+def standard_scene(lights=ALL_LIGHTS, size=(200, 150)):
+    return scene_from_dict({
+        "size": list(size),
+        "camera": {"position": [0.0, 1.5, 3.6], "target": [0.0, 0.4, 0.0]},
+        "object": [
+            {"mesh": "builtin:plane", "scale": 4.0, "params": {"color": [0.4, 0.4, 0.4]}},
+            {"mesh": "builtin:sphere", "position": [-0.6, 0.5, 0.0], "scale": 0.5,
+             "params": {"color": [0.8, 0.3, 0.2], "specular_exponent": 64.0}},
+            {"mesh": "builtin:torus", "position": [0.7, 0.5, 0.0], "rotation": [70, 0, 0],
+             "scale": 0.6, "params": {"color": [0.2, 0.5, 0.8], "specular_intensity": 0.8}},
+            {"mesh": "builtin:cube", "position": [0.0, 0.3, -1.0], "rotation": [0, 30, 0],
+             "scale": 0.4},
+        ],
+        "light": lights})
+
+
+@pytest.mark.parametrize("light", ALL_LIGHTS, ids=lambda light: light["type"])
+def test_forward_equals_deferred_per_light_type(render, light):
+    scene = standard_scene([light])
+    deferred, _ = render(scene, "deferred")
+    forward, _ = render(scene, "forward")
+    assert psnr(deferred.image[..., :3] / 255.0, forward.image[..., :3] / 255.0) >= 40.0
+
+
+def test_forward_equals_deferred_all_lights_and_gl33_path(render, gl):
+    scene = standard_scene()
+    deferred, _ = render(scene, "deferred")
+    forward, _ = render(scene, "forward")
+    value = psnr(deferred.image[..., :3] / 255.0, forward.image[..., :3] / 255.0)
+    assert value >= 40.0
+    gl33 = GLContext(gl.ctx, Features(storage_buffers=False))
+    with Renderer(scene, "deferred", gl=gl33) as renderer:
+        assert np.array_equal(renderer.render().image, deferred.image)
+
+
+def test_demo_scene_forward_equals_deferred(render):
+    scene = load_scene()
+    deferred, _ = render(scene, "deferred", size=(320, 180))
+    forward, _ = render(scene, "forward", size=(320, 180))
+    assert psnr(deferred.image[..., :3] / 255.0, forward.image[..., :3] / 255.0) >= 40.0
+
+
+def test_same_scene_twice_gives_the_same_bytes(render):
+    scene = standard_scene()
+    first, renderer = render(scene, "deferred")
+    again = renderer.render()
+    fresh, _ = render(standard_scene(), "deferred")
+    assert first.image.tobytes() == again.image.tobytes() == fresh.image.tobytes()
+
+
+def test_gbuffer_contents(render):
+    scene = standard_scene()
+    _, renderer = render(scene, "deferred")
+    t = renderer.targets
+    g = decode(t.read("albedo_specular"), t.read("normal_exponent_id"), t.read("linear_depth"))
+    background = g["material_id"] == 0
+    assert 0.05 < background.mean() < 0.7
+    assert np.all(g["linear_depth"][background] == 0.0)
+    assert np.all(g["material_id"][~background] == registry.materials.get("standard").type_id)
+    depth = g["linear_depth"][~background]
+    assert depth.min() > scene.camera.near and depth.max() < 10.0
+    # normals are view-space unit vectors facing the camera (z > 0 in view space)
+    normals = g["normal"][~background]
+    np.testing.assert_allclose(np.linalg.norm(normals, axis=1), 1.0, atol=1e-3)
+    assert np.mean(normals[:, 2] > -0.05) > 0.99
+    # the sphere's albedo lands in the G-buffer (8-bit)
+    sphere_red = np.isclose(g["albedo"][..., 0], 0.8, atol=1 / 255) & \
+        np.isclose(g["albedo"][..., 1], 0.3, atol=1 / 255)
+    assert sphere_red.sum() > 500
+
+
+def test_pass_list_is_ordered_by_phase_and_lights_are_bounded(render):
+    scene = standard_scene()
+    result, renderer = render(scene, "deferred")
+    names = [p.name for p in renderer.passes]
+    phases = [p.phase for p in renderer.passes]
+    order = [Phase.GEOMETRY, Phase.SCREEN, Phase.STIPPLE, Phase.LIGHTING, Phase.MATERIAL,
+             Phase.POST]
+    assert [order.index(p) for p in phases] == sorted(order.index(p) for p in phases)
+    assert names[:2] == ["gbuffer.clear", "plane0.gbuffer"]
+    assert {"lighting.point", "lighting.spot", "lighting.directional",
+            "lighting.ambient"} <= set(names)
+    for p in renderer.passes:
+        assert p.writes, p.name
+
+
+def test_point_light_volume_touches_only_its_pixels(render):
+    """A small point light far from the camera shades few pixels: the volume bounds it."""
+    light = {"type": "point", "position": [1.5, 0.2, 0.5], "radius": 0.4, "intensity": 3.0}
+    scene = standard_scene([light])
+    fragments = []
+
+    def count(render_pass, frame):
+        if render_pass.name == "lighting.point":
+            query = frame.ctx.query(samples=True)
+            with query:
+                render_pass.execute(frame)
+            fragments.append(query.samples)
+
+    render(scene, "deferred", on_pass=count)
+    width, height = scene.size
+    assert 0 < fragments[0] < 0.1 * width * height
+
+
+def test_fifty_frames_do_not_grow_live_gl_objects(gl, monkeypatch):
+    created = []
+    makers = ["buffer", "texture", "depth_texture", "framebuffer", "renderbuffer",
+              "vertex_array", "program", "compute_shader", "sampler"]
+    for maker in makers:
+        original = getattr(moderngl.Context, maker)
+
+        def wrapped(self, *args, _original=original, **kwargs):
+            obj = _original(self, *args, **kwargs)
+            created.append(obj)
+            return obj
+
+        monkeypatch.setattr(moderngl.Context, maker, wrapped)
+
+    def live() -> int:
+        return sum(type(o.mglo).__name__ != "InvalidObject" for o in created)
+
+    baseline = live()
+    renderer = Renderer(standard_scene(), "deferred", gl=gl)
+    renderer.render()
+    after_first = live()
+    assert after_first > baseline
+    for _ in range(50):
+        renderer.render()
+    assert live() == after_first
+    renderer.release()
+    assert live() == baseline
+
+
+def test_plugin_material_renders_in_both_pipelines(render):
+    from plugin_material import CheckerMaterial
+
+    registry.materials.register(CheckerMaterial)
+    try:
+        scene = scene_from_dict({
+            "size": [160, 120], "tonemap": "none",
+            "camera": {"position": [0.0, 2.5, 0.01], "target": [0.0, 0.0, 0.0]},
+            "object": [{"mesh": "builtin:plane", "material": "test_checker",
+                        "params": {"squares": 4}}],
+            "light": [{"type": "ambient", "color": [1.0, 1.0, 1.0], "ground": [1, 1, 1]}]})
+        deferred, renderer = render(scene, "deferred")
+        forward, _ = render(scene, "forward")
+        ids = renderer.targets.read("normal_exponent_id")[..., 3]
+        assert set(np.unique(ids)) == {0.0, float(CheckerMaterial.type_id)}
+        # both colours of the checkerboard are on screen, in both pipelines
+        for result in (deferred, forward):
+            blue = (result.hdr[..., 2] > 0.7) & (result.hdr[..., 0] < 0.2)
+            white = (result.hdr[..., 0] > 0.8) & (result.hdr[..., 2] > 0.8)
+            assert blue.sum() > 1000 and white.sum() > 1000
+        assert psnr(deferred.image[..., :3] / 255.0, forward.image[..., :3] / 255.0) >= 40.0
+    finally:
+        registry.materials.unregister(CheckerMaterial.name)

@@ -1,0 +1,97 @@
+import pytest
+
+from deferred.errors import InputError
+from deferred.scene import load_scene, parse_size, scene_from_toml
+
+GOOD = """
+size = [320, 200]
+[camera]
+position = [0.0, 1.0, 4.0]
+target = [0.0, 0.5, 0.0]
+fov = 45.0
+
+[[object]]
+mesh = "builtin:torus"
+material = "standard"
+position = [0.0, 0.5, 0.0]
+rotation = [0.0, 30.0, 0.0]
+scale = 1.0
+[object.params]
+color = [0.5, 0.2, 0.1]
+
+[[light]]
+type = "point"
+position = [2.0, 3.0, 2.0]
+color = [1.0, 0.9, 0.8]
+intensity = 20.0
+radius = 10.0
+"""
+
+
+def error_of(text: str) -> str:
+    with pytest.raises(InputError) as info:
+        scene_from_toml(text, name="s.toml")
+    return str(info.value)
+
+
+def test_design_example_loads():
+    scene = scene_from_toml(GOOD, name="s.toml")
+    assert scene.size == (320, 200)
+    assert [o.label for o in scene.objects] == ["torus0"]
+    assert scene.objects[0].material.params.color == (0.5, 0.2, 0.1)
+    assert scene.lights[0].params.radius == 10.0
+
+
+def test_builtin_demo_scene_loads():
+    scene = load_scene()
+    assert scene.objects and scene.lights
+
+
+@pytest.mark.parametrize("edit, expected", [
+    (lambda t: t.replace("size = [320, 200]", "size = [320, 0]"), "s.toml: size: size 320x0"),
+    (lambda t: t.replace("fov = 45.0", "fov = 400.0"), "s.toml: camera.fov: "),
+    (lambda t: t.replace('material = "standard"', 'material = "velvet"'),
+     "s.toml: object[0].material: unknown material 'velvet'"),
+    (lambda t: t.replace("color = [0.5, 0.2, 0.1]", "shininess = 3"),
+     "s.toml: object[0].params.shininess: unknown parameter"),
+    (lambda t: t.replace("color = [0.5, 0.2, 0.1]", "specular_intensity = 3.0"),
+     "s.toml: object[0].params.specular_intensity: Input should be less than or equal to 1"),
+    (lambda t: t.replace('type = "point"', 'type = "laser"'),
+     "s.toml: light[0].type: unknown light 'laser'"),
+    (lambda t: t.replace("radius = 10.0", "radius = -1.0"),
+     "s.toml: light[0].radius: Input should be greater than 0"),
+    (lambda t: t.replace('mesh = "builtin:torus"', 'mesh = "nope.obj"'),
+     "s.toml: object[0].mesh: mesh file not found"),
+    (lambda t: t.replace("[camera]", "[camera]\nzoom = 2"),
+     "s.toml: camera.zoom: unknown parameter"),
+    (lambda t: t + "\n[[object]]\nmaterial = 'standard'\n", "s.toml: object[1].mesh: missing"),
+    (lambda t: t.replace("scale = 1.0", "scale = 0.0"), "s.toml: object[0]: "),
+    (lambda t: t.replace("size = [320, 200]", "size = [320, 200"), "s.toml: malformed TOML"),
+])
+def test_validation_errors_name_file_key_and_problem(edit, expected):
+    message = error_of(edit(GOOD))
+    assert message.startswith(expected), message
+    assert "\n" not in message
+
+
+def test_scene_file_paths(tmp_path):
+    with pytest.raises(InputError, match="scene file not found"):
+        load_scene(tmp_path / "missing.toml")
+    (tmp_path / "mesh.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    (tmp_path / "scene.toml").write_text(
+        GOOD.replace('mesh = "builtin:torus"', 'mesh = "mesh.obj"'))
+    scene = load_scene(tmp_path / "scene.toml")  # the mesh path is relative to the scene file
+    assert scene.objects[0].mesh.name == "mesh.obj"
+
+
+def test_texture_path_is_checked_relative_to_the_scene(tmp_path):
+    text = GOOD.replace("color = [0.5, 0.2, 0.1]", 'texture = "wood.png"')
+    (tmp_path / "scene.toml").write_text(text)
+    with pytest.raises(InputError, match=r"object\[0\]\.params\.texture: texture file not found"):
+        load_scene(tmp_path / "scene.toml")
+
+
+@pytest.mark.parametrize("text", ["100", "10x", "axb", "0x10", "20000x10"])
+def test_bad_sizes(text):
+    with pytest.raises(InputError, match="--size"):
+        parse_size(text)

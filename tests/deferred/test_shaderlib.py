@@ -1,0 +1,107 @@
+from pathlib import Path
+
+import pytest
+
+from deferred.errors import ShaderError
+from deferred.shaderlib import MAX_INCLUDE_DEPTH, ShaderLibrary
+
+
+@pytest.fixture
+def library(gl, tmp_path):
+    lib = ShaderLibrary(gl.ctx, 330)
+    lib.roots = [tmp_path]
+    yield lib
+    lib.release()
+
+
+def write(root: Path, name: str, text: str) -> None:
+    path = root / name
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(text)
+
+
+def test_include_is_resolved_once_and_mapped_to_files(library, tmp_path):
+    write(tmp_path, "a.glsl", "float a() { return 1.0; }\n")
+    write(tmp_path, "b.glsl", '#include "a.glsl"\nfloat b() { return a(); }\n')
+    write(tmp_path, "main.frag", '#include "a.glsl"\n#include "b.glsl"\nout vec4 c;\n'
+                                 "void main() { c = vec4(b()); }\n")
+    source = library.assemble("main.frag", {"FOO": "2"})
+    assert source.text.startswith("#version 330 core\n#define FOO 2\n")
+    assert source.text.count("float a()") == 1
+    line = source.text.splitlines().index("float b() { return a(); }") + 1
+    assert source.locate(line) == ("b.glsl", 2)
+
+
+def test_compile_error_names_the_included_file_and_line(library, tmp_path):
+    write(tmp_path, "inc/bad.glsl",
+          "float ok() { return 1.0; }\n\nfloat broken() { return vec3(1.0); }\n")
+    write(tmp_path, "main.frag",
+          '#include "inc/bad.glsl"\nout vec4 c;\nvoid main() { c = vec4(ok()); }\n')
+    write(tmp_path, "quad.vert", "void main() { gl_Position = vec4(0.0); }\n")
+    with pytest.raises(ShaderError) as info:
+        library.program("quad.vert", "main.frag", defines={"A": "1", "B": "2"})
+    assert str(info.value).startswith("inc/bad.glsl:3:")
+
+
+def test_error_in_the_main_file_after_injected_defines(library, tmp_path):
+    write(tmp_path, "quad.vert",
+          "void main() {\n  gl_Position = vec4(0.0);\n  undefined_call();\n}\n")
+    write(tmp_path, "ok.frag", "out vec4 c;\nvoid main() { c = vec4(1.0); }\n")
+    with pytest.raises(ShaderError, match=r"^quad\.vert:3:"):
+        library.program("quad.vert", "ok.frag", defines={"X": "1", "Y": "2", "Z": "3"})
+
+
+def test_include_through_an_injected_define(library, tmp_path):
+    write(tmp_path, "surface_a.glsl", "vec4 colour() { return vec4(0.25); }\n")
+    write(tmp_path, "main.frag", "#include SURFACE\nout vec4 c;\nvoid main() { c = colour(); }\n")
+    source = library.assemble("main.frag", {"SURFACE": '"surface_a.glsl"'})
+    assert "vec4(0.25)" in source.text
+    with pytest.raises(ShaderError, match="no such define"):
+        library.assemble("main.frag", {})
+
+
+def test_include_cycle_and_depth_limit(library, tmp_path):
+    # Include-once makes a cycle harmless: each file appears once.
+    write(tmp_path, "x.glsl", '#include "y.glsl"\nfloat x;\n')
+    write(tmp_path, "y.glsl", '#include "x.glsl"\nfloat y;\n')
+    text = library.assemble("x.glsl").text
+    assert text.count("float x;") == 1 and text.count("float y;") == 1
+    for i in range(MAX_INCLUDE_DEPTH + 2):
+        write(tmp_path, f"d{i}.glsl", f'#include "d{i + 1}.glsl"\n')
+    write(tmp_path, f"d{MAX_INCLUDE_DEPTH + 2}.glsl", "\n")
+    with pytest.raises(ShaderError, match="deeper than"):
+        library.assemble("d0.glsl")
+
+
+def test_missing_include_is_reported(library, tmp_path):
+    write(tmp_path, "main.frag", '#include "nowhere.glsl"\n')
+    with pytest.raises(ShaderError, match="nowhere.glsl"):
+        library.assemble("main.frag")
+
+
+def test_programs_are_cached_by_files_and_defines(library, tmp_path):
+    write(tmp_path, "quad.vert", "void main() { gl_Position = vec4(0.0); }\n")
+    write(tmp_path, "ok.frag", "out vec4 c;\nvoid main() { c = vec4(VALUE); }\n")
+    first = library.program("quad.vert", "ok.frag", defines={"VALUE": "1.0"})
+    assert library.program("quad.vert", "ok.frag", defines={"VALUE": "1.0"}) is first
+    assert library.program("quad.vert", "ok.frag", defines={"VALUE": "0.5"}) is not first
+
+
+def test_every_packaged_shader_program_compiles(gl):
+    """The built-in programs compile on this driver (both light-buffer variants)."""
+    from deferred import registry
+    from deferred.light import DISPATCH_FILE, light_dispatch_glsl
+
+    types = [cls for _, cls in registry.lights.items()]
+    for version, defines in ((430, {"DEFERRED_STORAGE_BUFFERS": "1"}), (330, {})):
+        if version > gl.ctx.version_code:
+            continue
+        lib = ShaderLibrary(gl.ctx, version, defines)
+        lib.set_virtual_file(DISPATCH_FILE, light_dispatch_glsl(types))
+        surface = {"SURFACE_FILE": '"materials/standard/surface.glsl"'}
+        lib.program("common/mesh.vert", "gbuffer/geometry.frag", defines=surface)
+        lib.program("common/mesh.vert", "forward/lit.frag", defines=surface)
+        lib.program("lights/volume.vert", "lights/accumulate.frag")
+        lib.program("lights/fullscreen.vert", "lights/accumulate.frag")
+        lib.program("post/fullscreen.vert", "post/tonemap.frag")
+        lib.release()
