@@ -108,12 +108,13 @@ class LightTypePass(RenderPass):
     """Deferred lighting of every light of one type, instanced, added into light accumulation."""
 
     phase = Phase.LIGHTING
-    reads = (*GBUFFER_COLOR_TARGETS, DEPTH)
     writes = (LIGHT_ACCUMULATION,)
 
-    def __init__(self, light_type: type[Light]):
+    def __init__(self, light_type: type[Light], occlusion: str | None = None):
         self.light_type = light_type
         self.name = f"lighting.{light_type.name}"
+        self.occlusion = occlusion  # target holding ambient occlusion (SSAO), if any
+        self.reads = (*GBUFFER_COLOR_TARGETS, DEPTH) + ((occlusion,) if occlusion else ())
 
     def execute(self, frame: Frame) -> None:
         offset, count = frame.light_buffer.range(self.light_type)
@@ -121,9 +122,12 @@ class LightTypePass(RenderPass):
             return
         sphere = self.light_type.volume == "sphere"
         vertex = "lights/volume.vert" if sphere else "lights/fullscreen.vert"
-        program = frame.shaders.program(vertex, "lights/accumulate.frag")
+        defines = {"HAS_SSAO": "1"} if self.occlusion else {}
+        program = frame.shaders.program(vertex, "lights/accumulate.frag", defines=defines)
         frame.use_framebuffer((LIGHT_ACCUMULATION,), DEPTH, depth_write=False)
         textures = {f"u_{name}": frame.targets[name] for name in GBUFFER_COLOR_TARGETS}
+        if self.occlusion:
+            textures["u_ssao"] = frame.targets[self.occlusion]
         uniforms = {**frame.camera_uniforms(), "u_light_offset": offset}
         if sphere:
             # Back faces of the bounding sphere, kept where the surface lies in front of them:

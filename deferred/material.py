@@ -84,7 +84,8 @@ class Material:
         return path
 
     # -- shader inputs -----------------------------------------------------------------------
-    def defines(self) -> dict[str, str]:
+    def defines(self, obj: SceneObject) -> dict[str, str]:
+        """Preprocessor defines of this material's programs for ``obj``."""
         return {"SURFACE_FILE": f'"{self.surface_shader}"'}
 
     def uniforms(self, frame: Frame) -> dict[str, Any]:

@@ -119,8 +119,8 @@ class ObjectPass(RenderPass):
     """Draw one scene object's mesh with a program; materials build their passes on this.
 
     Subclasses (or callers) give the shader files, defines, the targets and state, and a
-    ``uniforms`` hook for per-draw values. ``draws`` > 1 renders the mesh that many times with
-    ``u_draw_index`` set (e.g. one shell per draw).
+    ``uniforms`` hook. ``draws`` > 1 renders the mesh that many times, each draw with its own
+    ``draw_uniforms`` (e.g. one shell per draw).
     """
 
     vertex: str = "common/mesh.vert"
@@ -133,6 +133,8 @@ class ObjectPass(RenderPass):
     cull: str | None = "back"
     blend: str | None = None
     extra_reads: tuple[str, ...] = ()
+    constants: dict[str, Any] | None = None  # uniforms fixed at construction
+    extra_defines: dict[str, str] | None = None
 
     def __init__(self, name: str, phase: Phase, obj: SceneObject, **options: Any):
         self.name = name
@@ -147,7 +149,7 @@ class ObjectPass(RenderPass):
                                             else ())
 
     def defines(self, frame: Frame) -> dict[str, str]:
-        return self.obj.material.defines()
+        return {**self.obj.material.defines(self.obj), **(self.extra_defines or {})}
 
     def uniforms(self, frame: Frame) -> dict[str, Any]:
         return {}
@@ -158,6 +160,10 @@ class ObjectPass(RenderPass):
     def draws(self, frame: Frame) -> int:
         return 1
 
+    def draw_uniforms(self, frame: Frame, index: int, count: int) -> dict[str, Any]:
+        """Uniforms that change from one draw of the pass to the next (e.g. a shell's depth)."""
+        return {}
+
     def program(self, frame: Frame) -> moderngl.Program:
         return frame.shaders.program(self.vertex, self.fragment, defines=self.defines(frame))
 
@@ -167,12 +173,11 @@ class ObjectPass(RenderPass):
         frame.set_state(depth_test=self.depth_test, depth_func=self.depth_func, cull=self.cull,
                         blend=self.blend)
         material = self.obj.material
-        uniforms = {**frame.object_uniforms(self.obj), **material.uniforms(frame)}
-        uniforms.update(self.uniforms(frame))
+        uniforms = {**frame.object_uniforms(self.obj), **material.uniforms(frame),
+                    **(self.constants or {}), **self.uniforms(frame)}
         textures = {**material.textures(frame), **self.textures(frame)}
         count = self.draws(frame)
         for index in range(count):
-            uniforms["u_draw_index"] = index
-            uniforms["u_draw_count"] = count
-            frame.bind(program, uniforms, textures)
+            frame.bind(program, {**uniforms, **self.draw_uniforms(frame, index, count)},
+                       textures)
             frame.draw_mesh(self.obj.mesh, program)

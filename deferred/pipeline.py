@@ -12,6 +12,7 @@ from .gbuffer import ALBEDO_SPECULAR, DEPTH, LINEAR_DEPTH, NORMAL_EXPONENT_ID
 from .light import LightTypePass
 from .passes import ClearPass, FullscreenPass, Phase, RenderPass
 from .scene import Scene
+from .screen import SSAO, ssao_passes
 from .targets import COMPOSITE, FINAL, LIGHT_ACCUMULATION
 
 TONEMAPS = {"none": 0, "reinhard": 1, "aces": 2}
@@ -63,7 +64,9 @@ class DeferredPipeline(Pipeline):
             {"u_normal_exponent_id": NORMAL_EXPONENT_ID}, (LIGHT_ACCUMULATION,),
             uniforms=lambda frame: {"u_background": frame.scene.background}))
         present = {type(light) for light in scene.lights}
-        passes += [LightTypePass(cls) for _, cls in registry.lights.items() if cls in present]
+        occlusion = SSAO if scene.ssao else None
+        passes += [LightTypePass(cls, occlusion) for _, cls in registry.lights.items()
+                   if cls in present]
         passes.append(FullscreenPass("material.composite_copy", Phase.MATERIAL, "post/copy.frag",
                                      {"u_source": LIGHT_ACCUMULATION}, (COMPOSITE,)))
         passes += object_passes(scene, Phase.MATERIAL)
@@ -73,7 +76,7 @@ class DeferredPipeline(Pipeline):
 
 def screen_passes(scene: Scene) -> list[RenderPass]:
     """Scene-wide screen-space passes over the clean G-buffer (before any stipple)."""
-    return []
+    return ssao_passes(scene.ssao) if scene.ssao else []
 
 
 class ForwardPipeline(Pipeline):

@@ -21,6 +21,7 @@ from .errors import InputError
 from .light import Light
 from .material import Material
 from .mesh import MeshData, load_mesh
+from .screen import SSAOSettings
 from .validation import format_validation_error
 
 if sys.version_info >= (3, 11):
@@ -71,6 +72,12 @@ class ObjectModel(_Strict):
         return self
 
 
+class SSAOModel(_Strict):
+    radius: float = Field(0.35, gt=0.0, description="view-space sampling radius")
+    strength: float = Field(1.0, ge=0.0, le=4.0, description="how dark full occlusion gets")
+    samples: int = Field(16, ge=1, le=128, description="samples per pixel")
+
+
 class LightModel(BaseModel):
     model_config = ConfigDict(extra="allow")
     type: str
@@ -82,6 +89,7 @@ class SceneModel(_Strict):
     exposure: float = Field(1.0, gt=0.0)
     tonemap: Literal["reinhard", "aces", "none"] = "aces"
     camera: CameraModel = Field(default_factory=CameraModel)
+    ssao: SSAOModel | None = Field(None, description="screen-space ambient occlusion (deferred)")
     object: list[ObjectModel] = Field(default_factory=list)
     light: list[LightModel] = Field(default_factory=list)
 
@@ -105,6 +113,7 @@ class Scene:
     background: tuple[float, float, float] = (0.02, 0.02, 0.025)
     exposure: float = 1.0
     tonemap: str = "aces"
+    ssao: SSAOSettings | None = None
     source: str = "<memory>"
 
     def add(self, mesh: MeshData | str, material: Material | str = "standard",
@@ -179,7 +188,8 @@ def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
     c = model.camera
     scene = Scene(camera=Camera(c.position, c.target, c.up, c.fov, c.near, c.far),
                   size=model.size, background=model.background, exposure=model.exposure,
-                  tonemap=model.tonemap, source=name)
+                  tonemap=model.tonemap, source=name,
+                  ssao=SSAOSettings(**model.ssao.model_dump()) if model.ssao else None)
     meshes: dict[str, MeshData] = {}
     for index, obj in enumerate(model.object):
         where = f"{name}: object[{index}]"

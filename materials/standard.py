@@ -33,8 +33,8 @@ class StandardMaterial(Material):
             raise InputError(f"texture file not found: {self.resolve_path(self.params.texture)}",
                              f"{where}.texture" if where else "texture")
 
-    def defines(self) -> dict[str, str]:
-        defines = super().defines()
+    def defines(self, obj) -> dict[str, str]:
+        defines = super().defines(obj)
         if self.params.texture is not None:
             defines["HAS_ALBEDO_TEXTURE"] = "1"
         return defines

@@ -15,4 +15,5 @@ struct Surface {
     float specular_intensity;  // [0, 1]
     float specular_exponent;   // Blinn-Phong exponent
     vec3 normal;               // view space, unit: the normal lights use
+    float occlusion;           // ambient occlusion [0, 1]; set by the pipeline, not the material
 };

@@ -9,6 +9,7 @@ out vec4 out_color;
 void main() {
     SurfaceInput i = surface_input();
     Surface s = material_surface(i);
+    s.occlusion = 1.0;
     vec3 V = normalize(-i.position);
     vec3 color = vec3(0.0);
     for (int k = 0; k < u_light_count; ++k) {

@@ -29,6 +29,7 @@ GBufferSample gbuffer_decode(vec4 albedo_specular, vec4 normal_exponent_id, floa
     g.surface.specular_intensity = albedo_specular.a;
     g.surface.normal = octahedral_decode(normal_exponent_id.xy);
     g.surface.specular_exponent = normal_exponent_id.z;
+    g.surface.occlusion = 1.0;
     g.material_id = normal_exponent_id.w;
     g.linear_depth = linear_depth;
     return g;

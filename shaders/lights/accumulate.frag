@@ -3,6 +3,9 @@
 #include "common/light_buffer.glsl"
 #include "generated/lights.glsl"
 
+#ifdef HAS_SSAO
+uniform sampler2D u_ssao;
+#endif
 uniform vec2 u_resolution;
 uniform mat4 u_inverse_projection;
 
@@ -12,6 +15,9 @@ out vec4 out_light;
 void main() {
     GBufferSample g = gbuffer_fetch(ivec2(gl_FragCoord.xy));
     if (g.material_id <= 0.0) discard;
+#ifdef HAS_SSAO
+    g.surface.occlusion = texelFetch(u_ssao, ivec2(gl_FragCoord.xy), 0).r;
+#endif
     vec3 P = view_position(gl_FragCoord.xy, g.linear_depth, u_resolution, u_inverse_projection);
     vec3 V = normalize(-P);
     out_light = vec4(evaluate_light(fetch_light(v_light_index), g.surface, P, V), 0.0);

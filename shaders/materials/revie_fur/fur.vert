@@ -1,0 +1,66 @@
+// Revie fur: the mesh at a shell depth (0 base, 1 outermost shell), with the comb direction from
+// the vertex colour (Listing 2.7's tangent-space encoding) or from the `comb` parameter.
+#include "techniques/shells.glsl"
+
+in vec3 in_position;
+in vec3 in_normal;
+in vec2 in_uv;
+in vec3 in_tangent;
+in vec3 in_binormal;
+in vec4 in_comb;
+
+uniform mat4 u_model_view;
+uniform mat4 u_projection;
+uniform mat3 u_normal_matrix;
+uniform float u_shell_depth;
+uniform float u_fur_length;     // object units, scaled per vertex by the comb alpha
+uniform float u_comb_strength;
+uniform vec3 u_comb;            // object space; used when the mesh has no comb colours
+
+out vec3 v_position;
+out vec3 v_normal;
+out vec3 v_tangent;
+out vec3 v_binormal;
+out vec2 v_uv;
+out vec4 v_comb;
+out vec4 v_base_clip;    // the base-mesh point under this shell point (Listing 2.2)
+out vec4 v_tip_clip;     // the outermost-shell point: where its stipple sample was written
+out float v_base_depth;  // linear view depths of those two points
+out float v_tip_depth;
+out float v_fur_extent;  // view-space length of the strand at this vertex
+out float v_shell_depth;
+
+invariant gl_Position;
+
+void main() {
+#ifdef VERTEX_COMB
+    vec3 comb_tangent = in_comb.xyz * 2.0 - 1.0;
+    vec3 comb = in_tangent * comb_tangent.x + in_binormal * comb_tangent.y
+              + in_normal * comb_tangent.z;
+#else
+    vec3 comb = u_comb - dot(u_comb, in_normal) * in_normal;
+    comb = dot(comb, comb) > 1e-8 ? normalize(comb) : in_tangent;
+    vec3 comb_tangent = vec3(dot(comb, in_tangent), dot(comb, in_binormal), 0.0);
+#endif
+    comb *= u_comb_strength;
+    float fur_length = u_fur_length * in_comb.a;
+    vec3 shell = in_position + shell_offset(in_normal, comb, u_shell_depth, fur_length);
+    vec3 tip = in_position + shell_offset(in_normal, comb, 1.0, fur_length);
+
+    vec4 position = u_model_view * vec4(shell, 1.0);
+    vec4 base_view = u_model_view * vec4(in_position, 1.0);
+    vec4 tip_view = u_model_view * vec4(tip, 1.0);
+    v_position = position.xyz;
+    v_normal = normalize(u_normal_matrix * in_normal);
+    v_tangent = normalize(mat3(u_model_view) * in_tangent);
+    v_binormal = normalize(mat3(u_model_view) * in_binormal);
+    v_uv = in_uv;
+    v_comb = vec4(comb_tangent * 0.5 + 0.5, in_comb.a);
+    v_base_clip = u_projection * base_view;
+    v_tip_clip = u_projection * tip_view;
+    v_base_depth = -base_view.z;
+    v_tip_depth = -tip_view.z;
+    v_fur_extent = length(tip_view.xyz - base_view.xyz);
+    v_shell_depth = u_shell_depth;
+    gl_Position = u_projection * position;
+}
