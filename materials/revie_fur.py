@@ -60,6 +60,8 @@ class RevieFurParams(MaterialParams):
     strand_softness: float = Field(0.1, gt=0.0, le=1.0,
                                    description="smoothstep width of the strand fade")
     seed: int = Field(1, ge=0, description="seed of the procedural heightfield")
+    occlusion_test: bool = Field(True, description="reject light samples the G-buffer shows "
+                                                   "occluded (off: Figure 2.8's error)")
 
     @field_validator("comb")
     @classmethod
@@ -103,6 +105,8 @@ class RevieFurMaterial(Material):
             defines["VERTEX_COMB"] = "1"
         if self.params.stipple:
             defines["FUR_STIPPLE"] = "1"
+        if self.params.occlusion_test:
+            defines["FUR_OCCLUSION_TEST"] = "1"
         return defines
 
     def uniforms(self, frame: Frame) -> dict[str, Any]:

@@ -36,8 +36,10 @@ bool irradiance_at(ivec2 pixel, float expected, float tolerance, out vec3 irradi
     irradiance = vec3(0.0);
     if (any(lessThan(pixel, ivec2(0))) || any(greaterThanEqual(pixel, ivec2(u_resolution))))
         return false;
+#ifdef FUR_OCCLUSION_TEST
     if (abs(texelFetch(u_normal_exponent_id, pixel, 0).w - u_material_id) > 0.5) return false;
     if (abs(texelFetch(u_linear_depth, pixel, 0).r - expected) > tolerance) return false;
+#endif
     vec3 albedo = max(texelFetch(u_albedo_specular, pixel, 0).rgb, vec3(1.0 / 255.0));
     irradiance = texelFetch(u_light_accumulation, pixel, 0).rgb / albedo;
     return true;

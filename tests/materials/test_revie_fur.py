@@ -1,0 +1,189 @@
+"""Revie's fur: each technique of the chapter, measured on buffers and final images."""
+
+import numpy as np
+import pytest
+import trimesh
+
+from deferred import registry
+from deferred.scene import scene_from_dict
+
+
+def fur_scene(params=None, size=(160, 120), lights=None, objects=(), camera=None, mesh=None,
+              **extra):
+    return scene_from_dict({
+        "size": list(size), "tonemap": "none",
+        "camera": camera or {"position": [0.0, 0.0, 3.2], "target": [0.0, 0.0, 0.0],
+                             "fov": 40.0},
+        "object": [{"name": "fur", "mesh": mesh or "builtin:sphere", "material": "revie_fur",
+                    "params": params or {}}, *objects],
+        "light": lights or [{"type": "directional", "direction": [-0.4, -0.6, -1.0]},
+                            {"type": "ambient", "color": [0.2, 0.2, 0.25]}],
+        **extra})
+
+
+def capture(render, scene, names, pipeline="deferred"):
+    """Targets after each pass: {pass name: {target: array (bottom row first)}}."""
+    shots = {}
+
+    def grab(render_pass, frame):
+        shots[render_pass.name] = {t: frame.targets.read(t) for t in names}
+
+    result, renderer = render(scene, pipeline, on_pass=grab)
+    return result, renderer, shots
+
+
+def parity(shape):
+    y, x = np.mgrid[0:shape[0], 0:shape[1]]
+    return (x % 2 == 0) & (y % 2 == 0)  # GL pixel coordinates: the pattern of Listing 2.6
+
+
+def test_stipple_pass_writes_one_pixel_per_2x2_tile(render):
+    targets = ["albedo_specular", "normal_exponent_id", "linear_depth", "depth"]
+    _, _, shots = capture(render, fur_scene({"shells": 0}), targets)
+    before, after = shots["fur.gbuffer"], shots["fur.stipple"]
+    changed = np.zeros(before["depth"].shape[:2], bool)
+    for name in targets:
+        changed |= np.any(before[name] != after[name], axis=-1)
+    stipple_class = parity(changed.shape)
+    assert changed.sum() > 500
+    assert not changed[~stipple_class].any()  # exactly one parity class of (x % 2, y % 2)
+    # the outer shell widens the silhouette: some stipple samples land on the background
+    assert (before["linear_depth"][..., 0][changed] == 0.0).any()
+
+
+def test_obliteration_leaves_no_stipple_value(render):
+    targets = ["composite", "depth", "linear_depth"]
+    _, renderer, on = capture(render, fur_scene({"shells": 0}), targets)
+    _, _, off = capture(render, fur_scene({"shells": 0, "stipple": False}), targets)
+    cleaned = on["fur.stipple_obliteration"]
+    reference = off["material.composite_copy"]
+    stipple_class = parity(cleaned["composite"].shape)
+    # away from stipple pixels the composition equals a frame rendered without any stipple
+    np.testing.assert_array_equal(cleaned["composite"][~stipple_class],
+                                  reference["composite"][~stipple_class])
+    np.testing.assert_array_equal(cleaned["depth"][~stipple_class],
+                                  reference["depth"][~stipple_class])
+    # on stipple pixels: the right-hand neighbour's value, in colour and in depth
+    stippled = on["fur.stipple"]["linear_depth"][..., 0] != \
+        on["fur.gbuffer"]["linear_depth"][..., 0]
+    ys, xs = np.nonzero(stippled)
+    keep = xs + 1 < stippled.shape[1]
+    ys, xs = ys[keep], xs[keep]
+    assert len(ys) > 300
+    np.testing.assert_array_equal(cleaned["composite"][ys, xs], reference["composite"][ys, xs + 1])
+    np.testing.assert_allclose(cleaned["depth"][ys, xs], reference["depth"][ys, xs + 1],
+                               atol=2e-6)
+
+
+def highlight_extents(hdr):
+    luminance = hdr[..., :3].mean(axis=-1)
+    mask = luminance > 0.5 * luminance.max()
+    ys, xs = np.nonzero(mask)
+    return xs.max() - xs.min() + 1, ys.max() - ys.min() + 1
+
+
+@pytest.mark.parametrize("material, params", [
+    ("revie_fur", {"shells": 0, "stipple": False, "comb": [1.0, 0.0, 0.0],
+                   "albedo_tip": [0.05, 0.05, 0.05], "specular_intensity": 1.0,
+                   "specular_exponent": 64.0}),
+    ("standard", {"color": [0.05, 0.05, 0.05], "specular_intensity": 1.0,
+                  "specular_exponent": 64.0}),
+])
+def test_highlight_stretches_across_the_grain(render, material, params):
+    """Revie Fig. 2.13: the grain runs along X; the highlight stretches along Z (image rows)."""
+    scene = scene_from_dict({
+        "size": [200, 200], "tonemap": "none",
+        "camera": {"position": [0.0, 3.0, 0.0], "target": [0.0, 0.0, 0.0],
+                   "up": [0.0, 0.0, -1.0], "fov": 70.0},
+        "object": [{"mesh": "builtin:plane", "scale": 8.0, "material": material,
+                    "params": params}],
+        "light": [{"type": "point", "position": [0.0, 3.0, 0.0], "intensity": 2.0,
+                   "radius": 20.0}]})
+    result, _ = render(scene)
+    along, across = highlight_extents(result.hdr)
+    if material == "revie_fur":
+        assert across >= 2 * along, (along, across)
+    else:
+        assert 0.75 <= across / along <= 1.33, (along, across)
+
+
+def silhouette_ring(shape, centre, radius, inner=0.8, outer=1.15):
+    y, x = np.mgrid[0:shape[0], 0:shape[1]]
+    r = np.hypot(x + 0.5 - centre[0], y + 0.5 - centre[1])
+    return (r > inner * radius) & (r < outer * radius)
+
+
+def test_rim_scattering_brightens_the_silhouette_against_a_back_light(render):
+    """Revie Fig. 2.4: a back-lit fur sphere glows at its rim only with rim bending."""
+    lights = [{"type": "directional", "direction": [0.0, 0.2, 1.0], "intensity": 2.0}]
+    means = {}
+    for strength in (0.0, 2.0):
+        scene = fur_scene({"rim_strength": strength, "shells": 16, "fur_length": 0.1},
+                          size=(160, 160), lights=lights)
+        result, _ = render(scene)
+        # sphere of radius 1 at distance 3.2 with a 40 degree field of view
+        radius_px = 160 / 2 / np.tan(np.radians(20.0)) * np.tan(np.arcsin(1.0 / 3.2))
+        ring = silhouette_ring(result.hdr.shape, (80, 80), radius_px)
+        means[strength] = result.hdr[..., :3][ring].mean()
+    assert means[2.0] > 1.5 * means[0.0] + 0.01, means
+
+
+@pytest.mark.parametrize("stipple, occlusion_test, red_expected", [
+    (True, True, False), (False, True, False), (False, False, True)])
+def test_shells_take_no_colour_from_an_occluder(render, stipple, occlusion_test, red_expected):
+    """Revie Fig. 2.8: strands combed out from under an occluder must not sample its light.
+
+    With the depth test off and no stipple sample to fall back on, the error shows (red fringe
+    under the red bar); with the test, or with the stipple sample, it does not.
+    """
+    red = {"mesh": "builtin:cube", "position": [0.0, 0.4, 1.3], "scale": [1.0, 0.3, 0.1],
+           "params": {"color": [1.0, 0.0, 0.0], "specular_intensity": 0.0}}
+    scene = fur_scene({"shells": 24, "fur_length": 0.25, "comb_strength": 1.5,
+                       "stipple": stipple, "occlusion_test": occlusion_test,
+                       "albedo_base": [0.6, 0.6, 0.6], "albedo_tip": [0.8, 0.8, 0.8]},
+                      size=(200, 160), objects=[red],
+                      lights=[{"type": "ambient", "color": [1.0, 1.0, 1.0],
+                               "ground": [1.0, 1.0, 1.0]}])
+    result, renderer = render(scene)
+    ids = renderer.targets.read("normal_exponent_id")[::-1, :, 3]
+    occluder = ids == registry.materials.get("standard").type_id
+    hdr = result.hdr
+    red_pixels = (hdr[..., 0] > 0.2) & (hdr[..., 1] < 0.5 * hdr[..., 0]) & ~occluder
+    if red_expected:
+        assert red_pixels.sum() > 50
+    else:
+        assert red_pixels.sum() == 0
+
+
+def test_fur_widens_the_silhouette_and_every_shell_runs(render):
+    covered = []
+    for length in (0.0001, 0.15, 0.3):
+        result, renderer = render(fur_scene({"fur_length": length, "shells": 12}))
+        assert result.draws_by_pass["fur.shells"] == 12
+        differs = np.any(result.hdr[..., :3] != result.hdr[0, 0, :3], axis=-1)
+        covered.append(differs.mean())
+    assert covered[0] < covered[1] < covered[2]
+    forward, _ = render(fur_scene({"shells": 7}), "forward")
+    assert forward.draws_by_pass["fur.forward_shells"] == 7
+
+
+def test_positions_only_mesh_renders_fur(render, tmp_path):
+    shape = trimesh.creation.icosphere(subdivisions=3, radius=0.9)
+    lines = [f"v {x:.6f} {y:.6f} {z:.6f}" for x, y, z in shape.vertices]
+    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in shape.faces]
+    (tmp_path / "scan.obj").write_text("\n".join(lines) + "\n")
+    for pipeline in ("deferred", "forward"):
+        result, _ = render(fur_scene({"shells": 8}, mesh=str(tmp_path / "scan.obj")), pipeline)
+        assert np.isfinite(result.hdr).all()
+        fur = np.any(result.hdr[..., :3] != result.hdr[0, 0, :3], axis=-1)
+        assert 0.2 < fur.mean() < 0.8
+
+
+def test_ssao_runs_before_stipple_and_never_sees_it(render):
+    ssao = {"radius": 0.3}
+    _, renderer, on = capture(render, fur_scene({"shells": 0}, ssao=ssao), ["ssao"])
+    _, _, off = capture(render, fur_scene({"shells": 0, "stipple": False}, ssao=ssao), ["ssao"])
+    names = [p.name for p in renderer.passes]
+    assert names.index("screen.ssao_blur") < names.index("fur.stipple")
+    np.testing.assert_array_equal(on["post.tonemap"]["ssao"], off["post.tonemap"]["ssao"])
+    assert on["post.tonemap"]["ssao"].min() < 0.9  # it does occlude something
