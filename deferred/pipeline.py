@@ -86,7 +86,9 @@ class ForwardPipeline(Pipeline):
         passes: list[RenderPass] = [ClearPass("forward.clear", Phase.FORWARD,
                                               {COMPOSITE: (*scene.background, 0.0)},
                                               depth=DEPTH)]
-        passes += object_passes(scene, Phase.FORWARD)
+        # Opaque passes first, then blended ones (shells, glass) over them, each in scene order.
+        forward = object_passes(scene, Phase.FORWARD)
+        passes += sorted(forward, key=lambda p: getattr(p, "blend", None) is not None)
         passes.append(tonemap_pass())
         return passes
 

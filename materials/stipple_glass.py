@@ -1,0 +1,80 @@
+"""Screen-door transparency in a deferred pipeline (Revie 2.3.4, Figure 2.14).
+
+The glass is written into the G-buffer at one pixel in two or four (``pattern``), so the pixels
+between keep the scene behind it; both are lit by the lighting phase as usual; the material
+phase deinterlaces them and blends glass over scene by ``opacity``. The forward technique is an
+ordinary alpha-blended lit pass.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any, Literal
+
+import moderngl
+from pydantic import Field
+
+from deferred.gbuffer import LINEAR_DEPTH, NORMAL_EXPONENT_ID
+from deferred.material import Material, MaterialParams
+from deferred.passes import ObjectPass, Phase, RenderPass
+from deferred.registry import materials
+from deferred.targets import COMPOSITE, LIGHT_ACCUMULATION
+
+from .techniques.stipple import StipplePass, pattern_defines
+
+if TYPE_CHECKING:
+    from deferred.frame import Frame
+    from deferred.scene import SceneObject
+
+
+class StippleGlassParams(MaterialParams):
+    color: tuple[float, float, float] = Field((0.55, 0.75, 0.85), description="glass tint")
+    opacity: float = Field(0.35, ge=0.0, le=1.0, description="glass over the scene behind")
+    pattern: Literal[2, 4] = Field(4, description="stipple density: 1 in 2 or 1 in 4 pixels")
+    specular_intensity: float = Field(0.9, ge=0.0, le=1.0, description="Blinn-Phong intensity")
+    specular_exponent: float = Field(96.0, ge=1.0, le=2048.0, description="Blinn-Phong exponent")
+
+
+class DeinterlacePass(ObjectPass):
+    """Blend each glass pixel from its tile's glass sample and scene samples."""
+
+    fragment = "materials/stipple_glass/deinterlace.frag"
+    colors = (COMPOSITE,)
+    depth_func = "lequal"
+    depth_write = False
+    extra_reads = (LIGHT_ACCUMULATION, NORMAL_EXPONENT_ID, LINEAR_DEPTH)
+
+    def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
+        return {"u_light_accumulation": frame.targets[LIGHT_ACCUMULATION],
+                "u_normal_exponent_id": frame.targets[NORMAL_EXPONENT_ID],
+                "u_linear_depth": frame.targets[LINEAR_DEPTH]}
+
+
+@materials.register
+class StippleGlassMaterial(Material):
+    name = "stipple_glass"
+    Params = StippleGlassParams
+    surface_shader = "materials/stipple_glass/surface.glsl"
+
+    def defines(self, obj: SceneObject) -> dict[str, str]:
+        return {**super().defines(obj), **pattern_defines(self.params.pattern)}
+
+    def uniforms(self, frame: Frame) -> dict[str, Any]:
+        p = self.params
+        return {"u_color": p.color, "u_opacity": p.opacity,
+                "u_specular_intensity": p.specular_intensity,
+                "u_specular_exponent": p.specular_exponent}
+
+    def geometry_passes(self, obj: SceneObject) -> list[RenderPass]:
+        return []  # transparent: nothing in the opaque G-buffer phase
+
+    def stipple_passes(self, obj: SceneObject) -> list[RenderPass]:
+        return [StipplePass(f"{obj.label}.stipple", Phase.STIPPLE, obj,
+                            fragment="materials/stipple_glass/stipple.frag")]
+
+    def material_passes(self, obj: SceneObject) -> list[RenderPass]:
+        return [DeinterlacePass(f"{obj.label}.deinterlace", Phase.MATERIAL, obj)]
+
+    def forward_passes(self, obj: SceneObject) -> list[RenderPass]:
+        return [ObjectPass(f"{obj.label}.forward", Phase.FORWARD, obj,
+                           fragment="materials/stipple_glass/forward.frag", colors=(COMPOSITE,),
+                           depth_write=False, blend="alpha")]
