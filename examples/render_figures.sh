@@ -1,0 +1,9 @@
+#!/usr/bin/env bash
+# Render every example scene into docs/figures/ (the images in the README).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+mkdir -p docs/figures
+for scene in examples/*.toml; do
+    deferred render "$scene" -o "docs/figures/$(basename "$scene" .toml).png"
+done
+deferred render -o docs/figures/demo.png --size 960x540
