@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import os
-import tempfile
+import secrets
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -34,11 +34,18 @@ def check_output_path(path: str | Path, where: str = "-o") -> Path:
     return path
 
 
+# OpenEXR stores channels sorted by name; this attribute keeps the order they were written in.
+CHANNEL_ORDER_ATTRIBUTE = "deferred:channels"
+
+
 def write_image(path: str | Path, pixels: np.ndarray, channels: Sequence[str] | None = None,
-                attributes: dict[str, object] | None = None, half: bool = False) -> Path:
+                attributes: dict[str, object] | None = None, half: bool = False,
+                channel_formats: Sequence[str] | None = None) -> Path:
     """Write ``pixels`` (H, W, C), top row first, atomically (temporary file, then rename).
 
     uint8 data is written as 8-bit; float data as float (or half) EXR with ``channels`` names.
+    ``channel_formats`` ("half" or "float" per channel) overrides ``half`` channel by channel.
+    A channel named ``Z`` becomes the image's ``z_channel``, one named ``A`` its alpha channel.
     """
     import OpenImageIO as oiio
 
@@ -49,6 +56,9 @@ def write_image(path: str | Path, pixels: np.ndarray, channels: Sequence[str] | 
     height, width, count = pixels.shape
     if pixels.dtype == np.uint8:
         fmt = oiio.UINT8
+    elif channel_formats is not None:
+        pixels = pixels.astype(np.float32)
+        fmt = oiio.FLOAT
     else:
         pixels = pixels.astype(np.float16 if half else np.float32)
         fmt = oiio.HALF if half else oiio.FLOAT
@@ -56,14 +66,19 @@ def write_image(path: str | Path, pixels: np.ndarray, channels: Sequence[str] | 
     if channels is not None:
         if len(channels) != count:
             raise ValueError(f"{len(channels)} channel names for {count} channels")
-        spec.channelnames = tuple(channels)
+        names = tuple(channels)
+        spec.channelnames = names
+        spec.alpha_channel = names.index("A") if "A" in names else -1
+        spec.z_channel = names.index("Z") if "Z" in names else -1
+        spec.attribute(CHANNEL_ORDER_ATTRIBUTE, ",".join(names))
+    if channel_formats is not None and fmt != oiio.UINT8:
+        if len(channel_formats) != count:
+            raise ValueError(f"{len(channel_formats)} channel formats for {count} channels")
+        spec.channelformats = tuple(oiio.TypeDesc(f) for f in channel_formats)
     for key, value in (attributes or {}).items():
         spec.attribute(key, value)
-    directory = path.parent if str(path.parent) else Path(".")
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix,
-                                         dir=directory)
-    os.close(handle)
-    try:
+
+    def write(temporary: str) -> None:
         output = oiio.ImageOutput.create(temporary)
         if output is None or not output.open(temporary, spec):
             raise RenderError(f"cannot write {path}: {oiio.geterror()}")
@@ -71,11 +86,30 @@ def write_image(path: str | Path, pixels: np.ndarray, channels: Sequence[str] | 
         output.close()
         if not ok:
             raise RenderError(f"cannot write {path}: {oiio.geterror()}")
+
+    _write_atomically(path, write)
+    return path
+
+
+def write_text(path: str | Path, text: str) -> Path:
+    """Write a text file atomically (JSON manifests, CSV)."""
+    path = Path(path)
+    _write_atomically(path, lambda temporary: Path(temporary).write_text(text, encoding="utf-8"))
+    return path
+
+
+def _write_atomically(path: Path, write) -> None:
+    """``write(temporary)`` next to ``path``, then rename over it: readers never see half a file."""
+    directory = path.parent if str(path.parent) else Path(".")
+    # Not mkstemp: its 0600 mode would survive the rename; the writer creates the file under
+    # the umask like any other output. The suffix stays last so OIIO picks the format.
+    temporary = str(directory / f".{path.stem}.{secrets.token_hex(6)}.tmp{path.suffix}")
+    try:
+        write(temporary)
         os.replace(temporary, path)
     finally:
         if os.path.exists(temporary):
             os.unlink(temporary)
-    return path
 
 
 def read_image(path: str | Path, srgb_to_linear: bool = False) -> np.ndarray:
@@ -107,7 +141,11 @@ def read_image(path: str | Path, srgb_to_linear: bool = False) -> np.ndarray:
 
 
 def read_channels(path: str | Path) -> tuple[np.ndarray, list[str], dict[str, object]]:
-    """Read every channel of an image (EXR dumps): pixels (H, W, C), names, a few attributes."""
+    """Read every channel of an image (EXR dumps): pixels (H, W, C), names, a few attributes.
+
+    Channels come back in the order they were written when the file records it (EXR itself
+    sorts them by name); ``z_channel`` and ``alpha_channel`` index into that order (-1: none).
+    """
     import OpenImageIO as oiio
 
     image = oiio.ImageInput.open(str(path))
@@ -117,9 +155,15 @@ def read_channels(path: str | Path) -> tuple[np.ndarray, list[str], dict[str, ob
         spec = image.spec()
         pixels = np.asarray(image.read_image(format=oiio.FLOAT), dtype=np.float32)
         names = list(spec.channelnames)
-        attributes = {"z_channel": spec.z_channel, "alpha_channel": spec.alpha_channel}
+        order = spec.getattribute(CHANNEL_ORDER_ATTRIBUTE)
     finally:
         image.close()
     if pixels.ndim == 2:
         pixels = pixels[..., None]
+    if isinstance(order, str) and sorted(order.split(",")) == sorted(names):
+        wanted = order.split(",")
+        pixels = pixels[..., [names.index(n) for n in wanted]]
+        names = wanted
+    attributes = {"z_channel": names.index("Z") if "Z" in names else -1,
+                  "alpha_channel": names.index("A") if "A" in names else -1}
     return pixels, names, attributes

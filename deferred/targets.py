@@ -35,6 +35,9 @@ class FrameTargets:
         self.specs: dict[str, TargetSpec] = {}
         self.textures: dict[str, moderngl.Texture] = {}
         self._framebuffers: dict[tuple, moderngl.Framebuffer] = {}
+        # (x, y, width, height) in GL pixels applied to every framebuffer handed out, draws and
+        # clears alike: the dump's pixel history replays a frame restricted to one pixel.
+        self.scissor: tuple[int, int, int, int] | None = None
         for name, spec in CORE_TARGETS.items():
             self.declare(name, spec)
 
@@ -71,23 +74,24 @@ class FrameTargets:
                 color_attachments=[self.textures[c] for c in colors],
                 depth_attachment=self.textures[depth] if depth else None)
             self._framebuffers[key] = fbo
+        fbo.scissor = self.scissor
         return fbo
+
+    def read_raw(self, name: str) -> np.ndarray:
+        """Target contents in their stored type (uint8, float16 or float32), (H, W, C), bottom
+        row first (GL order). Depth targets read as float32."""
+        spec = self.specs[name]
+        dtype = np.float32 if spec.depth else {"f1": np.uint8, "f2": np.float16,
+                                                "f4": np.float32}[spec.dtype]
+        data = np.frombuffer(self.textures[name].read(alignment=1), dtype=dtype)
+        return data.reshape(self.height, self.width, 1 if spec.depth else spec.components)
 
     def read(self, name: str) -> np.ndarray:
         """Target contents as float32 (H, W, C), bottom row first (GL order)."""
-        spec = self.specs[name]
-        texture = self.textures[name]
-        if spec.depth:
-            data = np.frombuffer(texture.read(alignment=1), dtype=np.float32)
-            return data.reshape(self.height, self.width, 1).copy()
-        if spec.dtype == "f1":
-            data = np.frombuffer(texture.read(alignment=1), dtype=np.uint8)
-            data = data.astype(np.float32) / 255.0
-        elif spec.dtype == "f2":
-            data = np.frombuffer(texture.read(alignment=1), dtype=np.float16).astype(np.float32)
-        else:
-            data = np.frombuffer(texture.read(alignment=1), dtype=np.float32).copy()
-        return data.reshape(self.height, self.width, spec.components)
+        data = self.read_raw(name)
+        if data.dtype == np.uint8:
+            return data.astype(np.float32) / 255.0
+        return data.astype(np.float32)
 
     def release(self) -> None:
         for fbo in self._framebuffers.values():
