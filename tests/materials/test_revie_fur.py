@@ -187,3 +187,62 @@ def test_ssao_runs_before_stipple_and_never_sees_it(render):
     assert names.index("screen.ssao_blur") < names.index("fur.stipple")
     np.testing.assert_array_equal(on["post.tonemap"]["ssao"], off["post.tonemap"]["ssao"])
     assert on["post.tonemap"]["ssao"].min() < 0.9  # it does occlude something
+
+
+def test_heightfield_image_controls_the_strands(render, tmp_path):
+    from deferred.imageio import write_image
+
+    results = {}
+    for name, value in (("bald", 0.0), ("full", 1.0)):
+        write_image(tmp_path / f"{name}.exr", np.full((8, 8, 3), value, np.float32))
+        result, _ = render(fur_scene({"heightfield": str(tmp_path / f"{name}.exr"),
+                                      "shells": 8, "fur_length": 0.3}))
+        results[name] = np.any(result.hdr[..., :3] != result.hdr[0, 0, :3], axis=-1).mean()
+    no_shells, _ = render(fur_scene({"shells": 0}))
+    bare = np.any(no_shells.hdr[..., :3] != no_shells.hdr[0, 0, :3], axis=-1).mean()
+    assert results["bald"] == pytest.approx(bare, abs=0.01)  # every strand faded out
+    assert results["full"] > bare + 0.05  # every shell drawn: the silhouette grows
+
+
+def test_missing_heightfield_is_a_clear_error(tmp_path):
+    from deferred.errors import InputError
+
+    with pytest.raises(InputError, match=r"object\[0\]\.params\.heightfield: heightfield image"):
+        scene_from_dict({"object": [{"mesh": "builtin:sphere", "material": "revie_fur",
+                                     "params": {"heightfield": "nope.png"}}]}, name="s.toml",
+                        base_dir=tmp_path)
+
+
+def test_vertex_colour_comb_and_length_are_used(render, tmp_path):
+    """Revie 2.4.1: RGB combs the fur, A scales its length (per vertex).
+
+    A plane seen from above, combed along +X or -X by its vertex colours: the stippled outer
+    shell slides off the plane's edge on the combed side only, by less when A is smaller.
+    """
+    from deferred.mesh import builtin_plane
+
+    plane = builtin_plane(divisions=8)
+    overhang = {}
+    for comb, alpha in ((1.0, 1.0), (0.0, 1.0), (1.0, 0.4)):
+        mesh = trimesh.Trimesh(plane.positions, plane.indices, process=False)
+        colours = np.tile([comb, 0.5, 0.5, alpha], (len(plane.positions), 1))
+        mesh.visual.vertex_colors = (colours * 255).round().astype(np.uint8)
+        path = tmp_path / f"plane_{comb}_{alpha}.ply"
+        mesh.export(path)
+        scene = fur_scene({"fur_length": 0.4, "comb_strength": 2.0, "shells": 0},
+                          mesh=str(path), camera={"position": [0.0, 3.0, 0.0],
+                                                  "target": [0.0, 0.0, 0.0],
+                                                  "up": [0.0, 0.0, -1.0], "fov": 60.0})
+        _, _, shots = capture(render, scene, ["linear_depth"])
+        base = shots["fur.gbuffer"]["linear_depth"][..., 0] > 0
+        outer = shots["fur.stipple"]["linear_depth"][..., 0] != \
+            shots["fur.gbuffer"]["linear_depth"][..., 0]
+        columns = np.nonzero(base.any(axis=0))[0]
+        stipple_columns = np.nonzero(outer.any(axis=0))[0]
+        overhang[(comb, alpha)] = (columns.min() - stipple_columns.min(),
+                                   stipple_columns.max() - columns.max())
+    left, right = overhang[(1.0, 1.0)]
+    assert right > 8 and left <= 1  # combed +X: off the right edge only
+    left, right = overhang[(0.0, 1.0)]
+    assert left > 8 and right <= 1  # combed -X: off the left edge only
+    assert 0 < overhang[(1.0, 0.4)][1] < overhang[(1.0, 1.0)][1]  # shorter fur, less overhang
