@@ -37,7 +37,6 @@ class Resources:
         self._meshes: dict[int, GpuMesh] = {}
         self._mesh_refs: list[MeshData] = []  # keep ids stable while cached
         self._textures: dict[Any, moderngl.Texture] = {}
-        self._buffers: dict[str, moderngl.Buffer] = {}
         self._fullscreen_vaos: dict[int, moderngl.VertexArray] = {}
 
     def gpu_mesh(self, mesh: MeshData) -> GpuMesh:
@@ -89,9 +88,6 @@ class Resources:
         for vao in self._fullscreen_vaos.values():
             vao.release()
         self._fullscreen_vaos.clear()
-        for buffer in self._buffers.values():
-            buffer.release()
-        self._buffers.clear()
 
 
 @dataclass
@@ -162,6 +158,10 @@ class Frame:
             program[name].value = unit
             unit += 1
         self.light_buffer.bind(program, unit)
+
+    def target_samplers(self, names) -> dict[str, moderngl.Texture]:
+        """Targets by the sampler names shaders use for them: ``u_<target name>``."""
+        return {f"u_{name}": self.targets[name] for name in names}
 
     # -- drawing -------------------------------------------------------------------------------
     def _count(self) -> None:

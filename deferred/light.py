@@ -125,7 +125,7 @@ class LightTypePass(RenderPass):
         defines = {"HAS_SSAO": "1"} if self.occlusion else {}
         program = frame.shaders.program(vertex, "lights/accumulate.frag", defines=defines)
         frame.use_framebuffer((LIGHT_ACCUMULATION,), DEPTH, depth_write=False)
-        textures = {f"u_{name}": frame.targets[name] for name in GBUFFER_COLOR_TARGETS}
+        textures = frame.target_samplers(GBUFFER_COLOR_TARGETS)
         if self.occlusion:
             textures["u_ssao"] = frame.targets[self.occlusion]
         uniforms = {**frame.camera_uniforms(), "u_light_offset": offset}

@@ -155,7 +155,8 @@ class ObjectPass(RenderPass):
         return {}
 
     def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
-        return {}
+        """Samplers of the pass: each target in ``extra_reads`` as ``u_<target>``."""
+        return frame.target_samplers(self.extra_reads)
 
     def draws(self, frame: Frame) -> int:
         return 1

@@ -89,8 +89,7 @@ class ShaderLibrary:
 
     def _expand(self, name: str, defines: dict[str, str], lines: list[str],
                 line_map: list[tuple[str, int]], included: set[str], stack: list[str]) -> None:
-        if name in stack:
-            raise ShaderError(f"{stack[-1]}: include cycle: {' -> '.join(stack + [name])}")
+        # Include-once (below) makes cycles harmless; the depth limit bounds what is left.
         if len(stack) >= MAX_INCLUDE_DEPTH:
             raise ShaderError(f"{stack[-1]}: includes nested deeper than {MAX_INCLUDE_DEPTH}")
         included.add(name)

@@ -79,12 +79,6 @@ class FurShellPass(ShellPass):
     colors = (COMPOSITE,)
     extra_reads = (LIGHT_ACCUMULATION, ALBEDO_SPECULAR, NORMAL_EXPONENT_ID, LINEAR_DEPTH)
 
-    def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
-        return {"u_light_accumulation": frame.targets[LIGHT_ACCUMULATION],
-                "u_albedo_specular": frame.targets[ALBEDO_SPECULAR],
-                "u_normal_exponent_id": frame.targets[NORMAL_EXPONENT_ID],
-                "u_linear_depth": frame.targets[LINEAR_DEPTH]}
-
 
 @materials.register
 class RevieFurMaterial(Material):

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any, Literal
 
-import moderngl
 from pydantic import Field
 
 from deferred.gbuffer import LINEAR_DEPTH, NORMAL_EXPONENT_ID
@@ -42,11 +41,6 @@ class DeinterlacePass(ObjectPass):
     depth_func = "lequal"
     depth_write = False
     extra_reads = (LIGHT_ACCUMULATION, NORMAL_EXPONENT_ID, LINEAR_DEPTH)
-
-    def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
-        return {"u_light_accumulation": frame.targets[LIGHT_ACCUMULATION],
-                "u_normal_exponent_id": frame.targets[NORMAL_EXPONENT_ID],
-                "u_linear_depth": frame.targets[LINEAR_DEPTH]}
 
 
 @materials.register

@@ -8,8 +8,6 @@ from the composition buffer. ``STIPPLE_PATTERN`` (2 or 4) selects the pattern in
 
 from __future__ import annotations
 
-from typing import Any
-
 from deferred.gbuffer import DEPTH, GBUFFER_COLOR_TARGETS, LINEAR_DEPTH, NORMAL_EXPONENT_ID
 from deferred.passes import ObjectPass
 from deferred.targets import COMPOSITE, LIGHT_ACCUMULATION
@@ -45,8 +43,3 @@ class StippleObliterationPass(ObjectPass):
     depth_test = True
     depth_func = "always"  # the pass writes depth (gl_FragDepth) wherever it keeps a fragment
     extra_reads = (LIGHT_ACCUMULATION, LINEAR_DEPTH, NORMAL_EXPONENT_ID)
-
-    def textures(self, frame) -> dict[str, Any]:
-        return {"u_light_accumulation": frame.targets[LIGHT_ACCUMULATION],
-                "u_linear_depth": frame.targets[LINEAR_DEPTH],
-                "u_normal_exponent_id": frame.targets[NORMAL_EXPONENT_ID]}
