@@ -22,7 +22,9 @@ if TYPE_CHECKING:
 # Blend modes by name: passes say what they want, not GL enums.
 BLEND_MODES = {
     "add": (moderngl.ONE, moderngl.ONE),
-    "alpha": (moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA),
+    # alpha stays coverage: a over background (0) gives a, over a surface (1) stays 1
+    "alpha": (moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA, moderngl.ONE,
+              moderngl.ONE_MINUS_SRC_ALPHA),
     "premultiplied": (moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA),
 }
 DEPTH_FUNCS = {"less": "<", "lequal": "<=", "gequal": ">=", "greater": ">", "equal": "==",

@@ -2,8 +2,9 @@
 
 Every mesh the framework draws has the same vertex format (``VERTEX_ATTRIBUTES``): position,
 normal, UV, tangent, binormal and the RGBA *comb* colour of Revie section 2.4.1 (RGB: comb
-direction in tangent space packed from [-1, 1] to [0, 1]; A: fur length scale). Missing normals are
-computed by trimesh, missing UVs come from an xatlas unwrap, tangent frames are built from the UVs.
+direction in tangent space packed from [-1, 1] to [0, 1]; A: fur length scale). Files load through
+trimesh; missing normals are computed (area-weighted face normals), missing UVs come from an
+xatlas unwrap, tangent frames are built from the UVs.
 """
 
 from __future__ import annotations
@@ -297,16 +298,33 @@ def load_mesh(spec: str, base_dir: Path | None = None, where: str | None = None)
     if "vertex_normals" in loaded._cache.cache:  # normals stored in the file
         normals = np.asarray(loaded.vertex_normals, dtype=np.float64)
     uvs = None
-    colors = None
     visual = loaded.visual
     if getattr(visual, "kind", None) == "texture" and getattr(visual, "uv", None) is not None:
         uvs = np.asarray(visual.uv, dtype=np.float64)
-    elif getattr(visual, "kind", None) == "vertex":
-        colors = np.asarray(visual.vertex_colors, dtype=np.float64) / 255.0
+    colors = _vertex_colours(loaded)
     try:
         return build_mesh(path.name, positions, indices, normals, uvs, colors)
     except InputError as exc:
         raise InputError(exc.message, where) from None
+
+
+def _vertex_colours(loaded) -> np.ndarray | None:
+    """Per-vertex RGBA in [0, 1], wherever trimesh put them (None when the file has none).
+
+    With UVs, trimesh keeps a texture visual and moves vertex colours (OBJ ``v x y z r g b``,
+    glTF ``COLOR_0``) into vertex attributes; without UVs they form a vertex-colour visual.
+    """
+    visual = loaded.visual
+    if getattr(visual, "kind", None) == "vertex":
+        return np.asarray(visual.vertex_colors, dtype=np.float64) / 255.0
+    for attributes in (getattr(loaded, "vertex_attributes", {}),
+                       getattr(visual, "vertex_attributes", {})):
+        colours = attributes.get("color") if attributes is not None else None
+        if colours is not None and len(colours) == len(loaded.vertices):
+            colours = np.asarray(colours)
+            scale = 255.0 if colours.dtype == np.uint8 or colours.max() > 1.0 else 1.0
+            return colours.astype(np.float64) / scale
+    return None
 
 
 # -- GPU side ----------------------------------------------------------------------------------

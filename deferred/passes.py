@@ -34,6 +34,20 @@ PHASE_ORDER = (Phase.GEOMETRY, Phase.SCREEN, Phase.STIPPLE, Phase.LIGHTING, Phas
                Phase.FORWARD, Phase.POST, Phase.OUTPUT)
 
 
+class Order:
+    """Where an object's pass runs within its phase (the pipeline sorts by it).
+
+    In the material phase, every object first restores the opaque scene (stipple obliteration),
+    then volumes (fur shells) and transparent surfaces are composited over it, far to near, so
+    the image does not depend on the order of objects in the scene. The forward phase uses the
+    same ranks: opaque lit passes, then blended ones.
+    """
+
+    OPAQUE = 0  # also: erasing stipple samples, which restores the opaque scene
+    VOLUME = 10  # blended, depth-tested without depth writes: sorted far to near
+    TRANSPARENT = 20  # blended surfaces over everything above: sorted far to near
+
+
 class RenderPass(ABC):
     """One step of a frame."""
 
@@ -41,6 +55,7 @@ class RenderPass(ABC):
     phase: Phase
     reads: tuple[str, ...] = ()
     writes: tuple[str, ...] = ()
+    order: int = Order.OPAQUE
 
     def prepare(self, frame: Frame) -> None:  # noqa: B027 - optional hook
         """Declare extra targets, upload data; called once per frame before any pass runs."""
@@ -141,7 +156,8 @@ class ObjectPass(RenderPass):
         self.phase = phase
         self.obj = obj
         for key, value in options.items():
-            if not hasattr(type(self), key):
+            if key.startswith("_") or callable(getattr(type(self), key, None)) or \
+                    not hasattr(type(self), key):
                 raise TypeError(f"{type(self).__name__} has no option '{key}'")
             setattr(self, key, value)
         self.reads = tuple(self.extra_reads)

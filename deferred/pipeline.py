@@ -7,10 +7,12 @@ passes, then the same post. Both see the scene only through the material and lig
 
 from __future__ import annotations
 
+import numpy as np
+
 from .errors import RenderError
 from .gbuffer import ALBEDO_SPECULAR, DEPTH, LINEAR_DEPTH, NORMAL_EXPONENT_ID
 from .light import LightTypePass
-from .passes import ClearPass, FullscreenPass, Phase, RenderPass
+from .passes import ClearPass, FullscreenPass, Order, Phase, RenderPass
 from .scene import Scene
 from .screen import SSAO, ssao_passes
 from .targets import COMPOSITE, FINAL, LIGHT_ACCUMULATION
@@ -26,7 +28,18 @@ def tonemap_pass() -> RenderPass:
 
 
 def object_passes(scene: Scene, phase: Phase) -> list[RenderPass]:
-    return [p for obj in scene.objects for p in obj.material.passes(phase, obj)]
+    """The objects' passes of ``phase``, by ``Order``: opaque ones in scene order, blended
+    ones (volumes, transparent surfaces) far to near, so object order never changes the image."""
+    view = scene.camera.view()
+    keyed = []
+    for index, obj in enumerate(scene.objects):
+        low, high = obj.mesh.bounds()
+        centre = obj.model @ np.append((low + high) / 2.0, 1.0)
+        distance = -(view @ centre)[2]
+        for render_pass in obj.material.passes(phase, obj):
+            blended = render_pass.order >= Order.VOLUME
+            keyed.append(((render_pass.order, -distance if blended else 0.0, index), render_pass))
+    return [render_pass for _, render_pass in sorted(keyed, key=lambda item: item[0])]
 
 
 class Pipeline:
@@ -86,9 +99,7 @@ class ForwardPipeline(Pipeline):
         passes: list[RenderPass] = [ClearPass("forward.clear", Phase.FORWARD,
                                               {COMPOSITE: (*scene.background, 0.0)},
                                               depth=DEPTH)]
-        # Opaque passes first, then blended ones (shells, glass) over them, each in scene order.
-        forward = object_passes(scene, Phase.FORWARD)
-        passes += sorted(forward, key=lambda p: getattr(p, "blend", None) is not None)
+        passes += object_passes(scene, Phase.FORWARD)
         passes.append(tonemap_pass())
         return passes
 

@@ -24,6 +24,7 @@ class Registry(Generic[T]):
         self.builtin_package = builtin_package
         self._classes: dict[str, type[T]] = {}
         self._loaded = False
+        self._next_id = 1  # ids are never reused: 0 means "none" in GPU buffers
 
     def register(self, cls: type[T]) -> type[T]:
         """Register ``cls`` under ``cls.name``; usable as a class decorator."""
@@ -34,8 +35,10 @@ class Registry(Generic[T]):
         if existing is not None and existing is not cls:
             raise ValueError(f"{self.what} '{name}' is already registered by "
                              f"{existing.__module__}.{existing.__qualname__}")
-        self._classes[name] = cls
-        cls.type_id = list(self._classes).index(name) + 1  # 0 means "none" in GPU buffers
+        if existing is None:
+            self._classes[name] = cls
+            cls.type_id = self._next_id
+            self._next_id += 1
         return cls
 
     def unregister(self, name: str) -> None:
@@ -44,12 +47,12 @@ class Registry(Generic[T]):
     def _load(self) -> None:
         if self._loaded:
             return
-        self._loaded = True
         importlib.import_module(self.builtin_package)
+        self._loaded = True
         for entry in entry_points(group=self.group):
             try:
                 cls = entry.load()
-            except Exception as exc:  # noqa: BLE001 - a broken plugin must not break the others
+            except Exception as exc:  # noqa: BLE001 - plugins fail in many ways; say which
                 raise InputError(f"cannot load {self.what} plugin '{entry.name}': {exc}",
                                  f"entry point {self.group}") from None
             self.register(cls)

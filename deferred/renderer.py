@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -66,6 +67,10 @@ class Renderer:
         for render_pass in self.passes:
             render_pass.prepare(frame)
         ctx = self.gl.ctx
+        self.gl.park()  # whatever framebuffer was bound may have been released since
+        stale = ctx.error  # reading clears it: errors below belong to our passes
+        if stale != "GL_NO_ERROR":
+            warnings.warn(f"GL error {stale} left by code outside the renderer", stacklevel=2)
         for render_pass in self.passes:
             frame.current_pass = render_pass.name
             if before_pass:

@@ -52,6 +52,11 @@ class CameraModel(_Strict):
             raise ValueError("far must be greater than near")
         if np.allclose(self.position, self.target):
             raise ValueError("position and target are the same point")
+        forward = np.subtract(self.target, self.position, dtype=float)
+        side = np.cross(forward / np.linalg.norm(forward), np.asarray(self.up, dtype=float))
+        if np.linalg.norm(side) < 1e-6:
+            raise ValueError("up is parallel to the view direction (or zero); "
+                             "choose another up vector")
         return self
 
 

@@ -64,7 +64,8 @@ class ShaderLibrary:
         """Provide generated GLSL under ``name`` (e.g. the light dispatch of the registry)."""
         if self.virtual_files.get(name) != text:
             self.virtual_files[name] = text
-            self._programs = {k: v for k, v in self._programs.items() if name not in k[-1]}
+            for key in [k for k in self._programs if name in k[-1]]:
+                self._programs.pop(key).release()
 
     def read(self, name: str) -> str:
         if name in self.virtual_files:

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
-from pydantic import Field
+from pydantic import Field, field_validator
 
 from deferred.light import Light, LightParams, view_direction
 from deferred.registry import lights
@@ -13,6 +13,13 @@ class AmbientParams(LightParams):
     color: tuple[float, float, float] = Field((0.3, 0.35, 0.45), description="sky colour")
     ground: tuple[float, float, float] = Field((0.1, 0.08, 0.06), description="ground colour")
     up: tuple[float, float, float] = Field((0.0, 1.0, 0.0), description="world up")
+
+    @field_validator("up")
+    @classmethod
+    def _nonzero(cls, value):
+        if np.linalg.norm(value) == 0.0:
+            raise ValueError("up must not be the zero vector")
+        return value
 
 
 @lights.register

@@ -1,9 +1,11 @@
 """Screen-door transparency in a deferred pipeline (Revie 2.3.4, Figure 2.14).
 
 The glass is written into the G-buffer at one pixel in two or four (``pattern``), so the pixels
-between keep the scene behind it; both are lit by the lighting phase as usual; the material
-phase deinterlaces them and blends glass over scene by ``opacity``. The forward technique is an
-ordinary alpha-blended lit pass.
+between keep the scene behind it; both are lit by the lighting phase as usual. In the material
+phase the glass's stipple samples are obliterated with the rest of the opaque scene, and later,
+with the transparent passes (far to near), each glass pixel blends its tile's glass sample by
+``opacity`` over whatever the composition buffer holds. The forward technique is an ordinary
+alpha-blended lit pass.
 """
 
 from __future__ import annotations
@@ -14,11 +16,11 @@ from pydantic import Field
 
 from deferred.gbuffer import LINEAR_DEPTH, NORMAL_EXPONENT_ID
 from deferred.material import Material, MaterialParams
-from deferred.passes import ObjectPass, Phase, RenderPass
+from deferred.passes import ObjectPass, Order, Phase, RenderPass
 from deferred.registry import materials
 from deferred.targets import COMPOSITE, LIGHT_ACCUMULATION
 
-from .techniques.stipple import StipplePass, pattern_defines
+from .techniques.stipple import StippleObliterationPass, StipplePass, pattern_defines
 
 if TYPE_CHECKING:
     from deferred.frame import Frame
@@ -34,12 +36,14 @@ class StippleGlassParams(MaterialParams):
 
 
 class DeinterlacePass(ObjectPass):
-    """Blend each glass pixel from its tile's glass sample and scene samples."""
+    """Blend each glass pixel's tile sample over the composition buffer."""
 
     fragment = "materials/stipple_glass/deinterlace.frag"
     colors = (COMPOSITE,)
     depth_func = "lequal"
     depth_write = False
+    blend = "alpha"
+    order = Order.TRANSPARENT
     extra_reads = (LIGHT_ACCUMULATION, NORMAL_EXPONENT_ID, LINEAR_DEPTH)
 
 
@@ -66,9 +70,11 @@ class StippleGlassMaterial(Material):
                             fragment="materials/stipple_glass/stipple.frag")]
 
     def material_passes(self, obj: SceneObject) -> list[RenderPass]:
-        return [DeinterlacePass(f"{obj.label}.deinterlace", Phase.MATERIAL, obj)]
+        return [StippleObliterationPass(f"{obj.label}.stipple_obliteration", Phase.MATERIAL,
+                                        obj),
+                DeinterlacePass(f"{obj.label}.deinterlace", Phase.MATERIAL, obj)]
 
     def forward_passes(self, obj: SceneObject) -> list[RenderPass]:
         return [ObjectPass(f"{obj.label}.forward", Phase.FORWARD, obj,
                            fragment="materials/stipple_glass/forward.frag", colors=(COMPOSITE,),
-                           depth_write=False, blend="alpha")]
+                           depth_write=False, blend="alpha", order=Order.TRANSPARENT)]

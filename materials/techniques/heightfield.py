@@ -40,6 +40,8 @@ def heightfield_texture(ctx: moderngl.Context, heights: np.ndarray) -> moderngl.
     heights = np.ascontiguousarray(heights[::-1], dtype=np.float32)  # GL rows bottom-up
     texture = ctx.texture((heights.shape[1], heights.shape[0]), 1, heights.tobytes(), dtype="f4")
     texture.repeat_x = texture.repeat_y = True
+    # No mipmaps on purpose: shells threshold the height, and averaged heights fall below the
+    # threshold, so minified fur would go bald instead of anti-aliased.
     texture.filter = (moderngl.LINEAR, moderngl.LINEAR)
     return texture
 

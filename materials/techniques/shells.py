@@ -10,7 +10,7 @@ from __future__ import annotations
 from typing import Any
 
 from deferred.gbuffer import DEPTH
-from deferred.passes import ObjectPass
+from deferred.passes import ObjectPass, Order
 
 
 def shell_depths(count: int) -> list[float]:
@@ -25,6 +25,7 @@ class ShellPass(ObjectPass):
     depth_func = "lequal"
     depth_write = False
     blend = "alpha"
+    order = Order.VOLUME
     count = 16
 
     def draws(self, frame) -> int:

@@ -111,3 +111,14 @@ def test_bad_meshes_are_input_errors(tmp_path):
     with pytest.raises(InputError, match="unsupported"):
         (tmp_path / "x.fbx").write_text("")
         load_mesh(str(tmp_path / "x.fbx"))
+
+
+def test_obj_with_uvs_keeps_its_vertex_colour_comb(tmp_path):
+    """The paper's asset format: UVs plus painted RGBA comb colours."""
+    lines = ["v 0 0 0 1 0.5 0.5", "v 1 0 0 1 0.5 0.5", "v 0 0 -1 1 0.5 0.5",
+             "vt 0 0", "vt 1 0", "vt 0 1", "vn 0 1 0", "f 1/1/1 2/2/1 3/3/1"]
+    (tmp_path / "painted.obj").write_text("\n".join(lines) + "\n")
+    mesh = load_mesh(str(tmp_path / "painted.obj"))
+    assert mesh.has_comb and not mesh.generated_uvs
+    # object +X is the tangent (+U) here: tangent-space (1, 0, 0) packed
+    np.testing.assert_allclose(mesh.comb[:, :3], [[1.0, 0.5, 0.5]] * 3, atol=1e-5)

@@ -45,6 +45,8 @@ def blinn_phong(points, to_light, radiance, specular, exponent, camera):
 
 
 def render_plane(gl, light, pipeline, storage, specular=0.0, exponent=16.0):
+    if storage and not gl.features.storage_buffers:
+        pytest.skip("the driver has no GL 4.3 storage buffers")
     scene = scene_from_dict({
         "size": list(SIZE), "tonemap": "none", "camera": CAMERA,
         "object": [{"mesh": "builtin:plane", "scale": 8.0,

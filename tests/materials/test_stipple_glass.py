@@ -52,3 +52,24 @@ def test_forward_glass_matches_deferred(render):
     difference = np.abs(deferred.hdr[..., :3] - forward.hdr[..., :3]).max(axis=-1)
     # identical inside; the stipple's half resolution only shows along the glass edges
     assert np.mean(difference < 1e-2) > 0.97
+
+
+def test_object_order_does_not_change_the_image(render):
+    """Material-phase composition: obliterations first, then shells and glass far to near."""
+    objects = [
+        {"name": "far_fur", "mesh": "builtin:sphere", "material": "revie_fur",
+         "position": [-0.3, 0.0, -0.6], "scale": 0.6, "params": {"shells": 8}},
+        {"name": "near_fur", "mesh": "builtin:sphere", "material": "revie_fur",
+         "position": [0.35, 0.0, 0.2], "scale": 0.5, "params": {"shells": 8, "seed": 3}},
+        {"name": "glass", "mesh": "builtin:cube", "material": "stipple_glass",
+         "position": [0.0, 0.0, 1.0], "scale": [0.6, 0.6, 0.02]},
+    ]
+    images = []
+    for order in ([0, 1, 2], [2, 1, 0], [1, 2, 0]):
+        scene = scene_from_dict({
+            "size": [160, 120], "camera": {"position": [0.0, 0.0, 3.2]},
+            "object": [objects[i] for i in order],
+            "light": [{"type": "ambient"}, {"type": "directional"}]})
+        result, _ = render(scene)
+        images.append(result.image)
+    assert np.array_equal(images[0], images[1]) and np.array_equal(images[0], images[2])

@@ -3,8 +3,7 @@
 // deferred stipple sample does, with the rim-bent normal; the brighter wins. Albedo and strand
 // fading are those of the deferred shells.
 #include "common/surface_input.glsl"
-#include "common/light_buffer.glsl"
-#include "generated/lights.glsl"
+#include "common/forward_lighting.glsl"
 #include "techniques/rim.glsl"
 #include SURFACE_FILE
 
@@ -18,12 +17,6 @@ uniform float u_rim_falloff;
 in float v_shell_depth;
 out vec4 out_color;
 
-vec3 lit(Surface s, vec3 P, vec3 V) {
-    vec3 color = vec3(0.0);
-    for (int k = 0; k < u_light_count; ++k) color += evaluate_light(fetch_light(k), s, P, V);
-    return color;
-}
-
 void main() {
     SurfaceInput i = surface_input();
     float height = texture(u_heightfield, i.uv * u_density).r;
@@ -32,11 +25,11 @@ void main() {
     Surface s = material_surface(i);
     s.occlusion = 1.0;
     vec3 V = normalize(-i.position);
-    vec3 light = lit(s, i.position, V);
+    vec3 light = forward_lighting(s, i.position, V);
 #ifdef FUR_STIPPLE
     Surface rim = s;
     rim.normal = rim_bend(i.normal, s.normal, -V, u_rim_strength, u_rim_falloff);
-    light = max(light, lit(rim, i.position, V));
+    light = max(light, forward_lighting(rim, i.position, V));
 #endif
     vec3 irradiance = light / max(s.albedo, vec3(1.0 / 255.0));
     out_color = vec4(irradiance * mix(u_albedo_base, s.albedo, v_shell_depth), alpha);

@@ -1,0 +1,43 @@
+"""Registries: entry-point plugins, unique and stable type ids, clear errors."""
+
+import pytest
+
+from deferred.errors import InputError
+from deferred.registry import Registry
+
+
+def fake_distribution(tmp_path, group, line):
+    info = tmp_path / "fake_plugin-0.1.dist-info"
+    info.mkdir()
+    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: fake-plugin\nVersion: 0.1\n")
+    (info / "entry_points.txt").write_text(f"[{group}]\n{line}\n")
+
+
+def test_entry_point_plugin_is_loaded(tmp_path, monkeypatch):
+    fake_distribution(tmp_path, "deferred.test_materials",
+                      "test_checker = plugin_material:CheckerMaterial")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    registry = Registry("material", "deferred.test_materials", "materials")
+    cls = registry.get("test_checker")
+    assert cls.__name__ == "CheckerMaterial"
+
+
+def test_broken_entry_point_is_an_input_error(tmp_path, monkeypatch):
+    fake_distribution(tmp_path, "deferred.test_broken", "oops = no_such_module:Thing")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    registry = Registry("material", "deferred.test_broken", "materials")
+    with pytest.raises(InputError, match="cannot load material plugin 'oops'"):
+        registry.get("standard")
+
+
+def test_type_ids_are_never_reused():
+    registry = Registry("material", "deferred.none", "materials")
+    classes = [type(name, (), {"name": name}) for name in ("x", "y", "z")]
+    registry.register(classes[0])
+    registry.register(classes[1])
+    registry.unregister("x")
+    registry.register(classes[2])
+    ids = {cls.name: cls.type_id for cls in classes}
+    assert len(set(ids.values())) == 3
+    with pytest.raises(InputError, match="unknown material 'x'"):
+        registry.get("x")
