@@ -87,11 +87,17 @@ class RevieFurMaterial(Material):
     surface_shader = "materials/revie_fur/surface.glsl"
 
     def check_files(self, where: str | None) -> None:
-        if self.params.heightfield is not None:
-            path = self.resolve_path(self.params.heightfield)
-            if not path.is_file():
-                raise InputError(f"heightfield image not found: {path}",
-                                 f"{where}.heightfield" if where else "heightfield")
+        if self.params.heightfield is None:
+            return
+        path = self.resolve_path(self.params.heightfield)
+        key = f"{where}.heightfield" if where else "heightfield"
+        if not path.is_file():
+            raise InputError(f"heightfield image not found: {path}", key)
+        try:
+            load_heightfield(path)  # unreadable images fail here, before any GL work
+        except InputError as exc:
+            raise InputError(f"cannot read heightfield image {path.name}: {exc.message}",
+                             key) from None
 
     def defines(self, obj: SceneObject) -> dict[str, str]:
         defines = {**super().defines(obj), **pattern_defines(4)}

@@ -256,3 +256,13 @@ def test_vertex_colour_comb_and_length_are_used(render, tmp_path):
     left, right = overhang[(0.0, 1.0)]
     assert left > 8 and right <= 1  # combed -X: off the left edge only
     assert 0 < overhang[(1.0, 0.4)][1] < overhang[(1.0, 1.0)][1]  # shorter fur, less overhang
+
+
+def test_unreadable_heightfield_is_a_clear_error(tmp_path):
+    from deferred.errors import InputError
+
+    (tmp_path / "noise.png").write_bytes(b"not a png at all")
+    with pytest.raises(InputError, match=r"object\[0\]\.params\.heightfield: cannot read"):
+        scene_from_dict({"object": [{"mesh": "builtin:sphere", "material": "revie_fur",
+                                     "params": {"heightfield": "noise.png"}}]}, name="s.toml",
+                        base_dir=tmp_path)
