@@ -53,24 +53,124 @@ def cli(debug: bool) -> None:
 @click.option("--size", help="WIDTHxHEIGHT, overrides the scene's size.")
 @click.option("--frames", type=click.IntRange(min=1), default=1, show_default=True,
               help="Render this many frames (timing); the last one is written.")
-def render(scene: str | None, output: str, pipeline: str, size: str | None, frames: int) -> None:
+@click.option("--view", "view_name", metavar="BUFFER",
+              help="Write one buffer instead of the final image: albedo, normal, depth, "
+                   "specular, material, light, composite, a target, or a pass (PASS or "
+                   "PASS:TARGET). '--view help' lists them.")
+def render(scene: str | None, output: str, pipeline: str, size: str | None, frames: int,
+           view_name: str | None) -> None:
     """Render SCENE (a TOML file; the built-in demo when omitted) to an image."""
+    from .dump import capture_frame, resolve_view, view, view_catalogue, write_view
     from .renderer import Renderer
 
+    if view_name == "help":
+        passes = PIPELINES[pipeline]().passes(_scene(scene))
+        for name, doc in view_catalogue(passes):
+            click.echo(f"{name:<36} {doc}")
+        return
     out = check_output_path(output)
     loaded = _scene(scene)
     with Renderer(loaded, pipeline, _size_option(size)) as renderer:
+        if view_name is not None:
+            view_pass, _ = resolve_view(view_name, renderer.passes)  # bad names fail here
         times = []
-        for _ in range(frames):
+        for frame in range(frames):
             start = time.perf_counter()
-            result = renderer.render()
+            if view_name is not None and frame == frames - 1:
+                capture = capture_frame(renderer, [view_pass] if view_pass else [],
+                                        warmup=False)
+            else:
+                result = renderer.render()
             renderer.gl.ctx.finish()
             times.append((time.perf_counter() - start) * 1000.0)
-    _write_result(out, result)
+    if view_name is not None:
+        write_view(out, view(capture, view_name))
+    else:
+        _write_result(out, result)
     width, height = renderer.size
     timing = f"{min(times):.1f} ms" if frames == 1 else \
         f"median {sorted(times)[len(times) // 2]:.1f} ms over {frames} frames"
-    stderr.print(f"wrote {out} ({width}x{height}, {pipeline}, {timing})")
+    shown = f", view {view_name}" if view_name is not None else ""
+    stderr.print(f"wrote {out} ({width}x{height}, {pipeline}{shown}, {timing})")
+
+
+@cli.command()
+@click.argument("scene", required=False, type=click.Path(dir_okay=False))
+@click.option("-o", "--output", metavar="DIR",
+              help="Dump folder (created if missing). With --compare: where difference images "
+                   "go (default DIR_B-diff next to DIR_B).")
+@click.option("--pipeline", type=click.Choice(sorted(PIPELINES)), default="deferred",
+              show_default=True)
+@click.option("--size", help="WIDTHxHEIGHT, overrides the scene's size.")
+@click.option("--passes", metavar="NAME,...",
+              help="Write only these passes' buffers (names or globs such as 'ball.*'); every "
+                   "pass still runs.")
+@click.option("--pixel", metavar="X,Y",
+              help="Print every pass that wrote this pixel (top-down coordinates) and what it "
+                   "wrote; recorded in the manifest too.")
+@click.option("--compare", nargs=2, type=click.Path(), metavar="DIR_A DIR_B",
+              help="Compare two dumps: per-buffer max/mean differences and difference images.")
+def dump(scene: str | None, output: str | None, pipeline: str, size: str | None,
+         passes: str | None, pixel: str | None, compare: tuple[str, str] | None) -> None:
+    """Write every buffer of every pass of one frame of SCENE as EXR, plus a contact sheet and
+    a manifest (DESIGN.md, "Dumps")."""
+    from rich.progress import Progress, SpinnerColumn, TextColumn
+
+    from .dump import dump_scene, format_history, parse_pixel, select_passes
+    from .renderer import Renderer
+
+    if compare:
+        if scene or passes or pixel or size:
+            raise InputError("compares two dump folders; give no scene, --size, --passes or "
+                             "--pixel with it", "--compare")
+        _compare(*compare, output)
+        return
+    if not output:
+        raise InputError("a dump needs an output folder", "-o")
+    out_dir = Path(output)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise InputError("exists and is not a folder", str(out_dir))
+    loaded = _scene(scene)
+    patterns = [p.strip() for p in passes.split(",") if p.strip()] if passes is not None else None
+    with Renderer(loaded, pipeline, _size_option(size)) as renderer:
+        chosen = select_passes(renderer.passes, patterns)  # bad input fails before any file
+        where = parse_pixel(pixel, renderer.size) if pixel is not None else None
+        with Progress(SpinnerColumn(), TextColumn("{task.description}"), console=stderr,
+                      transient=True) as progress:
+            task = progress.add_task("capturing")
+            manifest, history = dump_scene(
+                renderer, out_dir, patterns, where,
+                scene_file=str(Path(scene).resolve()) if scene else None,
+                progress=lambda name: progress.update(task, description=f"writing {name}"))
+    if history is not None and where is not None:
+        for line in format_history(history, *where, renderer.size):
+            click.echo(line)
+    width, height = renderer.size
+    stderr.print(f"wrote {out_dir}/ ({width}x{height}, {pipeline}, {len(chosen)} of "
+                 f"{len(manifest['passes'])} passes, frame {manifest['frame_ms']:.1f} ms)")
+
+
+def _compare(first: str, second: str, output: str | None) -> None:
+    from .dump import compare_dumps
+
+    b = Path(second)
+    out = Path(output) if output else b.parent / f"{b.name}-diff"
+    results = compare_dumps(first, second, out)
+    console = Console()
+    if not console.is_terminal:
+        console = Console(width=160)  # pipes and files: do not squeeze the table to 80 columns
+    table = Table(title=f"{first} vs {second}", title_justify="left")
+    for column in ("buffer", "channels", "max", "mean", "pixels"):
+        table.add_column(column, no_wrap=True, justify="left" if column == "buffer" else "right")
+    for r in results:
+        if r.problem:
+            table.add_row(r.buffer, "", "", "", r.problem)
+        else:
+            table.add_row(r.buffer, str(len(r.channels)), f"{r.max:.6g}", f"{r.mean:.6g}",
+                          str(r.pixels))
+    console.print(table)
+    differing = sum(1 for r in results if r.problem or r.max > 0.0)
+    stderr.print(f"{differing} of {len(results)} buffers differ; difference images in {out}/")
 
 
 def _write_result(out: Path, result) -> None:

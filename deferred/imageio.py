@@ -39,12 +39,10 @@ CHANNEL_ORDER_ATTRIBUTE = "deferred:channels"
 
 
 def write_image(path: str | Path, pixels: np.ndarray, channels: Sequence[str] | None = None,
-                attributes: dict[str, object] | None = None, half: bool = False,
-                channel_formats: Sequence[str] | None = None) -> Path:
+                attributes: dict[str, object] | None = None, half: bool = False) -> Path:
     """Write ``pixels`` (H, W, C), top row first, atomically (temporary file, then rename).
 
     uint8 data is written as 8-bit; float data as float (or half) EXR with ``channels`` names.
-    ``channel_formats`` ("half" or "float" per channel) overrides ``half`` channel by channel.
     A channel named ``Z`` becomes the image's ``z_channel``, one named ``A`` its alpha channel.
     """
     import OpenImageIO as oiio
@@ -56,9 +54,6 @@ def write_image(path: str | Path, pixels: np.ndarray, channels: Sequence[str] | 
     height, width, count = pixels.shape
     if pixels.dtype == np.uint8:
         fmt = oiio.UINT8
-    elif channel_formats is not None:
-        pixels = pixels.astype(np.float32)
-        fmt = oiio.FLOAT
     else:
         pixels = pixels.astype(np.float16 if half else np.float32)
         fmt = oiio.HALF if half else oiio.FLOAT
@@ -71,10 +66,6 @@ def write_image(path: str | Path, pixels: np.ndarray, channels: Sequence[str] | 
         spec.alpha_channel = names.index("A") if "A" in names else -1
         spec.z_channel = names.index("Z") if "Z" in names else -1
         spec.attribute(CHANNEL_ORDER_ATTRIBUTE, ",".join(names))
-    if channel_formats is not None and fmt != oiio.UINT8:
-        if len(channel_formats) != count:
-            raise ValueError(f"{len(channel_formats)} channel formats for {count} channels")
-        spec.channelformats = tuple(oiio.TypeDesc(f) for f in channel_formats)
     for key, value in (attributes or {}).items():
         spec.attribute(key, value)
 
