@@ -153,7 +153,7 @@ def dump(scene: str | None, output: str | None, pipeline: str, size: str | None,
 def _compare(first: str, second: str, output: str | None) -> None:
     from .dump import compare_dumps
 
-    b = Path(second)
+    b = Path(second).resolve()  # "." has no name to build the default from
     out = Path(output) if output else b.parent / f"{b.name}-diff"
     results = compare_dumps(first, second, out)
     console = Console()

@@ -304,10 +304,17 @@ def view_catalogue(passes: Sequence[RenderPass]) -> list[tuple[str, str]]:
 def resolve_view(name: str, passes: Sequence[RenderPass]) -> tuple[str | None, str | None]:
     """``(pass, target)`` a view name needs: (None, None) for a named view, (None, target) for
     a target's end-of-frame contents, (pass, target) for a target after a pass."""
+    written = {t for p in passes for t in p.writes}
     if name in NAMED_VIEWS:
+        needs = {"light": (LIGHT_ACCUMULATION,), "composite": (COMPOSITE,)}.get(
+            name, GBUFFER_COLOR_TARGETS)
+        missing = [t for t in needs if t not in written]
+        if missing:
+            raise InputError(f"view '{name}' shows {', '.join(missing)}, which no pass of this "
+                             "pipeline writes", "--view")
         return None, None
     by_name = {p.name: p for p in passes}
-    if name in {t for p in passes for t in p.writes}:
+    if name in written:
         return None, name
     pass_name, _, target = name.partition(":")
     render_pass = by_name.get(pass_name)
@@ -563,7 +570,7 @@ def write_dump(capture: FrameCapture, directory: str | Path,
         for future in pending:
             future.result()  # re-raise the first failure here
     for old in (directory / "passes").glob("*.exr"):
-        if f"passes/{old.name}" not in written:
+        if re.fullmatch(r"\d+_.+\.exr", old.name) and f"passes/{old.name}" not in written:
             old.unlink()
     manifest = build_manifest(capture, files, history, pixel, scene_file)
     write_text(directory / "manifest.json", json.dumps(manifest, indent=2) + "\n")
@@ -620,7 +627,8 @@ def build_manifest(capture: FrameCapture, files: dict[str, str],
         "size": list(capture.size),
         "gl": capture.gl_info,
         "frame_ms": round(capture.frame_ms, 4),
-        "timing": "wall clock around ctx.finish() per pass, after one warm-up frame",
+        "timing": "wall clock around ctx.finish() per pass; a one-pixel warm-up frame "
+                  "first compiles shaders and uploads meshes and textures",
         "orientation": "top row first",
         "gbuffer": {
             "bytes_per_pixel": bytes_per_pixel(),

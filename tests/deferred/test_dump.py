@@ -391,12 +391,16 @@ def test_cli_dump_writes_the_folder(tmp_path, capsys):
     manifest = json.loads((out / "manifest.json").read_text())
     assert manifest["scene"] == "builtin:demo.toml" and manifest["size"] == [96, 64]
     assert len(list((out / "passes").glob("*.exr"))) == len(manifest["passes"])
-    # again into the same folder, fewer passes: no stale pass file is left to mislead
+    # again into the same folder, fewer passes: no stale pass file is left to mislead, and
+    # files the dump did not make are left alone
+    (out / "passes" / "notes.exr").write_bytes(b"mine")
     code, _, err = run(capsys, "dump", "-o", out, "--size", "96x64", "--passes",
                        "lighting.*,post.tonemap")
     assert code == 0, err
-    names = sorted(p.name.split("_", 1)[1] for p in (out / "passes").iterdir())
-    assert names[-1] == "post.tonemap.exr" and all(
+    names = sorted(p.name for p in (out / "passes").iterdir())
+    assert names.pop() == "notes.exr"
+    names = [n.split("_", 1)[1] for n in names]
+    assert names[-1] == "post.tonemap.exr" and len(names) > 2 and all(
         n.startswith("lighting.") for n in names[:-1])
 
 
@@ -456,6 +460,9 @@ type = "ambient"
      "--view: pass 'ball.gbuffer' writes 4 targets; choose one of ball.gbuffer:albedo_specular"),
     (["render", "SCENE", "--view", "ball.gbuffer:light_accumulation", "-o", "v.png"],
      "--view: pass 'ball.gbuffer' does not write 'light_accumulation'"),
+    (["render", "SCENE", "--view", "albedo", "--pipeline", "forward", "-o", "v.png"],
+     "--view: view 'albedo' shows albedo_specular, normal_exponent_id, linear_depth, which no "
+     "pass of this pipeline writes"),
 ])
 def test_bad_input_exits_2_with_one_line_and_no_files(tmp_path, capsys, monkeypatch, args,
                                                       fragment):
