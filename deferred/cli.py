@@ -160,14 +160,15 @@ def _compare(first: str, second: str, output: str | None) -> None:
     if not console.is_terminal:
         console = Console(width=160)  # pipes and files: do not squeeze the table to 80 columns
     table = Table(title=f"{first} vs {second}", title_justify="left")
-    for column in ("buffer", "channels", "max", "mean", "pixels"):
-        table.add_column(column, no_wrap=True, justify="left" if column == "buffer" else "right")
+    for column in ("buffer", "channels", "max", "mean", "pixels", "note"):
+        table.add_column(column, no_wrap=True,
+                         justify="left" if column in ("buffer", "note") else "right")
     for r in results:
         if r.problem:
-            table.add_row(r.buffer, "", "", "", r.problem)
+            table.add_row(r.buffer, "", "", "", "", r.problem)
         else:
             table.add_row(r.buffer, str(len(r.channels)), f"{r.max:.6g}", f"{r.mean:.6g}",
-                          str(r.pixels))
+                          str(r.pixels), "")
     console.print(table)
     differing = sum(1 for r in results if r.problem or r.max > 0.0)
     stderr.print(f"{differing} of {len(results)} buffers differ; difference images in {out}/")
