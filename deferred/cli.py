@@ -80,7 +80,7 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
                 capture = capture_frame(renderer, [view_pass] if view_pass else [],
                                         warmup=False)
             else:
-                result = renderer.render()
+                result = renderer.render(readback=frame == frames - 1)
             renderer.gl.ctx.finish()
             times.append((time.perf_counter() - start) * 1000.0)
     if view_name is not None:

@@ -53,6 +53,15 @@ class GLContext:
 
     _parking: moderngl.Framebuffer | None = None
 
+    def make_current(self) -> None:
+        """Make this context the thread's current one.
+
+        Several standalone contexts can live in one thread (a session's plus one a CLI call
+        made and released): GL calls go to whichever is current, so each user of a context
+        makes it current before issuing work.
+        """
+        self.ctx.mglo.__enter__()
+
     def park(self) -> None:
         """Bind a framebuffer this context keeps for good.
 

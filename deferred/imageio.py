@@ -31,6 +31,8 @@ def check_output_path(path: str | Path, where: str = "-o") -> Path:
         raise InputError(f"output must end in {' or '.join(OUTPUT_SUFFIXES)}: {path}", where)
     if path.parent and not path.parent.exists():
         raise InputError(f"output folder does not exist: {path.parent}", where)
+    if path.is_dir():
+        raise InputError(f"output is a folder, not a file: {path}", where)
     return path
 
 

@@ -25,8 +25,8 @@ PassCallback = Callable[[RenderPass, Frame], None]
 
 @dataclass
 class RenderResult:
-    image: np.ndarray  # (H, W, 4) uint8, sRGB, top row first
-    hdr: np.ndarray  # (H, W, 4) float32, linear composite, top row first
+    image: np.ndarray | None  # (H, W, 4) uint8, sRGB, top row first (None: no readback)
+    hdr: np.ndarray | None  # (H, W, 4) float32, linear composite, top row first
     draw_calls: int
     draws_by_pass: dict[str, int]
 
@@ -42,8 +42,10 @@ class Renderer:
         self.scene = scene
         self.pipeline_name = pipeline
         self.size = check_size(size or scene.size, "size")
+        self.passes = PIPELINES[pipeline]().passes(scene)  # before any GL object exists
         self._owns_context = gl is None
         self.gl = gl or create_context()
+        self.gl.make_current()
         ctx = self.gl.ctx
         features = self.gl.features
         defines = {"DEFERRED_STORAGE_BUFFERS": "1"} if features.storage_buffers else {}
@@ -56,11 +58,13 @@ class Renderer:
         self.targets = FrameTargets(ctx, *self.size)
         self.resources = Resources(ctx)
         self.light_buffer = LightBuffer(ctx, features)
-        self.passes = PIPELINES[pipeline]().passes(scene)
         self.last_frame: Frame | None = None
 
     def render(self, on_pass: PassCallback | None = None,
-               before_pass: PassCallback | None = None) -> RenderResult:
+               before_pass: PassCallback | None = None, readback: bool = True) -> RenderResult:
+        """Run every pass once. ``on_pass``/``before_pass`` are called around each pass;
+        ``readback=False`` skips reading the images back (timing loops)."""
+        self.gl.make_current()
         frame = Frame(self.gl, self.shaders, self.targets, self.resources, self.scene,
                       self.light_buffer)
         self.light_buffer.upload(self.scene.lights, frame.view)
@@ -82,8 +86,8 @@ class Renderer:
             if on_pass:
                 on_pass(render_pass, frame)
         self.last_frame = frame
-        return RenderResult(self.read_final(), self.read_hdr(), frame.stats.draw_calls,
-                            dict(frame.stats.draws_by_pass))
+        image, hdr = (self.read_final(), self.read_hdr()) if readback else (None, None)
+        return RenderResult(image, hdr, frame.stats.draw_calls, dict(frame.stats.draws_by_pass))
 
     def read_final(self) -> np.ndarray:
         data = np.frombuffer(self.targets[FINAL].read(alignment=1), dtype=np.uint8)
@@ -93,6 +97,7 @@ class Renderer:
         return self.targets.read(COMPOSITE)[::-1].copy()
 
     def release(self) -> None:
+        self.gl.make_current()
         self.gl.park()
         self.light_buffer.release()
         self.resources.release()

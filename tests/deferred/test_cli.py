@@ -44,14 +44,17 @@ def test_render_forward_exr_is_linear_float(tmp_path, capsys):
     (["render", "-o", "x.jpg"], "-o: output must end in .png or .exr"),
     (["render", "--pipeline", "raytrace"], "Invalid value for '--pipeline'"),
     (["render", "--frames", "0"], "Invalid value for '--frames'"),
+    (["render", "-o", "folder.png"], "-o: output is a folder, not a file"),
 ])
 def test_bad_input_exits_2_with_one_line(tmp_path, capsys, monkeypatch, args, fragment):
     monkeypatch.chdir(tmp_path)
+    (tmp_path / "folder.png").mkdir()
     code, _, err = run(capsys, *args)
     assert code == 2
     assert fragment in err
     assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
-    assert list(tmp_path.iterdir()) == []
+    assert [p.name for p in tmp_path.iterdir()] == ["folder.png"]
+    assert list((tmp_path / "folder.png").iterdir()) == []
 
 
 def test_bad_scene_leaves_no_output(tmp_path, capsys):

@@ -182,3 +182,16 @@ def test_plugin_material_renders_in_both_pipelines(render):
         assert psnr(deferred.image[..., :3] / 255.0, forward.image[..., :3] / 255.0) >= 40.0
     finally:
         registry.materials.unregister(CheckerMaterial.name)
+
+
+def test_session_context_survives_another_context_released(gl):
+    """A CLI call inside a session makes and releases its own context; the session's renders
+    must still go to the session's context (each renderer makes its context current)."""
+    scene = standard_scene(size=(64, 48))
+    with Renderer(scene, "deferred", gl=gl) as renderer:
+        before = renderer.render().image
+        with Renderer(scene, "forward") as own:  # owns (and then releases) a second context
+            own.render()
+        assert np.array_equal(renderer.render().image, before)
+        albedo = renderer.targets.read("albedo_specular")
+        assert albedo[..., :3].max() > 0.5
