@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
-from pydantic import ValidationError
+from typing import Annotated
+
+from pydantic import AfterValidator, ValidationError
 
 
 def location(loc: tuple) -> str:
@@ -43,3 +45,13 @@ def _message(first: dict, count: int) -> str:
     if count > 1:
         message += f" (and {count - 1} more problem{'s' if count > 2 else ''})"
     return message
+
+
+def _nonzero(value: tuple[float, float, float]) -> tuple[float, float, float]:
+    if not any(value):
+        raise ValueError("must not be the zero vector")
+    return value
+
+
+# A direction: three floats, not all zero (normalised where it is used).
+NonZeroVec3 = Annotated[tuple[float, float, float], AfterValidator(_nonzero)]

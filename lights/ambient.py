@@ -3,23 +3,17 @@
 from __future__ import annotations
 
 import numpy as np
-from pydantic import Field, field_validator
+from pydantic import Field
 
 from deferred.light import Light, LightParams, view_direction
 from deferred.registry import lights
+from deferred.validation import NonZeroVec3
 
 
 class AmbientParams(LightParams):
     color: tuple[float, float, float] = Field((0.3, 0.35, 0.45), description="sky colour")
     ground: tuple[float, float, float] = Field((0.1, 0.08, 0.06), description="ground colour")
-    up: tuple[float, float, float] = Field((0.0, 1.0, 0.0), description="world up")
-
-    @field_validator("up")
-    @classmethod
-    def _nonzero(cls, value):
-        if np.linalg.norm(value) == 0.0:
-            raise ValueError("up must not be the zero vector")
-        return value
+    up: NonZeroVec3 = Field((0.0, 1.0, 0.0), description="world up")
 
 
 @lights.register

@@ -3,22 +3,15 @@
 from __future__ import annotations
 
 import numpy as np
-from pydantic import Field, field_validator
+from pydantic import Field
 
 from deferred.light import Light, LightParams, view_direction
 from deferred.registry import lights
+from deferred.validation import NonZeroVec3
 
 
 class DirectionalParams(LightParams):
-    direction: tuple[float, float, float] = Field((-0.4, -1.0, -0.6),
-                                                  description="direction the light travels")
-
-    @field_validator("direction")
-    @classmethod
-    def _nonzero(cls, value):
-        if np.linalg.norm(value) == 0.0:
-            raise ValueError("direction must not be the zero vector")
-        return value
+    direction: NonZeroVec3 = Field((-0.4, -1.0, -0.6), description="direction the light travels")
 
 
 @lights.register

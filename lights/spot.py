@@ -9,20 +9,18 @@ from pydantic import Field, model_validator
 
 from deferred.light import Light, view_direction, view_point
 from deferred.registry import lights
+from deferred.validation import NonZeroVec3
 
 from .point import PointParams
 
 
 class SpotParams(PointParams):
-    direction: tuple[float, float, float] = Field((0.0, -1.0, 0.0),
-                                                  description="axis of the cone")
+    direction: NonZeroVec3 = Field((0.0, -1.0, 0.0), description="axis of the cone")
     inner_angle: float = Field(20.0, ge=0.0, le=89.0, description="full intensity, degrees")
     outer_angle: float = Field(30.0, gt=0.0, le=90.0, description="zero beyond, degrees")
 
     @model_validator(mode="after")
     def _check(self) -> SpotParams:
-        if np.linalg.norm(self.direction) == 0.0:
-            raise ValueError("direction must not be the zero vector")
         if self.outer_angle <= self.inner_angle:
             raise ValueError("outer_angle must be greater than inner_angle")
         return self

@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import moderngl
-from pydantic import Field, field_validator
+from pydantic import Field
 
 from deferred.errors import InputError
 from deferred.gbuffer import ALBEDO_SPECULAR, LINEAR_DEPTH, NORMAL_EXPONENT_ID
@@ -24,6 +24,7 @@ from deferred.material import ForwardLitPass, GBufferPass, Material, MaterialPar
 from deferred.passes import Phase, RenderPass
 from deferred.registry import materials
 from deferred.targets import COMPOSITE, LIGHT_ACCUMULATION
+from deferred.validation import NonZeroVec3
 
 from .techniques.heightfield import heightfield_texture, load_heightfield, procedural_heightfield
 from .techniques.shells import ShellPass
@@ -53,8 +54,8 @@ class RevieFurParams(MaterialParams):
     rim_falloff: float = Field(3.0, gt=0.0, le=64.0, description="exponent of 1 - N.V")
     anisotropic: bool = Field(True, description="grain normals (highlights across the grain)")
     stipple: bool = Field(True, description="stippled outer shell (rim light, occlusion fix)")
-    comb: Vec3 = Field((0.0, -1.0, 0.0),
-                       description="object-space comb where the mesh has no vertex colours")
+    comb: NonZeroVec3 = Field((0.0, -1.0, 0.0),
+                              description="object-space comb where the mesh has no vertex colours")
     comb_strength: float = Field(0.6, ge=0.0, le=8.0, description="how far strands lean")
     heightfield: str | None = Field(None, description="strand height image (R channel)")
     strand_softness: float = Field(0.1, gt=0.0, le=1.0,
@@ -62,13 +63,6 @@ class RevieFurParams(MaterialParams):
     seed: int = Field(1, ge=0, description="seed of the procedural heightfield")
     occlusion_test: bool = Field(True, description="reject light samples the G-buffer shows "
                                                    "occluded (off: Figure 2.8's error)")
-
-    @field_validator("comb")
-    @classmethod
-    def _comb_nonzero(cls, value: Vec3) -> Vec3:
-        if sum(c * c for c in value) == 0.0:
-            raise ValueError("comb must not be the zero vector")
-        return value
 
 
 class FurShellPass(ShellPass):

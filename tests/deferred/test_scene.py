@@ -71,7 +71,7 @@ def test_builtin_demo_scene_loads():
      "s.toml: camera: Value error, up is parallel to the view direction"),
     (lambda t: t.replace('type = "point"', 'type = "ambient"\nup = [0, 0, 0]').replace(
         "radius = 10.0", "").replace("position = [2.0, 3.0, 2.0]", ""),
-     "s.toml: light[0].up: Value error, up must not be the zero vector"),
+     "s.toml: light[0].up: Value error, must not be the zero vector"),
 ])
 def test_validation_errors_name_file_key_and_problem(edit, expected):
     message = error_of(edit(GOOD))
