@@ -60,7 +60,8 @@ def cli(debug: bool) -> None:
 def render(scene: str | None, output: str, pipeline: str, size: str | None, frames: int,
            view_name: str | None) -> None:
     """Render SCENE (a TOML file; the built-in demo when omitted) to an image."""
-    from .dump import capture_frame, resolve_view, view, view_catalogue, write_view
+    from .buffer_views import resolve_view, view, view_catalogue, write_view
+    from .capture import capture_frame
     from .renderer import Renderer
 
     if view_name == "help":
@@ -116,7 +117,9 @@ def dump(scene: str | None, output: str | None, pipeline: str, size: str | None,
     a manifest (DESIGN.md, "Dumps")."""
     from rich.progress import Progress, SpinnerColumn, TextColumn
 
-    from .dump import dump_scene, format_history, parse_pixel, select_passes
+    from .capture import select_passes
+    from .dump import dump_scene
+    from .pixel_history import format_history, parse_pixel
     from .renderer import Renderer
 
     if compare:
@@ -151,7 +154,7 @@ def dump(scene: str | None, output: str | None, pipeline: str, size: str | None,
 
 
 def _compare(first: str, second: str, output: str | None) -> None:
-    from .dump import compare_dumps
+    from .dump_compare import compare_dumps
 
     b = Path(second).resolve()  # "." has no name to build the default from
     out = Path(output) if output else b.parent / f"{b.name}-diff"

@@ -8,18 +8,14 @@ import OpenImageIO as oiio
 import pytest
 
 from deferred import registry
+from deferred.buffer_views import view
+from deferred.capture import GBUFFER_CHANNELS, capture_frame
 from deferred.cli import main
-from deferred.dump import (
-    GBUFFER_CHANNELS,
-    capture_frame,
-    compare_dumps,
-    contact_tiles,
-    pixel_history,
-    view,
-    write_dump,
-)
+from deferred.dump import contact_tiles, write_dump
+from deferred.dump_compare import compare_dumps
 from deferred.gbuffer import decode
 from deferred.imageio import read_channels, read_image, write_image
+from deferred.pixel_history import pixel_history
 from deferred.renderer import Renderer
 from deferred.scene import scene_from_dict
 

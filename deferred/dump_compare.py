@@ -1,0 +1,101 @@
+"""Comparing dumps (``deferred dump --compare``): two dump folders read back, buffers matched by
+name (pass files by pass name) and channel, per-buffer max and mean absolute differences, and
+difference images.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .errors import InputError
+from .imageio import read_channels, write_image, write_text
+from .preview import heat_colors, to_uint8
+
+
+@dataclass
+class BufferDiff:
+    """Differences of one buffer between two dumps; ``problem`` says why it could not be
+    compared (missing on one side, other size or channels)."""
+
+    buffer: str
+    channels: list[str] = field(default_factory=list)
+    max: float = 0.0
+    mean: float = 0.0
+    pixels: int = 0  # pixels where any channel differs
+    per_channel_max: dict[str, float] = field(default_factory=dict)
+    problem: str | None = None
+    image: str | None = None  # difference image written, relative to the output folder
+
+    def describe(self) -> dict[str, Any]:
+        return {"buffer": self.buffer, "channels": self.channels, "max": self.max,
+                "mean": self.mean, "pixels": self.pixels, "per_channel_max": self.per_channel_max,
+                "problem": self.problem, "image": self.image}
+
+
+def dump_buffers(directory: Path) -> dict[str, Path]:
+    """Buffer key -> file of a dump folder; pass files are keyed by pass name, not number, so
+    dumps whose pass lists differ still line up."""
+    if not directory.is_dir():
+        raise InputError("not a folder", str(directory))
+    found = {p.name: p for p in sorted(directory.glob("*.exr"))}
+    for path in sorted((directory / "passes").glob("*.exr")):
+        found["passes/" + path.stem.split("_", 1)[-1]] = path
+    if not found:
+        raise InputError("no EXR buffers here: not a dump folder", str(directory))
+    return found
+
+
+def compare_dumps(first: str | Path, second: str | Path,
+                  output: str | Path | None = None) -> list[BufferDiff]:
+    """Per-buffer max/mean absolute differences of two dump folders, matched by channel name.
+
+    Buffers that differ get a difference image in ``output``: ``<buffer>.exr`` with |B - A| per
+    channel and ``<buffer>.png``, the largest channel difference scaled to the buffer's maximum
+    (turbo; black where equal). NaN equals NaN; NaN against a number counts as infinite.
+    """
+    a_files, b_files = dump_buffers(Path(first)), dump_buffers(Path(second))
+    out = Path(output) if output is not None else None
+    if out is not None:
+        out.mkdir(parents=True, exist_ok=True)
+    results = []
+    for key in list(a_files) + [k for k in b_files if k not in a_files]:
+        if key not in b_files or key not in a_files:
+            side = Path(second if key not in b_files else first)
+            results.append(BufferDiff(key, problem=f"missing in {side}"))
+            continue
+        results.append(_compare_buffer(key, a_files[key], b_files[key], out))
+    if out is not None:
+        write_text(out / "compare.json", json.dumps(
+            {"a": str(first), "b": str(second), "buffers": [r.describe() for r in results]},
+            indent=2) + "\n")
+    return results
+
+
+def _compare_buffer(key: str, path_a: Path, path_b: Path, out: Path | None) -> BufferDiff:
+    a, names_a, _ = read_channels(path_a)
+    b, names_b, _ = read_channels(path_b)
+    if a.shape[:2] != b.shape[:2]:
+        return BufferDiff(key, problem=f"size {a.shape[1]}x{a.shape[0]} vs "
+                                       f"{b.shape[1]}x{b.shape[0]}")
+    if sorted(names_a) != sorted(names_b):
+        return BufferDiff(key, names_b, problem="channels differ: "
+                          f"{' '.join(names_a)} vs {' '.join(names_b)}")
+    b = b[..., [names_b.index(n) for n in names_a]]
+    both_nan = np.isnan(a) & np.isnan(b)
+    diff = np.where(both_nan, 0.0, np.abs(b - a))
+    diff = np.where(np.isnan(diff), np.inf, diff).astype(np.float32)
+    result = BufferDiff(key, names_a, float(diff.max()), float(diff.mean()),
+                        int(np.count_nonzero(diff.max(axis=-1))),
+                        {n: float(diff[..., k].max()) for k, n in enumerate(names_a)})
+    if out is not None and result.max > 0.0:
+        stem = key.removesuffix(".exr")
+        (out / stem).parent.mkdir(parents=True, exist_ok=True)
+        write_image(out / f"{stem}.exr", diff, channels=names_a)
+        write_image(out / f"{stem}.png", to_uint8(heat_colors(diff.max(axis=-1))))
+        result.image = f"{stem}.exr"
+    return result
