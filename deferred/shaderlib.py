@@ -25,7 +25,8 @@ from .errors import ShaderError
 MAX_INCLUDE_DEPTH = 16
 
 _INCLUDE = re.compile(r'^\s*#\s*include\s+(?:"([^"]+)"|<([^>]+)>|([A-Za-z_]\w*))\s*$')
-_ERROR_LOCATION = re.compile(r"\b(\d+)(?::(\d+)\((\d+)\)|\((\d+)\))")
+# Mesa "0:57(3):", NVIDIA "0(57) :" - the location and the colon after it.
+_ERROR_LOCATION = re.compile(r"\b(\d+)(?::(\d+)\((\d+)\)|\((\d+)\))\s*:?")
 
 
 @dataclass
@@ -165,7 +166,7 @@ class ShaderLibrary:
                     file, file_line = source.locate(line)
                     if first_location is None:
                         first_location = f"{file}:{file_line}"
-                    return f"{file}:{file_line}"
+                    return f"{file}:{file_line}:"
 
                 raw = _ERROR_LOCATION.sub(replace, raw, count=1)
             lines_out.append(raw)

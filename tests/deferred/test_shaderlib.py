@@ -105,3 +105,18 @@ def test_every_packaged_shader_program_compiles(gl):
         lib.program("lights/fullscreen.vert", "lights/accumulate.frag")
         lib.program("post/fullscreen.vert", "post/tonemap.frag")
         lib.release()
+
+
+@pytest.mark.parametrize("driver_line", [
+    "0:5(12): error: `foo' undeclared",  # Mesa
+    "0(5) : error C1008: undefined variable \"foo\"",  # NVIDIA
+])
+def test_driver_error_formats_map_to_file_and_line(library, tmp_path, driver_line):
+    write(tmp_path, "inc.glsl", "// one\n// two\nfloat f() { return foo; }\n")
+    write(tmp_path, "main.frag", '#include "inc.glsl"\nvoid main() {}\n')
+    source = library.assemble("main.frag", {"A": "1"})  # version + 1 define + 2 comment lines
+    assert source.locate(5) == ("inc.glsl", 3)
+    message = f"GLSL Compiler failed\n\nfragment_shader\n===============\n{driver_line}\n"
+    mapped = ShaderLibrary._map_error(message, {"fragment_shader": source},
+                                      {"fragment_shader": "main.frag"})
+    assert mapped.startswith("inc.glsl:3: ") and "foo" in mapped
