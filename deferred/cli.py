@@ -177,6 +177,68 @@ def _compare(first: str, second: str, output: str | None) -> None:
     stderr.print(f"{differing} of {len(results)} buffers differ; difference images in {out}/")
 
 
+@cli.command()
+@click.argument("scene", required=False, type=click.Path(dir_okay=False))
+@click.option("--lights", default="1,16,64,256,1024", show_default=True, metavar="N,...",
+              help="Extra point lights added to the scene's own, one sweep point each.")
+@click.option("--shells", default="0,16,64", show_default=True, metavar="N,...",
+              help="Shell counts for every object whose material has 'shells'.")
+@click.option("--size", help="WIDTHxHEIGHT, overrides the scene's size.")
+@click.option("--runs", type=click.IntRange(min=1), default=10, show_default=True,
+              help="Timed frames per point (and as many again for the per-pass times).")
+@click.option("--warmup", type=click.IntRange(min=0), default=2, show_default=True,
+              help="Untimed frames first (shader compilation, first uploads).")
+@click.option("--pipelines", default="deferred,forward", show_default=True, metavar="NAME,...")
+@click.option("--json", "json_path", metavar="FILE.json", help="Results as JSON ('-': stdout).")
+@click.option("--csv", "csv_path", metavar="FILE.csv", help="Results as CSV.")
+@click.option("--plot", "plot_path", metavar="FILE.png", help="ms against light count.")
+def bench(scene: str | None, lights: str, shells: str, size: str | None, runs: int, warmup: int,
+          pipelines: str, json_path: str | None, csv_path: str | None,
+          plot_path: str | None) -> None:
+    """Time SCENE (the built-in demo when omitted) in each pipeline over a sweep of light and
+    shell counts (DESIGN.md, "Benchmarks")."""
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
+
+    from . import bench as benchmark
+
+    # Every option is checked before the first frame: bad input never costs a sweep.
+    sweep = benchmark.Sweep(lights=benchmark.parse_counts(lights, "--lights"),
+                            shells=benchmark.parse_counts(shells, "--shells"),
+                            pipelines=benchmark.parse_pipelines(pipelines),
+                            size=_size_option(size), runs=runs, warmup=warmup)
+    writers = {"--json": benchmark.write_json, "--csv": benchmark.write_csv,
+               "--plot": benchmark.write_plot}
+    outputs = {}
+    for where, path in (("--json", json_path), ("--csv", csv_path), ("--plot", plot_path)):
+        if path is not None and not (where == "--json" and path == "-"):
+            outputs[where] = benchmark.check_output(path, where)
+    loaded = _scene(scene)
+    shell_counts = benchmark.sweep_shells(loaded, sweep.shells)
+    if not benchmark.shell_objects(loaded):
+        stderr.print(f"{loaded.source}: no object has a 'shells' parameter; shell sweep "
+                     "skipped (shells 0)")
+    total = len(shell_counts) * len(sweep.lights) * len(sweep.pipelines)
+    with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+                  console=stderr, transient=True) as progress:
+        task = progress.add_task("benchmark", total=total)
+        started = []
+
+        def step(description: str) -> None:
+            progress.update(task, completed=len(started), description=description)
+            started.append(description)
+
+        report = benchmark.run_bench(loaded, sweep, progress=step)
+    # Not squeezed to 80 columns when stderr is a pipe or a file.
+    table_console = stderr if stderr.is_terminal else Console(stderr=True, width=160)
+    table_console.print(benchmark.results_table(report))
+    if json_path == "-":
+        click.echo(report.to_json(), nl=False)
+    for where, path in outputs.items():
+        writers[where](report, path)
+    if outputs:
+        stderr.print(f"wrote {', '.join(str(path) for path in outputs.values())}")
+
+
 def _write_result(out: Path, result) -> None:
     if out.suffix.lower() == ".exr":
         write_image(out, result.hdr, channels=("R", "G", "B", "A"))

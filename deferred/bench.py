@@ -1,0 +1,444 @@
+"""Benchmarks: the same scene through each pipeline over a sweep of light and shell counts.
+
+DESIGN.md, "Benchmarks". Every (pipeline, lights, shells) combination gets its own renderer on one
+shared GL context: ``warmup`` untimed frames, ``runs`` timed frames (wall clock around
+``render()`` plus ``ctx.finish()``; GL timer queries read nothing on llvmpipe), then ``runs``
+more frames timing each pass the same way, kept apart so the per-pass ``finish()`` calls do not
+inflate the totals.
+
+The light sweep adds ``L`` point lights to the scene's own, placed by a seeded generator inside
+the objects' world bounds where the camera sees them, each with a radius covering a fixed share
+of the view at its depth, so every light touches the screen whatever the scene's scale. The
+lights of a smaller count are the first lights of a larger one. The shell sweep sets ``shells``
+on every object whose material has that parameter (``revie_fur``).
+
+JSON: ``{"renderer": {...}, "results": [{"pipeline", "lights", "shells", "width", "height",
+"runs", "median_ms", "mean_ms", "min_ms", "max_ms", "stddev_ms", "times_ms", "passes_ms"}]}``.
+``lights`` counts the extra lights; ``renderer`` also records the G-buffer bytes per pixel, the
+CPU count and the scene. CSV: the same columns, ``times_ms`` and ``passes_ms`` as JSON text.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import os
+import statistics
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from pydantic import ValidationError
+
+from . import registry
+from .context import GLContext, create_context
+from .errors import InputError
+from .gbuffer import bytes_per_pixel
+from .imageio import write_image, write_text
+from .light import Light
+from .pipeline import PIPELINES
+from .scene import Scene, SceneObject
+
+DEFAULT_LIGHTS = (1, 16, 64, 256, 1024)
+DEFAULT_SHELLS = (0, 16, 64)
+MAX_LIGHTS = 16384  # the GL 3.3 path keeps one light per row of a texture
+LIGHT_SEED = 0
+# A light's radius is this share of the half-height of the view at its depth: on screen each
+# sphere spans about 15% of the image height, in any scene at any scale.
+LIGHT_VIEW_SHARE = 0.3
+LIGHT_INTENSITY = 2.0
+SHELLS = "shells"
+COLUMNS = ("pipeline", "lights", "shells", "width", "height", "runs", "median_ms", "mean_ms",
+           "min_ms", "max_ms", "stddev_ms", "times_ms", "passes_ms")
+OUTPUT_SUFFIXES = {"--json": ".json", "--csv": ".csv", "--plot": ".png"}
+
+
+# -- options -------------------------------------------------------------------------------------
+
+def parse_counts(text: str, where: str) -> list[int]:
+    """``"1,16,64"`` -> ``[1, 16, 64]``: non-negative integers, sorted, duplicates dropped."""
+    parts = [p.strip() for p in text.split(",")]
+    try:
+        counts = [int(p) for p in parts]
+    except ValueError:
+        raise InputError(f"expected comma-separated whole numbers such as 1,16,64, got '{text}'",
+                         where) from None
+    negative = [c for c in counts if c < 0]
+    if negative:
+        raise InputError(f"counts must be 0 or more, got {negative[0]}", where)
+    return sorted(set(counts))
+
+
+def parse_pipelines(text: str, where: str = "--pipelines") -> list[str]:
+    names = [p.strip() for p in text.split(",") if p.strip()]
+    if not names:
+        raise InputError(f"expected pipeline names such as deferred,forward, got '{text}'", where)
+    for name in names:
+        if name not in PIPELINES:
+            raise InputError(f"unknown pipeline '{name}' (choose from "
+                             f"{', '.join(PIPELINES)})", where)
+    return list(dict.fromkeys(names))
+
+
+def check_output(path: str | Path, where: str) -> Path:
+    """An output file named by ``where`` (``--json``...): right suffix, existing folder."""
+    path = Path(path)
+    suffix = OUTPUT_SUFFIXES[where]
+    if path.suffix.lower() != suffix:
+        raise InputError(f"output must end in {suffix}: {path}", where)
+    if not path.parent.is_dir():
+        raise InputError(f"output folder does not exist: {path.parent}", where)
+    if path.is_dir():
+        raise InputError(f"output is a folder, not a file: {path}", where)
+    return path
+
+
+# -- scene variants ------------------------------------------------------------------------------
+
+def world_bounds(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
+    """Axis-aligned world bounds of every object (the camera target +-1 in an empty scene)."""
+    if not scene.objects:
+        target = np.asarray(scene.camera.target, dtype=np.float64)
+        return target - 1.0, target + 1.0
+    corners = []
+    for obj in scene.objects:
+        low, high = obj.mesh.bounds()
+        box = np.array([[x, y, z, 1.0] for x in (low[0], high[0]) for y in (low[1], high[1])
+                        for z in (low[2], high[2])])
+        corners.append((box @ obj.model.T)[:, :3])
+    points = np.concatenate(corners)
+    return points.min(axis=0), points.max(axis=0)
+
+
+def extra_point_lights(scene: Scene, count: int, aspect: float,
+                       seed: int = LIGHT_SEED) -> list[Light]:
+    """``count`` point lights around and above the objects, centres on screen.
+
+    Candidates come from one seeded stream in fixed batches, so the lights of a smaller count are
+    a prefix of a larger count's. Where the camera sees too little of the bounds, the remaining
+    lights are taken off screen rather than not at all.
+    """
+    if count == 0:
+        return []
+    low, high = world_bounds(scene)
+    # "Above": a quarter of the objects' height over them (a tenth of their width when flat),
+    # not more, or lights would float clear of every surface.
+    height = max(float(high[1] - low[1]), 0.1 * float(np.max(high - low)), 1e-3)
+    high = high + np.array([0.0, 0.25 * height, 0.0])
+    camera = scene.camera
+    view = camera.view()
+    projection = camera.projection(aspect)
+    half_height = math.tan(math.radians(camera.fov) / 2.0)
+    rng = np.random.default_rng(seed)
+    accepted: list[tuple[np.ndarray, float]] = []
+    rejected: list[tuple[np.ndarray, float]] = []
+    for _ in range(64):
+        points = rng.uniform(low, high, size=(256, 3))
+        homogeneous = np.c_[points, np.ones(len(points))]
+        eye = homogeneous @ view.T
+        clip = eye @ projection.T
+        depth = -eye[:, 2]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ndc = clip[:, :2] / clip[:, 3:4]
+        visible = (depth > camera.near) & np.all(np.abs(ndc) <= 1.0, axis=1)
+        for point, distance, seen in zip(points, depth, visible, strict=True):
+            radius = LIGHT_VIEW_SHARE * half_height * max(abs(float(distance)), camera.near)
+            (accepted if seen else rejected).append((point, radius))
+        if len(accepted) >= count:
+            break
+    chosen = (accepted + rejected)[:count]
+    colors = np.random.default_rng(seed + 1).uniform(0.25, 1.0, size=(count, 3))
+    point_light = registry.lights.get("point")
+    return [point_light.from_dict({"position": tuple(float(v) for v in point),
+                                   "radius": radius,
+                                   "color": tuple(float(v) for v in color),
+                                   "intensity": LIGHT_INTENSITY})
+            for (point, radius), color in zip(chosen, colors, strict=True)]
+
+
+def with_extra_lights(scene: Scene, count: int, aspect: float, seed: int = LIGHT_SEED) -> Scene:
+    """A copy of ``scene`` with ``count`` more point lights (the scene itself is unchanged)."""
+    return replace(scene, lights=[*scene.lights, *extra_point_lights(scene, count, aspect, seed)])
+
+
+def has_shells(obj: SceneObject) -> bool:
+    return SHELLS in type(obj.material.params).model_fields
+
+
+def shell_objects(scene: Scene) -> list[SceneObject]:
+    """Objects whose material has a ``shells`` parameter."""
+    return [obj for obj in scene.objects if has_shells(obj)]
+
+
+def with_shells(scene: Scene, shells: int, where: str = "--shells") -> Scene:
+    """A copy of ``scene`` with ``shells`` on every object whose material has that parameter."""
+    objects = []
+    for obj in scene.objects:
+        if has_shells(obj):
+            material = obj.material
+            params = material.params
+            try:
+                # Validated, not model_copy(update=...): each material's range applies.
+                new_params = type(params).model_validate({**params.model_dump(), SHELLS: shells})
+            except ValidationError as exc:
+                problem = exc.errors()[0]["msg"]
+                raise InputError(f"{problem} for {obj.label} ({material.name}), got {shells}",
+                                 where) from None
+            obj = replace(obj, material=type(material)(new_params, material.base_dir))
+        objects.append(obj)
+    return replace(scene, objects=objects)
+
+
+# -- timing --------------------------------------------------------------------------------------
+
+def time_frames(renderer, runs: int, warmup: int) -> list[float]:
+    """Milliseconds of ``runs`` frames after ``warmup`` untimed ones (shaders compile there)."""
+    ctx = renderer.gl.ctx
+    for _ in range(warmup):
+        renderer.render(readback=False)
+    ctx.finish()
+    times = []
+    for _ in range(runs):
+        start = time.perf_counter()
+        renderer.render(readback=False)
+        ctx.finish()
+        times.append((time.perf_counter() - start) * 1000.0)
+    return times
+
+
+def time_passes(renderer, runs: int) -> dict[str, float]:
+    """Median milliseconds of each pass, in pass order, over ``runs`` frames.
+
+    ``finish()`` before and after every pass: llvmpipe answers no timer queries, and without the
+    fence a pass's work would be billed to whichever later pass waited for it.
+    """
+    ctx = renderer.gl.ctx
+    samples: dict[str, list[float]] = {p.name: [] for p in renderer.passes}
+    started: dict[str, float] = {}
+
+    def before(render_pass, frame) -> None:
+        ctx.finish()
+        started[render_pass.name] = time.perf_counter()
+
+    def after(render_pass, frame) -> None:
+        ctx.finish()
+        samples[render_pass.name].append((time.perf_counter() - started[render_pass.name]) * 1e3)
+
+    for _ in range(runs):
+        renderer.render(before_pass=before, on_pass=after, readback=False)
+    return {name: statistics.median(values) for name, values in samples.items()}
+
+
+# -- results -------------------------------------------------------------------------------------
+
+@dataclass
+class BenchResult:
+    """One (pipeline, lights, shells) point of a sweep; times in milliseconds."""
+
+    pipeline: str
+    lights: int
+    shells: int
+    width: int
+    height: int
+    times_ms: list[float]
+    passes_ms: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def runs(self) -> int:
+        return len(self.times_ms)
+
+    @property
+    def median_ms(self) -> float:
+        return statistics.median(self.times_ms)
+
+    @property
+    def mean_ms(self) -> float:
+        return statistics.fmean(self.times_ms)
+
+    @property
+    def min_ms(self) -> float:
+        return min(self.times_ms)
+
+    @property
+    def max_ms(self) -> float:
+        return max(self.times_ms)
+
+    @property
+    def stddev_ms(self) -> float:
+        return statistics.stdev(self.times_ms) if self.runs > 1 else 0.0
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"pipeline": self.pipeline, "lights": self.lights, "shells": self.shells,
+                "width": self.width, "height": self.height, "runs": self.runs,
+                "median_ms": self.median_ms, "mean_ms": self.mean_ms, "min_ms": self.min_ms,
+                "max_ms": self.max_ms, "stddev_ms": self.stddev_ms,
+                "times_ms": list(self.times_ms), "passes_ms": dict(self.passes_ms)}
+
+
+@dataclass
+class BenchReport:
+    renderer: dict[str, Any]
+    results: list[BenchResult]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"renderer": self.renderer, "results": [r.to_dict() for r in self.results]}
+
+    def to_json(self) -> str:
+        return json.dumps(self.to_dict(), indent=2) + "\n"
+
+    def to_csv(self) -> str:
+        out = io.StringIO()
+        writer = csv.DictWriter(out, COLUMNS, lineterminator="\n")
+        writer.writeheader()
+        for result in self.results:
+            row = result.to_dict()
+            row["times_ms"] = json.dumps(row["times_ms"])
+            row["passes_ms"] = json.dumps(row["passes_ms"])
+            writer.writerow(row)
+        return out.getvalue()
+
+
+@dataclass(frozen=True)
+class Sweep:
+    lights: Sequence[int] = DEFAULT_LIGHTS
+    shells: Sequence[int] = DEFAULT_SHELLS
+    pipelines: Sequence[str] = ("deferred", "forward")
+    size: tuple[int, int] | None = None  # None: the scene's size
+    runs: int = 10
+    warmup: int = 2
+
+
+def sweep_shells(scene: Scene, shells: Sequence[int]) -> list[int]:
+    """The shell counts a sweep really runs: one value (0) when no object has shells."""
+    return list(shells) if shell_objects(scene) else [0]
+
+
+def run_bench(scene: Scene, sweep: Sweep, gl: GLContext | None = None,
+              progress: Callable[[str], None] | None = None) -> BenchReport:
+    """Render every (pipeline, lights, shells) of ``sweep`` and time it.
+
+    Pipelines alternate innermost so that drift in the machine's speed (other load, clocks)
+    falls on both alike. ``progress(description)`` is called before each combination.
+    """
+    from .renderer import Renderer
+
+    if sweep.runs < 1:
+        raise InputError(f"runs must be 1 or more, got {sweep.runs}", "--runs")
+    if sweep.warmup < 0:
+        raise InputError(f"warmup must be 0 or more, got {sweep.warmup}", "--warmup")
+    if max(sweep.lights, default=0) + len(scene.lights) > MAX_LIGHTS:
+        raise InputError(f"at most {MAX_LIGHTS} lights in all, the scene has "
+                         f"{len(scene.lights)}", "--lights")
+    size = sweep.size or scene.size
+    aspect = size[0] / size[1]
+    shell_counts = sweep_shells(scene, sweep.shells)
+    variants = [with_shells(scene, s) if shell_objects(scene) else scene for s in shell_counts]
+    owns = gl is None
+    gl = gl or create_context()
+    results = []
+    try:
+        for shells, shelled in zip(shell_counts, variants, strict=True):
+            for lights in sweep.lights:
+                variant = with_extra_lights(shelled, lights, aspect)
+                for pipeline in sweep.pipelines:
+                    if progress:
+                        progress(f"{pipeline}, {lights} lights, {shells} shells")
+                    renderer = Renderer(variant, pipeline, size, gl=gl)
+                    try:
+                        times = time_frames(renderer, sweep.runs, sweep.warmup)
+                        passes = time_passes(renderer, sweep.runs)
+                    finally:
+                        renderer.release()
+                    results.append(BenchResult(pipeline, lights, shells, *renderer.size,
+                                               times, passes))
+        info = renderer_info(gl, scene)
+    finally:
+        if owns:
+            gl.release()
+    return BenchReport(info, results)
+
+
+def renderer_info(gl: GLContext, scene: Scene) -> dict[str, Any]:
+    """What the numbers were measured on: GL driver, features, G-buffer size, CPUs, scene."""
+    return {**gl.info, **gl.features.names(), "gbuffer_bytes_per_pixel": bytes_per_pixel(),
+            "cpus": os.cpu_count(), "scene": scene.source,
+            "scene_lights": len(scene.lights)}
+
+
+# -- outputs -------------------------------------------------------------------------------------
+
+def write_json(report: BenchReport, path: str | Path) -> Path:
+    return write_text(path, report.to_json())
+
+
+def write_csv(report: BenchReport, path: str | Path) -> Path:
+    return write_text(path, report.to_csv())
+
+
+def plot_image(report: BenchReport, title: str | None = None) -> np.ndarray:
+    """The plot as RGBA pixels: median ms (min..max shaded) against extra lights, one line per
+    pipeline, one panel per shell count."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    from matplotlib.ticker import NullLocator
+
+    shells = sorted({r.shells for r in report.results})
+    pipelines = list(dict.fromkeys(r.pipeline for r in report.results))
+    figure = Figure(figsize=(4.2 * len(shells) + 0.6, 3.8), dpi=100, layout="constrained")
+    FigureCanvasAgg(figure)  # Agg without pyplot: no global backend state, no display needed
+    axes = figure.subplots(1, len(shells), squeeze=False)[0]
+    for ax, count in zip(axes, shells, strict=True):
+        for pipeline in pipelines:
+            rows = sorted((r for r in report.results
+                           if r.shells == count and r.pipeline == pipeline),
+                          key=lambda r: r.lights)
+            x = [r.lights for r in rows]
+            line, = ax.plot(x, [r.median_ms for r in rows], marker="o", label=pipeline)
+            ax.fill_between(x, [r.min_ms for r in rows], [r.max_ms for r in rows],
+                            color=line.get_color(), alpha=0.2, linewidth=0)
+        ax.set_xscale("symlog", linthresh=1)  # light counts span decades and may include 0
+        counts = sorted({r.lights for r in report.results})
+        ax.set_xticks(counts, [str(c) for c in counts])
+        ax.xaxis.set_minor_locator(NullLocator())
+        ax.set_xlabel(f"extra point lights (+{report.renderer.get('scene_lights', 0)} "
+                      "in the scene)")
+        ax.set_ylabel("frame ms (median)")
+        ax.set_title(f"{count} shells" if len(shells) > 1 or count else "")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend()
+    if title:
+        figure.suptitle(title, fontsize=9)
+    figure.canvas.draw()
+    return np.asarray(figure.canvas.buffer_rgba()).copy()
+
+
+def write_plot(report: BenchReport, path: str | Path, title: str | None = None) -> Path:
+    return write_image(path, plot_image(report, title or plot_title(report)))
+
+
+def plot_title(report: BenchReport) -> str:
+    first = report.results[0]
+    return (f"{report.renderer.get('scene', '')}, {first.width}x{first.height}, "
+            f"{first.runs} runs, {report.renderer.get('renderer', '')}")
+
+
+def results_table(report: BenchReport):
+    """A rich table of the results (stderr in the CLI), the slowest pass of each row last."""
+    from rich.table import Table
+
+    table = Table(title=plot_title(report), title_justify="left")
+    for column in ("pipeline", "lights", "shells", "median ms", "min ms", "max ms", "stddev",
+                   "slowest pass"):
+        table.add_column(column, no_wrap=True,
+                         justify="left" if column in ("pipeline", "slowest pass") else "right")
+    for r in report.results:
+        slowest = max(r.passes_ms.items(), key=lambda item: item[1], default=None)
+        table.add_row(r.pipeline, str(r.lights), str(r.shells), f"{r.median_ms:.2f}",
+                      f"{r.min_ms:.2f}", f"{r.max_ms:.2f}", f"{r.stddev_ms:.2f}",
+                      f"{slowest[0]} {slowest[1]:.2f} ms" if slowest else "")
+    return table

@@ -1,0 +1,213 @@
+"""deferred bench: sweep structure, scene variants, outputs, bad input. Never timings."""
+
+import csv
+import itertools
+import json
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from deferred.bench import (
+    COLUMNS,
+    Sweep,
+    extra_point_lights,
+    run_bench,
+    shell_objects,
+    with_extra_lights,
+    with_shells,
+)
+from deferred.cli import main
+from deferred.errors import InputError
+from deferred.gbuffer import bytes_per_pixel
+from deferred.imageio import read_image
+from deferred.pipeline import PIPELINES
+from deferred.scene import load_scene, scene_from_dict
+
+LIGHTS_SCENE = Path(__file__).parents[2] / "benchmarks" / "lights.toml"
+FAST = ["--size", "64x36", "--runs", "2", "--warmup", "1"]
+
+
+def run(capsys, *args):
+    code = main(list(args))
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
+
+
+def standard_scene():
+    return scene_from_dict({
+        "size": [64, 36],
+        "camera": {"position": [0.0, 1.5, 3.0], "target": [0.0, 0.0, 0.0]},
+        "object": [{"mesh": "builtin:plane", "scale": 2.0},
+                   {"mesh": "builtin:sphere", "position": [0.0, 0.5, 0.0], "scale": 0.5}],
+        "light": [{"type": "ambient"}],
+    })
+
+
+def test_cli_sweep_writes_json_csv_plot(tmp_path, capsys):
+    out = {s: tmp_path / f"bench.{s}" for s in ("json", "csv", "png")}
+    code, stdout, err = run(capsys, "bench", *FAST, "--lights", "3,0", "--shells", "0,4",
+                            "--json", str(out["json"]), "--csv", str(out["csv"]),
+                            "--plot", str(out["png"]))
+    assert code == 0, err
+    assert stdout == ""  # stdout stays clean for --json -
+    assert "median ms" in err  # the table goes to stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bench.csv", "bench.json",
+                                                          "bench.png"]
+
+    report = json.loads(out["json"].read_text())
+    assert set(report) == {"renderer", "results"}
+    for key in ("vendor", "renderer", "version"):
+        assert report["renderer"][key]
+    assert report["renderer"]["gbuffer_bytes_per_pixel"] == bytes_per_pixel()
+    results = report["results"]
+    combos = Counter((r["pipeline"], r["lights"], r["shells"]) for r in results)
+    assert set(combos) == set(itertools.product(("deferred", "forward"), (0, 3), (0, 4)))
+    assert set(combos.values()) == {1}
+
+    demo = load_scene(None)
+    for r in results:
+        assert list(r) == list(COLUMNS)
+        assert (r["width"], r["height"], r["runs"]) == (64, 36, 2)
+        assert len(r["times_ms"]) == 2 and all(t > 0.0 for t in r["times_ms"])
+        assert r["min_ms"] <= r["median_ms"] <= r["max_ms"]
+        assert r["min_ms"] <= r["mean_ms"] <= r["max_ms"]
+        assert r["min_ms"] == min(r["times_ms"]) and r["max_ms"] == max(r["times_ms"])
+        assert r["stddev_ms"] >= 0.0
+        variant = with_extra_lights(with_shells(demo, r["shells"]), r["lights"], 64 / 36)
+        names = [p.name for p in PIPELINES[r["pipeline"]]().passes(variant)]
+        assert list(r["passes_ms"]) == names
+        assert all(t > 0.0 for t in r["passes_ms"].values())
+        shell_pass = "torus.shells" if r["pipeline"] == "deferred" else "torus.forward_shells"
+        assert (shell_pass in r["passes_ms"]) == (r["shells"] > 0)
+
+    with out["csv"].open(newline="") as f:
+        rows = list(csv.DictReader(f))
+    assert list(rows[0]) == list(COLUMNS)
+    assert len(rows) == len(results)
+    for row, r in zip(rows, results, strict=True):
+        assert (row["pipeline"], int(row["lights"]), int(row["shells"])) == \
+            (r["pipeline"], r["lights"], r["shells"])
+        assert float(row["median_ms"]) == r["median_ms"]
+        assert json.loads(row["times_ms"]) == r["times_ms"]
+        assert json.loads(row["passes_ms"]) == r["passes_ms"]
+
+    plot = read_image(out["png"])
+    assert plot.shape[0] > 100 and plot.shape[1] > 2 * plot.shape[0]  # one panel per shells
+    assert plot[..., :3].std() > 0.05
+
+
+def test_json_dash_goes_to_stdout(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    code, stdout, err = run(capsys, "bench", str(LIGHTS_SCENE), *FAST, "--lights", "2",
+                            "--pipelines", "forward", "--json", "-")
+    assert code == 0, err
+    report = json.loads(stdout)
+    assert [(r["pipeline"], r["lights"], r["shells"]) for r in report["results"]] == \
+        [("forward", 2, 0)]
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_scene_without_shells_sweeps_one_value(gl, capsys):
+    scene = standard_scene()
+    assert shell_objects(scene) == []
+    report = run_bench(scene, Sweep(lights=[0, 2], shells=[0, 16, 64], runs=1, warmup=0), gl=gl)
+    assert [(r.pipeline, r.lights, r.shells) for r in report.results] == [
+        ("deferred", 0, 0), ("forward", 0, 0), ("deferred", 2, 0), ("forward", 2, 0)]
+    assert all(r.runs == 1 and r.stddev_ms == 0.0 for r in report.results)
+
+    code, _, err = run(capsys, "bench", str(LIGHTS_SCENE), *FAST, "--lights", "0",
+                       "--pipelines", "deferred")
+    assert code == 0, err
+    assert "no object has a 'shells' parameter; shell sweep skipped (shells 0)" in err
+
+
+@pytest.mark.parametrize("count", [0, 1, 40])
+def test_extra_lights_are_added_to_a_copy(render, count):
+    scene = standard_scene()
+    before = list(scene.lights)
+    variant = with_extra_lights(scene, count, 64 / 36)
+    assert scene.lights == before  # the loaded scene is never changed
+    assert len(variant.lights) == len(before) + count
+    assert variant.lights[:len(before)] == before
+    assert all(light.name == "point" for light in variant.lights[len(before):])
+    _, renderer = render(variant, size=(64, 36), readback=False)
+    assert renderer.light_buffer.count == len(before) + count
+    passes = [p.name for p in renderer.passes]
+    assert ("lighting.point" in passes) == (count > 0)
+
+
+def test_extra_lights_deterministic_nested_and_on_screen():
+    scene = standard_scene()
+    aspect = 16 / 9
+    many = extra_point_lights(scene, 64, aspect)
+    again = extra_point_lights(scene, 64, aspect)
+    few = extra_point_lights(scene, 8, aspect)
+    assert [lt.params for lt in many] == [lt.params for lt in again]
+    assert [lt.params for lt in few] == [lt.params for lt in many[:8]]  # counts nest
+    assert len({lt.params.position for lt in many}) == 64
+    view = scene.camera.view()
+    projection = scene.camera.projection(aspect)
+    for light in many:
+        clip = projection @ view @ np.append(light.params.position, 1.0)
+        assert clip[3] > 0.0 and np.all(np.abs(clip[:2] / clip[3]) <= 1.0)
+        assert 0.0 < light.params.radius < 5.0
+
+
+@pytest.mark.parametrize("shells", [0, 3, 9])
+def test_shells_applied_to_fur_objects_only(render, shells):
+    demo = load_scene(None)
+    fur = {obj.label: obj.material.params.shells for obj in shell_objects(demo)}
+    assert set(fur) == {"torus", "ball"}
+    variant = with_shells(demo, shells)
+    assert {obj.label: obj.material.params.shells for obj in shell_objects(demo)} == fur
+    floor = next(obj for obj in variant.objects if obj.label == "floor")
+    assert floor.material is demo.objects[0].material  # no shells: untouched
+    for pipeline, suffix in (("deferred", "shells"), ("forward", "forward_shells")):
+        result, _ = render(variant, pipeline, size=(32, 18), readback=False)
+        for label in fur:
+            assert result.draws_by_pass.get(f"{label}.{suffix}", 0) == shells
+
+
+def test_shells_out_of_the_materials_range_is_bad_input():
+    with pytest.raises(InputError, match=r"^--shells: .*256.* for torus \(revie_fur\), got 999"):
+        with_shells(load_scene(None), 999)
+
+
+@pytest.mark.parametrize("args, fragment", [
+    (["--lights", "1,x"], "--lights: expected comma-separated whole numbers"),
+    (["--lights", ""], "--lights: expected comma-separated whole numbers"),
+    (["--lights", "4,-1"], "--lights: counts must be 0 or more, got -1"),
+    (["--lights", "20000"], "--lights: at most 16384 lights"),
+    (["--shells", "-2"], "--shells: counts must be 0 or more"),
+    (["--shells", "0,999"], "--shells: Input should be less than or equal to 256"),
+    (["--runs", "0"], "Invalid value for '--runs'"),
+    (["--warmup", "-1"], "Invalid value for '--warmup'"),
+    (["--pipelines", "deferred,raytrace"], "--pipelines: unknown pipeline 'raytrace'"),
+    (["--pipelines", ","], "--pipelines: expected pipeline names"),
+    (["--size", "0x10"], "--size: size 0x10 is impossible"),
+    (["--size", "wide"], "--size: expected WIDTHxHEIGHT"),
+    (["--json", "out.txt"], "--json: output must end in .json"),
+    (["--csv", "out.json"], "--csv: output must end in .csv"),
+    (["--plot", "out.jpg"], "--plot: output must end in .png"),
+    (["--csv", "missing/out.csv"], "--csv: output folder does not exist: missing"),
+    (["--json", "folder.json"], "--json: output is a folder, not a file"),
+    (["missing.toml"], "missing.toml: scene file not found"),
+])
+def test_bad_input_exits_2_with_one_line_and_no_files(tmp_path, capsys, monkeypatch, args,
+                                                      fragment):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "folder.json").mkdir()
+    # Outputs to prove none is written, and a tiny sweep so a check that fails to stop the
+    # command costs a second, not a default sweep.
+    others = {"--json": "r.json", "--csv": "r.csv", "--plot": "r.png", "--size": "16x9",
+              "--runs": "1", "--warmup": "0", "--lights": "0", "--shells": "0"}
+    extra = [x for key, value in others.items() if key not in args for x in (key, value)]
+    code, stdout, err = run(capsys, "bench", *args, *extra)
+    assert code == 2
+    assert fragment in err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    assert stdout == ""
+    assert [p.name for p in tmp_path.iterdir()] == ["folder.json"]
+    assert list((tmp_path / "folder.json").iterdir()) == []
