@@ -385,13 +385,14 @@ def plot_image(report: BenchReport, title: str | None = None) -> np.ndarray:
     pipeline, one panel per shell count."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
-    from matplotlib.ticker import NullLocator
+    from matplotlib.ticker import NullLocator, ScalarFormatter
 
     shells = sorted({r.shells for r in report.results})
     pipelines = list(dict.fromkeys(r.pipeline for r in report.results))
     figure = Figure(figsize=(4.2 * len(shells) + 0.6, 3.8), dpi=100, layout="constrained")
     FigureCanvasAgg(figure)  # Agg without pyplot: no global backend state, no display needed
-    axes = figure.subplots(1, len(shells), squeeze=False)[0]
+    # Shared log y: times span decades, and panels compare at a glance.
+    axes = figure.subplots(1, len(shells), squeeze=False, sharey=True)[0]
     for ax, count in zip(axes, shells, strict=True):
         for pipeline in pipelines:
             rows = sorted((r for r in report.results
@@ -407,7 +408,9 @@ def plot_image(report: BenchReport, title: str | None = None) -> np.ndarray:
         ax.xaxis.set_minor_locator(NullLocator())
         ax.set_xlabel(f"extra point lights (+{report.renderer.get('scene_lights', 0)} "
                       "in the scene)")
-        ax.set_ylabel("frame ms (median)")
+        ax.set_yscale("log")
+        ax.yaxis.set_major_formatter(ScalarFormatter())
+        ax.set_ylabel("frame ms (median, min..max shaded)")
         ax.set_title(f"{count} shells" if len(shells) > 1 or count else "")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend()

@@ -216,7 +216,7 @@ def bench(scene: str | None, lights: str, shells: str, size: str | None, runs: i
     shell_counts = benchmark.sweep_shells(loaded, sweep.shells)
     if not benchmark.shell_objects(loaded):
         stderr.print(f"{loaded.source}: no object has a 'shells' parameter; shell sweep "
-                     "skipped (shells 0)")
+                     "skipped (shells 0)", soft_wrap=True)
     total = len(shell_counts) * len(sweep.lights) * len(sweep.pipelines)
     with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
                   console=stderr, transient=True) as progress:
@@ -236,7 +236,8 @@ def bench(scene: str | None, lights: str, shells: str, size: str | None, runs: i
     for where, path in outputs.items():
         writers[where](report, path)
     if outputs:
-        stderr.print(f"wrote {', '.join(str(path) for path in outputs.values())}")
+        stderr.print(f"wrote {', '.join(str(path) for path in outputs.values())}",
+                     soft_wrap=True)
 
 
 def _write_result(out: Path, result) -> None:
