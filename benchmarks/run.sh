@@ -1,0 +1,17 @@
+#!/bin/sh
+# Re-run the sweeps whose results benchmarks/README.md reports (about four minutes on two cores).
+# Run from the repository root with the package installed (`pip install -e .`).
+set -e
+out=benchmarks/results
+
+# Lights alone: standard materials, forward vs deferred over the number of point lights.
+deferred bench benchmarks/lights.toml --size 640x360 --runs 5 \
+    --lights 0,1,2,4,8,16,64,256,1024 \
+    --json $out/lights-640x360.json --csv $out/lights-640x360.csv --plot $out/lights-640x360.png
+deferred bench benchmarks/lights.toml --size 1280x720 --runs 3 \
+    --lights 0,1,2,4,16,64,256 \
+    --json $out/lights-1280x720.json --csv $out/lights-1280x720.csv --plot $out/lights-1280x720.png
+
+# Fur shells: the built-in demo scene (Revie's fur on a torus and a sphere, 4 scene lights, SSAO).
+deferred bench --size 640x360 --runs 5 --lights 0,16,64 --shells 0,16,64 \
+    --json $out/shells-640x360.json --csv $out/shells-640x360.csv --plot $out/shells-640x360.png
