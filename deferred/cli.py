@@ -21,7 +21,7 @@ from .imageio import check_output_path, write_image
 from .pipeline import PIPELINES
 from .scene import load_scene, parse_size
 
-stderr = Console(stderr=True)
+stderr = Console(stderr=True)  # status lines never wrap on pipes
 
 
 class Options:
@@ -216,7 +216,7 @@ def bench(scene: str | None, lights: str, shells: str, size: str | None, runs: i
     shell_counts = benchmark.sweep_shells(loaded, sweep.shells)
     if not benchmark.shell_objects(loaded):
         stderr.print(f"{loaded.source}: no object has a 'shells' parameter; shell sweep "
-                     "skipped (shells 0)", soft_wrap=True)
+                     "skipped (shells 0)")
     total = len(shell_counts) * len(sweep.lights) * len(sweep.pipelines)
     with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
                   console=stderr, transient=True) as progress:
@@ -236,8 +236,7 @@ def bench(scene: str | None, lights: str, shells: str, size: str | None, runs: i
     for where, path in outputs.items():
         writers[where](report, path)
     if outputs:
-        stderr.print(f"wrote {', '.join(str(path) for path in outputs.values())}",
-                     soft_wrap=True)
+        stderr.print(f"wrote {', '.join(str(path) for path in outputs.values())}")
 
 
 def _write_result(out: Path, result) -> None:

@@ -99,7 +99,7 @@ class SceneModel(_Strict):
     light: list[LightModel] = Field(default_factory=list)
 
 
-@dataclass
+@dataclass(eq=False)  # identity: the model matrix is an array, and objects are unique anyway
 class SceneObject:
     label: str
     mesh: MeshData
