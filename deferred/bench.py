@@ -39,7 +39,7 @@ from . import registry
 from .context import GLContext, create_context
 from .errors import InputError
 from .gbuffer import bytes_per_pixel
-from .imageio import write_image, write_text
+from .imageio import check_output_path, write_image, write_text
 from .light import Light
 from .pipeline import PIPELINES
 from .scene import Scene, SceneObject
@@ -86,16 +86,8 @@ def parse_pipelines(text: str, where: str = "--pipelines") -> list[str]:
 
 
 def check_output(path: str | Path, where: str) -> Path:
-    """An output file named by ``where`` (``--json``...): right suffix, existing folder."""
-    path = Path(path)
-    suffix = OUTPUT_SUFFIXES[where]
-    if path.suffix.lower() != suffix:
-        raise InputError(f"output must end in {suffix}: {path}", where)
-    if not path.parent.is_dir():
-        raise InputError(f"output folder does not exist: {path.parent}", where)
-    if path.is_dir():
-        raise InputError(f"output is a folder, not a file: {path}", where)
-    return path
+    """An output file named by ``where`` (``--json``...) with that option's suffix."""
+    return check_output_path(path, where, (OUTPUT_SUFFIXES[where],))
 
 
 # -- scene variants ------------------------------------------------------------------------------

@@ -21,7 +21,7 @@ from .imageio import check_output_path, write_image
 from .pipeline import PIPELINES
 from .scene import load_scene, parse_size
 
-stderr = Console(stderr=True)  # status lines never wrap on pipes
+stderr = Console(stderr=True, soft_wrap=True)  # status lines never wrap on pipes
 
 
 class Options:

@@ -25,11 +25,14 @@ def srgb_decode(encoded: np.ndarray) -> np.ndarray:
     return np.where(encoded <= 0.04045, encoded / 12.92, np.power((encoded + 0.055) / 1.055, 2.4))
 
 
-def check_output_path(path: str | Path, where: str = "-o") -> Path:
+def check_output_path(path: str | Path, where: str = "-o",
+                      suffixes: tuple[str, ...] = OUTPUT_SUFFIXES) -> Path:
+    """An output file named by option ``where``: one of ``suffixes``, in an existing folder,
+    not itself a folder."""
     path = Path(path)
-    if path.suffix.lower() not in OUTPUT_SUFFIXES:
-        raise InputError(f"output must end in {' or '.join(OUTPUT_SUFFIXES)}: {path}", where)
-    if path.parent and not path.parent.exists():
+    if path.suffix.lower() not in suffixes:
+        raise InputError(f"output must end in {' or '.join(suffixes)}: {path}", where)
+    if not path.parent.is_dir():
         raise InputError(f"output folder does not exist: {path.parent}", where)
     if path.is_dir():
         raise InputError(f"output is a folder, not a file: {path}", where)
