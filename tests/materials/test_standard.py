@@ -4,6 +4,7 @@ import numpy as np
 
 from deferred.gbuffer import decode
 from deferred.imageio import write_image
+from deferred.scene import load_scene
 
 
 def test_texture_and_specular_land_in_the_gbuffer(render, tmp_path):
@@ -29,8 +30,6 @@ specular_exponent = 100.0
 [[light]]
 type = "ambient"
 """)
-    from deferred.scene import load_scene  # noqa: PLC0415
-
     _, renderer = render(load_scene(tmp_path / "scene.toml"))
     t = renderer.targets
     g = decode(t.read("albedo_specular"), t.read("normal_exponent_id"), t.read("linear_depth"))
