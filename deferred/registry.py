@@ -74,5 +74,5 @@ class Registry(Generic[T]):
         return list(self._classes.items())
 
 
-materials: Registry = Registry("material", "deferred.materials", "materials")
-lights: Registry = Registry("light", "deferred.lights", "lights")
+materials: Registry = Registry("material", "deferred.materials", "deferred.materials")
+lights: Registry = Registry("light", "deferred.lights", "deferred.lights")

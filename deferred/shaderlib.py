@@ -51,7 +51,7 @@ class ShaderLibrary:
         self.ctx = ctx
         self.glsl_version = glsl_version
         self.global_defines = dict(defines or {})
-        self.roots: list[Traversable | Path] = [resources.files("shaders")]
+        self.roots: list[Traversable | Path] = [resources.files("deferred.shaders")]
         self.virtual_files: dict[str, str] = {}
         self._programs: dict[tuple, moderngl.Program] = {}
 

@@ -17,7 +17,7 @@ def test_entry_point_plugin_is_loaded(tmp_path, monkeypatch):
     fake_distribution(tmp_path, "deferred.test_materials",
                       "test_checker = plugin_material:CheckerMaterial")
     monkeypatch.syspath_prepend(str(tmp_path))
-    registry = Registry("material", "deferred.test_materials", "materials")
+    registry = Registry("material", "deferred.test_materials", "deferred.materials")
     cls = registry.get("test_checker")
     assert cls.__name__ == "CheckerMaterial"
 
@@ -25,13 +25,13 @@ def test_entry_point_plugin_is_loaded(tmp_path, monkeypatch):
 def test_broken_entry_point_is_an_input_error(tmp_path, monkeypatch):
     fake_distribution(tmp_path, "deferred.test_broken", "oops = no_such_module:Thing")
     monkeypatch.syspath_prepend(str(tmp_path))
-    registry = Registry("material", "deferred.test_broken", "materials")
+    registry = Registry("material", "deferred.test_broken", "deferred.materials")
     with pytest.raises(InputError, match="cannot load material plugin 'oops'"):
         registry.get("standard")
 
 
 def test_type_ids_are_never_reused():
-    registry = Registry("material", "deferred.none", "materials")
+    registry = Registry("material", "deferred.none", "deferred.materials")
     classes = [type(name, (), {"name": name}) for name in ("x", "y", "z")]
     registry.register(classes[0])
     registry.register(classes[1])

@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 from deferred.context import Features, GLContext
+from deferred.lights.point import distance_falloff
+from deferred.lights.spot import cone_falloff
 from deferred.renderer import Renderer
 from deferred.scene import scene_from_dict
-from lights.point import distance_falloff
-from lights.spot import cone_falloff
 
 SIZE = (96, 72)
 CAMERA = {"position": [0.0, 4.0, 0.0], "target": [0.0, 0.0, 0.0], "up": [0.0, 0.0, -1.0],
