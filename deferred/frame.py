@@ -11,12 +11,15 @@ import numpy as np
 
 from .camera import gl_bytes
 from .context import GLContext
+from .errors import DeferredError, InputError, RenderError
 from .mesh import GpuMesh, MeshData
 from .shaderlib import ShaderLibrary
 from .targets import FrameTargets
 
 if TYPE_CHECKING:
     from .lightbuffer import LightBuffer
+    from .material import Material
+    from .passes import RenderPass
     from .scene import Scene, SceneObject
 
 # Blend modes by name: passes say what they want, not GL enums.
@@ -98,12 +101,32 @@ class FrameStats:
     draws_by_pass: dict[str, int] = field(default_factory=dict)
 
 
+@dataclass
+class MaterialInputs:
+    """A material's uniforms and textures for one frame, and which of them its programs
+    declare (strict mode checks that each is declared by at least one)."""
+
+    material: Material
+    uniforms: dict[str, Any]
+    textures: dict[str, moderngl.Texture]
+    declared: set[str] = field(default_factory=set)
+    programs: list[str] = field(default_factory=list)
+
+
 class Frame:
-    """What a pass sees while it runs: GL, shaders, targets, scene, camera and lights."""
+    """What a pass sees while it runs: GL, shaders, targets, scene, camera and lights.
+
+    In ``strict`` mode, a uniform or sampler a pass sets by name that its program does not
+    declare is an error, and so is a material uniform that none of the material's programs
+    declares: a misspelt name fails instead of being silently ignored. Uniforms every pass is
+    offered (camera, object transform, light buffer) are never errors.
+    """
 
     def __init__(self, gl: GLContext, shaders: ShaderLibrary, targets: FrameTargets,
-                 resources: Resources, scene: Scene, light_buffer: LightBuffer):
+                 resources: Resources, scene: Scene, light_buffer: LightBuffer,
+                 strict: bool = False):
         self.gl = gl
+        self.strict = strict
         self.ctx = gl.ctx
         self.shaders = shaders
         self.targets = targets
@@ -116,7 +139,28 @@ class Frame:
         self.projection = scene.camera.projection(self.width / self.height)
         self.inverse_projection = np.linalg.inv(self.projection)
         self.stats = FrameStats()
-        self.current_pass: str = ""
+        self.current_pass: RenderPass | None = None
+        self._materials: dict[int, MaterialInputs] = {}
+
+    # -- passes --------------------------------------------------------------------------------
+    def run_pass(self, render_pass: RenderPass) -> None:
+        """Clear the targets ``render_pass`` creates, run it, and name it in any failure."""
+        self.current_pass = render_pass
+        try:
+            for name in render_pass.creates:
+                self.targets.clear(name)
+            render_pass.execute(self)
+        except InputError:
+            raise
+        except DeferredError as exc:
+            if str(exc).startswith(f"pass {render_pass.name}:"):
+                raise
+            raise type(exc)(f"pass {render_pass.name}: {exc}") from exc
+        except Exception as exc:  # noqa: BLE001 - whatever a plugin's pass raises, say which
+            raise RenderError(f"pass {render_pass.name}: {type(exc).__name__}: {exc}") from exc
+        error = self.ctx.error
+        if error != "GL_NO_ERROR":
+            raise RenderError(f"pass {render_pass.name}: {error}")
 
     # -- uniforms ------------------------------------------------------------------------------
     def camera_uniforms(self) -> dict[str, Any]:
@@ -139,10 +183,41 @@ class Frame:
             **self.camera_uniforms(),
         }
 
+    def material_inputs(self, material: Material) -> MaterialInputs:
+        """``material``'s uniforms and textures, computed once per frame."""
+        inputs = self._materials.get(id(material))
+        if inputs is None:
+            inputs = MaterialInputs(material, material.uniforms(self), material.textures(self))
+            self._materials[id(material)] = inputs
+        return inputs
+
     def bind(self, program: moderngl.Program, uniforms: dict[str, Any] | None = None,
-             textures: dict[str, moderngl.Texture] | None = None) -> None:
-        """Set the uniforms ``program`` declares (others are ignored) and bind textures."""
-        for name, value in (uniforms or {}).items():
+             textures: dict[str, moderngl.Texture] | None = None, *,
+             offered: dict[str, Any] | None = None,
+             material: MaterialInputs | None = None) -> None:
+        """Set uniforms and bind textures on ``program``.
+
+        ``uniforms`` and ``textures`` are what the pass means to set: in strict mode each must
+        be declared by the program. ``offered`` values (camera, transforms) and the
+        ``material``'s are set where the program has them.
+        """
+        if self.strict:
+            declared = self.shaders.declared_uniforms(program)
+            unknown = [n for n in [*(uniforms or {}), *(textures or {})] if n not in declared]
+            if unknown:
+                raise RenderError(f"program {self.shaders.describe(program)} declares no "
+                                  f"uniform {', '.join(repr(n) for n in unknown)}")
+            if material is not None:
+                material.declared |= declared
+                material.programs.append(self.shaders.describe(program))
+        values = {**(offered or {})}
+        samplers: dict[str, moderngl.Texture] = {}
+        if material is not None:
+            values.update(material.uniforms)
+            samplers.update(material.textures)
+        values.update(uniforms or {})
+        samplers.update(textures or {})
+        for name, value in values.items():
             if name not in program:
                 continue
             member = program[name]
@@ -153,7 +228,7 @@ class Frame:
             else:
                 member.value = value
         unit = 0
-        for name, texture in (textures or {}).items():
+        for name, texture in samplers.items():
             if name not in program:
                 continue
             texture.use(location=unit)
@@ -161,15 +236,44 @@ class Frame:
             unit += 1
         self.light_buffer.bind(program, unit)
 
+    def check_material_uniforms(self) -> None:
+        """Strict mode, at the end of a frame: every uniform a material sets is declared by at
+        least one of its programs."""
+        for inputs in self._materials.values():
+            if not inputs.programs:
+                continue
+            # Passes switched off by a parameter (no shells) leave their uniforms unused in
+            # this frame: the material's shader folder still has to declare them.
+            declared = inputs.declared | self.shaders.declared_in_folder(
+                inputs.material.shader_folder())
+            unused = [n for n in [*inputs.uniforms, *inputs.textures] if n not in declared]
+            if unused:
+                raise RenderError(
+                    f"material {inputs.material.name}: no program of it declares uniform "
+                    f"{', '.join(repr(n) for n in unused)} (programs: "
+                    f"{', '.join(dict.fromkeys(inputs.programs))})")
+
+    def target(self, name: str) -> moderngl.Texture:
+        """The texture of target ``name``, which the running pass must declare."""
+        render_pass = self.current_pass
+        if render_pass is not None and name not in render_pass.reads and \
+                name not in render_pass.writes and name not in render_pass.creates:
+            raise RenderError(f"target '{name}' is used but not declared in the pass's reads, "
+                              "writes or creates")
+        if name not in self.targets:
+            raise RenderError(f"target '{name}' does not exist (targets: "
+                              f"{', '.join(self.targets.specs)})")
+        return self.targets[name]
+
     def target_samplers(self, names) -> dict[str, moderngl.Texture]:
         """Targets by the sampler names shaders use for them: ``u_<target name>``."""
-        return {f"u_{name}": self.targets[name] for name in names}
+        return {f"u_{name}": self.target(name) for name in names}
 
     # -- drawing -------------------------------------------------------------------------------
     def _count(self) -> None:
         self.stats.draw_calls += 1
-        self.stats.draws_by_pass[self.current_pass] = \
-            self.stats.draws_by_pass.get(self.current_pass, 0) + 1
+        name = self.current_pass.name if self.current_pass is not None else ""
+        self.stats.draws_by_pass[name] = self.stats.draws_by_pass.get(name, 0) + 1
 
     def draw_mesh(self, mesh: MeshData, program: moderngl.Program, instances: int = 1) -> None:
         self.resources.gpu_mesh(mesh).render(program, instances=instances)
@@ -182,10 +286,12 @@ class Frame:
 
     def use_framebuffer(self, colors: tuple[str, ...] | list[str], depth: str | None = None,
                         depth_write: bool = True) -> moderngl.Framebuffer:
+        for name in (*colors, *((depth,) if depth else ())):
+            self.target(name)  # declared by the pass, and existing
         fbo = self.targets.framebuffer(colors, depth)
         fbo.use()
         fbo.depth_mask = depth_write
-        self.ctx.viewport = (0, 0, self.width, self.height)
+        self.ctx.viewport = (0, 0, *fbo.size)
         return fbo
 
     def set_state(self, depth_test: bool = False, depth_func: str = "less",

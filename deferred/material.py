@@ -84,6 +84,11 @@ class Material:
         return path
 
     # -- shader inputs -----------------------------------------------------------------------
+    @classmethod
+    def shader_folder(cls) -> str:
+        """The folder of the material's own GLSL (that of ``surface_shader``)."""
+        return cls.surface_shader.rpartition("/")[0]
+
     def defines(self, obj: SceneObject) -> dict[str, str]:
         """Preprocessor defines of this material's programs for ``obj``."""
         return {"SURFACE_FILE": f'"{self.surface_shader}"'}

@@ -1,18 +1,22 @@
 """Passes: the pipeline is an ordered list of these (Revie section 2.1, Figure 2.3).
 
-Each pass has a unique name, the phase it belongs to, and the targets it reads and writes; dumps
-capture a pass's ``writes`` after it runs and benchmarks time it. Passes set all the GL state they
-need (``Frame.set_state``), so their order is the only coupling between them.
+Each pass has a unique name, the phase it belongs to, and the targets it creates (with their
+format and clear value), reads and writes; :mod:`deferred.graph` checks these declarations before
+any GL work, dumps capture a pass's ``writes`` after it runs and benchmarks time it. Passes set all
+the GL state they need (``Frame.set_state``), so their order is the only coupling between them.
 """
 
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from enum import Enum
+from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
 import moderngl
+
+from .targets_spec import TargetSpec
 
 if TYPE_CHECKING:
     from .frame import Frame
@@ -35,17 +39,22 @@ PHASE_ORDER = (Phase.GEOMETRY, Phase.SCREEN, Phase.STIPPLE, Phase.LIGHTING, Phas
 
 
 class Order:
-    """Where an object's pass runs within its phase (the pipeline sorts by it).
+    """Where a pass runs within its phase (the pipeline sorts by it).
 
-    In the material phase, every object first restores the opaque scene (stipple obliteration),
-    then volumes (fur shells) and transparent surfaces are composited over it, far to near, so
-    the image does not depend on the order of objects in the scene. The forward phase uses the
-    same ranks: opaque lit passes, then blended ones.
+    In the material phase, materials first alter their own opaque pixels of the composition
+    buffer, then the opaque scene is restored where stipple samples lie (obliteration copies
+    from what the composition holds by then), then volumes (fur shells) and transparent surfaces
+    are composited over it, far to near, so the image does not depend on the order of objects in
+    the scene. The forward phase uses the same ranks: opaque lit passes, then blended ones. Post
+    passes use them too: tone mapping first (``OPAQUE``), then effects over the final image.
     """
 
-    OPAQUE = 0  # also: erasing stipple samples, which restores the opaque scene
+    FIRST = -10  # scene-wide passes that must precede every object's (snapshots, setup)
+    OPAQUE = 0  # an object's own opaque pixels
+    RESTORE = 5  # erasing stipple samples, which restores the opaque scene
     VOLUME = 10  # blended, depth-tested without depth writes: sorted far to near
     TRANSPARENT = 20  # blended surfaces over everything above: sorted far to near
+    LAST = 30  # scene-wide passes over the finished phase (outlines, anti-aliasing)
 
 
 class RenderPass(ABC):
@@ -53,12 +62,13 @@ class RenderPass(ABC):
 
     name: str
     phase: Phase
+    creates: Mapping[str, TargetSpec] = MappingProxyType({})
     reads: tuple[str, ...] = ()
     writes: tuple[str, ...] = ()
     order: int = Order.OPAQUE
 
     def prepare(self, frame: Frame) -> None:  # noqa: B027 - optional hook
-        """Declare extra targets, upload data; called once per frame before any pass runs."""
+        """Upload per-frame data; called once per frame before any pass runs."""
 
     @abstractmethod
     def execute(self, frame: Frame) -> None:
@@ -66,28 +76,28 @@ class RenderPass(ABC):
 
     def describe(self) -> dict[str, Any]:
         return {"name": self.name, "phase": self.phase.value, "reads": list(self.reads),
-                "writes": list(self.writes)}
+                "writes": list(self.writes),
+                "creates": {name: spec.format_name for name, spec in self.creates.items()}}
 
     def __repr__(self) -> str:
         return f"<{type(self).__name__} {self.name} ({self.phase.value})>"
 
 
 class ClearPass(RenderPass):
-    """Clear colour targets to given values and optionally the depth target to 1."""
+    """Create targets and nothing else: the renderer clears each to its declared value when this
+    pass runs (the G-buffer's ``gbuffer.clear``)."""
 
-    def __init__(self, name: str, phase: Phase, colors: dict[str, tuple[float, ...]],
-                 depth: str | None = None):
+    def __init__(self, name: str, phase: Phase, creates: dict[str, TargetSpec]):
+        missing = [target for target, spec in creates.items() if spec.clear is None]
+        if missing:
+            raise ValueError(f"{name}: targets without a clear value: {', '.join(missing)}")
         self.name = name
         self.phase = phase
-        self.colors = colors
-        self.depth = depth
-        self.writes = tuple(colors) + ((depth,) if depth else ())
+        self.creates = dict(creates)
+        self.writes = tuple(creates)
 
     def execute(self, frame: Frame) -> None:
-        for target, value in self.colors.items():
-            frame.use_framebuffer([target]).clear(*value)
-        if self.depth:
-            frame.use_framebuffer([], self.depth).clear(depth=1.0)
+        pass  # the clears of ``creates`` are all there is
 
 
 class FullscreenPass(RenderPass):
@@ -99,8 +109,11 @@ class FullscreenPass(RenderPass):
                  uniforms: Callable[[Frame], dict[str, Any]] | None = None,
                  depth: str | None = None, depth_test: bool = False, depth_func: str = "less",
                  depth_write: bool = False, instances: Callable[[Frame], int] | None = None,
-                 vertex: str = "post/fullscreen.vert"):
+                 vertex: str = "post/fullscreen.vert", creates: dict[str, TargetSpec] | None = None,
+                 order: int = Order.OPAQUE):
         self.name = name
+        self.creates = dict(creates or {})
+        self.order = order
         self.phase = phase
         self.fragment = fragment
         self.vertex = vertex
@@ -114,17 +127,18 @@ class FullscreenPass(RenderPass):
         self.depth_func = depth_func
         self.depth_write = depth_write
         self.instances = instances
-        self.reads = tuple(dict.fromkeys(inputs.values()))
+        self.reads = tuple(dict.fromkeys(
+            [*inputs.values(), *(outputs if blend else ()),
+             *((depth,) if depth and (depth_test or not depth_write) else ())]))
         self.writes = outputs + ((depth,) if depth and depth_write else ())
 
     def execute(self, frame: Frame) -> None:
         program = frame.shaders.program(self.vertex, self.fragment, defines=self.defines)
         frame.use_framebuffer(self.outputs, self.depth, depth_write=self.depth_write)
         frame.set_state(depth_test=self.depth_test, depth_func=self.depth_func, blend=self.blend)
-        uniforms = frame.camera_uniforms()
-        if self.uniforms:
-            uniforms.update(self.uniforms(frame))
-        frame.bind(program, uniforms, {u: frame.targets[t] for u, t in self.inputs.items()})
+        frame.bind(program, self.uniforms(frame) if self.uniforms else {},
+                   {u: frame.target(t) for u, t in self.inputs.items()},
+                   offered=frame.camera_uniforms())
         count = self.instances(frame) if self.instances else 1
         if count > 0:
             frame.draw_fullscreen(program, instances=count)
@@ -160,7 +174,10 @@ class ObjectPass(RenderPass):
                     not hasattr(type(self), key):
                 raise TypeError(f"{type(self).__name__} has no option '{key}'")
             setattr(self, key, value)
-        self.reads = tuple(self.extra_reads)
+        self.reads = tuple(dict.fromkeys(
+            [*self.extra_reads, *(self.colors if self.blend else ()),
+             *((self.depth,) if self.depth and (self.depth_test or not self.depth_write)
+               else ())]))
         self.writes = tuple(self.colors) + ((self.depth,) if self.depth and self.depth_write
                                             else ())
 
@@ -189,12 +206,12 @@ class ObjectPass(RenderPass):
         frame.use_framebuffer(self.colors, self.depth, depth_write=self.depth_write)
         frame.set_state(depth_test=self.depth_test, depth_func=self.depth_func, cull=self.cull,
                         blend=self.blend)
-        material = self.obj.material
-        uniforms = {**frame.object_uniforms(self.obj), **material.uniforms(frame),
-                    **(self.constants or {}), **self.uniforms(frame)}
-        textures = {**material.textures(frame), **self.textures(frame)}
+        material = frame.material_inputs(self.obj.material)
+        uniforms = {**(self.constants or {}), **self.uniforms(frame)}
+        textures = self.textures(frame)
+        offered = frame.object_uniforms(self.obj)
         count = self.draws(frame)
         for index in range(count):
             frame.bind(program, {**uniforms, **self.draw_uniforms(frame, index, count)},
-                       textures)
+                       textures, offered=offered, material=material)
             frame.draw_mesh(self.obj.mesh, program)

@@ -7,15 +7,24 @@ passes, then the same post. Both see the scene only through the material and lig
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
-from .errors import RenderError
-from .gbuffer import ALBEDO_SPECULAR, DEPTH, LINEAR_DEPTH, NORMAL_EXPONENT_ID
+from .gbuffer import DEPTH, GBUFFER_TARGETS, NORMAL_EXPONENT_ID
+from .graph import compile_graph
 from .light import LightTypePass
 from .passes import ClearPass, FullscreenPass, Order, Phase, RenderPass
 from .scene import Scene
 from .screen import SSAO, ssao_passes
-from .targets import COMPOSITE, FINAL, LIGHT_ACCUMULATION
+from .targets import (
+    COMPOSITE,
+    COMPOSITE_SPEC,
+    FINAL,
+    FINAL_SPEC,
+    LIGHT_ACCUMULATION,
+    LIGHT_ACCUMULATION_SPEC,
+)
 
 TONEMAPS = {"none": 0, "reinhard": 1, "aces": 2}
 
@@ -23,7 +32,7 @@ TONEMAPS = {"none": 0, "reinhard": 1, "aces": 2}
 def tonemap_pass() -> RenderPass:
     return FullscreenPass(
         "post.tonemap", Phase.POST, "post/tonemap.frag", {"u_source": COMPOSITE}, (FINAL,),
-        uniforms=lambda frame: {"u_exposure": frame.scene.exposure,
+        creates={FINAL: FINAL_SPEC}, uniforms=lambda frame: {"u_exposure": frame.scene.exposure,
                                 "u_tonemap": TONEMAPS[frame.scene.tonemap]})
 
 
@@ -49,13 +58,8 @@ class Pipeline:
         raise NotImplementedError
 
     def passes(self, scene: Scene) -> list[RenderPass]:
-        passes = self.build(scene)
-        seen: set[str] = set()
-        for render_pass in passes:
-            if render_pass.name in seen:
-                raise RenderError(f"two passes are named '{render_pass.name}'")
-            seen.add(render_pass.name)
-        return passes
+        """The pass list for ``scene``, checked (:func:`deferred.graph.compile_graph`)."""
+        return compile_graph(self.build(scene)).passes
 
 
 class DeferredPipeline(Pipeline):
@@ -64,10 +68,7 @@ class DeferredPipeline(Pipeline):
     def build(self, scene: Scene) -> list[RenderPass]:
         from . import registry
 
-        passes: list[RenderPass] = [ClearPass(
-            "gbuffer.clear", Phase.GEOMETRY,
-            {ALBEDO_SPECULAR: (0.0,) * 4, NORMAL_EXPONENT_ID: (0.0,) * 4, LINEAR_DEPTH: (0.0,)},
-            depth=DEPTH)]
+        passes: list[RenderPass] = [ClearPass("gbuffer.clear", Phase.GEOMETRY, GBUFFER_TARGETS)]
         passes += object_passes(scene, Phase.GEOMETRY)
         passes += screen_passes(scene)
         passes += object_passes(scene, Phase.SCREEN)
@@ -75,13 +76,15 @@ class DeferredPipeline(Pipeline):
         passes.append(FullscreenPass(
             "lighting.background", Phase.LIGHTING, "lights/background.frag",
             {"u_normal_exponent_id": NORMAL_EXPONENT_ID}, (LIGHT_ACCUMULATION,),
+            creates={LIGHT_ACCUMULATION: LIGHT_ACCUMULATION_SPEC},
             uniforms=lambda frame: {"u_background": frame.scene.background}))
         present = {type(light) for light in scene.lights}
         occlusion = SSAO if scene.ssao else None
         passes += [LightTypePass(cls, occlusion) for _, cls in registry.lights.items()
                    if cls in present]
         passes.append(FullscreenPass("material.composite_copy", Phase.MATERIAL, "post/copy.frag",
-                                     {"u_source": LIGHT_ACCUMULATION}, (COMPOSITE,)))
+                                     {"u_source": LIGHT_ACCUMULATION}, (COMPOSITE,),
+                                     creates={COMPOSITE: COMPOSITE_SPEC}))
         passes += object_passes(scene, Phase.MATERIAL)
         passes.append(tonemap_pass())
         return passes
@@ -96,9 +99,9 @@ class ForwardPipeline(Pipeline):
     name = "forward"
 
     def build(self, scene: Scene) -> list[RenderPass]:
-        passes: list[RenderPass] = [ClearPass("forward.clear", Phase.FORWARD,
-                                              {COMPOSITE: (*scene.background, 0.0)},
-                                              depth=DEPTH)]
+        passes: list[RenderPass] = [ClearPass("forward.clear", Phase.FORWARD, {
+            COMPOSITE: replace(COMPOSITE_SPEC, clear=(*scene.background, 0.0)),
+            DEPTH: GBUFFER_TARGETS[DEPTH]})]
         passes += object_passes(scene, Phase.FORWARD)
         passes.append(tonemap_pass())
         return passes

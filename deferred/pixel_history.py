@@ -88,7 +88,7 @@ def pixel_history(renderer: Renderer, x: int, y: int) -> list[PixelEvent]:
         targets.scissor = (gx, gy, 1, 1)
         try:
             with query:
-                render_pass.execute(frame)
+                frame.run_pass(render_pass)
         finally:
             targets.scissor = None
         fragments = None if isinstance(render_pass, ClearPass) else int(query.samples)

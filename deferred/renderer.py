@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -10,8 +11,9 @@ import numpy as np
 
 from . import registry
 from .context import GLContext, create_context
-from .errors import InputError, RenderError
+from .errors import InputError
 from .frame import Frame, Resources
+from .graph import PassGraph, PassGraphError, compile_graph
 from .light import DISPATCH_FILE, light_dispatch_glsl
 from .lightbuffer import LightBuffer
 from .passes import RenderPass
@@ -31,18 +33,30 @@ class RenderResult:
     draws_by_pass: dict[str, int]
 
 
+def strict_default() -> bool:
+    """Strict mode unless asked otherwise: ``DEFERRED_STRICT=1`` (the tests set it)."""
+    return os.environ.get("DEFERRED_STRICT", "") in ("1", "true", "yes")
+
+
 class Renderer:
-    """Renders one scene with one pipeline; reuse it for many frames, then ``release()``."""
+    """Renders one scene with one pipeline; reuse it for many frames, then ``release()``.
+
+    ``strict`` turns a uniform set by name that a program does not declare into an error
+    (default: the ``DEFERRED_STRICT`` environment variable).
+    """
 
     def __init__(self, scene: Scene, pipeline: str = "deferred",
-                 size: tuple[int, int] | None = None, gl: GLContext | None = None):
+                 size: tuple[int, int] | None = None, gl: GLContext | None = None,
+                 strict: bool | None = None):
         if pipeline not in PIPELINES:
             raise InputError(f"unknown pipeline '{pipeline}' (choose from "
                              f"{', '.join(PIPELINES)})", "--pipeline")
         self.scene = scene
         self.pipeline_name = pipeline
+        self.strict = strict_default() if strict is None else strict
         self.size = check_size(size or scene.size, "size")
-        self.passes = PIPELINES[pipeline]().passes(scene)  # before any GL object exists
+        # The pass graph is built and checked before any GL object exists.
+        self.graph: PassGraph = compile_graph(PIPELINES[pipeline]().build(scene))
         self._owns_context = gl is None
         self.gl = gl or create_context()
         self.gl.make_current()
@@ -56,9 +70,36 @@ class Renderer:
                 self.shaders.add_root(cls.shader_root)
         self.shaders.set_virtual_file(DISPATCH_FILE, light_dispatch_glsl(light_types))
         self.targets = FrameTargets(ctx, *self.size)
+        self._declare_targets()
         self.resources = Resources(ctx)
         self.light_buffer = LightBuffer(ctx, features)
         self.last_frame: Frame | None = None
+
+    @property
+    def passes(self) -> list[RenderPass]:
+        return self.graph.passes
+
+    def _declare_targets(self) -> None:
+        for name, spec in self.graph.targets.items():
+            self.targets.declare(name, spec)
+
+    def insert_pass(self, render_pass: RenderPass, *, before: str | None = None,
+                    after: str | None = None) -> None:
+        """Insert ``render_pass`` before or after the pass named so; the graph is checked again
+        (and left as it was if the new pass does not fit) and new targets are created."""
+        if (before is None) == (after is None):
+            raise TypeError("insert_pass needs exactly one of before= or after=")
+        index = self.graph.index(before if before is not None else after)
+        passes = list(self.graph.passes)
+        passes.insert(index if before is not None else index + 1, render_pass)
+        graph = compile_graph(passes)
+        for name, spec in graph.targets.items():
+            if name in self.targets and not self.targets.specs[name].same_format(spec):
+                raise PassGraphError(f"pass {render_pass.name}: target '{name}' exists with "
+                                     "another format")
+        self.graph = graph
+        self.gl.make_current()
+        self._declare_targets()
 
     def render(self, on_pass: PassCallback | None = None,
                before_pass: PassCallback | None = None, readback: bool = True) -> RenderResult:
@@ -66,7 +107,7 @@ class Renderer:
         ``readback=False`` skips reading the images back (timing loops)."""
         self.gl.make_current()
         frame = Frame(self.gl, self.shaders, self.targets, self.resources, self.scene,
-                      self.light_buffer)
+                      self.light_buffer, strict=self.strict)
         self.light_buffer.upload(self.scene.lights, frame.view)
         for render_pass in self.passes:
             render_pass.prepare(frame)
@@ -76,15 +117,14 @@ class Renderer:
         if stale != "GL_NO_ERROR":
             warnings.warn(f"GL error {stale} left by code outside the renderer", stacklevel=2)
         for render_pass in self.passes:
-            frame.current_pass = render_pass.name
             if before_pass:
                 before_pass(render_pass, frame)
-            render_pass.execute(frame)
-            error = ctx.error
-            if error != "GL_NO_ERROR":
-                raise RenderError(f"pass {render_pass.name}: {error}")
+            frame.run_pass(render_pass)
             if on_pass:
                 on_pass(render_pass, frame)
+        frame.current_pass = None
+        if self.strict:
+            frame.check_material_uniforms()
         self.last_frame = frame
         image, hdr = (self.read_final(), self.read_hdr()) if readback else (None, None)
         return RenderResult(image, hdr, frame.stats.draw_calls, dict(frame.stats.draws_by_pass))

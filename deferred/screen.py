@@ -24,21 +24,15 @@ class SSAOSettings:
     samples: int = 16
 
 
-class _SSAOTargetPass(FullscreenPass):
-    def prepare(self, frame) -> None:
-        for name in self.outputs:
-            frame.targets.declare(name, SSAO_SPEC)
-
-
 def ssao_passes(settings: SSAOSettings) -> list[RenderPass]:
     """Raw hemisphere SSAO, then a depth-aware blur into the ``ssao`` target."""
     uniforms = {"u_radius": settings.radius, "u_strength": settings.strength,
                 "u_samples": settings.samples}
     return [
-        _SSAOTargetPass("screen.ssao", Phase.SCREEN, "screen/ssao.frag",
-                        {"u_linear_depth": LINEAR_DEPTH,
-                         "u_normal_exponent_id": NORMAL_EXPONENT_ID},
-                        (SSAO_RAW,), uniforms=lambda frame: uniforms),
-        _SSAOTargetPass("screen.ssao_blur", Phase.SCREEN, "screen/ssao_blur.frag",
-                        {"u_ssao_raw": SSAO_RAW, "u_linear_depth": LINEAR_DEPTH}, (SSAO,)),
+        FullscreenPass("screen.ssao", Phase.SCREEN, "screen/ssao.frag",
+                       {"u_linear_depth": LINEAR_DEPTH, "u_normal_exponent_id": NORMAL_EXPONENT_ID},
+                       (SSAO_RAW,), creates={SSAO_RAW: SSAO_SPEC}, uniforms=lambda frame: uniforms),
+        FullscreenPass("screen.ssao_blur", Phase.SCREEN, "screen/ssao_blur.frag",
+                       {"u_ssao_raw": SSAO_RAW, "u_linear_depth": LINEAR_DEPTH}, (SSAO,),
+                       creates={SSAO: SSAO_SPEC}),
     ]

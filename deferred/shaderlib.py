@@ -24,6 +24,9 @@ from .errors import ShaderError
 
 MAX_INCLUDE_DEPTH = 16
 
+# Uniform declarations of assembled GLSL (strict mode checks names against them; blocks excluded).
+_UNIFORM = re.compile(r"^\s*(?:layout\s*\([^)]*\)\s*)?uniform\s+(?:(?:lowp|mediump|highp)\s+)?"
+                      r"\w+\s+([^;{]+);", re.MULTILINE)
 _INCLUDE = re.compile(r'^\s*#\s*include\s+(?:"([^"]+)"|<([^>]+)>|([A-Za-z_]\w*))\s*$')
 # Mesa "0:57(3):", NVIDIA "0(57) :" - the location and the colon after it.
 _ERROR_LOCATION = re.compile(r"\b(\d+)(?::(\d+)\((\d+)\)|\((\d+)\))\s*:?")
@@ -54,6 +57,8 @@ class ShaderLibrary:
         self.roots: list[Traversable | Path] = [resources.files("deferred.shaders")]
         self.virtual_files: dict[str, str] = {}
         self._programs: dict[tuple, moderngl.Program] = {}
+        self._declared: dict[int, frozenset[str]] = {}  # program glo -> declared uniform names
+        self._labels: dict[int, str] = {}  # program glo -> its files, for messages
 
     # -- files -------------------------------------------------------------------------------
     def add_root(self, root: Traversable | Path) -> None:
@@ -134,7 +139,40 @@ class ShaderLibrary:
         except moderngl.Error as exc:
             raise ShaderError(self._map_error(str(exc), sources, stages)) from None
         self._programs[key] = program
+        self._declared[program.glo] = frozenset(
+            name for source in sources.values() for name in declared_uniforms(source.text))
+        self._labels[program.glo] = " + ".join(n for n in stages.values() if n is not None)
         return program
+
+    def declared_uniforms(self, program: moderngl.Program) -> frozenset[str]:
+        """Names of the uniforms (and samplers) the program's sources declare, used or not."""
+        return self._declared.get(program.glo, frozenset())
+
+    def declared_in_folder(self, folder: str) -> frozenset[str]:
+        """Uniforms declared by the shader files of ``folder`` (in any root) and the files they
+        include by path: what a material's programs can declare, whichever of them run."""
+        names: set[str] = set()
+        seen: set[str] = set()
+        pending = [f"{folder}/{entry.name}" for root in self.roots
+                   for entry in _folder_entries(root, folder)]
+        while pending:
+            name = pending.pop()
+            if name in seen:
+                continue
+            seen.add(name)
+            try:
+                text = self.read(name)
+            except ShaderError:
+                continue
+            names |= declared_uniforms(text)
+            for line in text.splitlines():
+                match = _INCLUDE.match(line)
+                if match and (match.group(1) or match.group(2)):
+                    pending.append(match.group(1) or match.group(2))
+        return frozenset(names)
+
+    def describe(self, program: moderngl.Program) -> str:
+        return self._labels.get(program.glo, "<program>")
 
     def compute(self, name: str, defines: dict[str, str] | None = None) -> moderngl.ComputeShader:
         source = self.assemble(name, defines)
@@ -179,3 +217,25 @@ class ShaderLibrary:
         for program in self._programs.values():
             program.release()
         self._programs.clear()
+        self._declared.clear()
+        self._labels.clear()
+
+
+def _folder_entries(root: Traversable | Path, folder: str) -> list[Traversable]:
+    directory = root.joinpath(*folder.split("/"))
+    if not directory.is_dir():
+        return []
+    return [entry for entry in directory.iterdir() if entry.is_file()]
+
+
+def declared_uniforms(text: str) -> set[str]:
+    """Uniform names declared in GLSL ``text`` (``uniform vec3 a, b[4];`` gives a and b)."""
+    text = re.sub(r"/\*.*?\*/", " ", text, flags=re.DOTALL)
+    text = re.sub(r"//[^\n]*", "", text)
+    names = set()
+    for match in _UNIFORM.finditer(text):
+        for part in match.group(1).split(","):
+            name = part.split("[")[0].split("=")[0].strip()
+            if name:
+                names.add(name)
+    return names

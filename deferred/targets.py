@@ -1,8 +1,9 @@
 """Named render targets of a frame, and framebuffers assembled from them.
 
-Passes declare what they read and write by target name; the dump and the benchmark use the same
-names. Core targets are the G-buffer (see :mod:`deferred.gbuffer`), the light accumulation, the
-composition buffer and the final image; a material or screen pass may declare more.
+Passes declare what they create, read and write by target name (:mod:`deferred.graph` checks
+it); the dump and the benchmark use the same names. Core targets are the G-buffer (see
+:mod:`deferred.gbuffer`), the light accumulation, the composition buffer and the final image; a
+material or effect pass may create more.
 """
 
 from __future__ import annotations
@@ -10,23 +11,20 @@ from __future__ import annotations
 import moderngl
 import numpy as np
 
-from .gbuffer import GBUFFER_TARGETS
 from .targets_spec import TargetSpec
 
 LIGHT_ACCUMULATION = "light_accumulation"
 COMPOSITE = "composite"
 FINAL = "final"
 
-CORE_TARGETS: dict[str, TargetSpec] = {
-    **GBUFFER_TARGETS,
-    LIGHT_ACCUMULATION: TargetSpec(4, "f2", "linear HDR light accumulated by every light"),
-    COMPOSITE: TargetSpec(4, "f2", "composition buffer: light accumulation + material phase"),
-    FINAL: TargetSpec(4, "f1", "tone mapped, sRGB encoded"),
-}
+LIGHT_ACCUMULATION_SPEC = TargetSpec(4, "f2", "linear HDR light accumulated by every light")
+COMPOSITE_SPEC = TargetSpec(4, "f2", "composition buffer: light accumulation + material phase")
+FINAL_SPEC = TargetSpec(4, "f1", "tone mapped, sRGB encoded")
 
 
 class FrameTargets:
-    """Owns the textures of every named target at one size, and framebuffers over them."""
+    """Owns the textures of the named targets of a frame at one size, and framebuffers over
+    them. The renderer declares the targets the pass graph creates."""
 
     def __init__(self, ctx: moderngl.Context, width: int, height: int):
         self.ctx = ctx
@@ -38,17 +36,14 @@ class FrameTargets:
         # (x, y, width, height) in GL pixels applied to every framebuffer handed out, draws and
         # clears alike: the dump's pixel history replays a frame restricted to one pixel.
         self.scissor: tuple[int, int, int, int] | None = None
-        for name, spec in CORE_TARGETS.items():
-            self.declare(name, spec)
 
     def declare(self, name: str, spec: TargetSpec) -> moderngl.Texture:
         """Create target ``name`` (or return it if it exists with the same format)."""
         if name in self.textures:
-            old = self.specs[name]
-            if (old.components, old.dtype, old.depth) != (spec.components, spec.dtype, spec.depth):
+            if not self.specs[name].same_format(spec):
                 raise ValueError(f"target '{name}' already declared as {self.specs[name]}")
             return self.textures[name]
-        size = (self.width, self.height)
+        size = self.size_of(spec)
         if spec.depth:
             texture = self.ctx.depth_texture(size)
         else:
@@ -58,6 +53,20 @@ class FrameTargets:
         self.specs[name] = spec
         self.textures[name] = texture
         return texture
+
+    def size_of(self, spec: TargetSpec) -> tuple[int, int]:
+        return (max(1, round(self.width * spec.scale)), max(1, round(self.height * spec.scale)))
+
+    def clear(self, name: str) -> None:
+        """Clear target ``name`` to its declared clear value (scissor applies)."""
+        spec = self.specs[name]
+        if spec.clear is None:
+            return
+        if spec.depth:
+            self.framebuffer((), name).clear(depth=spec.clear[0])
+        else:
+            value = (*spec.clear, 0.0, 0.0, 0.0, 0.0)[:4]
+            self.framebuffer((name,)).clear(*value)
 
     def __getitem__(self, name: str) -> moderngl.Texture:
         return self.textures[name]
@@ -84,7 +93,8 @@ class FrameTargets:
         dtype = np.float32 if spec.depth else {"f1": np.uint8, "f2": np.float16,
                                                 "f4": np.float32}[spec.dtype]
         data = np.frombuffer(self.textures[name].read(alignment=1), dtype=dtype)
-        return data.reshape(self.height, self.width, 1 if spec.depth else spec.components)
+        width, height = self.size_of(spec)
+        return data.reshape(height, width, 1 if spec.depth else spec.components)
 
     def read(self, name: str) -> np.ndarray:
         """Target contents as float32 (H, W, C), bottom row first (GL order)."""
@@ -100,3 +110,4 @@ class FrameTargets:
         for texture in self.textures.values():
             texture.release()
         self.textures.clear()
+        self.specs.clear()

@@ -50,3 +50,5 @@ def psnr(a: np.ndarray, b: np.ndarray, peak: float = 1.0) -> float:
 
 def pytest_configure(config):
     os.environ.setdefault("DEFERRED_GL_BACKEND", "egl")
+    # The tests run strict: a uniform set by name that no program declares is an error.
+    os.environ.setdefault("DEFERRED_STRICT", "1")
