@@ -38,7 +38,6 @@ from pydantic import ValidationError
 from . import registry
 from .context import GLContext, create_context
 from .errors import InputError
-from .gbuffer import bytes_per_pixel
 from .imageio import check_output_path, write_image, write_text
 from .light import Light
 from .pipeline import PIPELINES
@@ -357,7 +356,9 @@ def run_bench(scene: Scene, sweep: Sweep, gl: GLContext | None = None,
 
 def renderer_info(gl: GLContext, scene: Scene) -> dict[str, Any]:
     """What the numbers were measured on: GL driver, features, G-buffer size, CPUs, scene."""
-    return {**gl.info, **gl.features.names(), "gbuffer_bytes_per_pixel": bytes_per_pixel(),
+    layout = scene.gbuffer_layout()
+    return {**gl.info, **gl.features.names(), "gbuffer_bytes_per_pixel": layout.bytes_per_pixel,
+            "gbuffer_layout": layout.describe(),
             "cpus": os.cpu_count(), "scene": scene.source,
             "scene_lights": len(scene.lights)}
 

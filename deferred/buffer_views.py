@@ -33,6 +33,7 @@ NAMED_VIEWS: dict[str, tuple[tuple[str, ...], str]] = {
     "depth": (("Z",), "linear view depth, 0 = background (G-buffer)"),
     "specular": (GBUFFER_CHANNELS[3:5], "specular intensity and exponent (G-buffer)"),
     "material": (("material.id",), "material id, 0 = background (G-buffer)"),
+    "shading": (("shading.model",), "shading model id, 0 = background (G-buffer)"),
     "light": (("R", "G", "B"), "light accumulation, linear HDR"),
     "composite": (("R", "G", "B", "A"), "composition buffer, linear HDR before tone mapping"),
 }
@@ -132,9 +133,9 @@ def _named_view(capture: FrameCapture, name: str) -> View:
         preview = depth_colors(pixels[..., 0], covered)
     elif name == "specular":
         preview = grey(pixels[..., 0])
-    else:
+    else:  # material, shading: categorical ids
         preview = id_colors(pixels[..., 0])
-    return View(name, pixels, channels, name in ("albedo", "material"), preview)
+    return View(name, pixels, channels, name in ("albedo", "material", "shading"), preview)
 
 
 class _Described:

@@ -17,10 +17,12 @@ from .errors import InputError
 from .gbuffer import ALBEDO_SPECULAR, LINEAR_DEPTH, NORMAL_EXPONENT_ID, decode
 from .passes import RenderPass
 from .renderer import Renderer
+from .shading import GBufferLayout
 from .targets_spec import TargetSpec
 
 GBUFFER_CHANNELS = ("albedo.R", "albedo.G", "albedo.B", "specular.intensity",
-                    "specular.exponent", "N.X", "N.Y", "N.Z", "Z", "material.id")
+                    "specular.exponent", "N.X", "N.Y", "N.Z", "Z", "material.id",
+                    "shading.model")
 
 
 def channel_suffixes(spec: TargetSpec) -> tuple[str, ...]:
@@ -90,6 +92,7 @@ class FrameCapture:
     frame_ms: float
     tonemap: str = "aces"
     exposure: float = 1.0
+    layout: GBufferLayout = field(default_factory=lambda: GBufferLayout({}))
     _gbuffer: dict[str, np.ndarray] | None = field(default=None, repr=False, compare=False)
 
     def __getitem__(self, name: str) -> PassCapture:
@@ -119,8 +122,14 @@ class FrameCapture:
         """End-of-frame contents of target ``name``, float32 (H, W, C), top row first."""
         return to_float(self.targets[name])
 
+    def gbuffer_channels(self) -> tuple[str, ...]:
+        """The core channels, then each declared datum's as ``name.channel``."""
+        return GBUFFER_CHANNELS + tuple(
+            f"{name}.{channel}" for name, data in self.layout.data.items()
+            for channel in data.channels)
+
     def gbuffer(self) -> dict[str, np.ndarray]:
-        """The decoded G-buffer by channel name (:data:`GBUFFER_CHANNELS`), float32 (H, W)."""
+        """The decoded G-buffer by channel name (:meth:`gbuffer_channels`), float32 (H, W)."""
         if self._gbuffer is not None:
             return self._gbuffer
         g = decode(self.target(ALBEDO_SPECULAR), self.target(NORMAL_EXPONENT_ID),
@@ -130,8 +139,12 @@ class FrameCapture:
         normal = np.where(covered[..., None], g["normal"], 0.0).astype(np.float32)
         values = [g["albedo"][..., 0], g["albedo"][..., 1], g["albedo"][..., 2],
                   g["specular_intensity"], g["specular_exponent"], normal[..., 0],
-                  normal[..., 1], normal[..., 2], g["linear_depth"], g["material_id"]]
-        self._gbuffer = dict(zip(GBUFFER_CHANNELS, values, strict=True))
+                  normal[..., 1], normal[..., 2], g["linear_depth"], g["material_id"],
+                  g["shading_model"]]
+        for name in self.layout.data:
+            data = self.target(name)
+            values += [data[..., k] for k in range(data.shape[-1])]
+        self._gbuffer = dict(zip(self.gbuffer_channels(), values, strict=True))
         return self._gbuffer
 
 
@@ -197,4 +210,5 @@ def capture_frame(renderer: Renderer, passes: Sequence[str] | None = None,
         scene=scene.source, pipeline=renderer.pipeline_name, size=renderer.size,
         gl_info=renderer.gl.info, specs=dict(targets.specs), passes=captures,
         targets={name: targets.read_raw(name)[::-1] for name in targets.specs},
-        image=result.image, frame_ms=frame_ms, tonemap=scene.tonemap, exposure=scene.exposure)
+        image=result.image, frame_ms=frame_ms, tonemap=scene.tonemap, exposure=scene.exposure,
+        layout=scene.gbuffer_layout())

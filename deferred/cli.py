@@ -262,21 +262,29 @@ def materials() -> None:
 
 
 @cli.command()
-def info() -> None:
-    """GL vendor, renderer, version and the optional features in use."""
+@click.argument("scene", required=False, type=click.Path(dir_okay=False))
+def info(scene: str | None) -> None:
+    """GL vendor, renderer, version, the optional features in use, and the G-buffer layout of
+    SCENE (the built-in demo when omitted)."""
     from .context import create_context
-    from .gbuffer import bytes_per_pixel
 
+    layout = _scene(scene).gbuffer_layout()  # bad input fails before GL start-up
     gl = create_context()
     try:
         console = Console()
+        console.print(f"gbuffer: {layout.bytes_per_pixel} bytes per pixel")
+        for name, entry in layout.describe().items():
+            channels = f"  [{' '.join(entry['channels'])}]" if "channels" in entry else ""
+            console.print(f"  {name:<20} {entry['format']:<8} {entry['bytes_per_pixel']:>2} B  "
+                          f"{entry['description']}{channels}")
         for key, value in gl.info.items():
             console.print(f"{key:>16}: {value}")
         for key, value in gl.features.names().items():
             console.print(f"{key:>16}: {'on' if value else 'off'}")
-        console.print(f"{'gbuffer':>16}: {bytes_per_pixel()} bytes per pixel")
-        console.print(f"{'lights':>16}: {', '.join(registry.lights)}")
-        console.print(f"{'materials':>16}: {', '.join(registry.materials)}")
+        for what, reg in (("lights", registry.lights), ("materials", registry.materials),
+                          ("shading models", registry.shading_models),
+                          ("effects", registry.effects)):
+            console.print(f"{what:>16}: {', '.join(reg)}")
     finally:
         gl.release()
 

@@ -16,8 +16,8 @@ from typing import Any
 import numpy as np
 
 from .buffer_views import view
-from .capture import GBUFFER_CHANNELS, FrameCapture, PassCapture, capture_frame, fits_half, to_float
-from .gbuffer import GBUFFER_COLOR_TARGETS, GBUFFER_TARGETS, bytes_per_pixel
+from .capture import FrameCapture, PassCapture, capture_frame, fits_half, to_float
+from .gbuffer import GBUFFER_COLOR_TARGETS
 from .imageio import write_image, write_text
 from .pixel_history import PixelEvent, pixel_history
 from .preview import Tile, contact_sheet, target_views
@@ -61,7 +61,8 @@ def write_dump(capture: FrameCapture, directory: str | Path,
     """Write a capture as a dump folder; returns the manifest::
 
         DIR/gbuffer.exr       decoded G-buffer: albedo.R albedo.G albedo.B specular.intensity
-                              specular.exponent N.X N.Y N.Z Z material.id (Z is the z_channel)
+                              specular.exponent N.X N.Y N.Z Z material.id shading.model (Z is
+                              the z_channel), then declared data as <name>.<channel>
         DIR/light.exr         light accumulation, R G B
         DIR/final.exr         composition buffer (linear HDR), R G B A; DIR/final.png the frame
         DIR/passes/NN_<pass>.exr   what pass NN wrote, channels "<target>.R", ... ("<target>.Z")
@@ -102,7 +103,8 @@ def write_dump(capture: FrameCapture, directory: str | Path,
             written.add(name)
         if all(capture.written(t) for t in GBUFFER_COLOR_TARGETS):
             g = capture.gbuffer()
-            write("gbuffer.exr", np.stack(list(g.values()), axis=-1), channels=GBUFFER_CHANNELS)
+            write("gbuffer.exr", np.stack(list(g.values()), axis=-1),
+                  channels=capture.gbuffer_channels())
             files["gbuffer"] = "gbuffer.exr"
         if capture.written(LIGHT_ACCUMULATION):
             write("light.exr", capture.target(LIGHT_ACCUMULATION)[..., :3],
@@ -178,13 +180,16 @@ def build_manifest(capture: FrameCapture, files: dict[str, str],
                   "first compiles shaders and uploads meshes and textures",
         "orientation": "top row first",
         "gbuffer": {
-            "bytes_per_pixel": bytes_per_pixel(),
-            "targets": {name: _format(spec) for name, spec in GBUFFER_TARGETS.items()},
+            "bytes_per_pixel": capture.layout.bytes_per_pixel,
+            "targets": capture.layout.describe(),
             "file": files.get("gbuffer"),
-            "channels": list(GBUFFER_CHANNELS),
+            "channels": list(capture.gbuffer_channels()),
             "precision": "float",
             "notes": "decoded values: octahedral normals as N.X N.Y N.Z (0 where material.id "
-                     "is 0), Z = linear view depth (the z_channel, 0 = background)",
+                     "is 0), Z = linear view depth (the z_channel, 0 = background), "
+                     "material.id and shading.model unpacked from the id channel; declared "
+                     "data as stored, valid where the material that wrote the pixel declares "
+                     "it",
         },
         "targets": {name: _format(spec) for name, spec in capture.specs.items()},
         "files": files,

@@ -141,6 +141,7 @@ class Frame:
         self.stats = FrameStats()
         self.current_pass: RenderPass | None = None
         self._materials: dict[int, MaterialInputs] = {}
+        self._shading_textures: dict[str, moderngl.Texture] | None = None
 
     # -- passes --------------------------------------------------------------------------------
     def run_pass(self, render_pass: RenderPass) -> None:
@@ -179,9 +180,17 @@ class Frame:
             "u_model": obj.model,
             "u_model_view": model_view,
             "u_normal_matrix": normal_matrix,
-            "u_material_id": float(obj.material.type_id),
+            "u_surface_id": float(obj.material.surface_id()),
             **self.camera_uniforms(),
         }
+
+    def shading_textures(self) -> dict[str, moderngl.Texture]:
+        """Samplers of the scene's shading models (ramps...), offered wherever lights run."""
+        if self._shading_textures is None:
+            self._shading_textures = {}
+            for model in self.scene.shading_models():
+                self._shading_textures.update(model.textures(self))
+        return self._shading_textures
 
     def material_inputs(self, material: Material) -> MaterialInputs:
         """``material``'s uniforms and textures, computed once per frame."""
@@ -211,7 +220,7 @@ class Frame:
                 material.declared |= declared
                 material.programs.append(self.shaders.describe(program))
         values = {**(offered or {})}
-        samplers: dict[str, moderngl.Texture] = {}
+        samplers: dict[str, moderngl.Texture] = dict(self.shading_textures())
         if material is not None:
             values.update(material.uniforms)
             samplers.update(material.textures)

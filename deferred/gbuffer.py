@@ -4,7 +4,7 @@
 |--------------------|---------|---------------------------------------------------------|
 | albedo_specular    | RGBA8   | albedo.rgb (linear), specular intensity [0, 1]          |
 | normal_exponent_id | RGBA16F | view normal (octahedral, 2 ch.), specular exponent,     |
-|                    |         | material id (0 = background)                            |
+|                    |         | surface id: shading model * 64 + material (0 = none)    |
 | linear_depth       | R32F    | linear view depth -z_view (0 = background)              |
 | depth              | DEPTH24 | hardware depth (light volumes depth-test against it)    |
 
@@ -12,10 +12,17 @@
 is reconstructed from the linear depth and the pixel's view ray (``gbuffer/layout.glsl``).
 
 Normals are octahedral-encoded [Cigolle et al. 2014] so a view-space unit vector fits two half
-floats. Material ids are the registry's ``type_id`` of the material that wrote the pixel.
+floats. The id channel packs the registry ``type_id`` of the material that wrote the pixel and of
+its shading model (:func:`deferred.shading.surface_id`), exact in a half float.
+
+Materials may add targets of their own (:class:`deferred.shading.GBufferData`); the GLSL that
+declares, writes and fetches them is generated per scene (:func:`data_struct_glsl`,
+:func:`data_write_glsl`, :func:`data_fetch_glsl`).
 """
 
 from __future__ import annotations
+
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -37,8 +44,47 @@ GBUFFER_TARGETS: dict[str, TargetSpec] = {
 }
 
 
+DATA_STRUCT_FILE = "generated/gbuffer_data.glsl"
+DATA_FETCH_FILE = "generated/gbuffer_data_fetch.glsl"
+
+
 def bytes_per_pixel() -> int:
+    """Bytes per pixel of the core G-buffer (a scene without declared data)."""
     return sum(spec.bytes_per_pixel for spec in GBUFFER_TARGETS.values())
+
+
+def data_write_file(names: Sequence[str]) -> str:
+    """The generated GLSL writing these data targets (a material's G-buffer passes)."""
+    return f"generated/gbuffer_write/{'+'.join(names) or 'none'}.glsl"
+
+
+def data_struct_glsl(names: Sequence[str]) -> str:
+    """``struct SurfaceData``: one vec4 per declared datum of the scene."""
+    fields = [f"    vec4 {name};" for name in names] or ["    float unused;"]
+    return "struct SurfaceData {\n" + "\n".join(fields) + "\n};\n"
+
+
+def data_write_glsl(names: Sequence[str]) -> str:
+    """Outputs after the core ones and ``gbuffer_write_data`` for one material's data."""
+    first = len(GBUFFER_COLOR_TARGETS)
+    lines = [f"layout(location = {first + k}) out vec4 out_{name};"
+             for k, name in enumerate(names)]
+    lines.append("void gbuffer_write_data(SurfaceData d) {")
+    lines += [f"    out_{name} = d.{name};" for name in names]
+    lines.append("}")
+    return "\n".join(lines) + "\n"
+
+
+def data_fetch_glsl(names: Sequence[str]) -> str:
+    """Samplers ``u_<name>`` and ``gbuffer_fetch_data``: the lights' read of the data."""
+    lines = [f"uniform sampler2D u_{name};" for name in names]
+    lines.append("SurfaceData gbuffer_fetch_data(ivec2 pixel) {")
+    lines.append("    SurfaceData d;")
+    lines += [f"    d.{name} = texelFetch(u_{name}, pixel, 0);" for name in names]
+    if not names:
+        lines.append("    d.unused = 0.0;")
+    lines += ["    return d;", "}"]
+    return "\n".join(lines) + "\n"
 
 
 def octahedral_encode(n: np.ndarray) -> np.ndarray:
@@ -69,11 +115,17 @@ def octahedral_decode(e: np.ndarray) -> np.ndarray:
 def decode(albedo_specular: np.ndarray, normal_exponent_id: np.ndarray,
            linear_depth: np.ndarray) -> dict[str, np.ndarray]:
     """Decode read-back G-buffer targets to named arrays (albedo, normal, depth, ...)."""
+    from .shading import split_surface_id
+
+    ids = np.rint(normal_exponent_id[..., 3])
+    material_id, shading_model = split_surface_id(ids)
     return {
         "albedo": albedo_specular[..., :3],
         "specular_intensity": albedo_specular[..., 3],
         "normal": octahedral_decode(normal_exponent_id[..., :2]).astype(np.float32),
         "specular_exponent": normal_exponent_id[..., 2],
-        "material_id": normal_exponent_id[..., 3],
+        "surface_id": ids.astype(np.float32),
+        "material_id": material_id.astype(np.float32),
+        "shading_model": shading_model.astype(np.float32),
         "linear_depth": linear_depth[..., 0],
     }

@@ -33,6 +33,7 @@ if TYPE_CHECKING:
 
 Vec3 = tuple[float, float, float]
 DISPATCH_FILE = "generated/lights.glsl"
+SHADING_DISPATCH_FILE = "generated/shading_models.glsl"
 
 
 class LightParams(BaseModel):
@@ -79,8 +80,10 @@ def view_direction(view: np.ndarray, direction) -> np.ndarray:
 
 
 def light_dispatch_glsl(light_types: list[type[Light]]) -> str:
-    """GLSL of ``evaluate_light``: include every light type and switch on its type id."""
-    lines = [f'#include "{cls.glsl_file}"' for cls in light_types]
+    """GLSL of ``evaluate_light``: include the light types and switch on their type id (and
+    the shading models' dispatch, which the lights call)."""
+    lines = [f'#include "{SHADING_DISPATCH_FILE}"']
+    lines += [f'#include "{cls.glsl_file}"' for cls in light_types]
     lines.append("vec3 evaluate_light(LightRecord light, Surface s, vec3 P, vec3 V) {")
     lines.append("    int kind = int(light.color.w + 0.5);")
     lines += [f"    if (kind == {cls.type_id}) return {cls.glsl_function}(light, s, P, V);"
@@ -105,16 +108,21 @@ def light_volume_mesh() -> tuple[MeshData, float]:
 
 
 class LightTypePass(RenderPass):
-    """Deferred lighting of every light of one type, instanced, added into light accumulation."""
+    """Deferred lighting of every light of one type, instanced, added into light accumulation.
+
+    It reads the G-buffer, including the scene's declared data (``gbuffer``, the colour targets
+    of the scene's layout), so every shading model finds what it reads."""
 
     phase = Phase.LIGHTING
     writes = (LIGHT_ACCUMULATION,)
 
-    def __init__(self, light_type: type[Light], occlusion: str | None = None):
+    def __init__(self, light_type: type[Light], occlusion: str | None = None,
+                 gbuffer: tuple[str, ...] = GBUFFER_COLOR_TARGETS):
         self.light_type = light_type
         self.name = f"lighting.{light_type.name}"
         self.occlusion = occlusion  # target holding ambient occlusion (SSAO), if any
-        self.reads = (*GBUFFER_COLOR_TARGETS, DEPTH) + ((occlusion,) if occlusion else ())
+        self.gbuffer = gbuffer
+        self.reads = (*gbuffer, DEPTH, LIGHT_ACCUMULATION) + ((occlusion,) if occlusion else ())
 
     def execute(self, frame: Frame) -> None:
         offset, count = frame.light_buffer.range(self.light_type)
@@ -125,7 +133,7 @@ class LightTypePass(RenderPass):
         defines = {"HAS_SSAO": "1"} if self.occlusion else {}
         program = frame.shaders.program(vertex, "lights/accumulate.frag", defines=defines)
         frame.use_framebuffer((LIGHT_ACCUMULATION,), DEPTH, depth_write=False)
-        textures = frame.target_samplers(GBUFFER_COLOR_TARGETS)
+        textures = frame.target_samplers(self.gbuffer)
         if self.occlusion:
             textures["u_ssao"] = frame.target(self.occlusion)
         uniforms = {"u_light_offset": offset}

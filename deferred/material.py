@@ -4,23 +4,30 @@ A material is a class with a unique ``name``, a pydantic ``Params`` model (defau
 one-line description per field) and a ``surface_shader``: a GLSL file defining
 ``Surface material_surface(SurfaceInput i)`` (``common/surface.glsl``). With only that, the base
 class gives it a G-buffer pass (geometry phase) and a forward lit pass (forward pipeline). Materials
-that need more (stipple, shells, composition) override the ``*_passes`` hooks; they never edit the
-pipeline. Register with ``@deferred.registry.materials.register`` or the entry-point group
-``deferred.materials``.
+that need more (stipple, shells, composition) override the ``*_passes`` hooks, and may add passes
+once per scene (``scene_passes``); they never edit the pipeline. Register with
+``@deferred.registry.materials.register`` or the entry-point group ``deferred.materials``.
+
+Parameters become uniforms by name: field ``fur_length`` is ``u_fur_length`` (numbers, booleans
+and tuples of numbers; strings and ``None`` are not uniforms). ``uniform_overrides`` maps a field
+to ``None`` (not a uniform: a pass count, a file, a define) or to a function giving the uniforms
+it becomes.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from importlib.resources.abc import Traversable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
 
 import moderngl
-from pydantic import BaseModel, ConfigDict, ValidationError
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from .errors import InputError
-from .gbuffer import DEPTH, GBUFFER_COLOR_TARGETS
+from .gbuffer import DEPTH, GBUFFER_COLOR_TARGETS, data_write_file
 from .passes import ObjectPass, Phase, RenderPass
+from .shading import GBufferData, material_data, surface_id
 from .targets import COMPOSITE
 from .validation import format_validation_error
 
@@ -35,12 +42,32 @@ class MaterialParams(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
 
+class BlinnPhongParams(MaterialParams):
+    """The Blinn-Phong parameters the G-buffer stores (a mixin: redefine a field to change its
+    default)."""
+
+    specular_intensity: float = Field(0.5, ge=0.0, le=1.0, description="Blinn-Phong intensity")
+    specular_exponent: float = Field(32.0, ge=1.0, le=2048.0, description="Blinn-Phong exponent")
+
+
+def uniform_value(value: Any) -> bool:
+    """Whether a parameter value maps to a GLSL uniform as it is."""
+    if isinstance(value, bool | int | float):
+        return True
+    return isinstance(value, tuple) and 2 <= len(value) <= 4 and \
+        all(isinstance(v, int | float) and not isinstance(v, bool) for v in value)
+
+
 class GBufferPass(ObjectPass):
-    """Geometry phase: the material's surface written into the G-buffer."""
+    """Geometry phase: the material's surface written into the G-buffer: the core targets and
+    the G-buffer data the material declares (``Material.gbuffer_targets``)."""
 
     fragment = "gbuffer/geometry.frag"
-    colors = GBUFFER_COLOR_TARGETS
     depth = DEPTH
+
+    def __init__(self, name: str, phase: Phase, obj: SceneObject, **options: Any):
+        options.setdefault("colors", obj.material.gbuffer_targets())
+        super().__init__(name, phase, obj, **options)
 
 
 class ForwardLitPass(ObjectPass):
@@ -56,7 +83,11 @@ class Material:
     Params: ClassVar[type[MaterialParams]] = MaterialParams
     surface_shader: ClassVar[str] = ""
     shader_root: ClassVar[Traversable | Path | None] = None  # extra GLSL root (plugins)
-    type_id: ClassVar[int] = 0  # set by the registry; written to the G-buffer's material id
+    type_id: ClassVar[int] = 0  # set by the registry; written to the G-buffer's id channel
+    shading_model: str = "blinn_phong"  # the BRDF lights call (a registered shading model)
+    gbuffer_data: tuple[GBufferData, ...] = ()  # extra per-pixel data (deferred.shading)
+    # field -> None (not a uniform) or value -> {uniform: value} (see the module documentation)
+    uniform_overrides: ClassVar[dict[str, Callable[[Any], dict[str, Any]] | None]] = {}
 
     def __init__(self, params: MaterialParams | None = None, base_dir: Path | None = None):
         self.params = params if params is not None else self.Params()
@@ -71,6 +102,10 @@ class Material:
         except ValidationError as exc:
             raise InputError(*format_validation_error(exc, where)) from None
         material = cls(params, base_dir)
+        from . import registry
+
+        registry.shading_models.get(material.shading_model,
+                                    f"{where}: shading model" if where else "shading model")
         material.check_files(where)
         return material
 
@@ -91,10 +126,33 @@ class Material:
 
     def defines(self, obj: SceneObject) -> dict[str, str]:
         """Preprocessor defines of this material's programs for ``obj``."""
-        return {"SURFACE_FILE": f'"{self.surface_shader}"'}
+        names = [data.name for data in material_data(self)]
+        return {"SURFACE_FILE": f'"{self.surface_shader}"',
+                "GBUFFER_DATA_WRITE": f'"{data_write_file(names)}"'}
+
+    def gbuffer_targets(self) -> tuple[str, ...]:
+        """The targets this material's G-buffer passes write: the core G-buffer, then its data
+        (its own and its shading model's), in the order of ``gbuffer/write.glsl``'s outputs."""
+        return (*GBUFFER_COLOR_TARGETS, *(data.name for data in material_data(self)))
+
+    def surface_id(self) -> int:
+        """The G-buffer id of this material's pixels: its shading model and its type id."""
+        from . import registry
+
+        return surface_id(self.type_id, registry.shading_models.get(self.shading_model).type_id)
 
     def uniforms(self, frame: Frame) -> dict[str, Any]:
-        return {}
+        """``u_<field>`` for every parameter that is a uniform (``uniform_overrides``)."""
+        out: dict[str, Any] = {}
+        for name in type(self.params).model_fields:
+            value = getattr(self.params, name)
+            if name in self.uniform_overrides:
+                override = self.uniform_overrides[name]
+                if override is not None:
+                    out.update(override(value))
+            elif uniform_value(value):
+                out[f"u_{name}"] = value
+        return out
 
     def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
         return {}

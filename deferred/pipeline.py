@@ -66,9 +66,8 @@ class DeferredPipeline(Pipeline):
     name = "deferred"
 
     def build(self, scene: Scene) -> list[RenderPass]:
-        from . import registry
-
-        passes: list[RenderPass] = [ClearPass("gbuffer.clear", Phase.GEOMETRY, GBUFFER_TARGETS)]
+        layout = scene.gbuffer_layout()
+        passes: list[RenderPass] = [ClearPass("gbuffer.clear", Phase.GEOMETRY, layout.targets)]
         passes += object_passes(scene, Phase.GEOMETRY)
         passes += screen_passes(scene)
         passes += object_passes(scene, Phase.SCREEN)
@@ -78,10 +77,9 @@ class DeferredPipeline(Pipeline):
             {"u_normal_exponent_id": NORMAL_EXPONENT_ID}, (LIGHT_ACCUMULATION,),
             creates={LIGHT_ACCUMULATION: LIGHT_ACCUMULATION_SPEC},
             uniforms=lambda frame: {"u_background": frame.scene.background}))
-        present = {type(light) for light in scene.lights}
         occlusion = SSAO if scene.ssao else None
-        passes += [LightTypePass(cls, occlusion) for _, cls in registry.lights.items()
-                   if cls in present]
+        passes += [LightTypePass(cls, occlusion, layout.color_targets)
+                   for cls in scene.light_types()]
         passes.append(FullscreenPass("material.composite_copy", Phase.MATERIAL, "post/copy.frag",
                                      {"u_source": LIGHT_ACCUMULATION}, (COMPOSITE,),
                                      creates={COMPOSITE: COMPOSITE_SPEC}))

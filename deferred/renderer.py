@@ -9,12 +9,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import registry
 from .context import GLContext, create_context
 from .errors import InputError
 from .frame import Frame, Resources
+from .generated import generated_glsl
 from .graph import PassGraph, PassGraphError, compile_graph
-from .light import DISPATCH_FILE, light_dispatch_glsl
 from .lightbuffer import LightBuffer
 from .passes import RenderPass
 from .pipeline import PIPELINES
@@ -64,11 +63,14 @@ class Renderer:
         features = self.gl.features
         defines = {"DEFERRED_STORAGE_BUFFERS": "1"} if features.storage_buffers else {}
         self.shaders = ShaderLibrary(ctx, features.glsl_version(), defines)
-        light_types = [cls for _, cls in registry.lights.items()]
-        for cls in [type(obj.material) for obj in scene.objects] + light_types:
+        light_types = scene.light_types()
+        shading_models = scene.shading_models()
+        for cls in [type(obj.material) for obj in scene.objects] + light_types + shading_models:
             if cls.shader_root is not None:
                 self.shaders.add_root(cls.shader_root)
-        self.shaders.set_virtual_file(DISPATCH_FILE, light_dispatch_glsl(light_types))
+        for name, text in generated_glsl(light_types, shading_models, scene.gbuffer_layout(),
+                                         [obj.material for obj in scene.objects]).items():
+            self.shaders.set_virtual_file(name, text)
         self.targets = FrameTargets(ctx, *self.size)
         self._declare_targets()
         self.resources = Resources(ctx)

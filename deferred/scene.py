@@ -22,6 +22,7 @@ from .light import Light
 from .material import Material
 from .mesh import MeshData, load_mesh
 from .screen import SSAOSettings
+from .shading import GBufferLayout, ShadingModel, compose_layout
 from .validation import format_validation_error
 
 if sys.version_info >= (3, 11):
@@ -120,6 +121,20 @@ class Scene:
     tonemap: str = "aces"
     ssao: SSAOSettings | None = None
     source: str = "<memory>"
+
+    def gbuffer_layout(self) -> GBufferLayout:
+        """The G-buffer of this scene: the core plus the data its materials declare."""
+        return compose_layout(obj.material for obj in self.objects)
+
+    def shading_models(self) -> list[type[ShadingModel]]:
+        """The shading models the scene's materials use, by id (only these are compiled)."""
+        found = {registry.shading_models.get(obj.material.shading_model)
+                 for obj in self.objects}
+        return sorted(found, key=lambda cls: cls.type_id)
+
+    def light_types(self) -> list[type[Light]]:
+        """The light types of the scene, by id (only these are compiled)."""
+        return sorted({type(light) for light in self.lights}, key=lambda cls: cls.type_id)
 
     def add(self, mesh: MeshData | str, material: Material | str = "standard",
             position=(0.0, 0.0, 0.0), rotation=(0.0, 0.0, 0.0), scale=1.0,

@@ -80,7 +80,8 @@ class ShaderLibrary:
             candidate = root.joinpath(*name.split("/"))
             if candidate.is_file():
                 return candidate.read_text(encoding="utf-8")
-        raise ShaderError(f"shader file not found: {name} (searched {len(self.roots)} roots)")
+        searched = ", ".join(str(root) for root in self.roots)
+        raise ShaderError(f"shader file not found: {name} (searched: {searched})")
 
     def assemble(self, name: str, defines: dict[str, str] | None = None) -> Source:
         """Resolve includes of ``name`` and inject ``#version`` and defines."""

@@ -13,14 +13,14 @@ Passes per phase (section 2.4):
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import moderngl
 from pydantic import Field
 
 from deferred.errors import InputError
 from deferred.gbuffer import ALBEDO_SPECULAR, LINEAR_DEPTH, NORMAL_EXPONENT_ID
-from deferred.material import ForwardLitPass, GBufferPass, Material, MaterialParams
+from deferred.material import BlinnPhongParams, ForwardLitPass, GBufferPass, Material
 from deferred.passes import Phase, RenderPass
 from deferred.registry import materials
 from deferred.targets import COMPOSITE, LIGHT_ACCUMULATION
@@ -36,10 +36,11 @@ if TYPE_CHECKING:
 
 Vec3 = tuple[float, float, float]
 FUR_VERTEX = "materials/revie_fur/fur.vert"
+BASE_SHELL = {"u_shell_depth": 0.0}
 OUTER_SHELL = {"u_shell_depth": 1.0}
 
 
-class RevieFurParams(MaterialParams):
+class RevieFurParams(BlinnPhongParams):
     fur_length: float = Field(0.15, gt=0.0, le=4.0,
                               description="strand length, object units (x vertex colour alpha)")
     shells: int = Field(16, ge=0, le=256, description="concentric shells in the material phase")
@@ -79,6 +80,8 @@ class RevieFurMaterial(Material):
     name = "revie_fur"
     Params = RevieFurParams
     surface_shader = "materials/revie_fur/surface.glsl"
+    # pass counts, switches compiled as defines and the heightfield source are not uniforms
+    uniform_overrides = {"shells": None, "stipple": None, "occlusion_test": None, "seed": None}
 
     def check_files(self, where: str | None) -> None:
         if self.params.heightfield is None:
@@ -103,15 +106,6 @@ class RevieFurMaterial(Material):
             defines["FUR_OCCLUSION_TEST"] = "1"
         return defines
 
-    def uniforms(self, frame: Frame) -> dict[str, Any]:
-        p = self.params
-        return {"u_fur_length": p.fur_length, "u_comb": p.comb, "u_comb_strength": p.comb_strength,
-                "u_shell_depth": 0.0, "u_albedo_base": p.albedo_base, "u_albedo_tip": p.albedo_tip,
-                "u_specular_intensity": p.specular_intensity,
-                "u_specular_exponent": p.specular_exponent, "u_anisotropic": p.anisotropic,
-                "u_rim_strength": p.rim_strength, "u_rim_falloff": p.rim_falloff,
-                "u_density": p.density, "u_strand_softness": p.strand_softness}
-
     def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
         return {"u_heightfield": self.heightfield_texture(frame)}
 
@@ -128,7 +122,8 @@ class RevieFurMaterial(Material):
 
     # -- passes ------------------------------------------------------------------------------
     def geometry_passes(self, obj: SceneObject) -> list[RenderPass]:
-        return [GBufferPass(f"{obj.label}.gbuffer", Phase.GEOMETRY, obj, vertex=FUR_VERTEX)]
+        return [GBufferPass(f"{obj.label}.gbuffer", Phase.GEOMETRY, obj, vertex=FUR_VERTEX,
+                            constants=BASE_SHELL)]
 
     def stipple_passes(self, obj: SceneObject) -> list[RenderPass]:
         if not self.params.stipple:
@@ -149,7 +144,7 @@ class RevieFurMaterial(Material):
 
     def forward_passes(self, obj: SceneObject) -> list[RenderPass]:
         passes: list[RenderPass] = [ForwardLitPass(f"{obj.label}.forward", Phase.FORWARD, obj,
-                                                   vertex=FUR_VERTEX)]
+                                                   vertex=FUR_VERTEX, constants=BASE_SHELL)]
         if self.params.shells > 0:
             passes.append(ShellPass(f"{obj.label}.forward_shells", Phase.FORWARD, obj,
                                     vertex=FUR_VERTEX, colors=(COMPOSITE,),

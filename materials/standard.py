@@ -2,24 +2,22 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import moderngl
 from pydantic import Field
 
 from deferred.errors import InputError
-from deferred.material import Material, MaterialParams
+from deferred.material import BlinnPhongParams, Material
 from deferred.registry import materials
 
 if TYPE_CHECKING:
     from deferred.frame import Frame
 
 
-class StandardParams(MaterialParams):
+class StandardParams(BlinnPhongParams):
     color: tuple[float, float, float] = Field((0.8, 0.8, 0.8), description="linear RGB albedo")
     texture: str | None = Field(None, description="albedo image (sRGB), multiplied by color")
-    specular_intensity: float = Field(0.5, ge=0.0, le=1.0, description="Blinn-Phong intensity")
-    specular_exponent: float = Field(32.0, ge=1.0, le=2048.0, description="Blinn-Phong exponent")
 
 
 @materials.register
@@ -38,11 +36,6 @@ class StandardMaterial(Material):
         if self.params.texture is not None:
             defines["HAS_ALBEDO_TEXTURE"] = "1"
         return defines
-
-    def uniforms(self, frame: Frame) -> dict[str, Any]:
-        return {"u_color": self.params.color,
-                "u_specular_intensity": self.params.specular_intensity,
-                "u_specular_exponent": self.params.specular_exponent}
 
     def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
         if self.params.texture is None:

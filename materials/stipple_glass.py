@@ -10,12 +10,12 @@ alpha-blended lit pass.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Literal
 
 from pydantic import Field
 
 from deferred.gbuffer import LINEAR_DEPTH, NORMAL_EXPONENT_ID
-from deferred.material import Material, MaterialParams
+from deferred.material import BlinnPhongParams, Material
 from deferred.passes import ObjectPass, Order, Phase, RenderPass
 from deferred.registry import materials
 from deferred.targets import COMPOSITE, LIGHT_ACCUMULATION
@@ -23,11 +23,10 @@ from deferred.targets import COMPOSITE, LIGHT_ACCUMULATION
 from .techniques.stipple import StippleObliterationPass, StipplePass, pattern_defines
 
 if TYPE_CHECKING:
-    from deferred.frame import Frame
     from deferred.scene import SceneObject
 
 
-class StippleGlassParams(MaterialParams):
+class StippleGlassParams(BlinnPhongParams):
     color: tuple[float, float, float] = Field((0.55, 0.75, 0.85), description="glass tint")
     opacity: float = Field(0.35, ge=0.0, le=1.0, description="glass over the scene behind")
     pattern: Literal[2, 4] = Field(4, description="stipple density: 1 in 2 or 1 in 4 pixels")
@@ -52,15 +51,10 @@ class StippleGlassMaterial(Material):
     name = "stipple_glass"
     Params = StippleGlassParams
     surface_shader = "materials/stipple_glass/surface.glsl"
+    uniform_overrides = {"pattern": None}  # a define (STIPPLE_PATTERN)
 
     def defines(self, obj: SceneObject) -> dict[str, str]:
         return {**super().defines(obj), **pattern_defines(self.params.pattern)}
-
-    def uniforms(self, frame: Frame) -> dict[str, Any]:
-        p = self.params
-        return {"u_color": p.color, "u_opacity": p.opacity,
-                "u_specular_intensity": p.specular_intensity,
-                "u_specular_exponent": p.specular_exponent}
 
     def geometry_passes(self, obj: SceneObject) -> list[RenderPass]:
         return []  # transparent: nothing in the opaque G-buffer phase

@@ -8,7 +8,8 @@ from the composition buffer. ``STIPPLE_PATTERN`` (2 or 4) selects the pattern in
 
 from __future__ import annotations
 
-from deferred.gbuffer import DEPTH, GBUFFER_COLOR_TARGETS, LINEAR_DEPTH, NORMAL_EXPONENT_ID
+from deferred.gbuffer import DEPTH, LINEAR_DEPTH, NORMAL_EXPONENT_ID
+from deferred.material import GBufferPass
 from deferred.passes import ObjectPass
 from deferred.targets import COMPOSITE, LIGHT_ACCUMULATION
 
@@ -21,12 +22,9 @@ def pattern_defines(pattern: int) -> dict[str, str]:
     return {"STIPPLE_PATTERN": str(pattern)}
 
 
-class StipplePass(ObjectPass):
+class StipplePass(GBufferPass):
     """Stipple phase: a mesh into the G-buffer at the pattern's pixels only (fragment shader
     decides, via ``stipple_sample``)."""
-
-    colors = GBUFFER_COLOR_TARGETS
-    depth = DEPTH
 
 
 class StippleObliterationPass(ObjectPass):

@@ -1,4 +1,5 @@
-// Forward shading: every light of the frame evaluated at one surface point.
+// Forward shading: every light of the frame evaluated at one surface point, each through the
+// surface's shading model (the same GLSL the deferred lights call).
 #include "common/light_buffer.glsl"
 #include "generated/lights.glsl"
 

@@ -1,4 +1,4 @@
-// Light records and the reflectance model shared by the deferred and forward pipelines.
+// Light records and the shading-model interface shared by the deferred and forward pipelines.
 #include "common/surface.glsl"
 
 // One light, four vec4s in view space (deferred.light.Light.record):
@@ -13,14 +13,11 @@ struct LightRecord {
     vec4 extra;
 };
 
-// Blinn-Phong with the G-buffer's quantities (albedo, specular intensity and exponent).
-vec3 blinn_phong(Surface s, vec3 L, vec3 V, vec3 radiance) {
-    float n_dot_l = dot(s.normal, L);
-    if (n_dot_l <= 0.0) return vec3(0.0);
-    vec3 H = normalize(L + V);
-    float specular = s.specular_intensity * pow(max(dot(s.normal, H), 0.0), s.specular_exponent);
-    return radiance * n_dot_l * (s.albedo + vec3(specular));
-}
+// The surface's shading model answers a light (generated dispatch, deferred.shading): L unit
+// toward the light, V unit toward the viewer, radiance arriving at the point.
+vec3 shade_light(Surface s, vec3 L, vec3 V, vec3 radiance);
+// ... and ambient irradiance (default: albedo * irradiance).
+vec3 shade_ambient(Surface s, vec3 irradiance);
 
 // Inverse-square falloff windowed to reach exactly 0 at the radius:
 //   (clamp(1 - (d/r)^4, 0, 1))^2 / (d^2 + 1)

@@ -1,5 +1,6 @@
 // The surface interface between materials and lights (the G-buffer's contents, decoded).
 // A material's surface file defines: Surface material_surface(SurfaceInput i);
+#include "generated/gbuffer_data.glsl"
 
 struct SurfaceInput {
     vec3 position;   // view space
@@ -13,7 +14,20 @@ struct SurfaceInput {
 struct Surface {
     vec3 albedo;               // linear RGB
     float specular_intensity;  // [0, 1]
-    float specular_exponent;   // Blinn-Phong exponent
+    float specular_exponent;   // Blinn-Phong exponent (its analogue in other shading models)
     vec3 normal;               // view space, unit: the normal lights use
     float occlusion;           // ambient occlusion [0, 1]; set by the pipeline, not the material
+    int shading_model;         // the BRDF lights call; set by the framework from u_surface_id
+    SurfaceData data;          // G-buffer data the scene's materials declare, by name
 };
+
+// The G-buffer id channel packs shading model * MATERIAL_IDS + material id (deferred.shading).
+const float MATERIAL_IDS = 64.0;
+
+int surface_shading_model(float surface_id) {
+    return int(floor((surface_id + 0.5) / MATERIAL_IDS));
+}
+
+float surface_material_id(float surface_id) {
+    return mod(floor(surface_id + 0.5), MATERIAL_IDS);
+}

@@ -1,4 +1,5 @@
-// Fragment-side inputs of common/mesh.vert, gathered into a SurfaceInput.
+// Fragment-side inputs of common/mesh.vert, gathered into a SurfaceInput, and the material's
+// surface completed with what the framework owns (shading model, occlusion).
 #include "common/surface.glsl"
 
 in vec3 v_position;
@@ -7,6 +8,8 @@ in vec3 v_tangent;
 in vec3 v_binormal;
 in vec2 v_uv;
 in vec4 v_comb;
+
+uniform float u_surface_id;  // this object's G-buffer id: shading model and material
 
 SurfaceInput surface_input() {
     SurfaceInput i;
@@ -17,4 +20,13 @@ SurfaceInput surface_input() {
     i.uv = v_uv;
     i.comb = v_comb;
     return i;
+}
+
+Surface material_surface(SurfaceInput i);  // defined by the material's SURFACE_FILE
+
+Surface evaluate_surface(SurfaceInput i) {
+    Surface s = material_surface(i);
+    s.shading_model = surface_shading_model(u_surface_id);
+    s.occlusion = 1.0;
+    return s;
 }

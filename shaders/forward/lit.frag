@@ -7,7 +7,6 @@ out vec4 out_color;
 
 void main() {
     SurfaceInput i = surface_input();
-    Surface s = material_surface(i);
-    s.occlusion = 1.0;
+    Surface s = evaluate_surface(i);
     out_color = vec4(forward_lighting(s, i.position, normalize(-i.position)), 1.0);
 }

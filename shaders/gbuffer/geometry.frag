@@ -3,9 +3,7 @@
 #include "gbuffer/write.glsl"
 #include SURFACE_FILE
 
-uniform float u_material_id;
-
 void main() {
     SurfaceInput i = surface_input();
-    gbuffer_write(material_surface(i), i.position, u_material_id);
+    gbuffer_write(evaluate_surface(i), i.position, u_surface_id);
 }

@@ -1,25 +1,11 @@
 // G-buffer encoding and decoding; the format is documented in deferred/gbuffer.py.
 #include "common/surface.glsl"
-
-// Octahedral normal encoding (Cigolle et al. 2014): a unit vector in two signed values.
-vec2 octahedral_wrap(vec2 v) {
-    return (1.0 - abs(v.yx)) * vec2(v.x >= 0.0 ? 1.0 : -1.0, v.y >= 0.0 ? 1.0 : -1.0);
-}
-
-vec2 octahedral_encode(vec3 n) {
-    n /= abs(n.x) + abs(n.y) + abs(n.z);
-    return n.z >= 0.0 ? n.xy : octahedral_wrap(n.xy);
-}
-
-vec3 octahedral_decode(vec2 e) {
-    vec3 n = vec3(e, 1.0 - abs(e.x) - abs(e.y));
-    if (n.z < 0.0) n.xy = octahedral_wrap(n.xy);
-    return normalize(n);
-}
+#include "gbuffer/octahedral.glsl"
 
 struct GBufferSample {
     Surface surface;
-    float material_id;   // 0 = background
+    float surface_id;    // shading model * MATERIAL_IDS + material id; 0 = background
+    float material_id;   // the material's registry id; 0 = background
     float linear_depth;  // -z_view
 };
 
@@ -30,9 +16,16 @@ GBufferSample gbuffer_decode(vec4 albedo_specular, vec4 normal_exponent_id, floa
     g.surface.normal = octahedral_decode(normal_exponent_id.xy);
     g.surface.specular_exponent = normal_exponent_id.z;
     g.surface.occlusion = 1.0;
-    g.material_id = normal_exponent_id.w;
+    g.surface.shading_model = surface_shading_model(normal_exponent_id.w);
+    g.surface_id = normal_exponent_id.w;
+    g.material_id = surface_material_id(normal_exponent_id.w);
     g.linear_depth = linear_depth;
     return g;
+}
+
+// Whether a G-buffer id is that of the surface `surface_id` (stipple and shell lookups).
+bool same_surface(float stored_id, float surface_id) {
+    return abs(stored_id - surface_id) < 0.5;
 }
 
 // View-space position of a pixel from its linear depth: position is never stored.

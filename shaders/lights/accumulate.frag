@@ -14,7 +14,7 @@ out vec4 out_light;
 
 void main() {
     GBufferSample g = gbuffer_fetch(ivec2(gl_FragCoord.xy));
-    if (g.material_id <= 0.0) discard;
+    if (g.surface_id <= 0.0) discard;
 #ifdef HAS_SSAO
     g.surface.occlusion = texelFetch(u_ssao, ivec2(gl_FragCoord.xy), 0).r;
 #endif

@@ -7,6 +7,6 @@ uniform vec3 u_background;
 out vec4 out_light;
 
 void main() {
-    float material_id = texelFetch(u_normal_exponent_id, ivec2(gl_FragCoord.xy), 0).w;
-    out_light = material_id > 0.0 ? vec4(0.0, 0.0, 0.0, 1.0) : vec4(u_background, 0.0);
+    float surface_id = texelFetch(u_normal_exponent_id, ivec2(gl_FragCoord.xy), 0).w;
+    out_light = surface_id > 0.0 ? vec4(0.0, 0.0, 0.0, 1.0) : vec4(u_background, 0.0);
 }

@@ -2,5 +2,5 @@
 #include "common/lighting.glsl"
 
 vec3 directional_light(LightRecord light, Surface s, vec3 P, vec3 V) {
-    return blinn_phong(s, -light.direction.xyz, V, light.color.rgb);
+    return shade_light(s, -light.direction.xyz, V, light.color.rgb);
 }

@@ -6,5 +6,5 @@ vec3 point_light(LightRecord light, Surface s, vec3 P, vec3 V) {
     float d = length(to_light);
     float falloff = distance_falloff(d, light.position.w);
     if (falloff <= 0.0) return vec3(0.0);
-    return blinn_phong(s, to_light / d, V, light.color.rgb * falloff);
+    return shade_light(s, to_light / d, V, light.color.rgb * falloff);
 }

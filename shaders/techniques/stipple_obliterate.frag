@@ -2,11 +2,12 @@
 // mesh's stipple sample sits, the neighbouring pixel's light and depth replace it in the
 // composition buffer, leaving the scene the stipple covered.
 #include "techniques/stipple.glsl"
+#include "gbuffer/layout.glsl"
 
 uniform sampler2D u_light_accumulation;
 uniform sampler2D u_linear_depth;
 uniform sampler2D u_normal_exponent_id;
-uniform float u_material_id;
+uniform float u_surface_id;
 uniform vec2 u_resolution;
 uniform mat4 u_projection;
 
@@ -17,9 +18,8 @@ void main() {
     ivec2 pixel = ivec2(gl_FragCoord.xy);
     if (!stipple_sample(pixel)) discard;
     // Ours only if the G-buffer holds this very surface: same material, same depth.
-    float material_id = texelFetch(u_normal_exponent_id, pixel, 0).w;
     float depth = texelFetch(u_linear_depth, pixel, 0).r;
-    if (abs(material_id - u_material_id) > 0.5) discard;
+    if (!same_surface(texelFetch(u_normal_exponent_id, pixel, 0).w, u_surface_id)) discard;
     if (abs(depth + v_position.z) > 1e-3 * depth + 1e-5) discard;
     ivec2 neighbour = stipple_neighbour(pixel, ivec2(u_resolution));
     out_color = texelFetch(u_light_accumulation, neighbour, 0);

@@ -85,7 +85,7 @@ def test_gbuffer_exr_round_trip(tmp_path, renderer):
     assert sorted(spec.channelnames) == sorted(GBUFFER_CHANNELS)
     assert spec.channelnames[spec.z_channel] == "Z"  # the EXR's depth channel
     assert spec.format == oiio.FLOAT
-    assert raw.shape == (SIZE[1], SIZE[0], 10)
+    assert raw.shape == (SIZE[1], SIZE[0], len(GBUFFER_CHANNELS))
 
     pixels, names, attributes = read_channels(tmp_path / "gbuffer.exr")
     assert names == list(GBUFFER_CHANNELS)  # written order survives EXR's sorting
@@ -98,6 +98,7 @@ def test_gbuffer_exr_round_trip(tmp_path, renderer):
     np.testing.assert_array_equal(c["specular.exponent"], g["specular_exponent"])
     np.testing.assert_array_equal(c["Z"], g["linear_depth"])
     np.testing.assert_array_equal(c["material.id"], g["material_id"])
+    np.testing.assert_array_equal(c["shading.model"], g["shading_model"])
     normal = np.stack([c["N.X"], c["N.Y"], c["N.Z"]], -1)
     np.testing.assert_allclose(normal[covered], g["normal"][covered], atol=1e-6)
     assert np.all(normal[~covered] == 0.0)
@@ -480,7 +481,7 @@ def test_cli_render_view(tmp_path, capsys):
     code, stdout, err = run(capsys, "render", scene, "--view", "help")
     assert code == 0, err
     names = [line.split()[0] for line in stdout.splitlines()]
-    assert names[:7] == ["albedo", "normal", "depth", "specular", "material", "light",
+    assert names[:8] == ["albedo", "normal", "depth", "specular", "material", "shading", "light",
                          "composite"]
     assert "lighting.ambient" in names and "ball.gbuffer:TARGET" in names
 

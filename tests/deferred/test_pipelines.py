@@ -11,6 +11,7 @@ from deferred.gbuffer import decode
 from deferred.passes import Phase
 from deferred.renderer import Renderer
 from deferred.scene import load_scene, scene_from_dict
+from deferred.shading import surface_id
 
 ALL_LIGHTS = [
     {"type": "ambient", "color": [0.2, 0.22, 0.3], "ground": [0.1, 0.05, 0.02]},
@@ -84,6 +85,8 @@ def test_gbuffer_contents(render):
     assert 0.05 < background.mean() < 0.7
     assert np.all(g["linear_depth"][background] == 0.0)
     assert np.all(g["material_id"][~background] == registry.materials.get("standard").type_id)
+    assert np.all(g["shading_model"][~background] ==
+                  registry.shading_models.get("blinn_phong").type_id)
     depth = g["linear_depth"][~background]
     assert depth.min() > scene.camera.near and depth.max() < 10.0
     # normals are view-space unit vectors facing the camera (z > 0 in view space)
@@ -173,7 +176,9 @@ def test_plugin_material_renders_in_both_pipelines(render):
         deferred, renderer = render(scene, "deferred")
         forward, _ = render(scene, "forward")
         ids = renderer.targets.read("normal_exponent_id")[..., 3]
-        assert set(np.unique(ids)) == {0.0, float(CheckerMaterial.type_id)}
+        blinn_phong = registry.shading_models.get("blinn_phong").type_id
+        assert set(np.unique(ids)) == {0.0, float(surface_id(CheckerMaterial.type_id,
+                                                             blinn_phong))}
         # both colours of the checkerboard are on screen, in both pipelines
         for result in (deferred, forward):
             blue = (result.hdr[..., 2] > 0.7) & (result.hdr[..., 0] < 0.2)

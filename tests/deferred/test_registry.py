@@ -3,7 +3,7 @@
 import pytest
 
 from deferred.errors import InputError
-from deferred.registry import Registry
+from deferred.registry import PluginWarning, Registry
 
 
 def fake_distribution(tmp_path, group, line):
@@ -22,12 +22,29 @@ def test_entry_point_plugin_is_loaded(tmp_path, monkeypatch):
     assert cls.__name__ == "CheckerMaterial"
 
 
-def test_broken_entry_point_is_an_input_error(tmp_path, monkeypatch):
-    fake_distribution(tmp_path, "deferred.test_broken", "oops = no_such_module:Thing")
+def test_broken_plugin_fails_only_where_it_is_asked_for(tmp_path, monkeypatch):
+    fake_distribution(tmp_path, "deferred.test_broken",
+                      "oops = no_such_module:Thing\ntest_checker = plugin_material:CheckerMaterial")
     monkeypatch.syspath_prepend(str(tmp_path))
-    registry = Registry("material", "deferred.test_broken", "deferred.materials")
-    with pytest.raises(InputError, match="cannot load material plugin 'oops'"):
-        registry.get("standard")
+    registry = Registry("material", "deferred.test_broken", "json")  # no built-ins
+    # asking for the good plugin loads it alone: the broken one is never imported
+    assert registry.get("test_checker").__name__ == "CheckerMaterial"
+    with pytest.raises(InputError, match="cannot load material plugin 'oops' \\(fake-plugin\\): "
+                                         "ModuleNotFoundError"):
+        registry.get("oops")
+    # listing skips it with a warning naming it
+    with pytest.warns(PluginWarning, match="plugin 'oops'"):
+        registry = Registry("material", "deferred.test_broken", "json")
+        assert list(registry) == ["test_checker"]
+
+
+def test_entry_points_load_lazily(tmp_path, monkeypatch):
+    fake_distribution(tmp_path, "deferred.test_lazy",
+                      "test_checker = plugin_material:CheckerMaterial")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    registry = Registry("material", "deferred.test_lazy", "json")
+    registry.get("test_checker")
+    assert set(registry._tried) == {"test_checker"}
 
 
 def test_type_ids_are_never_reused():

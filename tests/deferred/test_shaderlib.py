@@ -88,23 +88,39 @@ def test_programs_are_cached_by_files_and_defines(library, tmp_path):
 
 
 def test_every_packaged_shader_program_compiles(gl):
-    """The built-in programs compile on this driver (both light-buffer variants)."""
+    """The built-in programs compile on this driver (both light-buffer variants), with every
+    built-in light type and shading model and their G-buffer data; installed plugins play no
+    part."""
     from deferred import registry
-    from deferred.light import DISPATCH_FILE, light_dispatch_glsl
+    from deferred.generated import generated_glsl
+    from deferred.materials.standard import StandardMaterial
+    from deferred.shading import GBufferLayout
 
-    types = [cls for _, cls in registry.lights.items()]
+    lights = registry.lights.builtins()
+    models = registry.shading_models.builtins()
+    assert {m.name for m in models} >= {"blinn_phong", "kajiya_kay", "toon"}
+    layout = GBufferLayout({d.name: d for m in models for d in m.gbuffer_data})
+    files = generated_glsl(lights, models, layout, [StandardMaterial()])
     for version, defines in ((430, {"DEFERRED_STORAGE_BUFFERS": "1"}), (330, {})):
         if version > gl.ctx.version_code:
             continue
         lib = ShaderLibrary(gl.ctx, version, defines)
-        lib.set_virtual_file(DISPATCH_FILE, light_dispatch_glsl(types))
-        surface = {"SURFACE_FILE": '"materials/standard/surface.glsl"'}
+        for name, text in files.items():
+            lib.set_virtual_file(name, text)
+        surface = {"SURFACE_FILE": '"materials/standard/surface.glsl"',
+                   "GBUFFER_DATA_WRITE": '"generated/gbuffer_write/none.glsl"'}
         lib.program("common/mesh.vert", "gbuffer/geometry.frag", defines=surface)
         lib.program("common/mesh.vert", "forward/lit.frag", defines=surface)
         lib.program("lights/volume.vert", "lights/accumulate.frag")
         lib.program("lights/fullscreen.vert", "lights/accumulate.frag")
         lib.program("post/fullscreen.vert", "post/tonemap.frag")
         lib.release()
+
+
+def test_missing_file_lists_the_roots_searched(library, tmp_path):
+    with pytest.raises(ShaderError, match=f"shader file not found: nope.glsl \\(searched: "
+                                          f"{tmp_path}\\)"):
+        library.read("nope.glsl")
 
 
 @pytest.mark.parametrize("driver_line", [

@@ -6,6 +6,7 @@ import trimesh
 
 from deferred import registry
 from deferred.scene import scene_from_dict
+from deferred.shading import split_surface_id
 
 
 def fur_scene(params=None, size=(160, 120), lights=None, objects=(), camera=None, mesh=None,
@@ -147,7 +148,7 @@ def test_shells_take_no_colour_from_an_occluder(render, stipple, occlusion_test,
                                "ground": [1.0, 1.0, 1.0]}])
     result, renderer = render(scene)
     ids = renderer.targets.read("normal_exponent_id")[::-1, :, 3]
-    occluder = ids == registry.materials.get("standard").type_id
+    occluder = split_surface_id(ids)[0] == registry.materials.get("standard").type_id
     hdr = result.hdr
     red_pixels = (hdr[..., 0] > 0.2) & (hdr[..., 1] < 0.5 * hdr[..., 0]) & ~occluder
     if red_expected:

@@ -22,8 +22,7 @@ void main() {
     float height = texture(u_heightfield, i.uv * u_density).r;
     float alpha = 1.0 - smoothstep(height - u_strand_softness, height, v_shell_depth);
     if (alpha <= 0.0) discard;
-    Surface s = material_surface(i);
-    s.occlusion = 1.0;
+    Surface s = evaluate_surface(i);
     vec3 V = normalize(-i.position);
     vec3 light = forward_lighting(s, i.position, V);
 #ifdef FUR_STIPPLE

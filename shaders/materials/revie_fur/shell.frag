@@ -4,6 +4,7 @@
 // albedo and re-applies albedo_base..albedo_tip over the shell depth, and fades strands with
 // smoothstep against the heightfield.
 #include "techniques/stipple.glsl"
+#include "gbuffer/layout.glsl"
 
 uniform sampler2D u_light_accumulation;
 uniform sampler2D u_albedo_specular;
@@ -11,7 +12,7 @@ uniform sampler2D u_normal_exponent_id;
 uniform sampler2D u_linear_depth;
 uniform sampler2D u_heightfield;
 uniform vec2 u_resolution;
-uniform float u_material_id;
+uniform float u_surface_id;
 uniform vec3 u_albedo_base;
 uniform vec3 u_albedo_tip;
 uniform float u_density;
@@ -37,7 +38,7 @@ bool irradiance_at(ivec2 pixel, float expected, float tolerance, out vec3 irradi
     if (any(lessThan(pixel, ivec2(0))) || any(greaterThanEqual(pixel, ivec2(u_resolution))))
         return false;
 #ifdef FUR_OCCLUSION_TEST
-    if (abs(texelFetch(u_normal_exponent_id, pixel, 0).w - u_material_id) > 0.5) return false;
+    if (!same_surface(texelFetch(u_normal_exponent_id, pixel, 0).w, u_surface_id)) return false;
     if (abs(texelFetch(u_linear_depth, pixel, 0).r - expected) > tolerance) return false;
 #endif
     vec3 albedo = max(texelFetch(u_albedo_specular, pixel, 0).rgb, vec3(1.0 / 255.0));

@@ -6,14 +6,13 @@
 #include "techniques/rim.glsl"
 #include SURFACE_FILE
 
-uniform float u_material_id;
 uniform float u_rim_strength;
 uniform float u_rim_falloff;
 
 void main() {
     if (!stipple_sample(ivec2(gl_FragCoord.xy))) discard;
     SurfaceInput i = surface_input();
-    Surface s = material_surface(i);
+    Surface s = evaluate_surface(i);
     s.normal = rim_bend(i.normal, s.normal, normalize(i.position), u_rim_strength, u_rim_falloff);
-    gbuffer_write(s, i.position, u_material_id);
+    gbuffer_write(s, i.position, u_surface_id);
 }

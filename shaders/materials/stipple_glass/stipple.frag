@@ -5,10 +5,8 @@
 #include "techniques/stipple.glsl"
 #include SURFACE_FILE
 
-uniform float u_material_id;
-
 void main() {
     if (!stipple_sample(ivec2(gl_FragCoord.xy))) discard;
     SurfaceInput i = surface_input();
-    gbuffer_write(material_surface(i), i.position, u_material_id);
+    gbuffer_write(evaluate_surface(i), i.position, u_surface_id);
 }

@@ -1,0 +1,96 @@
+"""Built-in shading models (see :mod:`deferred.shading`); importing this module registers them.
+
+- ``blinn_phong``: the standard model (albedo, specular intensity and exponent).
+- ``kajiya_kay``: strands (Silva et al. Eq. 6; Kajiya and Kay 1989): diffuse |T x L|, specular
+  ((T.L)(T.E) + |T x L||T x E|)^p along the strand tangent T, stored as G-buffer data.
+- ``toon``: N.L through a ramp texture (a row per ramp, chosen per pixel by G-buffer data) and
+  a hard-edged specular band (X-toon, Costigan's cartoon shading).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import moderngl
+import numpy as np
+
+from deferred.registry import shading_models
+from deferred.shading import GBufferData, ShadingModel
+
+if TYPE_CHECKING:
+    from deferred.frame import Frame
+
+STRAND_TANGENT = GBufferData(
+    "strand_tangent", "RG16F", ("u", "v"),
+    "strand tangent, view space, octahedral (kajiya_kay: techniques/strand_tangent.glsl)")
+TOON_RAMP = GBufferData("toon_ramp", "R8", ("row",), "row of the toon ramp texture / 255")
+
+
+@shading_models.register
+class BlinnPhong(ShadingModel):
+    name = "blinn_phong"
+    glsl_file = "shading_models/blinn_phong.glsl"
+    glsl_function = "blinn_phong"
+
+
+@shading_models.register
+class KajiyaKay(ShadingModel):
+    name = "kajiya_kay"
+    glsl_file = "shading_models/kajiya_kay.glsl"
+    glsl_function = "kajiya_kay"
+    gbuffer_data = (STRAND_TANGENT,)
+
+
+def _ramp(values: np.ndarray, dark, light) -> np.ndarray:
+    return np.asarray(dark)[None, :] * (1.0 - values[:, None]) + \
+        np.asarray(light)[None, :] * values[:, None]
+
+
+def toon_ramps(width: int = 256) -> dict[str, np.ndarray]:
+    """The built-in ramps, (width, 3) linear RGB over N.L from -1 (left) to 1 (right)."""
+    n_dot_l = np.linspace(-1.0, 1.0, width)
+
+    def steps(edges, tones, softness=0.02):
+        out = np.full(width, tones[0])
+        for edge, low, high in zip(edges, tones, tones[1:], strict=False):
+            t = np.clip((n_dot_l - edge) / softness + 0.5, 0.0, 1.0)
+            out = out + (high - low) * t
+        return out
+
+    soft = np.clip((n_dot_l + 0.2) / 0.8, 0.0, 1.0)
+    grey = (1.0, 1.0, 1.0)
+    return {
+        "two_tone": _ramp(steps([0.1], [0.12, 1.0]), (0, 0, 0), grey),
+        "three_tone": _ramp(steps([0.0, 0.5], [0.05, 0.4, 1.0]), (0, 0, 0), grey),
+        "soft": _ramp(soft * soft * (3.0 - 2.0 * soft), (0, 0, 0), grey),
+        "warm_cool": _ramp(steps([0.15], [0.0, 1.0], 0.1), (0.10, 0.14, 0.32), (1.0, 0.92, 0.78)),
+    }
+
+
+TOON_RAMP_NAMES = tuple(toon_ramps())
+
+
+@shading_models.register
+class Toon(ShadingModel):
+    name = "toon"
+    glsl_file = "shading_models/toon.glsl"
+    glsl_function = "toon"
+    gbuffer_data = (TOON_RAMP,)
+
+    @classmethod
+    def textures(cls, frame: Frame) -> dict[str, moderngl.Texture]:
+        def create(ctx: moderngl.Context) -> moderngl.Texture:
+            rows = np.stack(list(toon_ramps().values()))  # (rows, width, 3)
+            data = np.concatenate([rows, np.ones(rows.shape[:2] + (1,))], axis=-1)
+            texture = ctx.texture((rows.shape[1], rows.shape[0]), 4,
+                                  data.astype(np.float32).tobytes(), dtype="f4")
+            texture.filter = (moderngl.LINEAR, moderngl.LINEAR)
+            texture.repeat_x = texture.repeat_y = False
+            return texture
+
+        return {"u_toon_ramps": frame.resources.texture("toon_ramps", create)}
+
+    @staticmethod
+    def ramp_row(name: str) -> float:
+        """The ``toon_ramp`` value selecting ramp ``name``."""
+        return TOON_RAMP_NAMES.index(name) / 255.0
