@@ -8,38 +8,33 @@ that need more (stipple, shells, composition) override the ``*_passes`` hooks, a
 once per scene (``scene_passes``); they never edit the pipeline. Register with
 ``@deferred.registry.materials.register`` or the entry-point group ``deferred.materials``.
 
-Parameters become uniforms by name: field ``fur_length`` is ``u_fur_length`` (numbers, booleans
-and tuples of numbers; strings and ``None`` are not uniforms). ``uniform_overrides`` maps a field
-to ``None`` (not a uniform: a pass count, a file, a define) or to a function giving the uniforms
-it becomes.
+Parameters become uniforms by name (:mod:`deferred.params`): field ``fur_length`` is
+``u_fur_length``; ``uniform_overrides`` maps a field to ``None`` (not a uniform: a pass count, a
+file, a define) or to a function giving the uniforms it becomes.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from importlib.resources.abc import Traversable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
 
 import moderngl
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, Field
 
-from .errors import InputError
 from .gbuffer import DEPTH, GBUFFER_COLOR_TARGETS, data_write_file
+from .params import Params, UniformOverrides, params_uniforms, validate_params
 from .passes import ObjectPass, Phase, RenderPass
 from .shading import GBufferData, material_data, surface_id
 from .targets import COMPOSITE
-from .validation import format_validation_error
 
 if TYPE_CHECKING:
     from .frame import Frame
     from .scene import SceneObject
 
 
-class MaterialParams(BaseModel):
+class MaterialParams(Params):
     """Base of every material's parameter model: unknown keys are errors."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True)
 
 
 class BlinnPhongParams(MaterialParams):
@@ -48,14 +43,6 @@ class BlinnPhongParams(MaterialParams):
 
     specular_intensity: float = Field(0.5, ge=0.0, le=1.0, description="Blinn-Phong intensity")
     specular_exponent: float = Field(32.0, ge=1.0, le=2048.0, description="Blinn-Phong exponent")
-
-
-def uniform_value(value: Any) -> bool:
-    """Whether a parameter value maps to a GLSL uniform as it is."""
-    if isinstance(value, bool | int | float):
-        return True
-    return isinstance(value, tuple) and 2 <= len(value) <= 4 and \
-        all(isinstance(v, int | float) and not isinstance(v, bool) for v in value)
 
 
 class GBufferPass(ObjectPass):
@@ -87,7 +74,7 @@ class Material:
     shading_model: str = "blinn_phong"  # the BRDF lights call (a registered shading model)
     gbuffer_data: tuple[GBufferData, ...] = ()  # extra per-pixel data (deferred.shading)
     # field -> None (not a uniform) or value -> {uniform: value} (see the module documentation)
-    uniform_overrides: ClassVar[dict[str, Callable[[Any], dict[str, Any]] | None]] = {}
+    uniform_overrides: ClassVar[UniformOverrides] = {}
 
     def __init__(self, params: MaterialParams | None = None, base_dir: Path | None = None):
         self.params = params if params is not None else self.Params()
@@ -97,11 +84,7 @@ class Material:
     def from_dict(cls, values: dict[str, Any], base_dir: Path | None = None,
                   where: str | None = None) -> Material:
         """Validate ``values`` against ``Params``; errors name the offending key."""
-        try:
-            params = cls.Params(**values)
-        except ValidationError as exc:
-            raise InputError(*format_validation_error(exc, where)) from None
-        material = cls(params, base_dir)
+        material = cls(validate_params(cls.Params, values, where), base_dir)
         from . import registry
 
         registry.shading_models.get(material.shading_model,
@@ -143,16 +126,7 @@ class Material:
 
     def uniforms(self, frame: Frame) -> dict[str, Any]:
         """``u_<field>`` for every parameter that is a uniform (``uniform_overrides``)."""
-        out: dict[str, Any] = {}
-        for name in type(self.params).model_fields:
-            value = getattr(self.params, name)
-            if name in self.uniform_overrides:
-                override = self.uniform_overrides[name]
-                if override is not None:
-                    out.update(override(value))
-            elif uniform_value(value):
-                out[f"u_{name}"] = value
-        return out
+        return params_uniforms(self.params, self.uniform_overrides)
 
     def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
         return {}
@@ -172,6 +146,13 @@ class Material:
 
     def forward_passes(self, obj: SceneObject) -> list[RenderPass]:
         return [ForwardLitPass(f"{obj.label}.forward", Phase.FORWARD, obj)]
+
+    @classmethod
+    def scene_passes(cls, objects: list[SceneObject], phase: Phase) -> list[RenderPass]:
+        """Passes this material adds once per scene, not per object, in ``phase`` (scene-wide
+        setup, screen or post effects of its own); ``objects`` are the scene's objects of this
+        material. Passes of one name from several materials (a shared technique's) run once."""
+        return []
 
     def passes(self, phase: Phase, obj: SceneObject) -> list[RenderPass]:
         hooks = {Phase.GEOMETRY: self.geometry_passes, Phase.SCREEN: self.screen_passes,

@@ -87,6 +87,8 @@ class ClearPass(RenderPass):
     """Create targets and nothing else: the renderer clears each to its declared value when this
     pass runs (the G-buffer's ``gbuffer.clear``)."""
 
+    order = Order.FIRST
+
     def __init__(self, name: str, phase: Phase, creates: dict[str, TargetSpec]):
         missing = [target for target, spec in creates.items() if spec.clear is None]
         if missing:
@@ -142,6 +144,14 @@ class FullscreenPass(RenderPass):
         count = self.instances(frame) if self.instances else 1
         if count > 0:
             frame.draw_fullscreen(program, instances=count)
+
+
+def copy_pass(name: str, phase: Phase, source: str, target: str, spec: TargetSpec,
+              order: int = Order.OPAQUE) -> FullscreenPass:
+    """A pass creating ``target`` as a copy of ``source`` (a snapshot a later pass reads while it
+    writes ``source``: GL forbids reading a texture while rendering into it)."""
+    return FullscreenPass(name, phase, "post/copy.frag", {"u_source": source}, (target,),
+                          creates={target: spec}, order=order)
 
 
 class ObjectPass(RenderPass):

@@ -2,7 +2,14 @@
 
 Deferred (Revie 2.1): geometry -> screen -> stipple -> lighting -> material -> post -> output.
 Forward: one lit pass per object (every light looped per fragment), then the materials' forward
-passes, then the same post. Both see the scene only through the material and light interfaces.
+passes, then the same post. Both see the scene only through the material, light and effect
+interfaces.
+
+Within a phase, passes run by ``Order`` rank; at one rank the pipeline's own passes come first,
+then scene-wide passes (effects, materials' ``scene_passes``) in scene order, then the objects':
+opaque ones in scene order, blended ones (volumes, transparent surfaces) far to near, so object
+order never changes the image. A scene-wide pass that several materials contribute under one
+name (a shared technique's) runs once.
 """
 
 from __future__ import annotations
@@ -11,12 +18,13 @@ from dataclasses import replace
 
 import numpy as np
 
+from .effect import AMBIENT_OCCLUSION
+from .errors import InputError
 from .gbuffer import DEPTH, GBUFFER_TARGETS, NORMAL_EXPONENT_ID
 from .graph import compile_graph
 from .light import LightTypePass
 from .passes import ClearPass, FullscreenPass, Order, Phase, RenderPass
 from .scene import Scene
-from .screen import SSAO, ssao_passes
 from .targets import (
     COMPOSITE,
     COMPOSITE_SPEC,
@@ -28,26 +36,59 @@ from .targets import (
 
 TONEMAPS = {"none": 0, "reinhard": 1, "aces": 2}
 
+PIPELINE_PASS, SCENE_PASS, OBJECT_PASS = 0, 1, 2  # groups within one Order rank
+
 
 def tonemap_pass() -> RenderPass:
     return FullscreenPass(
         "post.tonemap", Phase.POST, "post/tonemap.frag", {"u_source": COMPOSITE}, (FINAL,),
-        creates={FINAL: FINAL_SPEC}, uniforms=lambda frame: {"u_exposure": frame.scene.exposure,
+        creates={FINAL: FINAL_SPEC}, order=Order.FIRST,
+        uniforms=lambda frame: {"u_exposure": frame.scene.exposure,
                                 "u_tonemap": TONEMAPS[frame.scene.tonemap]})
 
 
-def object_passes(scene: Scene, phase: Phase) -> list[RenderPass]:
-    """The objects' passes of ``phase``, by ``Order``: opaque ones in scene order, blended
-    ones (volumes, transparent surfaces) far to near, so object order never changes the image."""
+def scene_passes(scene: Scene, pipeline: str) -> list[RenderPass]:
+    """Scene-wide passes of every phase: the effects' (those applying to ``pipeline``), then the
+    materials' (once per material class, shared names once)."""
+    passes: list[RenderPass] = []
+    for effect in scene.effects:
+        if pipeline in effect.pipelines:
+            passes += effect.passes(scene, pipeline)
+    by_class: dict[type, list] = {}
+    for obj in scene.objects:
+        by_class.setdefault(type(obj.material), []).append(obj)
+    phases = [Phase.FORWARD] if pipeline == "forward" else \
+        [Phase.GEOMETRY, Phase.SCREEN, Phase.STIPPLE, Phase.LIGHTING, Phase.MATERIAL]
+    shared: dict[str, RenderPass] = {}
+    for cls, objects in by_class.items():
+        for phase in [*phases, Phase.POST]:
+            for render_pass in cls.scene_passes(objects, phase):
+                first = shared.get(render_pass.name)
+                if first is None:
+                    shared[render_pass.name] = render_pass
+                    passes.append(render_pass)
+                elif type(first) is not type(render_pass):
+                    raise InputError(f"two materials add different scene passes named "
+                                     f"'{render_pass.name}'", f"material {cls.name}")
+    return passes
+
+
+def phase_passes(scene: Scene, phase: Phase, fixed: list[RenderPass],
+                 scene_wide: list[RenderPass]) -> list[RenderPass]:
+    """Every pass of ``phase``: the pipeline's own (``fixed``), the scene-wide ones of this
+    phase and the objects', ranked as the module documentation says."""
+    keyed = [((p.order, PIPELINE_PASS, 0.0, k), p) for k, p in enumerate(fixed)]
+    keyed += [((p.order, SCENE_PASS, 0.0, k), p) for k, p in enumerate(scene_wide)
+              if p.phase == phase]
     view = scene.camera.view()
-    keyed = []
     for index, obj in enumerate(scene.objects):
         low, high = obj.mesh.bounds()
         centre = obj.model @ np.append((low + high) / 2.0, 1.0)
         distance = -(view @ centre)[2]
         for render_pass in obj.material.passes(phase, obj):
             blended = render_pass.order >= Order.VOLUME
-            keyed.append(((render_pass.order, -distance if blended else 0.0, index), render_pass))
+            keyed.append(((render_pass.order, OBJECT_PASS, -distance if blended else 0.0, index),
+                          render_pass))
     return [render_pass for _, render_pass in sorted(keyed, key=lambda item: item[0])]
 
 
@@ -67,41 +108,39 @@ class DeferredPipeline(Pipeline):
 
     def build(self, scene: Scene) -> list[RenderPass]:
         layout = scene.gbuffer_layout()
-        passes: list[RenderPass] = [ClearPass("gbuffer.clear", Phase.GEOMETRY, layout.targets)]
-        passes += object_passes(scene, Phase.GEOMETRY)
-        passes += screen_passes(scene)
-        passes += object_passes(scene, Phase.SCREEN)
-        passes += object_passes(scene, Phase.STIPPLE)
-        passes.append(FullscreenPass(
+        wide = scene_passes(scene, self.name)
+        clear = ClearPass("gbuffer.clear", Phase.GEOMETRY, layout.targets)
+        passes = phase_passes(scene, Phase.GEOMETRY, [clear], wide)
+        passes += phase_passes(scene, Phase.SCREEN, [], wide)
+        passes += phase_passes(scene, Phase.STIPPLE, [], wide)
+        occlusion = AMBIENT_OCCLUSION if any(AMBIENT_OCCLUSION in p.creates for p in passes) \
+            else None
+        background = FullscreenPass(
             "lighting.background", Phase.LIGHTING, "lights/background.frag",
             {"u_normal_exponent_id": NORMAL_EXPONENT_ID}, (LIGHT_ACCUMULATION,),
-            creates={LIGHT_ACCUMULATION: LIGHT_ACCUMULATION_SPEC},
-            uniforms=lambda frame: {"u_background": frame.scene.background}))
-        occlusion = SSAO if scene.ssao else None
-        passes += [LightTypePass(cls, occlusion, layout.color_targets)
-                   for cls in scene.light_types()]
-        passes.append(FullscreenPass("material.composite_copy", Phase.MATERIAL, "post/copy.frag",
-                                     {"u_source": LIGHT_ACCUMULATION}, (COMPOSITE,),
-                                     creates={COMPOSITE: COMPOSITE_SPEC}))
-        passes += object_passes(scene, Phase.MATERIAL)
-        passes.append(tonemap_pass())
+            creates={LIGHT_ACCUMULATION: LIGHT_ACCUMULATION_SPEC}, order=Order.FIRST,
+            uniforms=lambda frame: {"u_background": frame.scene.background})
+        lights = [LightTypePass(cls, occlusion, layout.color_targets)
+                  for cls in scene.light_types()]
+        passes += phase_passes(scene, Phase.LIGHTING, [background, *lights], wide)
+        composite = FullscreenPass("material.composite_copy", Phase.MATERIAL, "post/copy.frag",
+                                   {"u_source": LIGHT_ACCUMULATION}, (COMPOSITE,),
+                                   creates={COMPOSITE: COMPOSITE_SPEC}, order=Order.FIRST)
+        passes += phase_passes(scene, Phase.MATERIAL, [composite], wide)
+        passes += phase_passes(scene, Phase.POST, [tonemap_pass()], wide)
         return passes
-
-
-def screen_passes(scene: Scene) -> list[RenderPass]:
-    """Scene-wide screen-space passes over the clean G-buffer (before any stipple)."""
-    return ssao_passes(scene.ssao) if scene.ssao else []
 
 
 class ForwardPipeline(Pipeline):
     name = "forward"
 
     def build(self, scene: Scene) -> list[RenderPass]:
-        passes: list[RenderPass] = [ClearPass("forward.clear", Phase.FORWARD, {
+        wide = scene_passes(scene, self.name)
+        clear = ClearPass("forward.clear", Phase.FORWARD, {
             COMPOSITE: replace(COMPOSITE_SPEC, clear=(*scene.background, 0.0)),
-            DEPTH: GBUFFER_TARGETS[DEPTH]})]
-        passes += object_passes(scene, Phase.FORWARD)
-        passes.append(tonemap_pass())
+            DEPTH: GBUFFER_TARGETS[DEPTH]})
+        passes = phase_passes(scene, Phase.FORWARD, [clear], wide)
+        passes += phase_passes(scene, Phase.POST, [tonemap_pass()], wide)
         return passes
 
 

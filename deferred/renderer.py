@@ -65,7 +65,8 @@ class Renderer:
         self.shaders = ShaderLibrary(ctx, features.glsl_version(), defines)
         light_types = scene.light_types()
         shading_models = scene.shading_models()
-        for cls in [type(obj.material) for obj in scene.objects] + light_types + shading_models:
+        for cls in [*(type(obj.material) for obj in scene.objects), *light_types,
+                    *shading_models, *(type(effect) for effect in scene.effects)]:
             if cls.shader_root is not None:
                 self.shaders.add_root(cls.shader_root)
         for name, text in generated_glsl(light_types, shading_models, scene.gbuffer_layout(),

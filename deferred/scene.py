@@ -17,11 +17,11 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 
 from . import registry
 from .camera import Camera, model_matrix
+from .effect import Effect
 from .errors import InputError
 from .light import Light
 from .material import Material
 from .mesh import MeshData, load_mesh
-from .screen import SSAOSettings
 from .shading import GBufferLayout, ShadingModel, compose_layout
 from .validation import format_validation_error
 
@@ -78,13 +78,9 @@ class ObjectModel(_Strict):
         return self
 
 
-class SSAOModel(_Strict):
-    radius: float = Field(0.35, gt=0.0, description="view-space sampling radius")
-    strength: float = Field(1.0, ge=0.0, le=4.0, description="how dark full occlusion gets")
-    samples: int = Field(16, ge=1, le=128, description="samples per pixel")
+class TypedModel(BaseModel):
+    """A ``[[light]]`` or ``[[effect]]`` table: its type, then that type's parameters."""
 
-
-class LightModel(BaseModel):
     model_config = ConfigDict(extra="allow")
     type: str
 
@@ -95,9 +91,11 @@ class SceneModel(_Strict):
     exposure: float = Field(1.0, gt=0.0)
     tonemap: Literal["reinhard", "aces", "none"] = "aces"
     camera: CameraModel = Field(default_factory=CameraModel)
-    ssao: SSAOModel | None = Field(None, description="screen-space ambient occlusion (deferred)")
+    ssao: dict[str, Any] | None = Field(
+        None, description="screen-space ambient occlusion (the same as [[effect]] type 'ssao')")
     object: list[ObjectModel] = Field(default_factory=list)
-    light: list[LightModel] = Field(default_factory=list)
+    light: list[TypedModel] = Field(default_factory=list)
+    effect: list[TypedModel] = Field(default_factory=list)
 
 
 @dataclass(eq=False)  # identity: the model matrix is an array, and objects are unique anyway
@@ -119,7 +117,7 @@ class Scene:
     background: tuple[float, float, float] = (0.02, 0.02, 0.025)
     exposure: float = 1.0
     tonemap: str = "aces"
-    ssao: SSAOSettings | None = None
+    effects: list[Effect] = field(default_factory=list)
     source: str = "<memory>"
 
     def gbuffer_layout(self) -> GBufferLayout:
@@ -208,8 +206,7 @@ def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
     c = model.camera
     scene = Scene(camera=Camera(c.position, c.target, c.up, c.fov, c.near, c.far),
                   size=model.size, background=model.background, exposure=model.exposure,
-                  tonemap=model.tonemap, source=name,
-                  ssao=SSAOSettings(**model.ssao.model_dump()) if model.ssao else None)
+                  tonemap=model.tonemap, source=name)
     meshes: dict[str, MeshData] = {}
     for index, obj in enumerate(model.object):
         where = f"{name}: object[{index}]"
@@ -227,4 +224,14 @@ def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
         where = f"{name}: light[{index}]"
         light_cls = registry.lights.get(light.type, f"{where}.type")
         scene.lights.append(light_cls.from_dict(light.model_extra or {}, where))
+    effects = [(f"{name}: effect[{index}]", e.type, e.model_extra or {})
+               for index, e in enumerate(model.effect)]
+    if model.ssao is not None:  # the [ssao] table of earlier scene files
+        if any(kind == "ssao" for _, kind, _ in effects):
+            raise InputError("ssao is given both as [ssao] and as an [[effect]]; keep one",
+                             f"{name}: ssao")
+        effects.insert(0, (f"{name}: ssao", "ssao", model.ssao))
+    for where, kind, values in effects:
+        effect_cls = registry.effects.get(kind, f"{where}.type")
+        scene.effects.append(effect_cls.from_dict(values, where))
     return scene

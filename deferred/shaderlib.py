@@ -46,6 +46,21 @@ class Source:
         return ("<generated>", line)
 
 
+_registered_roots: list[Traversable | Path] = []
+
+
+def register_shader_root(root: Traversable | Path | str) -> None:
+    """Search ``root`` for GLSL in every shader library from now on: the public way for a
+    plugin to ship shader files (a package's ``importlib.resources.files(...)`` or a folder).
+    Roots are searched in order, the framework's own first; a class's ``shader_root``
+    (materials, lights, shading models, effects) is added for the scenes that use it."""
+    root = Path(root) if isinstance(root, str) else root
+    if not root.is_dir():
+        raise ValueError(f"shader root is not a folder: {root}")
+    if root not in _registered_roots:
+        _registered_roots.append(root)
+
+
 class ShaderLibrary:
     """Resolves, assembles, compiles and caches GLSL programs for one context."""
 
@@ -54,7 +69,8 @@ class ShaderLibrary:
         self.ctx = ctx
         self.glsl_version = glsl_version
         self.global_defines = dict(defines or {})
-        self.roots: list[Traversable | Path] = [resources.files("deferred.shaders")]
+        self.roots: list[Traversable | Path] = [resources.files("deferred.shaders"),
+                                                *_registered_roots]
         self.virtual_files: dict[str, str] = {}
         self._programs: dict[tuple, moderngl.Program] = {}
         self._declared: dict[int, frozenset[str]] = {}  # program glo -> declared uniform names

@@ -28,7 +28,12 @@ from deferred.validation import NonZeroVec3
 
 from .techniques.heightfield import heightfield_texture, load_heightfield, procedural_heightfield
 from .techniques.shells import ShellPass
-from .techniques.stipple import StippleObliterationPass, StipplePass, pattern_defines
+from .techniques.stipple import (
+    StippleObliterationPass,
+    StipplePass,
+    pattern_defines,
+    stipple_scene_passes,
+)
 
 if TYPE_CHECKING:
     from deferred.frame import Frame
@@ -121,6 +126,11 @@ class RevieFurMaterial(Material):
             lambda ctx: heightfield_texture(ctx, procedural_heightfield(seed=seed)))
 
     # -- passes ------------------------------------------------------------------------------
+    @classmethod
+    def scene_passes(cls, objects: list[SceneObject], phase: Phase) -> list[RenderPass]:
+        stippled = any(obj.material.params.stipple for obj in objects)
+        return stipple_scene_passes(phase) if stippled else []
+
     def geometry_passes(self, obj: SceneObject) -> list[RenderPass]:
         return [GBufferPass(f"{obj.label}.gbuffer", Phase.GEOMETRY, obj, vertex=FUR_VERTEX,
                             constants=BASE_SHELL)]

@@ -20,7 +20,12 @@ from deferred.passes import ObjectPass, Order, Phase, RenderPass
 from deferred.registry import materials
 from deferred.targets import COMPOSITE, LIGHT_ACCUMULATION
 
-from .techniques.stipple import StippleObliterationPass, StipplePass, pattern_defines
+from .techniques.stipple import (
+    StippleObliterationPass,
+    StipplePass,
+    pattern_defines,
+    stipple_scene_passes,
+)
 
 if TYPE_CHECKING:
     from deferred.scene import SceneObject
@@ -55,6 +60,10 @@ class StippleGlassMaterial(Material):
 
     def defines(self, obj: SceneObject) -> dict[str, str]:
         return {**super().defines(obj), **pattern_defines(self.params.pattern)}
+
+    @classmethod
+    def scene_passes(cls, objects: list[SceneObject], phase: Phase) -> list[RenderPass]:
+        return stipple_scene_passes(phase)
 
     def geometry_passes(self, obj: SceneObject) -> list[RenderPass]:
         return []  # transparent: nothing in the opaque G-buffer phase

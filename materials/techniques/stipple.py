@@ -4,16 +4,32 @@ A stipple pass writes a mesh into the G-buffer at one pixel in two or four; the 
 lights those samples like any other; a material-phase pass then reads them back and erases them
 from the composition buffer. ``STIPPLE_PATTERN`` (2 or 4) selects the pattern in
 ``techniques/stipple.glsl``.
+
+Obliteration restores what the composition holds, not the raw light: after every material's own
+opaque pass (``Order.OPAQUE``), one scene-wide pass snapshots the composition
+(:func:`stipple_scene_passes`, shared by every stipple user) and each obliteration copies the
+neighbouring pixel from that snapshot, so a material that altered its pixels keeps its look
+under another's stipple samples.
 """
 
 from __future__ import annotations
 
 from deferred.gbuffer import DEPTH, LINEAR_DEPTH, NORMAL_EXPONENT_ID
 from deferred.material import GBufferPass
-from deferred.passes import ObjectPass
-from deferred.targets import COMPOSITE, LIGHT_ACCUMULATION
+from deferred.passes import ObjectPass, Order, Phase, RenderPass, copy_pass
+from deferred.targets import COMPOSITE, COMPOSITE_SPEC
 
 PATTERNS = (2, 4)
+COMPOSITE_SNAPSHOT = "composite_snapshot"
+
+
+def stipple_scene_passes(phase: Phase) -> list[RenderPass]:
+    """The once-per-scene pass obliteration needs: in the material phase, the composition as
+    materials' opaque passes left it (every stipple user returns it; it runs once)."""
+    if phase != Phase.MATERIAL:
+        return []
+    return [copy_pass("material.stipple_snapshot", Phase.MATERIAL, COMPOSITE,
+                      COMPOSITE_SNAPSHOT, COMPOSITE_SPEC, order=Order.RESTORE)]
 
 
 def pattern_defines(pattern: int) -> dict[str, str]:
@@ -29,7 +45,8 @@ class StipplePass(GBufferPass):
 
 class StippleObliterationPass(ObjectPass):
     """Material phase: where this mesh's stipple samples sit in the composition buffer, copy the
-    neighbouring pixel's light and depth over them (``techniques/stipple_obliterate.frag``).
+    neighbouring pixel's composition (from the snapshot) and depth over them
+    (``techniques/stipple_obliterate.frag``).
 
     Drawn with the same vertex shader and uniforms as the stipple pass; a pixel is treated as a
     stipple sample only if the G-buffer there holds this material at this fragment's depth.
@@ -40,4 +57,5 @@ class StippleObliterationPass(ObjectPass):
     depth = DEPTH
     depth_test = True
     depth_func = "always"  # the pass writes depth (gl_FragDepth) wherever it keeps a fragment
-    extra_reads = (LIGHT_ACCUMULATION, LINEAR_DEPTH, NORMAL_EXPONENT_ID)
+    order = Order.RESTORE
+    extra_reads = (COMPOSITE_SNAPSHOT, LINEAR_DEPTH, NORMAL_EXPONENT_ID)

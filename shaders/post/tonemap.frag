@@ -1,4 +1,6 @@
 // Post: exposure, tone mapping and sRGB encoding of the composition buffer.
+#include "common/color.glsl"
+
 uniform sampler2D u_source;
 uniform float u_exposure;
 uniform int u_tonemap;  // 0 none (clamp), 1 Reinhard, 2 ACES (Narkowicz 2015 fit)
@@ -7,11 +9,6 @@ out vec4 out_color;
 
 vec3 aces_fit(vec3 x) {
     return clamp((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0);
-}
-
-vec3 srgb_encode(vec3 c) {
-    c = clamp(c, 0.0, 1.0);
-    return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(0.0031308, c));
 }
 
 void main() {

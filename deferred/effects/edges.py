@@ -1,0 +1,55 @@
+"""Edges: outlines from G-buffer discontinuities (the cartoon material's outlines, Costigan's
+Sobel + dilation), detected over the clean G-buffer in the screen phase and composited over the
+tone-mapped frame in post (``screen/edges.frag``)."""
+
+from __future__ import annotations
+
+from pydantic import Field
+
+from ..effect import Effect, EffectParams
+from ..gbuffer import LINEAR_DEPTH, NORMAL_EXPONENT_ID
+from ..passes import FullscreenPass, Order, Phase, RenderPass
+from ..registry import effects
+from ..targets import FINAL
+from ..targets_spec import TargetSpec
+
+EDGES_RAW = "edges_raw"
+EDGES = "edges"
+EDGES_SPEC = TargetSpec(1, "f1", "edge mask (1 = line)")
+
+
+class EdgesParams(EffectParams):
+    width: int = Field(1, ge=1, le=16, description="line width in pixels (dilation)")
+    color: tuple[float, float, float] = Field((0.0, 0.0, 0.0), description="linear RGB")
+    opacity: float = Field(1.0, ge=0.0, le=1.0, description="line opacity")
+    depth_threshold: float = Field(0.05, gt=0.0, le=10.0,
+                                   description="depth break: relative inverse-depth jump")
+    normal_threshold: float = Field(0.35, gt=0.0, le=2.0,
+                                    description="crease: normal change across a pixel")
+    ids: bool = Field(True, description="lines where the surface id changes")
+
+
+@effects.register
+class Edges(Effect):
+    name = "edges"
+    Params = EdgesParams
+    pipelines = ("deferred",)  # reads the G-buffer
+
+    def passes(self, scene, pipeline: str) -> list[RenderPass]:
+        return [
+            FullscreenPass("screen.edges", Phase.SCREEN, "screen/edges.frag",
+                           {"u_linear_depth": LINEAR_DEPTH,
+                            "u_normal_exponent_id": NORMAL_EXPONENT_ID},
+                           (EDGES_RAW,), creates={EDGES_RAW: EDGES_SPEC},
+                           uniforms=lambda frame: {
+                               "u_depth_threshold": self.params.depth_threshold,
+                               "u_normal_threshold": self.params.normal_threshold,
+                               "u_ids": self.params.ids}),
+            FullscreenPass("screen.edges_dilate", Phase.SCREEN, "screen/edges_dilate.frag",
+                           {"u_edges_raw": EDGES_RAW}, (EDGES,), creates={EDGES: EDGES_SPEC},
+                           uniforms=lambda frame: {"u_width": self.params.width}),
+            FullscreenPass("post.edges", Phase.POST, "post/edges_composite.frag",
+                           {"u_edges": EDGES}, (FINAL,), blend="alpha", order=Order.TRANSPARENT,
+                           uniforms=lambda frame: {"u_color": self.params.color,
+                                                   "u_opacity": self.params.opacity}),
+        ]

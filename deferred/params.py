@@ -1,0 +1,55 @@
+"""Validated parameters (materials, effects) and the uniforms they become.
+
+Every parameter model forbids unknown keys and is frozen. A field ``foo`` becomes the uniform
+``u_foo`` when its value is a number, a boolean or a tuple of 2 to 4 numbers; strings and
+``None`` are not uniforms. ``overrides`` maps a field to ``None`` (not a uniform: a pass count,
+a define, a file) or to a function of the value giving the uniforms it becomes.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from pydantic import BaseModel, ConfigDict, ValidationError
+
+from .errors import InputError
+from .validation import format_validation_error
+
+UniformOverrides = dict[str, Callable[[Any], dict[str, Any]] | None]
+
+
+class Params(BaseModel):
+    """Base of every parameter model: unknown keys are errors, values never change."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+def validate_params(model: type[Params], values: dict[str, Any], where: str | None) -> Params:
+    """``model(**values)``; a validation error is an ``InputError`` naming the key."""
+    try:
+        return model(**values)
+    except ValidationError as exc:
+        raise InputError(*format_validation_error(exc, where)) from None
+
+
+def uniform_value(value: Any) -> bool:
+    """Whether a parameter value maps to a GLSL uniform as it is."""
+    if isinstance(value, bool | int | float):
+        return True
+    return isinstance(value, tuple) and 2 <= len(value) <= 4 and \
+        all(isinstance(v, int | float) and not isinstance(v, bool) for v in value)
+
+
+def params_uniforms(params: BaseModel, overrides: UniformOverrides) -> dict[str, Any]:
+    """``u_<field>`` for every field of ``params`` that is a uniform (see the module doc)."""
+    out: dict[str, Any] = {}
+    for name in type(params).model_fields:
+        value = getattr(params, name)
+        if name in overrides:
+            override = overrides[name]
+            if override is not None:
+                out.update(override(value))
+        elif uniform_value(value):
+            out[f"u_{name}"] = value
+    return out
