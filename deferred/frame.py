@@ -29,6 +29,8 @@ BLEND_MODES = {
     "alpha": (moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA, moderngl.ONE,
               moderngl.ONE_MINUS_SRC_ALPHA),
     "premultiplied": (moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA),
+    # colour times the source (a tint over what is there); alpha kept
+    "multiply": (moderngl.DST_COLOR, moderngl.ZERO, moderngl.ZERO, moderngl.ONE),
 }
 DEPTH_FUNCS = {"less": "<", "lequal": "<=", "gequal": ">=", "greater": ">", "equal": "==",
                "always": "1"}

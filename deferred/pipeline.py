@@ -14,6 +14,7 @@ name (a shared technique's) runs once.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import replace
 
 import numpy as np
@@ -54,6 +55,9 @@ def scene_passes(scene: Scene, pipeline: str) -> list[RenderPass]:
     for effect in scene.effects:
         if pipeline in effect.pipelines:
             passes += effect.passes(scene, pipeline)
+        else:
+            warnings.warn(f"effect {effect.name} applies to the {', '.join(effect.pipelines)} "
+                          f"pipeline only; skipped in the {pipeline} pipeline", stacklevel=2)
     by_class: dict[type, list] = {}
     for obj in scene.objects:
         by_class.setdefault(type(obj.material), []).append(obj)
