@@ -53,12 +53,14 @@ def cli(debug: bool) -> None:
 @click.option("--size", help="WIDTHxHEIGHT, overrides the scene's size.")
 @click.option("--frames", type=click.IntRange(min=1), default=1, show_default=True,
               help="Render this many frames (timing); the last one is written.")
+@click.option("--strict", is_flag=True,
+              help="Fail on a uniform set by name that its program does not declare.")
 @click.option("--view", "view_name", metavar="BUFFER",
               help="Write one buffer instead of the final image: albedo, normal, depth, "
                    "specular, material, light, composite, a target, or a pass (PASS or "
                    "PASS:TARGET). '--view help' lists them.")
 def render(scene: str | None, output: str, pipeline: str, size: str | None, frames: int,
-           view_name: str | None) -> None:
+           strict: bool, view_name: str | None) -> None:
     """Render SCENE (a TOML file; the built-in demo when omitted) to an image."""
     from .buffer_views import resolve_view, view, view_catalogue, write_view
     from .capture import capture_frame
@@ -71,7 +73,7 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
         return
     out = check_output_path(output)
     loaded = _scene(scene)
-    with Renderer(loaded, pipeline, _size_option(size)) as renderer:
+    with Renderer(loaded, pipeline, _size_option(size), strict=strict or None) as renderer:
         if view_name is not None:
             view_pass, _ = resolve_view(view_name, renderer.passes)  # bad names fail here
         times = []
@@ -109,10 +111,13 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
 @click.option("--pixel", metavar="X,Y",
               help="Print every pass that wrote this pixel (top-down coordinates) and what it "
                    "wrote; recorded in the manifest too.")
+@click.option("--strict", is_flag=True,
+              help="Fail on a uniform set by name that its program does not declare.")
 @click.option("--compare", nargs=2, type=click.Path(), metavar="DIR_A DIR_B",
               help="Compare two dumps: per-buffer max/mean differences and difference images.")
 def dump(scene: str | None, output: str | None, pipeline: str, size: str | None,
-         passes: str | None, pixel: str | None, compare: tuple[str, str] | None) -> None:
+         passes: str | None, pixel: str | None, strict: bool,
+         compare: tuple[str, str] | None) -> None:
     """Write every buffer of every pass of one frame of SCENE as EXR, plus a contact sheet and
     a manifest (DESIGN.md, "Dumps")."""
     from rich.progress import Progress, SpinnerColumn, TextColumn
@@ -135,7 +140,7 @@ def dump(scene: str | None, output: str | None, pipeline: str, size: str | None,
         raise InputError("exists and is not a folder", str(out_dir))
     loaded = _scene(scene)
     patterns = [p.strip() for p in passes.split(",") if p.strip()] if passes is not None else None
-    with Renderer(loaded, pipeline, _size_option(size)) as renderer:
+    with Renderer(loaded, pipeline, _size_option(size), strict=strict or None) as renderer:
         chosen = select_passes(renderer.passes, patterns)  # bad input fails before any file
         where = parse_pixel(pixel, renderer.size) if pixel is not None else None
         with Progress(SpinnerColumn(), TextColumn("{task.description}"), console=stderr,
@@ -271,7 +276,7 @@ def info(scene: str | None) -> None:
     layout = _scene(scene).gbuffer_layout()  # bad input fails before GL start-up
     gl = create_context()
     try:
-        console = Console()
+        console = Console(soft_wrap=True, markup=False)  # one line per entry; [..] is text
         console.print(f"gbuffer: {layout.bytes_per_pixel} bytes per pixel")
         for name, entry in layout.describe().items():
             channels = f"  [{' '.join(entry['channels'])}]" if "channels" in entry else ""

@@ -38,7 +38,8 @@ GBUFFER_COLOR_TARGETS = (ALBEDO_SPECULAR, NORMAL_EXPONENT_ID, LINEAR_DEPTH)
 GBUFFER_TARGETS: dict[str, TargetSpec] = {
     ALBEDO_SPECULAR: TargetSpec(4, "f1", "albedo.rgb, specular intensity", clear=(0.0,) * 4),
     NORMAL_EXPONENT_ID: TargetSpec(4, "f2", "octahedral view normal (2), specular exponent, "
-                                            "material id", clear=(0.0,) * 4),
+                                            "surface id (shading model, material)",
+                                   clear=(0.0,) * 4),
     LINEAR_DEPTH: TargetSpec(1, "f4", "linear view depth (0 = background)", clear=(0.0,)),
     DEPTH: TargetSpec(1, "f4", "hardware depth", depth=True, clear=(1.0,)),
 }
