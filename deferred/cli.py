@@ -256,7 +256,8 @@ def materials() -> None:
     """List registered materials and their parameters."""
     console = Console()
     for name, cls in registry.materials.items():
-        table = Table(title=f"{name}  (id {cls.type_id}, {cls.__module__})", title_justify="left")
+        table = Table(title=f"{name}  (id {cls.type_id}, shading model {cls.shading_model}, "
+                            f"{cls.__module__})", title_justify="left")
         for column in ("parameter", "type", "default", "range"):
             table.add_column(column, no_wrap=True)
         table.add_column("description")

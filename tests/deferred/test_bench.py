@@ -60,7 +60,10 @@ def test_cli_sweep_writes_json_csv_plot(tmp_path, capsys):
     assert set(report) == {"renderer", "results"}
     for key in ("vendor", "renderer", "version"):
         assert report["renderer"][key]
-    assert report["renderer"]["gbuffer_bytes_per_pixel"] == bytes_per_pixel()
+    assert report["renderer"]["gbuffer_bytes_per_pixel"] == bytes_per_pixel() == 20
+    layout = report["renderer"]["gbuffer_layout"]
+    assert list(layout) == ["albedo_specular", "normal_exponent_id", "linear_depth", "depth"]
+    assert sum(entry["bytes_per_pixel"] for entry in layout.values()) == 20
     results = report["results"]
     combos = Counter((r["pipeline"], r["lights"], r["shells"]) for r in results)
     assert set(combos) == set(itertools.product(("deferred", "forward"), (0, 3), (0, 4)))

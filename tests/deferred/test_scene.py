@@ -50,8 +50,8 @@ def test_builtin_demo_scene_loads():
 @pytest.mark.parametrize("edit, expected", [
     (lambda t: t.replace("size = [320, 200]", "size = [320, 0]"), "s.toml: size: size 320x0"),
     (lambda t: t.replace("fov = 45.0", "fov = 400.0"), "s.toml: camera.fov: "),
-    (lambda t: t.replace('material = "standard"', 'material = "velvet"'),
-     "s.toml: object[0].material: unknown material 'velvet'"),
+    (lambda t: t.replace('material = "standard"', 'material = "no_such_material"'),
+     "s.toml: object[0].material: unknown material 'no_such_material'"),
     (lambda t: t.replace("color = [0.5, 0.2, 0.1]", "shininess = 3"),
      "s.toml: object[0].params.shininess: unknown parameter"),
     (lambda t: t.replace("color = [0.5, 0.2, 0.1]", "specular_intensity = 3.0"),
