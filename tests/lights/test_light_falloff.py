@@ -4,6 +4,7 @@ import math
 
 import numpy as np
 import pytest
+from plane_reference import plane_points
 
 from deferred.context import Features, GLContext
 from deferred.lights.point import distance_falloff
@@ -14,23 +15,6 @@ from deferred.scene import scene_from_dict
 SIZE = (96, 72)
 CAMERA = {"position": [0.0, 4.0, 0.0], "target": [0.0, 0.0, 0.0], "up": [0.0, 0.0, -1.0],
           "fov": 60.0}
-
-
-def plane_points(scene) -> np.ndarray:
-    """World position where each pixel's centre ray meets the plane y = 0 (bottom row first)."""
-    width, height = SIZE
-    view = scene.camera.view()
-    projection = scene.camera.projection(width / height)
-    inverse = np.linalg.inv(projection @ view)
-    x = (np.arange(width) + 0.5) / width * 2.0 - 1.0
-    y = (np.arange(height) + 0.5) / height * 2.0 - 1.0
-    xx, yy = np.meshgrid(x, y)
-    def unproject(z):
-        p = np.stack([xx, yy, np.full_like(xx, z), np.ones_like(xx)], -1) @ inverse.T
-        return p[..., :3] / p[..., 3:]
-    near, far = unproject(-1.0), unproject(1.0)
-    t = near[..., 1] / (near[..., 1] - far[..., 1])
-    return near + (far - near) * t[..., None]
 
 
 def blinn_phong(points, to_light, radiance, specular, exponent, camera):
@@ -71,7 +55,7 @@ def test_point_light_falloff_reaches_zero_at_radius(gl, pipeline, storage):
     light = {"type": "point", "position": position.tolist(), "color": [1.0, 0.5, 0.25],
              "intensity": 3.0, "radius": 1.8}
     scene, image = render_plane(gl, light, pipeline, storage)
-    points = plane_points(scene)
+    points = plane_points(scene, SIZE)
     to_light = position - points
     d = np.linalg.norm(to_light, axis=-1)
     radiance = np.array([1.0, 0.5, 0.25]) * 3.0 * distance_falloff(d, 1.8)[..., None]
@@ -91,7 +75,7 @@ def test_spot_light_cone_against_numpy(gl, pipeline, storage):
              "color": [0.2, 1.0, 0.6], "intensity": 4.0, "radius": 4.0,
              "inner_angle": 15.0, "outer_angle": 30.0}
     scene, image = render_plane(gl, light, pipeline, storage)
-    points = plane_points(scene)
+    points = plane_points(scene, SIZE)
     to_light = position - points
     d = np.linalg.norm(to_light, axis=-1)
     direction = to_light / d[..., None]
@@ -110,7 +94,7 @@ def test_directional_light_with_blinn_phong_highlight(gl, pipeline, storage):
     light = {"type": "directional", "direction": direction.tolist(), "color": [1.0, 1.0, 1.0],
              "intensity": 0.8}
     scene, image = render_plane(gl, light, pipeline, storage, specular=0.5, exponent=24.0)
-    points = plane_points(scene)
+    points = plane_points(scene, SIZE)
     to_light = np.broadcast_to(-direction / np.linalg.norm(direction), points.shape)
     want = blinn_phong(points, to_light, np.array([0.8, 0.8, 0.8]), 0.5, 24.0,
                        CAMERA["position"])

@@ -5,6 +5,7 @@ dumps), and the isolation of models a scene does not use."""
 import numpy as np
 import pytest
 from model_materials import StrandMaterial, ToonMaterial
+from plane_reference import plane_points
 
 from deferred import registry
 from deferred.capture import capture_frame
@@ -29,23 +30,6 @@ def model_materials():
         registry.materials.unregister(cls.name)
 
 
-def plane_points(scene) -> np.ndarray:
-    """World position where each pixel's centre ray meets the plane y = 0 (bottom row first)."""
-    width, height = SIZE
-    inverse = np.linalg.inv(scene.camera.projection(width / height) @ scene.camera.view())
-    x = (np.arange(width) + 0.5) / width * 2.0 - 1.0
-    y = (np.arange(height) + 0.5) / height * 2.0 - 1.0
-    xx, yy = np.meshgrid(x, y)
-
-    def unproject(z):
-        p = np.stack([xx, yy, np.full_like(xx, z), np.ones_like(xx)], -1) @ inverse.T
-        return p[..., :3] / p[..., 3:]
-
-    near, far = unproject(-1.0), unproject(1.0)
-    t = near[..., 1] / (near[..., 1] - far[..., 1])
-    return near + (far - near) * t[..., None]
-
-
 def plane_scene(material: str, params: dict, objects: list | None = None, camera=None):
     return scene_from_dict({
         "size": list(SIZE), "tonemap": "none", "camera": camera or CAMERA,
@@ -63,7 +47,7 @@ def render_hdr(gl, scene, pipeline):
 def light_terms(scene):
     from deferred.lights.point import distance_falloff
 
-    points = plane_points(scene)
+    points = plane_points(scene, SIZE)
     to_light = LIGHT_POSITION - points
     d = np.linalg.norm(to_light, axis=-1, keepdims=True)
     L = to_light / d
