@@ -57,7 +57,7 @@ def cli(debug: bool) -> None:
               help="Fail on a uniform set by name that its program does not declare.")
 @click.option("--view", "view_name", metavar="BUFFER",
               help="Write one buffer instead of the final image: albedo, normal, depth, "
-                   "specular, material, light, composite, a target, or a pass (PASS or "
+                   "specular, material, shading, light, composite, a target, or a pass (PASS or "
                    "PASS:TARGET). '--view help' lists them.")
 def render(scene: str | None, output: str, pipeline: str, size: str | None, frames: int,
            strict: bool, view_name: str | None) -> None:

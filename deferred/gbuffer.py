@@ -49,11 +49,6 @@ DATA_STRUCT_FILE = "generated/gbuffer_data.glsl"
 DATA_FETCH_FILE = "generated/gbuffer_data_fetch.glsl"
 
 
-def bytes_per_pixel() -> int:
-    """Bytes per pixel of the core G-buffer (a scene without declared data)."""
-    return sum(spec.bytes_per_pixel for spec in GBUFFER_TARGETS.values())
-
-
 def data_write_file(names: Sequence[str]) -> str:
     """The generated GLSL writing these data targets (a material's G-buffer passes)."""
     return f"generated/gbuffer_write/{'+'.join(names) or 'none'}.glsl"

@@ -7,7 +7,9 @@ and refuses, naming the pass and the target:
 - two passes with one name;
 - a target created twice;
 - a read or write of a target no pass creates (an unknown target);
-- a read or write before the pass that creates the target (no earlier producer).
+- a read or write before the pass that creates the target (no earlier producer);
+- a target sampled by the pass that draws into it (a GL feedback loop: snapshot it first with
+  :func:`deferred.passes.copy_pass`).
 
 What it returns is every target of the frame with its format: the renderer creates exactly
 those, and clears each when its creating pass runs.
@@ -59,6 +61,10 @@ def compile_graph(passes: Sequence[RenderPass]) -> PassGraph:
     created: set[str] = set()
     for render_pass in passes:
         created.update(render_pass.creates)
+        for target in render_pass.samples:
+            if target in render_pass.writes:
+                raise PassGraphError(f"pass {render_pass.name}: samples target '{target}' while "
+                                     "writing it (snapshot it first with copy_pass)")
         for kind, used in (("reads", render_pass.reads), ("writes", render_pass.writes)):
             for target in used:
                 if target in created:

@@ -19,14 +19,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import Field
 
-from .errors import InputError
 from .gbuffer import DEPTH, GBUFFER_COLOR_TARGETS
 from .mesh import MeshData, build_mesh
+from .params import Params, validate_params
 from .passes import Phase, RenderPass
 from .targets import LIGHT_ACCUMULATION
-from .validation import format_validation_error
 
 if TYPE_CHECKING:
     from .frame import Frame
@@ -36,9 +35,7 @@ DISPATCH_FILE = "generated/lights.glsl"
 SHADING_DISPATCH_FILE = "generated/shading_models.glsl"
 
 
-class LightParams(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
-
+class LightParams(Params):
     color: Vec3 = Field((1.0, 1.0, 1.0), description="linear RGB colour")
     intensity: float = Field(1.0, ge=0.0, description="multiplier of color")
 
@@ -57,10 +54,7 @@ class Light:
 
     @classmethod
     def from_dict(cls, values: dict[str, Any], where: str | None = None) -> Light:
-        try:
-            return cls(cls.Params(**values))
-        except ValidationError as exc:
-            raise InputError(*format_validation_error(exc, where)) from None
+        return cls(validate_params(cls.Params, values, where))
 
     def radiance(self) -> np.ndarray:
         return np.asarray(self.params.color, dtype=np.float64) * self.params.intensity
@@ -122,7 +116,8 @@ class LightTypePass(RenderPass):
         self.name = f"lighting.{light_type.name}"
         self.occlusion = occlusion  # target holding ambient occlusion (SSAO), if any
         self.gbuffer = gbuffer
-        self.reads = (*gbuffer, DEPTH, LIGHT_ACCUMULATION) + ((occlusion,) if occlusion else ())
+        self.samples = (*gbuffer, *((occlusion,) if occlusion else ()))
+        self.reads = (*self.samples, DEPTH, LIGHT_ACCUMULATION)
 
     def execute(self, frame: Frame) -> None:
         offset, count = frame.light_buffer.range(self.light_type)

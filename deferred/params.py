@@ -18,6 +18,13 @@ from .validation import format_validation_error
 
 UniformOverrides = dict[str, Callable[[Any], dict[str, Any]] | None]
 
+# Uniforms the framework sets on every pass (camera, transforms, ids, light buffer): a parameter
+# must not shadow one.
+RESERVED_UNIFORMS = frozenset({
+    "u_projection", "u_inverse_projection", "u_view", "u_resolution", "u_near_far", "u_model",
+    "u_model_view", "u_normal_matrix", "u_surface_id", "u_light_count", "u_lights",
+    "u_light_offset", "u_volume_scale"})
+
 
 class Params(BaseModel):
     """Base of every parameter model: unknown keys are errors, values never change."""
@@ -52,4 +59,9 @@ def params_uniforms(params: BaseModel, overrides: UniformOverrides) -> dict[str,
                 out.update(override(value))
         elif uniform_value(value):
             out[f"u_{name}"] = value
+    reserved = RESERVED_UNIFORMS.intersection(out)
+    if reserved:
+        raise ValueError(f"{type(params).__name__}: parameters would set the framework's "
+                         f"uniform {', '.join(sorted(reserved))}; rename them or map them with "
+                         "uniform_overrides")
     return out

@@ -46,10 +46,11 @@ class Order:
     from what the composition holds by then), then volumes (fur shells) and transparent surfaces
     are composited over it, far to near, so the image does not depend on the order of objects in
     the scene. The forward phase uses the same ranks: opaque lit passes, then blended ones. Post
-    passes use them too: tone mapping first (``OPAQUE``), then effects over the final image.
+    passes use them too: tone mapping first (``FIRST``), effects composited over the final image
+    (``TRANSPARENT``), anti-aliasing last (``LAST``).
     """
 
-    FIRST = -10  # scene-wide passes that must precede every object's (snapshots, setup)
+    FIRST = -10  # passes that must precede every object's (clears, copies, tone mapping)
     OPAQUE = 0  # an object's own opaque pixels
     RESTORE = 5  # erasing stipple samples, which restores the opaque scene
     VOLUME = 10  # blended, depth-tested without depth writes: sorted far to near
@@ -65,6 +66,7 @@ class RenderPass(ABC):
     creates: Mapping[str, TargetSpec] = MappingProxyType({})
     reads: tuple[str, ...] = ()
     writes: tuple[str, ...] = ()
+    samples: tuple[str, ...] = ()  # the reads bound as textures: never also written (GL feedback)
     order: int = Order.OPAQUE
 
     def prepare(self, frame: Frame) -> None:  # noqa: B027 - optional hook
@@ -129,6 +131,7 @@ class FullscreenPass(RenderPass):
         self.depth_func = depth_func
         self.depth_write = depth_write
         self.instances = instances
+        self.samples = tuple(dict.fromkeys(inputs.values()))
         self.reads = tuple(dict.fromkeys(
             [*inputs.values(), *(outputs if blend else ()),
              *((depth,) if depth and (depth_test or not depth_write) else ())]))
@@ -184,6 +187,7 @@ class ObjectPass(RenderPass):
                     not hasattr(type(self), key):
                 raise TypeError(f"{type(self).__name__} has no option '{key}'")
             setattr(self, key, value)
+        self.samples = tuple(self.extra_reads)
         self.reads = tuple(dict.fromkeys(
             [*self.extra_reads, *(self.colors if self.blend else ()),
              *((self.depth,) if self.depth and (self.depth_test or not self.depth_write)

@@ -24,7 +24,7 @@ from .errors import InputError
 from .gbuffer import DEPTH, GBUFFER_TARGETS, NORMAL_EXPONENT_ID
 from .graph import compile_graph
 from .light import LightTypePass
-from .passes import ClearPass, FullscreenPass, Order, Phase, RenderPass
+from .passes import ClearPass, FullscreenPass, Order, Phase, RenderPass, copy_pass
 from .scene import Scene
 from .targets import (
     COMPOSITE,
@@ -71,7 +71,8 @@ def scene_passes(scene: Scene, pipeline: str) -> list[RenderPass]:
                 if first is None:
                     shared[render_pass.name] = render_pass
                     passes.append(render_pass)
-                elif type(first) is not type(render_pass):
+                elif type(first) is not type(render_pass) or \
+                        first.describe() != render_pass.describe():
                     raise InputError(f"two materials add different scene passes named "
                                      f"'{render_pass.name}'", f"material {cls.name}")
     return passes
@@ -127,9 +128,8 @@ class DeferredPipeline(Pipeline):
         lights = [LightTypePass(cls, occlusion, layout.color_targets)
                   for cls in scene.light_types()]
         passes += phase_passes(scene, Phase.LIGHTING, [background, *lights], wide)
-        composite = FullscreenPass("material.composite_copy", Phase.MATERIAL, "post/copy.frag",
-                                   {"u_source": LIGHT_ACCUMULATION}, (COMPOSITE,),
-                                   creates={COMPOSITE: COMPOSITE_SPEC}, order=Order.FIRST)
+        composite = copy_pass("material.composite_copy", Phase.MATERIAL, LIGHT_ACCUMULATION,
+                              COMPOSITE, COMPOSITE_SPEC, order=Order.FIRST)
         passes += phase_passes(scene, Phase.MATERIAL, [composite], wide)
         passes += phase_passes(scene, Phase.POST, [tonemap_pass()], wide)
         return passes

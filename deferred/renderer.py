@@ -33,7 +33,7 @@ class RenderResult:
 
 
 def strict_default() -> bool:
-    """Strict mode unless asked otherwise: ``DEFERRED_STRICT=1`` (the tests set it)."""
+    """Whether renderers are strict when not told: ``DEFERRED_STRICT=1`` (the tests set it)."""
     return os.environ.get("DEFERRED_STRICT", "") in ("1", "true", "yes")
 
 
@@ -54,8 +54,16 @@ class Renderer:
         self.pipeline_name = pipeline
         self.strict = strict_default() if strict is None else strict
         self.size = check_size(size or scene.size, "size")
-        # The pass graph is built and checked before any GL object exists.
+        # The pass graph and the generated GLSL are built and checked before any GL object
+        # exists: bad input never leaves a context behind.
         self.graph: PassGraph = compile_graph(PIPELINES[pipeline]().build(scene))
+        light_types = scene.light_types()
+        shading_models = scene.shading_models()
+        generated = generated_glsl(light_types, shading_models, scene.gbuffer_layout(),
+                                   [obj.material for obj in scene.objects])
+        roots = [cls.shader_root for cls in [
+            *(type(obj.material) for obj in scene.objects), *light_types, *shading_models,
+            *(type(effect) for effect in scene.effects)] if cls.shader_root is not None]
         self._owns_context = gl is None
         self.gl = gl or create_context()
         self.gl.make_current()
@@ -63,14 +71,9 @@ class Renderer:
         features = self.gl.features
         defines = {"DEFERRED_STORAGE_BUFFERS": "1"} if features.storage_buffers else {}
         self.shaders = ShaderLibrary(ctx, features.glsl_version(), defines)
-        light_types = scene.light_types()
-        shading_models = scene.shading_models()
-        for cls in [*(type(obj.material) for obj in scene.objects), *light_types,
-                    *shading_models, *(type(effect) for effect in scene.effects)]:
-            if cls.shader_root is not None:
-                self.shaders.add_root(cls.shader_root)
-        for name, text in generated_glsl(light_types, shading_models, scene.gbuffer_layout(),
-                                         [obj.material for obj in scene.objects]).items():
+        for root in roots:
+            self.shaders.add_root(root)
+        for name, text in generated.items():
             self.shaders.set_virtual_file(name, text)
         self.targets = FrameTargets(ctx, *self.size)
         self._declare_targets()

@@ -231,7 +231,11 @@ def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
             raise InputError("ssao is given both as [ssao] and as an [[effect]]; keep one",
                              f"{name}: ssao")
         effects.insert(0, (f"{name}: ssao", "ssao", model.ssao))
+    seen: set[str] = set()
     for where, kind, values in effects:
+        if kind in seen:
+            raise InputError(f"effect '{kind}' is given twice (one of each type)", f"{where}.type")
+        seen.add(kind)
         effect_cls = registry.effects.get(kind, f"{where}.type")
         scene.effects.append(effect_cls.from_dict(values, where))
     return scene

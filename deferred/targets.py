@@ -63,7 +63,9 @@ class FrameTargets:
         if spec.clear is None:
             return
         if spec.depth:
-            self.framebuffer((), name).clear(depth=spec.clear[0])
+            fbo = self.framebuffer((), name)
+            fbo.depth_mask = True  # a cached framebuffer keeps the mask its last pass set
+            fbo.clear(depth=spec.clear[0])
         else:
             value = (*spec.clear, 0.0, 0.0, 0.0, 0.0)[:4]
             self.framebuffer((name,)).clear(*value)

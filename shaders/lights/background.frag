@@ -1,5 +1,5 @@
 // Start of the lighting phase: light accumulation is 0 on surfaces and the scene background
-// where the G-buffer holds none (material id 0), so later phases can sample any pixel.
+// where the G-buffer holds none (surface id 0), so later phases can sample any pixel.
 // Alpha is coverage: 1 on surfaces, 0 on the background.
 uniform sampler2D u_normal_exponent_id;
 uniform vec3 u_background;

@@ -6,7 +6,8 @@
 //  - depth: the second difference of inverse linear depth along rows, columns and diagonals.
 //    Inverse depth is affine in screen space over any plane, so a flat surface gives exactly
 //    zero whatever its slope (a Sobel of raw depth would flag every tilted plane); a depth
-//    break gives a large negative value on its near side.
+//    break gives a large negative value on its near side. The background counts as infinitely
+//    far (inverse depth 0), so silhouettes against it are depth breaks too.
 #include "gbuffer/layout.glsl"
 
 uniform sampler2D u_linear_depth;
@@ -69,8 +70,9 @@ void main() {
     for (int k = 0; k < 4; ++k) {
         float a = depth_at(p + axes[k]);
         float b = depth_at(p - axes[k]);
-        if (a <= 0.0 || b <= 0.0) continue;
-        float second = (1.0 / a + 1.0 / b - 2.0 / d) * d;
+        float inverse_a = a > 0.0 ? 1.0 / a : 0.0;
+        float inverse_b = b > 0.0 ? 1.0 / b : 0.0;
+        float second = (inverse_a + inverse_b - 2.0 / d) * d;
         if (second < -u_depth_threshold) edge = 1.0;
     }
     out_edge = edge;

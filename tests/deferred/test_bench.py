@@ -20,7 +20,6 @@ from deferred.bench import (
 )
 from deferred.cli import main
 from deferred.errors import InputError
-from deferred.gbuffer import bytes_per_pixel
 from deferred.imageio import read_image
 from deferred.pipeline import PIPELINES
 from deferred.scene import load_scene, scene_from_dict
@@ -60,7 +59,7 @@ def test_cli_sweep_writes_json_csv_plot(tmp_path, capsys):
     assert set(report) == {"renderer", "results"}
     for key in ("vendor", "renderer", "version"):
         assert report["renderer"][key]
-    assert report["renderer"]["gbuffer_bytes_per_pixel"] == bytes_per_pixel() == 20
+    assert report["renderer"]["gbuffer_bytes_per_pixel"] == 20
     layout = report["renderer"]["gbuffer_layout"]
     assert list(layout) == ["albedo_specular", "normal_exponent_id", "linear_depth", "depth"]
     assert sum(entry["bytes_per_pixel"] for entry in layout.values()) == 20

@@ -85,6 +85,20 @@ def test_edges_draw_on_silhouettes_and_depth_breaks(gl):
     assert np.all(result.image[edges][:, :3] == 0)
 
 
+def test_edges_against_the_background_without_ids(gl):
+    sphere = [{"mesh": "builtin:sphere", "scale": 0.8}]
+    camera = {"position": [0.0, 0.0, 4.0], "target": [0.0, 0.0, 0.0]}
+    _, targets, _ = render(gl, scene([{"type": "edges", "ids": False}], objects=sphere,
+                                     size=(96, 72), camera=camera))
+    depth = targets["linear_depth"][..., 0]
+    covered = depth > 0.0
+    rim = covered & ~(np.roll(covered, 1, 0) & np.roll(covered, -1, 0) &
+                      np.roll(covered, 1, 1) & np.roll(covered, -1, 1))
+    edges = targets["edges"][..., 0] > 0.5
+    assert rim.sum() > 50 and edges[rim].mean() > 0.95  # depth breaks against infinity
+    assert edges[~covered].sum() == 0
+
+
 def test_edges_nowhere_on_a_flat_lit_plane(gl):
     plane = [{"mesh": "builtin:plane", "scale": 40.0}]
     tilted = {"position": [0.3, 2.5, 2.0], "target": [0.0, 0.0, 0.0]}
@@ -95,12 +109,32 @@ def test_edges_nowhere_on_a_flat_lit_plane(gl):
     assert targets["edges"].max() == 0.0
 
 
-def test_edges_width_dilates_the_lines(gl):
-    _, thin, _ = render(gl, scene([{"type": "edges", "width": 1}]))
-    _, wide, _ = render(gl, scene([{"type": "edges", "width": 3}]))
-    assert np.array_equal(thin["edges"], thin["edges_raw"])
-    ratio = (wide["edges"] > 0.5).sum() / (thin["edges"] > 0.5).sum()
-    assert 2.5 < ratio < 6.0
+def run_through(row: np.ndarray, x: int) -> int:
+    """Length of the run of True in ``row`` that contains ``x``."""
+    left = x
+    while left > 0 and row[left - 1]:
+        left -= 1
+    right = x
+    while right + 1 < len(row) and row[right + 1]:
+        right += 1
+    return right - left + 1
+
+
+@pytest.mark.parametrize("width", [1, 2, 3, 5])
+def test_edges_width_is_the_line_width_in_pixels(gl, width):
+    # a cube seen face on: its silhouette is a square of vertical and horizontal lines
+    cube = [{"mesh": "builtin:cube", "scale": 0.8}]
+    _, targets, _ = render(gl, scene([{"type": "edges", "width": width}], objects=cube,
+                                     size=(96, 72), camera={"position": [0.0, 0.0, 5.0],
+                                                            "target": [0.0, 0.0, 0.0]}))
+    raw, edges = targets["edges_raw"][..., 0] > 0.5, targets["edges"][..., 0] > 0.5
+    middle = raw.shape[0] // 2
+    x = np.nonzero(raw[middle])[0]
+    assert len(x) == 2  # one pixel on each side of the square
+    assert run_through(edges[middle], x[0]) == width
+    assert run_through(edges[middle], x[1]) == width
+    y = np.nonzero(raw[:, raw.shape[1] // 2])[0]
+    assert len(y) == 2 and run_through(edges[:, raw.shape[1] // 2], y[0]) == width
 
 
 def test_g_buffer_effects_are_skipped_in_forward_with_a_warning(gl):
@@ -113,10 +147,11 @@ def test_g_buffer_effects_are_skipped_in_forward_with_a_warning(gl):
     ({"type": "blur"}, r"effect\[0\].type: unknown effect 'blur' \(choose from"),
     ({"type": "edges", "width": 0}, r"effect\[0\].width: Input should be greater than or equal"),
     ({"type": "fxaa", "strength": 1}, r"effect\[0\].strength: unknown parameter"),
+    ([{"type": "fxaa"}, {"type": "fxaa"}], r"effect\[1\].type: effect 'fxaa' is given twice"),
 ])
 def test_bad_effect_tables_name_the_key(effect, message):
     with pytest.raises(InputError, match=message):
-        scene([effect])
+        scene(effect if isinstance(effect, list) else [effect])
 
 
 def test_the_ssao_table_still_works_and_is_not_given_twice(gl):

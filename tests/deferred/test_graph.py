@@ -4,7 +4,7 @@ them, passes named in failures, strict uniforms, passes inserted from Python."""
 import numpy as np
 import pytest
 
-from deferred.errors import RenderError
+from deferred.errors import InputError, RenderError
 from deferred.gbuffer import LINEAR_DEPTH
 from deferred.graph import PassGraphError, compile_graph
 from deferred.material import Material
@@ -57,6 +57,9 @@ def test_graph_accepts_a_consistent_list_and_lists_its_targets():
     ([Marker("a", creates={"t": SPEC}), Marker("b", creates={"t": SPEC})],
      "pass b: creates target 't', which pass a already creates"),
     ([Marker("a"), Marker("a")], "two passes are named 'a'"),
+    ([Marker("a", creates={"t": SPEC}),
+      FullscreenPass("b", Phase.POST, "post/copy.frag", {"u_source": "t"}, ("t",))],
+     "pass b: samples target 't' while writing it (snapshot it first with copy_pass)"),
 ])
 def test_graph_errors_name_the_pass_and_the_target(passes, message):
     with pytest.raises(PassGraphError, match=message.replace("(", r"\(").replace(")", r"\)")):
@@ -126,7 +129,8 @@ def test_insert_pass_is_checked_and_placed(render):
     renderer.render()
     assert np.array_equal(renderer.targets.read("probe"), renderer.targets.read(LINEAR_DEPTH))
     late = FullscreenPass("test.too_early", Phase.GEOMETRY, "post/copy.frag",
-                          {"u_source": "probe"}, ("probe",))
+                          {"u_source": "probe"}, ("late",),
+                          creates={"late": TargetSpec(1, "f4", "late", clear=(0.0,))})
     with pytest.raises(PassGraphError, match="pass test.too_early: reads target 'probe' before"):
         renderer.insert_pass(late, before="gbuffer.clear")
     assert "test.too_early" not in [p.name for p in renderer.passes]  # left as it was
@@ -201,3 +205,57 @@ def test_a_material_uniform_no_program_declares_is_an_error_in_strict_mode(gl):
             renderer.render()
     finally:
         renderer.release()
+
+
+def test_a_half_size_target_is_created_at_half_size_and_drawn_whole(render):
+    scene = scene_from_dict(SCENE)
+    _, renderer = render(scene)
+    half = TargetSpec(4, "f2", "half", clear=(0.0,) * 4, scale=0.5)
+    renderer.insert_pass(FullscreenPass("test.half", Phase.POST, "post/copy.frag",
+                                        {"u_source": COMPOSITE}, ("half",),
+                                        creates={"half": half}), after="post.tonemap")
+    renderer.render()
+    assert renderer.targets["half"].size == (24, 16)
+    # the viewport follows the target: every pixel written (the frame's lower-left quarter)
+    np.testing.assert_array_equal(renderer.targets.read("half"),
+                                  renderer.targets.read(COMPOSITE)[:16, :24])
+
+
+def test_a_bad_layout_is_refused_before_any_gl_work():
+    from deferred.shading import GBufferData
+
+    class DeclaresFoo(Material):
+        name = "test_declares_foo"
+        surface_shader = "materials/standard/surface.glsl"
+        gbuffer_data = (GBufferData("foo", "R8", ("x",)),)
+
+    class DeclaresFooAgain(DeclaresFoo):
+        name = "test_declares_foo_again"
+        gbuffer_data = (GBufferData("foo", "RG8", ("x", "y")),)
+
+    scene = scene_from_dict({**SCENE, "object": [{"mesh": "builtin:sphere"}] * 2})
+    scene.objects[0].material = DeclaresFoo()
+    scene.objects[1].material = DeclaresFooAgain()
+    for pipeline in ("deferred", "forward"):
+        with pytest.raises(InputError, match="G-buffer data 'foo' is declared as RG8"):
+            Renderer(scene, pipeline, gl=NoGL())
+
+
+def test_a_parameter_may_not_shadow_a_framework_uniform(render):
+    from pydantic import Field
+
+    from deferred.material import MaterialParams
+
+    class ShadowingParams(MaterialParams):
+        resolution: float = Field(2.0)
+
+    class Shadowing(Material):
+        name = "test_shadowing"
+        Params = ShadowingParams
+        surface_shader = "materials/standard/surface.glsl"
+
+    scene = scene_from_dict(SCENE)
+    scene.objects[0].material = Shadowing()
+    with pytest.raises(RenderError, match="parameters would set the framework's uniform "
+                                          "u_resolution"):
+        render(scene)
