@@ -52,6 +52,7 @@ LIGHT_SEED = 0
 LIGHT_VIEW_SHARE = 0.3
 LIGHT_INTENSITY = 2.0
 SHELLS = "shells"
+MIN_SHELLS = "min_shells"
 COLUMNS = ("pipeline", "lights", "shells", "width", "height", "runs", "median_ms", "mean_ms",
            "min_ms", "max_ms", "stddev_ms", "times_ms", "passes_ms")
 OUTPUT_SUFFIXES = {"--json": ".json", "--csv": ".csv", "--plot": ".png"}
@@ -167,7 +168,8 @@ def shell_objects(scene: Scene) -> list[SceneObject]:
 
 
 def with_shells(scene: Scene, shells: int, where: str = "--shells") -> Scene:
-    """A copy of ``scene`` with ``shells`` on every object whose material has that parameter."""
+    """A copy of ``scene`` with ``shells`` on every object whose material has that parameter,
+    drawn whatever the distance (``min_shells`` too, where the material has it)."""
     objects = []
     for obj in scene.objects:
         if has_shells(obj):
@@ -175,7 +177,11 @@ def with_shells(scene: Scene, shells: int, where: str = "--shells") -> Scene:
             params = material.params
             try:
                 # Validated, not model_copy(update=...): each material's range applies.
-                new_params = type(params).model_validate({**params.model_dump(), SHELLS: shells})
+                # The sweep fixes the count: a level of detail's minimum (if any) goes with it.
+                values = {**params.model_dump(), SHELLS: shells}
+                if MIN_SHELLS in values and shells > 0:
+                    values[MIN_SHELLS] = shells
+                new_params = type(params).model_validate(values)
             except ValidationError as exc:
                 problem = exc.errors()[0]["msg"]
                 raise InputError(f"{problem} for {obj.label} ({material.name}), got {shells}",

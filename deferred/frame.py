@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -43,7 +44,7 @@ class Resources:
         self.ctx = ctx
         self._meshes: dict[int, GpuMesh] = {}
         self._mesh_refs: list[MeshData] = []  # keep ids stable while cached
-        self._textures: dict[Any, moderngl.Texture] = {}
+        self._cached: dict[Any, Any] = {}
         self._fullscreen_vaos: dict[int, moderngl.VertexArray] = {}
 
     def gpu_mesh(self, mesh: MeshData) -> GpuMesh:
@@ -54,13 +55,19 @@ class Resources:
             self._mesh_refs.append(mesh)
         return gpu
 
-    def texture(self, key: Any, create) -> moderngl.Texture:
-        """A cached texture; ``create()`` makes it the first time ``key`` is asked for."""
-        texture = self._textures.get(key)
-        if texture is None:
-            texture = create(self.ctx)
-            self._textures[key] = texture
-        return texture
+    def cached(self, key: Any, create: Callable[[moderngl.Context], Any]) -> Any:
+        """A GPU object kept for the renderer's life (anything with ``release()``);
+        ``create(ctx)`` makes it the first time ``key`` is asked for."""
+        made = self._cached.get(key)
+        if made is None:
+            made = create(self.ctx)
+            self._cached[key] = made
+        return made
+
+    def texture(self, key: Any, create: Callable[[moderngl.Context], moderngl.Texture]
+                ) -> moderngl.Texture:
+        """A cached texture (see :meth:`cached`)."""
+        return self.cached(key, create)
 
     def image_texture(self, path: Path, srgb: bool = True) -> moderngl.Texture:
         from .imageio import read_image
@@ -89,9 +96,9 @@ class Resources:
             gpu.release()
         self._meshes.clear()
         self._mesh_refs.clear()
-        for texture in self._textures.values():
-            texture.release()
-        self._textures.clear()
+        for made in self._cached.values():
+            made.release()
+        self._cached.clear()
         for vao in self._fullscreen_vaos.values():
             vao.release()
         self._fullscreen_vaos.clear()
@@ -281,19 +288,20 @@ class Frame:
         return {f"u_{name}": self.target(name) for name in names}
 
     # -- drawing -------------------------------------------------------------------------------
-    def _count(self) -> None:
+    def count_draw(self) -> None:
+        """Count a draw call of the running pass (passes drawing by other means call it)."""
         self.stats.draw_calls += 1
         name = self.current_pass.name if self.current_pass is not None else ""
         self.stats.draws_by_pass[name] = self.stats.draws_by_pass.get(name, 0) + 1
 
     def draw_mesh(self, mesh: MeshData, program: moderngl.Program, instances: int = 1) -> None:
         self.resources.gpu_mesh(mesh).render(program, instances=instances)
-        self._count()
+        self.count_draw()
 
     def draw_fullscreen(self, program: moderngl.Program, instances: int = 1) -> None:
         vao = self.resources.fullscreen_vertex_array(program)
         vao.render(moderngl.TRIANGLES, vertices=3, instances=instances)
-        self._count()
+        self.count_draw()
 
     def use_framebuffer(self, colors: tuple[str, ...] | list[str], depth: str | None = None,
                         depth_write: bool = True) -> moderngl.Framebuffer:
@@ -306,8 +314,10 @@ class Frame:
         return fbo
 
     def set_state(self, depth_test: bool = False, depth_func: str = "less",
-                  cull: str | None = None, blend: str | None = None) -> None:
+                  cull: str | None = None, blend: str | None = None,
+                  depth_offset: tuple[float, float] = (0.0, 0.0)) -> None:
         """Set the fixed-function state a pass needs; every pass states all of it."""
+        self.ctx.polygon_offset = depth_offset
         flags = moderngl.NOTHING
         if depth_test:
             flags |= moderngl.DEPTH_TEST

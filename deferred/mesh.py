@@ -343,18 +343,23 @@ class GpuMesh:
         self.vbo = self.ctx.buffer(self.data.interleaved().tobytes())
         self.ibo = self.ctx.buffer(self.data.indices.astype(np.uint32).tobytes())
 
+    def vertex_buffer(self, program: moderngl.Program) -> tuple:
+        """The vertex buffer with the format of the attributes ``program`` reads (moderngl's
+        ``(buffer, format, *names)``), for vertex arrays over other index buffers too."""
+        fmt, names = [], []
+        for name, count in VERTEX_ATTRIBUTES:
+            attribute = f"in_{name}"
+            if attribute in program:
+                fmt.append(f"{count}f")
+                names.append(attribute)
+            else:
+                fmt.append(f"{count * 4}x")
+        return (self.vbo, " ".join(fmt), *names)
+
     def vertex_array(self, program: moderngl.Program) -> moderngl.VertexArray:
         vao = self._arrays.get(program.glo)
         if vao is None:
-            fmt, names = [], []
-            for name, count in VERTEX_ATTRIBUTES:
-                attribute = f"in_{name}"
-                if attribute in program:
-                    fmt.append(f"{count}f")
-                    names.append(attribute)
-                else:
-                    fmt.append(f"{count * 4}x")
-            vao = self.ctx.vertex_array(program, [(self.vbo, " ".join(fmt), *names)],
+            vao = self.ctx.vertex_array(program, [self.vertex_buffer(program)],
                                         index_buffer=self.ibo, index_element_size=4)
             self._arrays[program.glo] = vao
         return vao

@@ -160,13 +160,15 @@ def copy_pass(name: str, phase: Phase, source: str, target: str, spec: TargetSpe
 class ObjectPass(RenderPass):
     """Draw one scene object's mesh with a program; materials build their passes on this.
 
-    Subclasses (or callers) give the shader files, defines, the targets and state, and a
-    ``uniforms`` hook. ``draws`` > 1 renders the mesh that many times, each draw with its own
-    ``draw_uniforms`` (e.g. one shell per draw).
+    Subclasses (or callers) give the shader files (a geometry shader too, if any), defines, the
+    targets and state, and a ``uniforms`` hook. ``draws`` > 1 renders the mesh that many times,
+    each draw with its own ``draw_uniforms`` (e.g. one shell per draw; ``None`` skips the draw).
+    ``draw`` issues one draw call (override it to draw other primitives of the mesh).
     """
 
     vertex: str = "common/mesh.vert"
     fragment: str = ""
+    geometry: str | None = None
     colors: tuple[str, ...] = ()
     depth: str | None = "depth"
     depth_test: bool = True
@@ -174,6 +176,7 @@ class ObjectPass(RenderPass):
     depth_write: bool = True
     cull: str | None = "back"
     blend: str | None = None
+    depth_offset: tuple[float, float] = (0.0, 0.0)  # glPolygonOffset (factor, units)
     extra_reads: tuple[str, ...] = ()
     constants: dict[str, Any] | None = None  # uniforms fixed at construction
     extra_defines: dict[str, str] | None = None
@@ -208,24 +211,32 @@ class ObjectPass(RenderPass):
     def draws(self, frame: Frame) -> int:
         return 1
 
-    def draw_uniforms(self, frame: Frame, index: int, count: int) -> dict[str, Any]:
-        """Uniforms that change from one draw of the pass to the next (e.g. a shell's depth)."""
+    def draw_uniforms(self, frame: Frame, index: int, count: int) -> dict[str, Any] | None:
+        """Uniforms that change from one draw of the pass to the next (e.g. a shell's depth);
+        ``None`` skips draw ``index``."""
         return {}
 
+    def draw(self, frame: Frame, program: moderngl.Program) -> None:
+        frame.draw_mesh(self.obj.mesh, program)
+
     def program(self, frame: Frame) -> moderngl.Program:
-        return frame.shaders.program(self.vertex, self.fragment, defines=self.defines(frame))
+        return frame.shaders.program(self.vertex, self.fragment, self.geometry,
+                                     defines=self.defines(frame))
 
     def execute(self, frame: Frame) -> None:
         program = self.program(frame)
         frame.use_framebuffer(self.colors, self.depth, depth_write=self.depth_write)
         frame.set_state(depth_test=self.depth_test, depth_func=self.depth_func, cull=self.cull,
-                        blend=self.blend)
+                        blend=self.blend, depth_offset=self.depth_offset)
         material = frame.material_inputs(self.obj.material)
         uniforms = {**(self.constants or {}), **self.uniforms(frame)}
         textures = self.textures(frame)
         offered = frame.object_uniforms(self.obj)
         count = self.draws(frame)
         for index in range(count):
-            frame.bind(program, {**uniforms, **self.draw_uniforms(frame, index, count)},
-                       textures, offered=offered, material=material)
-            frame.draw_mesh(self.obj.mesh, program)
+            per_draw = self.draw_uniforms(frame, index, count)
+            if per_draw is None:
+                continue
+            frame.bind(program, {**uniforms, **per_draw}, textures, offered=offered,
+                       material=material)
+            self.draw(frame, program)

@@ -5,20 +5,21 @@ Passes per phase (section 2.4):
 - stipple: the outermost shell into one pixel of every 2x2 tile, rim-bent normals at the
   silhouette (2.3.2, 2.3.4, Listings 2.3 and 2.6), after the screen phase;
 - lighting: nothing special, both samples are lit like any pixel (2.4.3);
-- material: stipple obliteration, then ``shells`` concentric shells that take their light from
+- material: stipple obliteration, then concentric shells and fins that take their light from
   the light accumulation at the base and stipple samples (2.4.4, Listings 2.1 and 2.2);
 - forward: the same fur lit per fragment, for preview and for the benchmark (2.4).
+
+The shells, their fur volume, level of detail and fins are the shared fur technique
+(``techniques/fur.py``); what is Revie's here is how the fur is lit.
 """
 
 from __future__ import annotations
 
-from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import moderngl
 from pydantic import Field
 
-from deferred.errors import InputError
 from deferred.gbuffer import ALBEDO_SPECULAR, LINEAR_DEPTH, NORMAL_EXPONENT_ID
 from deferred.material import BlinnPhongParams, ForwardLitPass, GBufferPass, Material
 from deferred.passes import Phase, RenderPass
@@ -26,7 +27,15 @@ from deferred.registry import materials
 from deferred.targets import COMPOSITE, LIGHT_ACCUMULATION
 from deferred.validation import NonZeroVec3
 
-from .techniques.heightfield import heightfield_texture, load_heightfield, procedural_heightfield
+from .techniques.fins import FinPass
+from .techniques.fur import (
+    FUR_UNIFORM_OVERRIDES,
+    FurParams,
+    check_heightfield,
+    fur_object_uniforms,
+    fur_volume_texture,
+    tiles_per_unit,
+)
 from .techniques.shells import ShellPass
 from .techniques.stipple import (
     StippleObliterationPass,
@@ -41,16 +50,12 @@ if TYPE_CHECKING:
 
 Vec3 = tuple[float, float, float]
 FUR_VERTEX = "materials/revie_fur/fur.vert"
-BASE_SHELL = {"u_shell_depth": 0.0}
-OUTER_SHELL = {"u_shell_depth": 1.0}
+SHELL_FRAGMENT = "materials/revie_fur/shell.frag"
+FORWARD_SHELL_FRAGMENT = "materials/revie_fur/forward_shell.frag"
+STIPPLE_PARITY = (0, 0)  # the (even, even) pixel of each 2x2 tile, as Listing 2.6
 
 
-class RevieFurParams(BlinnPhongParams):
-    fur_length: float = Field(0.15, gt=0.0, le=4.0,
-                              description="strand length, object units (x vertex colour alpha)")
-    shells: int = Field(16, ge=0, le=256, description="concentric shells in the material phase")
-    density: float = Field(6.0, gt=0.0, le=1024.0,
-                           description="heightfield repeats across the UV range")
+class RevieFurParams(FurParams, BlinnPhongParams):
     albedo_base: Vec3 = Field((0.10, 0.06, 0.035), description="albedo at the strand roots")
     albedo_tip: Vec3 = Field((0.78, 0.58, 0.38), description="albedo at the tips (surface)")
     specular_intensity: float = Field(0.25, ge=0.0, le=1.0, description="Blinn-Phong intensity")
@@ -63,10 +68,6 @@ class RevieFurParams(BlinnPhongParams):
     comb: NonZeroVec3 = Field((0.0, -1.0, 0.0),
                               description="object-space comb where the mesh has no vertex colours")
     comb_strength: float = Field(0.6, ge=0.0, le=8.0, description="how far strands lean")
-    heightfield: str | None = Field(None, description="strand height image (R channel)")
-    strand_softness: float = Field(0.1, gt=0.0, le=1.0,
-                                   description="smoothstep width of the strand fade")
-    seed: int = Field(1, ge=0, description="seed of the procedural heightfield")
     occlusion_test: bool = Field(True, description="reject light samples the G-buffer shows "
                                                    "occluded (off: Figure 2.8's error)")
 
@@ -74,7 +75,16 @@ class RevieFurParams(BlinnPhongParams):
 class FurShellPass(ShellPass):
     """Material-phase shells reading light accumulation + G-buffer (shell.frag)."""
 
-    fragment = "materials/revie_fur/shell.frag"
+    fragment = SHELL_FRAGMENT
+    vertex = FUR_VERTEX
+    colors = (COMPOSITE,)
+    extra_reads = (LIGHT_ACCUMULATION, ALBEDO_SPECULAR, NORMAL_EXPONENT_ID, LINEAR_DEPTH)
+
+
+class FurFinPass(FinPass):
+    """Material-phase fins, lit from the light accumulation like the shells (shell.frag)."""
+
+    fragment = SHELL_FRAGMENT
     vertex = FUR_VERTEX
     colors = (COMPOSITE,)
     extra_reads = (LIGHT_ACCUMULATION, ALBEDO_SPECULAR, NORMAL_EXPONENT_ID, LINEAR_DEPTH)
@@ -85,24 +95,19 @@ class RevieFurMaterial(Material):
     name = "revie_fur"
     Params = RevieFurParams
     surface_shader = "materials/revie_fur/surface.glsl"
-    # pass counts, switches compiled as defines and the heightfield source are not uniforms
-    uniform_overrides = {"shells": None, "stipple": None, "occlusion_test": None, "seed": None}
+    # pass counts and switches compiled as defines are not uniforms; density becomes tiles
+    uniform_overrides = {**FUR_UNIFORM_OVERRIDES, "stipple": None, "occlusion_test": None,
+                         "density": lambda _: {}}
 
     def check_files(self, where: str | None) -> None:
-        if self.params.heightfield is None:
-            return
-        path = self.resolve_path(self.params.heightfield)
-        key = f"{where}.heightfield" if where else "heightfield"
-        if not path.is_file():
-            raise InputError(f"heightfield image not found: {path}", key)
-        try:
-            load_heightfield(path)  # unreadable images fail here, before any GL work
-        except InputError as exc:
-            raise InputError(f"cannot read heightfield image {path.name}: {exc.message}",
-                             key) from None
+        check_heightfield(self.params, self.heightfield_path(), where)
+
+    def heightfield_path(self):
+        return None if self.params.heightfield is None else \
+            self.resolve_path(self.params.heightfield)
 
     def defines(self, obj: SceneObject) -> dict[str, str]:
-        defines = {**super().defines(obj), **pattern_defines(4)}
+        defines = {**super().defines(obj), **pattern_defines(4, STIPPLE_PARITY)}
         if obj.mesh.has_comb:
             defines["VERTEX_COMB"] = "1"
         if self.params.stipple:
@@ -111,19 +116,20 @@ class RevieFurMaterial(Material):
             defines["FUR_OCCLUSION_TEST"] = "1"
         return defines
 
-    def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
-        return {"u_heightfield": self.heightfield_texture(frame)}
+    def uniforms(self, frame: Frame) -> dict[str, Any]:
+        return {**super().uniforms(frame), "u_fur_tiles": tiles_per_unit(self.params)}
 
-    def heightfield_texture(self, frame: Frame) -> moderngl.Texture:
-        if self.params.heightfield is not None:
-            path: Path = self.resolve_path(self.params.heightfield)
-            return frame.resources.texture(
-                ("heightfield", str(path)),
-                lambda ctx: heightfield_texture(ctx, load_heightfield(path)))
-        seed = self.params.seed
-        return frame.resources.texture(
-            ("heightfield", seed),
-            lambda ctx: heightfield_texture(ctx, procedural_heightfield(seed=seed)))
+    def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
+        return {"u_fur_volume": fur_volume_texture(frame, self.params,
+                                                   self.heightfield_path())}
+
+    @staticmethod
+    def vertex_constants(obj: SceneObject, shell_depth: float | None = None) -> dict[str, Any]:
+        """Uniforms of the fur vertex shader fixed for the object (and the shell depth)."""
+        constants = {"u_fur_scale": fur_object_uniforms(obj, obj.material.params)["u_fur_scale"]}
+        if shell_depth is not None:
+            constants["u_shell_depth"] = shell_depth
+        return constants
 
     # -- passes ------------------------------------------------------------------------------
     @classmethod
@@ -133,31 +139,43 @@ class RevieFurMaterial(Material):
 
     def geometry_passes(self, obj: SceneObject) -> list[RenderPass]:
         return [GBufferPass(f"{obj.label}.gbuffer", Phase.GEOMETRY, obj, vertex=FUR_VERTEX,
-                            constants=BASE_SHELL)]
+                            constants=self.vertex_constants(obj, 0.0))]
 
     def stipple_passes(self, obj: SceneObject) -> list[RenderPass]:
         if not self.params.stipple:
             return []
         return [StipplePass(f"{obj.label}.stipple", Phase.STIPPLE, obj, vertex=FUR_VERTEX,
-                            fragment="materials/revie_fur/stipple.frag", constants=OUTER_SHELL)]
+                            fragment="materials/revie_fur/stipple.frag",
+                            constants=self.vertex_constants(obj, 1.0))]
 
     def material_passes(self, obj: SceneObject) -> list[RenderPass]:
         passes: list[RenderPass] = []
         if self.params.stipple:
             passes.append(StippleObliterationPass(f"{obj.label}.stipple_obliteration",
                                                   Phase.MATERIAL, obj, vertex=FUR_VERTEX,
-                                                  constants=OUTER_SHELL))
+                                                  constants=self.vertex_constants(obj, 1.0)))
         if self.params.shells > 0:
+            # fins first: the shells composite over them, which fill the gaps between shell
+            # rims at grazing angles
+            if self.params.fins:
+                passes.append(FurFinPass(f"{obj.label}.fins", Phase.MATERIAL, obj,
+                                         constants=self.vertex_constants(obj)))
             passes.append(FurShellPass(f"{obj.label}.shells", Phase.MATERIAL, obj,
-                                       count=self.params.shells))
+                                       constants=self.vertex_constants(obj)))
         return passes
 
     def forward_passes(self, obj: SceneObject) -> list[RenderPass]:
         passes: list[RenderPass] = [ForwardLitPass(f"{obj.label}.forward", Phase.FORWARD, obj,
-                                                   vertex=FUR_VERTEX, constants=BASE_SHELL)]
+                                                   vertex=FUR_VERTEX,
+                                                   constants=self.vertex_constants(obj, 0.0))]
         if self.params.shells > 0:
+            if self.params.fins:
+                passes.append(FinPass(f"{obj.label}.forward_fins", Phase.FORWARD, obj,
+                                      vertex=FUR_VERTEX, colors=(COMPOSITE,),
+                                      fragment=FORWARD_SHELL_FRAGMENT,
+                                      constants=self.vertex_constants(obj)))
             passes.append(ShellPass(f"{obj.label}.forward_shells", Phase.FORWARD, obj,
                                     vertex=FUR_VERTEX, colors=(COMPOSITE,),
-                                    fragment="materials/revie_fur/forward_shell.frag",
-                                    count=self.params.shells))
+                                    fragment=FORWARD_SHELL_FRAGMENT,
+                                    constants=self.vertex_constants(obj)))
         return passes

@@ -59,7 +59,9 @@ class StippleGlassMaterial(Material):
     uniform_overrides = {"pattern": None}  # a define (STIPPLE_PATTERN)
 
     def defines(self, obj: SceneObject) -> dict[str, str]:
-        return {**super().defines(obj), **pattern_defines(self.params.pattern)}
+        # the other parity classes than fur's (0, 0), so glass and fur samples coexist
+        parity = (1, 1) if self.params.pattern == 4 else (1, 0)
+        return {**super().defines(obj), **pattern_defines(self.params.pattern, parity)}
 
     @classmethod
     def scene_passes(cls, objects: list[SceneObject], phase: Phase) -> list[RenderPass]:

@@ -1,8 +1,8 @@
-"""Concentric shells (Revie 2.3.1): a mesh drawn N times, each pushed further out, blended.
-
-Shell ``k`` of ``N`` sits at depth ``(k + 1) / N`` of the fur layer (so the last one is the
-outermost shell, where the stipple samples live); the vertex shader offsets it with
-``shell_offset`` (``techniques/shells.glsl``, Listing 2.1).
+"""Concentric shells (Revie 2.3.1; Lengyel et al. 2001): a mesh drawn n times, each pushed further
+out, blended. The count follows the level of detail of the fur technique (``fur.shell_count``):
+shell ``k`` sits at depth ``k / n`` of the fur layer (the first at the root), the outermost fades
+with the fraction of ``n``; the vertex shader offsets it with ``shell_offset``
+(``techniques/shells.glsl``, Listing 2.1).
 """
 
 from __future__ import annotations
@@ -12,13 +12,12 @@ from typing import Any
 from deferred.gbuffer import DEPTH
 from deferred.passes import ObjectPass, Order
 
-
-def shell_depths(count: int) -> list[float]:
-    return [(k + 1) / count for k in range(count)]
+from .fur import shell_count, shell_layout
 
 
 class ShellPass(ObjectPass):
-    """Draw ``count`` shells of the object, innermost first, alpha-blended over the target."""
+    """Draw the object's shells, innermost first, alpha-blended over the target. The object's
+    material parameters are a ``FurParams``."""
 
     depth = DEPTH
     depth_test = True
@@ -26,10 +25,18 @@ class ShellPass(ObjectPass):
     depth_write = False
     blend = "alpha"
     order = Order.VOLUME
-    count = 16
+    # The root shell lies on the base mesh: pulled toward the eye it wins the depth test even
+    # where obliteration restored a neighbour's depth.
+    depth_offset = (-1.0, -2.0)
 
     def draws(self, frame) -> int:
-        return self.count
+        params = self.obj.material.params
+        self._layout = shell_layout(shell_count(frame, self.obj, params), params.shell_range)
+        return len(self._layout)
 
-    def draw_uniforms(self, frame, index: int, count: int) -> dict[str, Any]:
-        return {"u_shell_depth": (index + 1) / count}
+    def draw_uniforms(self, frame, index: int, count: int) -> dict[str, Any] | None:
+        shell = self._layout[index]
+        if shell is None:
+            return None
+        depth, fade = shell
+        return {"u_shell_depth": depth, "u_shell_fade": fade, "u_root_shell": index == 0}

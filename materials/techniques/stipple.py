@@ -32,10 +32,14 @@ def stipple_scene_passes(phase: Phase) -> list[RenderPass]:
                       COMPOSITE_SNAPSHOT, COMPOSITE_SPEC, order=Order.RESTORE)]
 
 
-def pattern_defines(pattern: int) -> dict[str, str]:
+def pattern_defines(pattern: int, parity: tuple[int, int] = (0, 0)) -> dict[str, str]:
+    """Defines of ``techniques/stipple.glsl``: the pattern (1 in 2 or 1 in 4) and the parity
+    class of the user (Revie 2.3.4: different users interleave instead of overwriting each
+    other's samples; fur takes (0, 0), glass (1, 1) or the odd checkerboard)."""
     if pattern not in PATTERNS:
         raise ValueError(f"stipple pattern must be one of {PATTERNS}, got {pattern}")
-    return {"STIPPLE_PATTERN": str(pattern)}
+    return {"STIPPLE_PATTERN": str(pattern),
+            "STIPPLE_PARITY": f"ivec2({parity[0] % 2}, {parity[1] % 2})"}
 
 
 class StipplePass(GBufferPass):

@@ -1,30 +1,31 @@
-// Stipple patterns (Revie 2.3.4, Listing 2.6, Figure 2.14), in GL pixel coordinates.
-//   STIPPLE_PATTERN 4: one in four, the (even, even) pixel of every 2x2 tile;
-//   STIPPLE_PATTERN 2: one in two, a checkerboard.
+// Stipple patterns (Revie 2.3.4, Listing 2.6, Figure 2.14), in GL pixel coordinates. Each
+// stipple user takes its own parity class (STIPPLE_PARITY), so several interleave (2.3.4):
+//   STIPPLE_PATTERN 4: one in four, the pixel at STIPPLE_PARITY of every 2x2 tile;
+//   STIPPLE_PATTERN 2: one in two, the checkerboard whose x + y has the parity of
+//                      STIPPLE_PARITY.x + STIPPLE_PARITY.y.
 #ifndef STIPPLE_PATTERN
 #define STIPPLE_PATTERN 4
 #endif
+#ifndef STIPPLE_PARITY
+#define STIPPLE_PARITY ivec2(0, 0)
+#endif
 
 bool stipple_sample(ivec2 pixel) {
+    ivec2 q = pixel - STIPPLE_PARITY;
 #if STIPPLE_PATTERN == 2
-    return ((pixel.x + pixel.y) & 1) == 0;
+    return ((q.x + q.y) & 1) == 0;
 #else
-    return (pixel.x & 1) == 0 && (pixel.y & 1) == 0;
+    return (q.x & 1) == 0 && (q.y & 1) == 0;
 #endif
 }
 
 // The stipple pixel of the tile containing `pixel` (the sample a material reads back).
 ivec2 stipple_pixel_of(ivec2 pixel) {
 #if STIPPLE_PATTERN == 2
-    return ((pixel.x + pixel.y) & 1) == 0 ? pixel : pixel - ivec2(1, 0);
+    return stipple_sample(pixel) ? pixel : pixel - ivec2(1, 0);
 #else
-    return pixel & ~1;
+    return ((pixel - STIPPLE_PARITY) & ~1) + STIPPLE_PARITY;
 #endif
-}
-
-// A pixel next to a stipple sample that holds the scene the stipple sits on.
-ivec2 stipple_neighbour(ivec2 pixel, ivec2 size) {
-    return ivec2(pixel.x + 1 < size.x ? pixel.x + 1 : pixel.x - 1, pixel.y);
 }
 
 // Window-space depth of a linear view depth (the inverse of what the G-buffer stores).

@@ -1,6 +1,11 @@
 // Stipple obliteration (Revie 2.4.4, Figure 2.19): drawn with the stippled mesh; where this
-// mesh's stipple sample sits, the neighbouring pixel's composition (a snapshot taken after the
-// materials' own opaque passes) and depth replace it, leaving the scene the stipple covered.
+// mesh's stipple sample sits, a neighbouring pixel's composition (from the snapshot taken after
+// the materials' own opaque passes) and depth replace it, leaving the scene the stipple covered.
+//
+// The neighbour must show the surface the sample covered, not an occluder beside it: among the
+// pixels around the sample (the 8 of its 3x3 block for the 1-in-4 pattern, the 4 edge-adjacent
+// for 1-in-2, all outside this pattern) those nearer than the sample are out (an occluder edge
+// stays straight), and of the rest the one whose surface (id and depth) most others share wins.
 #include "techniques/stipple.glsl"
 #include "gbuffer/layout.glsl"
 
@@ -14,6 +19,18 @@ uniform mat4 u_projection;
 in vec3 v_position;
 out vec4 out_color;
 
+#if STIPPLE_PATTERN == 2
+const int CANDIDATES = 4;
+#else
+const int CANDIDATES = 8;
+#endif
+const ivec2 OFFSETS[8] = ivec2[](ivec2(1, 0), ivec2(-1, 0), ivec2(0, 1), ivec2(0, -1),
+                                 ivec2(1, 1), ivec2(-1, 1), ivec2(1, -1), ivec2(-1, -1));
+
+bool same_depth(float a, float b) {
+    return abs(a - b) <= 0.02 * max(a, b) + 1e-4;  // background (0) matches only background
+}
+
 void main() {
     ivec2 pixel = ivec2(gl_FragCoord.xy);
     if (!stipple_sample(pixel)) discard;
@@ -21,7 +38,38 @@ void main() {
     float depth = texelFetch(u_linear_depth, pixel, 0).r;
     if (!same_surface(texelFetch(u_normal_exponent_id, pixel, 0).w, u_surface_id)) discard;
     if (abs(depth + v_position.z) > 1e-3 * depth + 1e-5) discard;
-    ivec2 neighbour = stipple_neighbour(pixel, ivec2(u_resolution));
-    out_color = texelFetch(u_composite_snapshot, neighbour, 0);
-    gl_FragDepth = window_depth(texelFetch(u_linear_depth, neighbour, 0).r, u_projection);
+
+    float ids[8];
+    float depths[8];
+    bool valid[8];
+    ivec2 size = ivec2(u_resolution);
+    for (int k = 0; k < CANDIDATES; ++k) {
+        ivec2 q = pixel + OFFSETS[k];
+        valid[k] = all(greaterThanEqual(q, ivec2(0))) && all(lessThan(q, size));
+        ids[k] = 0.0;
+        depths[k] = 0.0;
+        if (!valid[k]) continue;
+        depths[k] = texelFetch(u_linear_depth, q, 0).r;
+        ids[k] = texelFetch(u_normal_exponent_id, q, 0).w;
+        // behind the sample (or background): what the stipple may have covered
+        valid[k] = depths[k] <= 0.0 || depths[k] >= depth * (1.0 - 1e-3);
+    }
+    int best = -1;
+    int best_votes = 0;
+    for (int k = 0; k < CANDIDATES; ++k) {
+        if (!valid[k]) continue;
+        int votes = 0;
+        for (int j = 0; j < CANDIDATES; ++j) {
+            if (valid[j] && same_surface(ids[j], ids[k]) && same_depth(depths[j], depths[k]))
+                votes += 1;
+        }
+        if (votes > best_votes) {
+            best = k;
+            best_votes = votes;
+        }
+    }
+    ivec2 source = best >= 0 ? pixel + OFFSETS[best]
+                             : clamp(pixel + ivec2(1, 0), ivec2(0), size - 1);
+    out_color = texelFetch(u_composite_snapshot, source, 0);
+    gl_FragDepth = window_depth(texelFetch(u_linear_depth, source, 0).r, u_projection);
 }

@@ -32,7 +32,8 @@ def test_glass_is_stippled_then_blended_over_the_scene(render, pattern):
     result, _ = render(glass_scene(pattern), on_pass=grab)
     written = shots["wall.gbuffer"] != shots["glass.stipple"]
     y, x = np.mgrid[0:written.shape[0], 0:written.shape[1]]
-    stipple_class = ((x + y) % 2 == 0) if pattern == 2 else ((x % 2 == 0) & (y % 2 == 0))
+    # glass takes the parity classes fur leaves free (fur: the (even, even) pixels)
+    stipple_class = ((x + y) % 2 == 1) if pattern == 2 else ((x % 2 == 1) & (y % 2 == 1))
     assert written.sum() > 200 and not written[~stipple_class].any()
     interior = written.copy()
     rows, cols = np.nonzero(written)
@@ -73,3 +74,40 @@ def test_object_order_does_not_change_the_image(render):
         result, _ = render(scene)
         images.append(result.image)
     assert np.array_equal(images[0], images[1]) and np.array_equal(images[0], images[2])
+
+
+@pytest.mark.parametrize("pattern", [2, 4])
+def test_glass_and_fur_samples_coexist(render, pattern):
+    """Revie 2.3.4 interleaving: glass in front of fur takes another parity class, so the fur's
+    outer-shell samples behind the glass are still in the G-buffer for its shells."""
+    scene = scene_from_dict({
+        "size": [160, 120], "tonemap": "none",
+        "camera": {"position": [0.0, 0.0, 3.0], "target": [0.0, 0.0, 0.0]},
+        "object": [
+            {"name": "fur", "mesh": "builtin:sphere", "material": "revie_fur", "scale": 0.8,
+             "params": {"shells": 4}},
+            {"name": "glass", "mesh": "builtin:cube", "position": [0.0, 0.0, 1.2],
+             "scale": [0.5, 0.5, 0.02], "material": "stipple_glass",
+             "params": {"pattern": pattern}}],
+        "light": [{"type": "ambient"}]})
+    shots = {}
+
+    def grab(render_pass, frame):
+        if render_pass.name == "glass.stipple":
+            shots["ids"] = frame.targets.read("normal_exponent_id")[..., 3]
+
+    render(scene, on_pass=grab)
+    from deferred import registry
+
+    ids = shots["ids"] % 64
+    y, x = np.mgrid[0:ids.shape[0], 0:ids.shape[1]]
+    fur_class = (x % 2 == 0) & (y % 2 == 0)
+    glass = ids == registry.materials.get("stipple_glass").type_id
+    fur = ids == registry.materials.get("revie_fur").type_id
+    behind_glass = np.zeros_like(glass)
+    rows, cols = np.nonzero(glass)
+    behind_glass[rows.min() + 2:rows.max() - 2, cols.min() + 2:cols.max() - 2] = True
+    assert glass[behind_glass].mean() > 0.2
+    # every fur-class pixel behind the glass still holds the fur (its stipple sample)
+    assert fur[behind_glass & fur_class].all()
+    assert not (glass & fur_class).any()

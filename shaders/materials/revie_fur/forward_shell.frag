@@ -1,27 +1,35 @@
 // Revie fur, forward technique (2.4: "a separate technique ... in a forward-shaded fashion"):
-// each shell fragment is lit directly by every light, with the grain normal and, as the
-// deferred stipple sample does, with the rim-bent normal; the brighter wins. Albedo and strand
-// fading are those of the deferred shells.
+// each shell or fin fragment is lit directly by every light, with the grain normal and, as the
+// deferred stipple sample does, with the rim-bent normal; the brighter wins. Coverage, albedo
+// over the depth and self-shadowing are those of the deferred shells.
 #include "common/surface_input.glsl"
 #include "common/forward_lighting.glsl"
 #include "techniques/rim.glsl"
+#include "techniques/fur.glsl"
 #include SURFACE_FILE
 
-uniform sampler2D u_heightfield;
 uniform vec3 u_albedo_base;
-uniform float u_density;
-uniform float u_strand_softness;
 uniform float u_rim_strength;
 uniform float u_rim_falloff;
+uniform float u_shell_fade;
+uniform bool u_root_shell;  // the first shell: the skin, opaque, with the strands' roots on it
 
 in float v_shell_depth;
+in vec3 v_fur_position;
+in vec3 v_fur_normal;
+#ifdef FUR_FINS
+in float v_fin_fade;
+#endif
 out vec4 out_color;
 
 void main() {
+    vec2 strands = fur_sample(v_fur_position, v_fur_normal, v_shell_depth);
+    float alpha = u_root_shell ? 1.0 : strands.x * u_shell_fade;
+#ifdef FUR_FINS
+    alpha *= v_fin_fade;
+#endif
+    if (alpha < 0.5 / 255.0) discard;
     SurfaceInput i = surface_input();
-    float height = texture(u_heightfield, i.uv * u_density).r;
-    float alpha = 1.0 - smoothstep(height - u_strand_softness, height, v_shell_depth);
-    if (alpha <= 0.0) discard;
     Surface s = evaluate_surface(i);
     vec3 V = normalize(-i.position);
     vec3 light = forward_lighting(s, i.position, V);
@@ -31,5 +39,8 @@ void main() {
     light = max(light, forward_lighting(rim, i.position, V));
 #endif
     vec3 irradiance = light / max(s.albedo, vec3(1.0 / 255.0));
-    out_color = vec4(irradiance * mix(u_albedo_base, s.albedo, v_shell_depth), alpha);
+    // strands' own brightness where they cover; the skin between them on the root shell
+    float brightness = mix(1.0, strands.y / max(strands.x, 1e-4), min(strands.x, 1.0));
+    vec3 albedo = mix(u_albedo_base, u_albedo_tip, v_shell_depth) * fur_shadow(v_shell_depth);
+    out_color = vec4(irradiance * albedo * brightness, alpha);
 }

@@ -1,5 +1,6 @@
 // Revie fur: the mesh at a shell depth (0 base, 1 outermost shell), with the comb direction from
 // the vertex colour (Listing 2.7's tangent-space encoding) or from the `comb` parameter.
+// With FUR_FINS the outputs feed the fin geometry shader (techniques/fins.geom) under vs_ names.
 #include "techniques/shells.glsl"
 
 in vec3 in_position;
@@ -16,6 +17,25 @@ uniform float u_shell_depth;
 uniform float u_fur_length;     // object units, scaled per vertex by the comb alpha
 uniform float u_comb_strength;
 uniform vec3 u_comb;            // object space; used when the mesh has no comb colours
+uniform vec3 u_fur_scale;       // object axes to world units (the model matrix's scale)
+
+#ifdef FUR_FINS
+#define v_position vs_position
+#define v_normal vs_normal
+#define v_tangent vs_tangent
+#define v_binormal vs_binormal
+#define v_uv vs_uv
+#define v_comb vs_comb
+#define v_base_clip vs_base_clip
+#define v_tip_clip vs_tip_clip
+#define v_base_depth vs_base_depth
+#define v_tip_depth vs_tip_depth
+#define v_fur_extent vs_fur_extent
+#define v_shell_depth vs_shell_depth
+#define v_fur_position vs_fur_position
+#define v_fur_normal vs_fur_normal
+#define v_tip_position vs_tip_position
+#endif
 
 out vec3 v_position;
 out vec3 v_normal;
@@ -23,12 +43,15 @@ out vec3 v_tangent;
 out vec3 v_binormal;
 out vec2 v_uv;
 out vec4 v_comb;
-out vec4 v_base_clip;    // the base-mesh point under this shell point (Listing 2.2)
-out vec4 v_tip_clip;     // the outermost-shell point: where its stipple sample was written
-out float v_base_depth;  // linear view depths of those two points
+out vec4 v_base_clip;     // the base-mesh point under this shell point (Listing 2.2)
+out vec4 v_tip_clip;      // the outermost-shell point: where its stipple sample was written
+out float v_base_depth;   // linear view depths of those two points
 out float v_tip_depth;
-out float v_fur_extent;  // view-space length of the strand at this vertex
+out float v_fur_extent;   // view-space length of the strand at this vertex
 out float v_shell_depth;
+out vec3 v_fur_position;  // the base point in world-scaled object space (fur volume lookups)
+out vec3 v_fur_normal;    // object-space normal (triplanar weights)
+out vec3 v_tip_position;  // view space (fins)
 
 invariant gl_Position;
 
@@ -62,5 +85,8 @@ void main() {
     v_tip_depth = -tip_view.z;
     v_fur_extent = length(tip_view.xyz - base_view.xyz);
     v_shell_depth = u_shell_depth;
+    v_fur_position = in_position * u_fur_scale;
+    v_fur_normal = in_normal;
+    v_tip_position = tip_view.xyz;
     gl_Position = u_projection * position;
 }

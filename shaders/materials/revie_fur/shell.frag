@@ -1,30 +1,40 @@
-// Revie material phase shells (2.4.4, Figure 2.20): each shell fragment takes its light from the
-// light accumulation at the base-mesh point and at the outer-shell stipple sample, rejects a
+// Revie material phase shells and fins (2.4.4, Figure 2.20): each fragment takes its light from
+// the light accumulation at the base-mesh point and at the outer-shell stipple sample, rejects a
 // sample the G-buffer shows occluded, keeps the brighter (the scattering halo), divides out the
-// albedo and re-applies albedo_base..albedo_tip over the shell depth, and fades strands with
-// smoothstep against the heightfield.
+// albedo, and re-applies albedo_base..albedo_tip over the depth, darkened toward the roots
+// (techniques/fur.glsl). Its coverage comes from the mip-mapped fur volume. The first shell is
+// the skin: opaque, root-coloured, over the base mesh (whose G-buffer albedo is the tip colour,
+// so dividing it out of the light stays well conditioned).
+//
+// A base point that lands on one of this fur's stipple samples (or a pixel beside the surface)
+// takes the light of the nearest neighbour holding the base surface: nothing is discarded for
+// the stipple pattern, so no dot grid appears where the outer sample is off-screen or occluded.
 #include "techniques/stipple.glsl"
+#include "techniques/fur.glsl"
 #include "gbuffer/layout.glsl"
 
 uniform sampler2D u_light_accumulation;
 uniform sampler2D u_albedo_specular;
 uniform sampler2D u_normal_exponent_id;
 uniform sampler2D u_linear_depth;
-uniform sampler2D u_heightfield;
 uniform vec2 u_resolution;
 uniform float u_surface_id;
 uniform vec3 u_albedo_base;
 uniform vec3 u_albedo_tip;
-uniform float u_density;
-uniform float u_strand_softness;
+uniform float u_shell_fade;
+uniform bool u_root_shell;  // the first shell: the skin, opaque, with the strands' roots on it  // the outermost shell fades in with the level of detail
 
-in vec2 v_uv;
 in vec4 v_base_clip;
 in vec4 v_tip_clip;
 in float v_base_depth;
 in float v_tip_depth;
 in float v_fur_extent;
 in float v_shell_depth;
+in vec3 v_fur_position;
+in vec3 v_fur_normal;
+#ifdef FUR_FINS
+in float v_fin_fade;
+#endif
 
 out vec4 out_color;
 
@@ -32,36 +42,66 @@ ivec2 pixel_of(vec4 clip) {
     return ivec2(floor((clip.xy / clip.w * 0.5 + 0.5) * u_resolution));
 }
 
-// Light / albedo at `pixel` if it holds this fur within `tolerance` of `expected` depth.
-bool irradiance_at(ivec2 pixel, float expected, float tolerance, out vec3 irradiance) {
-    irradiance = vec3(0.0);
-    if (any(lessThan(pixel, ivec2(0))) || any(greaterThanEqual(pixel, ivec2(u_resolution))))
-        return false;
+bool inside(ivec2 pixel) {
+    return all(greaterThanEqual(pixel, ivec2(0))) && all(lessThan(pixel, ivec2(u_resolution)));
+}
+
+// Whether `pixel` holds this fur within `tolerance` of `expected` linear depth.
+bool holds_fur(ivec2 pixel, float expected, float tolerance) {
+    if (!inside(pixel)) return false;
 #ifdef FUR_OCCLUSION_TEST
     if (!same_surface(texelFetch(u_normal_exponent_id, pixel, 0).w, u_surface_id)) return false;
     if (abs(texelFetch(u_linear_depth, pixel, 0).r - expected) > tolerance) return false;
 #endif
-    vec3 albedo = max(texelFetch(u_albedo_specular, pixel, 0).rgb, vec3(1.0 / 255.0));
-    irradiance = texelFetch(u_light_accumulation, pixel, 0).rgb / albedo;
     return true;
 }
 
+vec3 irradiance_at(ivec2 pixel) {
+    vec3 albedo = max(texelFetch(u_albedo_specular, pixel, 0).rgb, vec3(1.0 / 255.0));
+    return texelFetch(u_light_accumulation, pixel, 0).rgb / albedo;
+}
+
+const ivec2 AROUND[8] = ivec2[](ivec2(1, 0), ivec2(-1, 0), ivec2(0, 1), ivec2(0, -1),
+                                ivec2(1, 1), ivec2(-1, 1), ivec2(1, -1), ivec2(-1, -1));
+
+// The base sample: the pixel under the base point or the first neighbour holding the base.
+bool base_irradiance(ivec2 pixel, float tolerance, out vec3 irradiance) {
+    irradiance = vec3(0.0);
+    if (holds_fur(pixel, v_base_depth, tolerance)) {
+        irradiance = irradiance_at(pixel);
+        return true;
+    }
+    for (int k = 0; k < 8; ++k) {
+        if (holds_fur(pixel + AROUND[k], v_base_depth, tolerance)) {
+            irradiance = irradiance_at(pixel + AROUND[k]);
+            return true;
+        }
+    }
+    return false;
+}
+
 void main() {
-    float height = texture(u_heightfield, v_uv * u_density).r;
-    float alpha = 1.0 - smoothstep(height - u_strand_softness, height, v_shell_depth);
-    if (alpha <= 0.0) discard;
+    vec2 strands = fur_sample(v_fur_position, v_fur_normal, v_shell_depth);
+    float alpha = u_root_shell ? 1.0 : strands.x * u_shell_fade;
+#ifdef FUR_FINS
+    alpha *= v_fin_fade;
+#endif
+    if (alpha < 0.5 / 255.0) discard;
     float tolerance = 0.5 * v_fur_extent + 0.002 * v_base_depth;
     vec3 base_light;
-    vec3 tip_light;
-    bool base_valid = irradiance_at(pixel_of(v_base_clip), v_base_depth, tolerance, base_light);
+    vec3 tip_light = vec3(0.0);
+    bool base_valid = base_irradiance(pixel_of(v_base_clip), tolerance, base_light);
     bool tip_valid = false;
 #ifdef FUR_STIPPLE
-    tip_valid = irradiance_at(stipple_pixel_of(pixel_of(v_tip_clip)), v_tip_depth, tolerance,
-                              tip_light);
+    ivec2 tip = stipple_pixel_of(pixel_of(v_tip_clip));
+    tip_valid = holds_fur(tip, v_tip_depth, tolerance);
+    if (tip_valid) tip_light = irradiance_at(tip);
 #endif
-    if (!base_valid && !tip_valid) discard;
+    if (!base_valid && !tip_valid) discard;  // both samples hidden: the strand's light is unknown
     vec3 irradiance = base_valid && tip_valid ? max(base_light, tip_light)
                     : (base_valid ? base_light : tip_light);
-    vec3 albedo = mix(u_albedo_base, u_albedo_tip, v_shell_depth);
-    out_color = vec4(irradiance * albedo, alpha);
+    // strands' own brightness where they cover; the skin between them on the root shell
+    float brightness = mix(1.0, strands.y / max(strands.x, 1e-4), min(strands.x, 1.0));
+    vec3 albedo = mix(u_albedo_base, u_albedo_tip, v_shell_depth) * fur_shadow(v_shell_depth);
+    out_color = vec4(irradiance * albedo * brightness, alpha);
 }

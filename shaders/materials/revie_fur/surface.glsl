@@ -1,5 +1,6 @@
 // Revie fur surface for the G-buffer and the forward base pass: the outer albedo, specular, and
-// the anisotropic grain normal (Listing 2.5) unless `anisotropic` is off.
+// the anisotropic grain normal (Listing 2.5) unless `anisotropic` is off. What shows of the base
+// is the root shell drawn over it (the skin); this albedo is what the light samples divide out.
 #include "common/surface.glsl"
 #include "techniques/grain_normal.glsl"
 

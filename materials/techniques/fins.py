@@ -1,0 +1,100 @@
+"""Fins (Lengyel et al. 2001): strips extruded from silhouette edges along the fur direction and
+textured with the fur volume, so fur seen edge-on reads as strands rather than the stacked rims
+of shells. ``techniques/fins.geom`` builds them from each edge and its two faces; this module
+finds the edges (:func:`edge_adjacency`) and draws them (:class:`FinPass`).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import moderngl
+import numpy as np
+
+from deferred.gbuffer import DEPTH
+from deferred.mesh import GpuMesh, MeshData
+from deferred.passes import ObjectPass, Order
+
+
+def edge_adjacency(mesh: MeshData, tolerance: float = 1e-6) -> np.ndarray:
+    """(E, 4) uint32 ``[c1, a, b, c2]`` per interior edge: its endpoints as triangle 1 winds
+    them and the vertices opposite the edge in its two triangles (lines_adjacency order).
+    Vertices split at UV seams are welded by position, so seams are interior edges too; edges
+    with one face, or more than two, get no fin."""
+    positions = np.asarray(mesh.positions, dtype=np.float64)
+    keys = np.round(positions / tolerance).astype(np.int64)
+    _, welded = np.unique(keys, axis=0, return_inverse=True)
+    welded = welded.reshape(-1)
+    faces = np.asarray(mesh.indices, dtype=np.int64).reshape(-1, 3)
+    # every directed edge (a -> b) of every face, with the vertex opposite it
+    a = faces.reshape(-1)
+    b = faces[:, [1, 2, 0]].reshape(-1)
+    opposite = faces[:, [2, 0, 1]].reshape(-1)
+    wa, wb = welded[a], welded[b]
+    low, high = np.minimum(wa, wb), np.maximum(wa, wb)
+    key = low * (welded.max() + 1) + high
+    order = np.argsort(key, kind="stable")
+    sorted_key = key[order]
+    starts = np.flatnonzero(np.r_[True, sorted_key[1:] != sorted_key[:-1]])
+    counts = np.diff(np.r_[starts, len(sorted_key)])
+    pairs = starts[counts == 2]
+    first, second = order[pairs], order[pairs + 1]
+    keep = wa[first] == wb[second]  # consistent winding: the second face runs b -> a
+    first, second = first[keep], second[keep]
+    return np.stack([opposite[first], a[first], b[first], opposite[second]],
+                    axis=1).astype(np.uint32)
+
+
+class FinGeometry:
+    """The edges of a mesh as lines-with-adjacency over the mesh's own vertex buffer."""
+
+    def __init__(self, ctx: moderngl.Context, gpu_mesh: GpuMesh, edges: np.ndarray):
+        self.ctx = ctx
+        self.gpu_mesh = gpu_mesh
+        self.count = int(edges.size)
+        self.ibo = ctx.buffer(np.ascontiguousarray(edges).tobytes())
+        self._arrays: dict[int, moderngl.VertexArray] = {}
+
+    def render(self, program: moderngl.Program) -> None:
+        vao = self._arrays.get(program.glo)
+        if vao is None:
+            vao = self.ctx.vertex_array(program, [self.gpu_mesh.vertex_buffer(program)],
+                                        index_buffer=self.ibo, index_element_size=4)
+            self._arrays[program.glo] = vao
+        vao.render(moderngl.LINES_ADJACENCY, vertices=self.count)
+
+    def release(self) -> None:
+        for vao in self._arrays.values():
+            vao.release()
+        self._arrays.clear()
+        self.ibo.release()
+
+
+class FinPass(ObjectPass):
+    """Fins of an object: ``geometry = "techniques/fins.geom"`` over the material's fur vertex
+    shader compiled with ``FUR_FINS``; blended like shells, never culled."""
+
+    geometry = "techniques/fins.geom"
+    depth = DEPTH
+    depth_test = True
+    depth_func = "lequal"
+    depth_write = False
+    cull = None
+    blend = "alpha"
+    order = Order.VOLUME
+
+    def defines(self, frame) -> dict[str, str]:
+        return {**super().defines(frame), "FUR_FINS": "1"}
+
+    def uniforms(self, frame) -> dict[str, Any]:
+        params = self.obj.material.params
+        return {"u_fin_band": params.fin_band, "u_shell_fade": 1.0, "u_shell_depth": 0.0,
+                "u_root_shell": False}
+
+    def draw(self, frame, program: moderngl.Program) -> None:
+        mesh = self.obj.mesh
+        geometry = frame.resources.cached(
+            ("fins", id(mesh)),
+            lambda ctx: FinGeometry(ctx, frame.resources.gpu_mesh(mesh), edge_adjacency(mesh)))
+        geometry.render(program)
+        frame.count_draw()

@@ -1,0 +1,186 @@
+"""The shared fur technique: the parameters every shell fur has, the mip-mapped fur volume its
+shells and fins sample (``fur_volume.py``, ``shaders/techniques/fur.glsl``), density in world
+units, level of detail and self-shadowing. ``revie_fur`` builds on it, and the curling and
+clumping shell fur will: they differ in how fur is lit and shaped, not in how shells are drawn.
+
+- **Density** is strands per square world unit: the volume tiles ``sqrt(density / strands per
+  tile)`` times per world unit along the surface, looked up triplanar in the object's axes scaled
+  to world size, so charts, seams and poles of an unwrap play no part.
+- **Root shell and skin**: shell ``k`` of ``n`` sits at depth ``k / n``, the first at the root;
+  the skin under the strands is the root colour darkened by Silva et al.'s shadow factor
+  ``gamma(h) = (K - 1 + h) / K`` (``self_shadow`` = K), which darkens every shell toward the roots.
+- **Level of detail**: the shell count follows the fur layer's projected thickness,
+  ``n = clamp(pixels / lod_error, min_shells, shells)``, continuous; shells sit at ``k / n`` and
+  the outermost fades by the fraction, so a dolly never pops (:func:`shell_count`).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Literal
+
+import moderngl
+import numpy as np
+from pydantic import Field, model_validator
+
+from deferred.errors import InputError
+from deferred.material import MaterialParams
+
+from .fur_volume import (
+    FurPattern,
+    heightfield_volume,
+    pattern,
+    strand_volume,
+    volume_texture,
+)
+from .heightfield import load_heightfield
+
+if TYPE_CHECKING:
+    from deferred.frame import Frame
+    from deferred.scene import SceneObject
+
+# A heightfield image tile counts as this many strands when density converts to tiles per unit.
+IMAGE_TILE_STRANDS = 1024
+
+
+class FurParams(MaterialParams):
+    """The fur technique's parameters (a mixin of fur materials' parameter models)."""
+
+    fur_length: float = Field(0.15, gt=0.0, le=4.0,
+                              description="strand length, object units (x vertex colour alpha)")
+    shells: int = Field(16, ge=0, le=256, description="most concentric shells (close up)")
+    min_shells: int = Field(2, ge=1, le=256,
+                            description="fewest shells (far away; at most `shells`)")
+    lod_error: float = Field(1.0, gt=0.0, le=64.0,
+                             description="projected fur thickness per shell, pixels")
+    density: float = Field(12000.0, gt=0.0, le=1e7,
+                           description="strands per square world unit")
+    pattern: Literal["fine", "coarse", "patchy"] = Field(
+        "fine", description="built-in strand pattern of the fur volume")
+    thickness_base: float | None = Field(None, gt=0.0, le=2.0,
+                                         description="strand diameter at the root / spacing "
+                                                     "(default: the pattern's)")
+    thickness_tip: float | None = Field(None, ge=0.0, le=2.0,
+                                        description="strand diameter at the tip / spacing")
+    length_variation: float | None = Field(None, ge=0.0, le=1.0,
+                                           description="strand lengths vary down to 1 - this")
+    heightfield: str | None = Field(None, description="strand height image (R channel) "
+                                                      "instead of the pattern")
+    strand_softness: float = Field(0.1, gt=0.0, le=1.0,
+                                   description="fade of a heightfield strand's tip")
+    seed: int = Field(1, ge=0, description="seed of the strand pattern")
+    self_shadow: float = Field(2.5, ge=1.0, le=64.0,
+                               description="Silva's K_shadow: roots darkened to (K - 1) / K")
+    fins: bool = Field(True, description="fins at silhouette edges (Lengyel 2001)")
+    fin_band: float = Field(0.3, gt=0.0, le=1.0,
+                            description="|N.V| below which an edge grows a fin")
+    shell_range: tuple[float, float] = Field(
+        (0.0, 1.0), description="draw only shells at depths in this range (debugging: one "
+                                "shell, the roots)")
+
+    @model_validator(mode="after")
+    def _check_fur(self) -> FurParams:
+        low, high = self.shell_range
+        if not 0.0 <= low <= high <= 1.0:
+            raise ValueError("shell_range must be two depths 0 <= low <= high <= 1")
+        return self
+
+
+# Fields of FurParams that are not uniforms as they stand.
+FUR_UNIFORM_OVERRIDES: dict[str, Any] = {
+    "shells": None, "min_shells": None, "lod_error": None, "pattern": None,
+    "thickness_base": None, "thickness_tip": None, "length_variation": None, "seed": None,
+    "strand_softness": None, "fins": None, "fin_band": None, "shell_range": None,
+    "density": None,
+}
+
+
+def fur_pattern(params: FurParams) -> FurPattern:
+    return pattern(params.pattern, thickness_base=params.thickness_base,
+                   thickness_tip=params.thickness_tip,
+                   length_variation=params.length_variation, seed=params.seed)
+
+
+def strands_per_tile(params: FurParams) -> int:
+    if params.heightfield is not None:
+        return IMAGE_TILE_STRANDS
+    grid = max(1, round(math.sqrt(fur_pattern(params).strands)))
+    return grid * grid
+
+
+def tiles_per_unit(params: FurParams) -> float:
+    """Fur volume tiles per world unit along the surface, from strands per square unit."""
+    return math.sqrt(params.density / strands_per_tile(params))
+
+
+def check_heightfield(params: FurParams, path: Path | None, where: str | None) -> None:
+    """Bad input for a heightfield image that is missing or unreadable (before GL work)."""
+    if path is None:
+        return
+    key = f"{where}.heightfield" if where else "heightfield"
+    if not path.is_file():
+        raise InputError(f"heightfield image not found: {path}", key)
+    try:
+        load_heightfield(path)
+    except InputError as exc:
+        raise InputError(f"cannot read heightfield image {path.name}: {exc.message}",
+                         key) from None
+
+
+def fur_volume_texture(frame: Frame, params: FurParams,
+                       heightfield: Path | None) -> moderngl.TextureArray:
+    """The object's fur volume, made once per renderer and pattern."""
+    if heightfield is not None:
+        softness = params.strand_softness
+        return frame.resources.texture(
+            ("fur_volume", str(heightfield), softness),
+            lambda ctx: volume_texture(ctx, heightfield_volume(load_heightfield(heightfield),
+                                                               softness=softness)))
+    spec = fur_pattern(params)
+    return frame.resources.texture(("fur_volume", spec),
+                                   lambda ctx: volume_texture(ctx, strand_volume(spec)))
+
+
+def object_scale(obj: SceneObject) -> np.ndarray:
+    """World length of the object's unit axes (its model matrix's scale)."""
+    return np.linalg.norm(obj.model[:3, :3], axis=0)
+
+
+def fur_object_uniforms(obj: SceneObject, params: FurParams) -> dict[str, Any]:
+    """Per-object uniforms of the fur vertex stage and volume lookups."""
+    return {"u_fur_scale": tuple(float(s) for s in object_scale(obj)),
+            "u_fur_tiles": tiles_per_unit(params)}
+
+
+def projected_fur_pixels(frame: Frame, obj: SceneObject, fur_length: float) -> float:
+    """How many pixels the fur layer is thick where the object comes nearest the camera."""
+    low, high = obj.mesh.bounds()
+    scale = float(object_scale(obj).max())
+    centre = obj.model @ np.append((low + high) / 2.0, 1.0)
+    radius = 0.5 * float(np.linalg.norm(high - low)) * scale
+    camera = np.asarray(frame.scene.camera.position, dtype=np.float64)
+    distance = max(float(np.linalg.norm(centre[:3] - camera)) - radius,
+                   frame.scene.camera.near)
+    focal = 0.5 * frame.height * frame.projection[1, 1]  # pixels per unit at distance 1
+    return fur_length * scale * focal / distance
+
+
+def shell_count(frame: Frame, obj: SceneObject, params: FurParams) -> float:
+    """The continuous shell count for the object this frame (see the module documentation)."""
+    pixels = projected_fur_pixels(frame, obj, params.fur_length)
+    return float(np.clip(pixels / params.lod_error, min(params.min_shells, params.shells),
+                         params.shells))
+
+
+def shell_layout(count: float, shell_range: tuple[float, float] = (0.0, 1.0)
+                 ) -> list[tuple[float, float] | None]:
+    """(depth, fade) of each shell drawn for a continuous count (None: outside the range)."""
+    drawn = math.ceil(count - 1e-9)
+    shells: list[tuple[float, float] | None] = []
+    for k in range(drawn):
+        depth = k / count
+        fade = 1.0 if k < drawn - 1 else count - (drawn - 1)
+        low, high = shell_range
+        shells.append((depth, fade) if low <= depth <= high else None)
+    return shells

@@ -1,0 +1,156 @@
+"""The fur volume: a tileable stack of slices through a patch of strands (Lengyel et al. 2001,
+"Real-Time Fur over Arbitrary Surfaces": the shells are slices of a volume texture made from a
+geometric model of a patch of hair).
+
+Strands are generated, seeded, on a jittered grid over a square tile. Each strand has a root
+position, a length (1 minus up to ``length_variation``), a random lean, a brightness and a
+diameter that tapers linearly from ``thickness_base`` at the root to ``thickness_tip`` at the tip
+(both relative to the mean spacing between strands). Slice ``k`` of ``layers`` is the cut through
+the patch at height ``(k + 0.5) / layers`` of the fur layer: each texel holds the strand's
+coverage of it (anti-aliased disc edges) and the strand's brightness.
+
+The texture is a 2D array (a slice per layer) of RGBA8 holding brightness * coverage in R and
+coverage in A, with mipmaps: a mip texel's alpha is the fraction of the area strands cover and
+R / A their mean brightness, so distant fur averages to the right colour and density instead of
+going bald (thresholding) or noisy (no filtering). Shells interpolate between adjacent slices.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import moderngl
+import numpy as np
+
+PATTERNS = ("fine", "coarse", "patchy")
+
+
+@dataclass(frozen=True)
+class FurPattern:
+    """How a tile of strands is made (see the module documentation)."""
+
+    strands: int = 1024  # per tile, on a sqrt(strands) jittered grid
+    thickness_base: float = 0.8  # diameter at the root / mean strand spacing
+    thickness_tip: float = 0.15  # diameter at the tip / mean strand spacing
+    length_variation: float = 0.35  # lengths are uniform in [1 - variation, 1]
+    lean: float = 0.6  # how far a tip wanders from above its root, in strand spacings
+    patches: float = 0.0  # > 0: strand length scaled by a tileable low-frequency noise
+    seed: int = 1
+    size: int = 128  # texels per tile side
+    layers: int = 16
+
+
+def pattern(name: str, **overrides) -> FurPattern:
+    """A built-in pattern, with any field overridden."""
+    presets = {
+        "fine": FurPattern(),
+        "coarse": FurPattern(strands=196, thickness_base=0.7, thickness_tip=0.2, lean=0.35),
+        "patchy": FurPattern(strands=1024, patches=0.8, length_variation=0.2),
+    }
+    if name not in presets:
+        raise ValueError(f"unknown fur pattern '{name}' (choose from {', '.join(presets)})")
+    fields = {key: value for key, value in overrides.items() if value is not None}
+    return FurPattern(**{**presets[name].__dict__, **fields})
+
+
+def _tileable_noise(rng: np.random.Generator, size: int, cells: int) -> np.ndarray:
+    """Smooth value noise in [0, 1] that tiles, ``cells`` lattice cells across."""
+    lattice = rng.uniform(0.0, 1.0, (cells, cells))
+    t = (np.arange(size) + 0.5) / size * cells
+    i = np.floor(t).astype(int)
+    f = t - i
+    f = f * f * (3.0 - 2.0 * f)
+    i0, i1 = i % cells, (i + 1) % cells
+    rows = lattice[i0][:, i0] * (1 - f)[None, :] + lattice[i0][:, i1] * f[None, :]
+    rows1 = lattice[i1][:, i0] * (1 - f)[None, :] + lattice[i1][:, i1] * f[None, :]
+    return rows * (1 - f)[:, None] + rows1 * f[:, None]
+
+
+def strand_volume(p: FurPattern) -> np.ndarray:
+    """(layers, size, size, 2) float32: coverage and brightness of each slice, tileable, the
+    same for the same pattern (``seed``)."""
+    rng = np.random.default_rng(p.seed)
+    grid = max(1, round(np.sqrt(p.strands)))
+    count = grid * grid
+    spacing = 1.0 / grid  # tile units
+    cells = (np.stack(np.meshgrid(np.arange(grid), np.arange(grid), indexing="ij"), -1)
+             .reshape(-1, 2))
+    roots = (cells + rng.uniform(0.1, 0.9, (count, 2))) * spacing  # (y, x) in [0, 1)
+    lengths = 1.0 - p.length_variation * rng.uniform(0.0, 1.0, count)
+    if p.patches > 0.0:
+        noise = _tileable_noise(rng, p.size, 4)
+        at_root = noise[(roots[:, 0] * p.size).astype(int) % p.size,
+                        (roots[:, 1] * p.size).astype(int) % p.size]
+        lengths *= 1.0 - p.patches * np.clip(1.0 - 2.0 * at_root, 0.0, 1.0)
+    angle = rng.uniform(0.0, 2.0 * np.pi, count)
+    lean = p.lean * spacing * rng.uniform(0.3, 1.0, count)
+    lean_vector = np.stack([np.sin(angle), np.cos(angle)], -1) * lean[:, None]
+    brightness = rng.uniform(0.7, 1.0, count)
+
+    size = p.size
+    texel = 1.0 / size
+    radius_max = 0.5 * spacing * max(p.thickness_base, p.thickness_tip)
+    reach = int(np.ceil(radius_max / texel)) + 1
+    offsets = np.arange(-reach, reach + 1)
+    oy, ox = np.meshgrid(offsets, offsets, indexing="ij")
+    volume = np.zeros((p.layers, size, size, 2), np.float32)
+    for k in range(p.layers):
+        h = (k + 0.5) / p.layers
+        alive = lengths > h
+        if not alive.any():
+            continue
+        t = h / lengths[alive]  # position along each strand, root 0 to tip 1
+        centre = roots[alive] + lean_vector[alive] * t[:, None] ** 2  # a gentle curve
+        radius = 0.5 * spacing * (p.thickness_base + (p.thickness_tip - p.thickness_base) * t)
+        base = np.floor(centre / texel).astype(int)  # (n, 2)
+        ty = base[:, 0, None, None] + oy[None]
+        tx = base[:, 1, None, None] + ox[None]
+        dy = (ty + 0.5) * texel - centre[:, 0, None, None]
+        dx = (tx + 0.5) * texel - centre[:, 1, None, None]
+        distance = np.sqrt(dy * dy + dx * dx)
+        # Anti-aliased disc: the fraction of a texel inside the strand's cross-section.
+        coverage = np.clip((radius[:, None, None] - distance) / texel + 0.5, 0.0, 1.0)
+        index = ((ty % size) * size + (tx % size)).ravel()
+        coverage = coverage.ravel()
+        covered = np.zeros(size * size)
+        np.maximum.at(covered, index, coverage)
+        # brightness: the coverage-weighted mean of the strands over the texel (overlaps are few)
+        weight = np.zeros(size * size)
+        weighted = np.zeros(size * size)
+        np.add.at(weight, index, coverage)
+        np.add.at(weighted, index, coverage * np.repeat(brightness[alive], oy.size))
+        volume[k, ..., 0] = covered.reshape(size, size)
+        volume[k, ..., 1] = np.where(weight > 0.0, weighted / np.maximum(weight, 1e-12),
+                                     1.0).reshape(size, size)
+    return volume
+
+
+def heightfield_volume(heights: np.ndarray, layers: int = 16,
+                       softness: float = 0.1) -> np.ndarray:
+    """A heightfield image (strand height per texel, Revie 2.4.1) as a volume: a texel is covered
+    in the slices below its height, faded over ``softness`` as the chapter's smoothstep."""
+    h = (np.arange(layers) + 0.5) / layers
+    t = np.clip((h[:, None, None] - (heights[None] - softness)) / softness, 0.0, 1.0)
+    coverage = 1.0 - t * t * (3.0 - 2.0 * t)
+    volume = np.stack([coverage, np.ones_like(coverage)], -1).astype(np.float32)
+    return volume
+
+
+def volume_texture(ctx: moderngl.Context, volume: np.ndarray) -> moderngl.TextureArray:
+    """The volume as a mip-mapped, repeating RGBA8 2D array texture (see the module doc)."""
+    layers, height, width, _ = volume.shape
+    coverage, brightness = volume[..., 0], volume[..., 1]
+    rgba = np.zeros((layers, height, width, 4), np.float32)
+    rgba[..., 0] = brightness * coverage  # premultiplied: mips average it with the coverage
+    rgba[..., 3] = coverage
+    data = np.clip(np.rint(rgba[:, ::-1] * 255.0), 0, 255).astype(np.uint8)  # GL rows bottom-up
+    texture = ctx.texture_array((width, height, layers), 4, np.ascontiguousarray(data).tobytes())
+    texture.build_mipmaps()
+    texture.repeat_x = texture.repeat_y = True
+    texture.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+    return texture
+
+
+def mean_coverage(volume: np.ndarray) -> np.ndarray:
+    """Per slice, the fraction of the tile strands cover (what the coarsest mip holds)."""
+    return volume[..., 0].mean(axis=(1, 2))

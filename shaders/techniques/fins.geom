@@ -1,0 +1,80 @@
+// Fins (Lengyel et al. 2001): at silhouette edges, a strip extruded from the edge along the fur
+// direction to the strand tips, so grazing fur reads as strands instead of stacked shell rims.
+// Input: an edge with its two opposite vertices (lines_adjacency: c1, a, b, c2; the faces are
+// (a, b, c1) and (b, a, c2) in mesh winding), each vertex carrying the fur vertex outputs under
+// vs_ names (FUR_FINS). An edge gets a fin where the surface is edge-on to the viewer: the
+// fin fades in as |N.V| of the edge's normal (the mean of its faces') drops below u_fin_band,
+// fully opaque at the silhouette, so fins never pop as the silhouette moves across the mesh.
+layout(lines_adjacency) in;
+layout(triangle_strip, max_vertices = 4) out;
+
+in vec3 vs_position[];
+in vec3 vs_normal[];
+in vec3 vs_tangent[];
+in vec3 vs_binormal[];
+in vec2 vs_uv[];
+in vec4 vs_comb[];
+in vec4 vs_base_clip[];
+in vec4 vs_tip_clip[];
+in float vs_base_depth[];
+in float vs_tip_depth[];
+in float vs_fur_extent[];
+in float vs_shell_depth[];
+in vec3 vs_fur_position[];
+in vec3 vs_fur_normal[];
+in vec3 vs_tip_position[];
+
+uniform float u_fin_band;  // |N.V| below which an edge grows a fin
+
+out vec3 v_position;
+out vec3 v_normal;
+out vec3 v_tangent;
+out vec3 v_binormal;
+out vec2 v_uv;
+out vec4 v_comb;
+out vec4 v_base_clip;
+out vec4 v_tip_clip;
+out float v_base_depth;
+out float v_tip_depth;
+out float v_fur_extent;
+out float v_shell_depth;
+out vec3 v_fur_position;
+out vec3 v_fur_normal;
+out float v_fin_fade;
+
+void emit(int i, bool tip, float fade) {
+    v_position = tip ? vs_tip_position[i] : vs_position[i];
+    v_normal = vs_normal[i];
+    v_tangent = vs_tangent[i];
+    v_binormal = vs_binormal[i];
+    v_uv = vs_uv[i];
+    v_comb = vs_comb[i];
+    v_base_clip = vs_base_clip[i];
+    v_tip_clip = vs_tip_clip[i];
+    v_base_depth = vs_base_depth[i];
+    v_tip_depth = vs_tip_depth[i];
+    v_fur_extent = vs_fur_extent[i];
+    v_shell_depth = tip ? 1.0 : 0.0;
+    v_fur_position = vs_fur_position[i];
+    v_fur_normal = vs_fur_normal[i];
+    v_fin_fade = fade;
+    gl_Position = tip ? vs_tip_clip[i] : vs_base_clip[i];
+    EmitVertex();
+}
+
+void main() {
+    vec3 a = vs_position[1];
+    vec3 b = vs_position[2];
+    vec3 n1 = normalize(cross(b - a, vs_position[0] - a));
+    vec3 n2 = normalize(cross(a - b, vs_position[3] - b));
+    vec3 V = normalize(-0.5 * (a + b));
+    vec3 edge_normal = n1 + n2;
+    if (dot(edge_normal, edge_normal) < 1e-8) return;  // a knife edge: no side to grow from
+    float fade = 1.0 - smoothstep(0.0, u_fin_band, abs(dot(normalize(edge_normal), V)));
+    if (fade <= 0.0) return;
+    emit(1, false, fade);
+    emit(2, false, fade);
+    emit(1, true, fade);
+    emit(2, true, fade);
+    EndPrimitive();
+}

@@ -1,0 +1,44 @@
+// The fur technique's volume lookups (materials/techniques/fur.py, fur_volume.py): coverage and
+// brightness of the strands at height h (0 root .. 1 tip) of the fur layer.
+//
+// Mapping: triplanar, in world units. Strands are looked up at the base-mesh point under the
+// fragment (object space scaled to world size, times the tiles per unit that `density` gives),
+// in the three axis planes, blended by the object-space normal. It has no UV seams and no poles,
+// and the density is the same on every part of every mesh whatever its unwrap.
+
+uniform sampler2DArray u_fur_volume;  // slices of the strand volume, mip-mapped (alpha = coverage)
+uniform float u_fur_tiles;            // volume tiles per world unit
+uniform float u_self_shadow;          // Silva's K_shadow >= 1: fur darkens toward the roots
+
+// Coverage (x) and brightness * coverage (y) of the slices around h, interpolated.
+vec2 fur_slices(vec2 coord, vec2 dx, vec2 dy, float h) {
+    float layers = float(textureSize(u_fur_volume, 0).z);
+    float x = clamp(h * layers - 0.5, 0.0, layers - 1.0);
+    float k0 = floor(x);
+    float k1 = min(k0 + 1.0, layers - 1.0);
+    vec4 a = textureGrad(u_fur_volume, vec3(coord, k0), dx, dy);
+    vec4 b = textureGrad(u_fur_volume, vec3(coord, k1), dx, dy);
+    vec4 s = mix(a, b, x - k0);
+    return vec2(s.a, s.r);
+}
+
+// (coverage, brightness * coverage) at the fur position (world units, object axes) and
+// object-space normal of a base-mesh point, at height h.
+vec2 fur_sample(vec3 fur_position, vec3 fur_normal, float h) {
+    vec3 p = fur_position * u_fur_tiles;
+    // Derivatives in uniform control flow; the branches below only skip negligible planes.
+    vec3 px = dFdx(p);
+    vec3 py = dFdy(p);
+    vec3 w = pow(abs(fur_normal), vec3(8.0));
+    w /= max(w.x + w.y + w.z, 1e-6);
+    vec2 s = vec2(0.0);
+    if (w.x > 0.01) s += w.x * fur_slices(p.yz, px.yz, py.yz, h);
+    if (w.y > 0.01) s += w.y * fur_slices(p.zx, px.zx, py.zx, h);
+    if (w.z > 0.01) s += w.z * fur_slices(p.xy, px.xy, py.xy, h);
+    return s;
+}
+
+// Silva et al.'s shadow factor gamma = (K - 1 + h) / K: self-shadowing of the lower fur.
+float fur_shadow(float h) {
+    return (u_self_shadow - 1.0 + h) / u_self_shadow;
+}
