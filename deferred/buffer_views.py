@@ -6,7 +6,7 @@ as values for EXR and as a display image for PNG, and the catalogue of view name
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -24,6 +24,7 @@ from .gbuffer import GBUFFER_COLOR_TARGETS
 from .imageio import srgb_encode, write_image
 from .passes import RenderPass
 from .preview import depth_colors, grey, id_colors, normal_colors, target_views, to_uint8, tonemap
+from .scene import Scene
 from .targets import COMPOSITE, LIGHT_ACCUMULATION
 
 # Buffer views by name (``deferred render --view``): channels and what they show.
@@ -50,10 +51,40 @@ class View:
     preview: np.ndarray  # (H, W, 3) float in [0, 1]
 
 
-def view_catalogue(passes: Sequence[RenderPass]) -> list[tuple[str, str]]:
-    """Every ``--view`` name for a pass list, with what it shows."""
+def material_views(scene: Scene) -> dict[str, str]:
+    """``<material>.<view>`` -> what it shows, for the materials of ``scene``."""
+    out = {}
+    for obj in scene.objects:
+        for name, (doc, _) in obj.material.debug_views.items():
+            out[f"{obj.material.name}.{name}"] = f"{doc} (a debug view of the material)"
+    return out
+
+
+def with_material_view(scene: Scene, name: str) -> Scene | None:
+    """A copy of ``scene`` whose objects of the material draw debug view ``name``
+    (``<material>.<view>``); None when ``name`` is no material's view."""
+    material_name, _, view_name = name.partition(".")
+    objects = []
+    found = False
+    for obj in scene.objects:
+        material = obj.material
+        if material.name == material_name and view_name in material.debug_views:
+            overrides = material.debug_views[view_name][1]
+            params = type(material.params).model_validate(
+                {**material.params.model_dump(), **overrides})
+            obj = replace(obj, material=type(material)(params, material.base_dir))
+            found = True
+        objects.append(obj)
+    return replace(scene, objects=objects) if found else None
+
+
+def view_catalogue(passes: Sequence[RenderPass], scene: Scene | None = None
+                   ) -> list[tuple[str, str]]:
+    """Every ``--view`` name for a pass list (and the scene's material views), with what it
+    shows."""
     rows = [(name, f"{doc} [{' '.join(channels)}]") for name, (channels, doc)
             in NAMED_VIEWS.items()]
+    rows += list(material_views(scene).items()) if scene is not None else []
     targets = dict.fromkeys(t for p in passes for t in p.writes)
     rows += [(t, "target at the end of the frame") for t in targets if t not in NAMED_VIEWS]
     for p in passes:

@@ -57,22 +57,35 @@ def cli(debug: bool) -> None:
               help="Fail on a uniform set by name that its program does not declare.")
 @click.option("--view", "view_name", metavar="BUFFER",
               help="Write one buffer instead of the final image: albedo, normal, depth, "
-                   "specular, material, shading, light, composite, a target, or a pass (PASS or "
-                   "PASS:TARGET). '--view help' lists them.")
+                   "specular, material, shading, light, composite, a target, a pass (PASS or "
+                   "PASS:TARGET) or a material's debug view (MATERIAL.VIEW, e.g. "
+                   "revie_fur.samples). '--view help' lists them.")
 def render(scene: str | None, output: str, pipeline: str, size: str | None, frames: int,
            strict: bool, view_name: str | None) -> None:
     """Render SCENE (a TOML file; the built-in demo when omitted) to an image."""
-    from .buffer_views import resolve_view, view, view_catalogue, write_view
+    from .buffer_views import (
+        resolve_view,
+        view,
+        view_catalogue,
+        with_material_view,
+        write_view,
+    )
     from .capture import capture_frame
     from .renderer import Renderer
 
     if view_name == "help":
-        passes = PIPELINES[pipeline]().passes(_scene(scene))
-        for name, doc in view_catalogue(passes):
+        loaded = _scene(scene)
+        passes = PIPELINES[pipeline]().passes(loaded)
+        for name, doc in view_catalogue(passes, loaded):
             click.echo(f"{name:<36} {doc}")
         return
     out = check_output_path(output)
     loaded = _scene(scene)
+    shown_name = view_name
+    if view_name is not None:
+        debug_scene = with_material_view(loaded, view_name)
+        if debug_scene is not None:  # the material draws the view: the frame shows it
+            loaded, view_name = debug_scene, None
     with Renderer(loaded, pipeline, _size_option(size), strict=strict or None) as renderer:
         if view_name is not None:
             view_pass, _ = resolve_view(view_name, renderer.passes)  # bad names fail here
@@ -93,7 +106,7 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
     width, height = renderer.size
     timing = f"{min(times):.1f} ms" if frames == 1 else \
         f"median {sorted(times)[len(times) // 2]:.1f} ms over {frames} frames"
-    shown = f", view {view_name}" if view_name is not None else ""
+    shown = f", view {shown_name}" if shown_name is not None else ""
     stderr.print(f"wrote {out} ({width}x{height}, {pipeline}{shown}, {timing})")
 
 

@@ -75,6 +75,9 @@ class Material:
     gbuffer_data: tuple[GBufferData, ...] = ()  # extra per-pixel data (deferred.shading)
     # field -> None (not a uniform) or value -> {uniform: value} (see the module documentation)
     uniform_overrides: ClassVar[UniformOverrides] = {}
+    # debug views (``deferred render --view <material>.<name>``): name -> (what it shows, the
+    # parameters that make the material draw it)
+    debug_views: ClassVar[dict[str, tuple[str, dict[str, Any]]]] = {}
 
     def __init__(self, params: MaterialParams | None = None, base_dir: Path | None = None):
         self.params = params if params is not None else self.Params()

@@ -29,9 +29,11 @@ from deferred.validation import NonZeroVec3
 
 from .techniques.fins import FinPass
 from .techniques.fur import (
+    FUR_DEBUG_VIEWS,
     FUR_UNIFORM_OVERRIDES,
     FurParams,
     check_heightfield,
+    debug_defines,
     fur_object_uniforms,
     fur_volume_texture,
     tiles_per_unit,
@@ -96,8 +98,8 @@ class RevieFurMaterial(Material):
     Params = RevieFurParams
     surface_shader = "materials/revie_fur/surface.glsl"
     # pass counts and switches compiled as defines are not uniforms; density becomes tiles
-    uniform_overrides = {**FUR_UNIFORM_OVERRIDES, "stipple": None, "occlusion_test": None,
-                         "density": lambda _: {}}
+    uniform_overrides = {**FUR_UNIFORM_OVERRIDES, "stipple": None, "occlusion_test": None}
+    debug_views = FUR_DEBUG_VIEWS
 
     def check_files(self, where: str | None) -> None:
         check_heightfield(self.params, self.heightfield_path(), where)
@@ -114,7 +116,7 @@ class RevieFurMaterial(Material):
             defines["FUR_STIPPLE"] = "1"
         if self.params.occlusion_test:
             defines["FUR_OCCLUSION_TEST"] = "1"
-        return defines
+        return {**defines, **debug_defines(self.params)}
 
     def uniforms(self, frame: Frame) -> dict[str, Any]:
         return {**super().uniforms(frame), "u_fur_tiles": tiles_per_unit(self.params)}

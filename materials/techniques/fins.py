@@ -89,7 +89,12 @@ class FinPass(ObjectPass):
     def uniforms(self, frame) -> dict[str, Any]:
         params = self.obj.material.params
         return {"u_fin_band": params.fin_band, "u_shell_fade": 1.0, "u_shell_depth": 0.0,
-                "u_root_shell": False}
+                "u_root_shell": False, "u_shell_weight": 1.0, "u_shell_count": 1.0}
+
+    def draws(self, frame) -> int:
+        # debug views of the skin or one shell show no fins
+        return 0 if self.obj.material.params.debug in ("comb", "shell_count",
+                                                       "single_shell") else 1
 
     def draw(self, frame, program: moderngl.Program) -> None:
         mesh = self.obj.mesh

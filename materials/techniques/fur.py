@@ -78,6 +78,8 @@ class FurParams(MaterialParams):
     shell_range: tuple[float, float] = Field(
         (0.0, 1.0), description="draw only shells at depths in this range (debugging: one "
                                 "shell, the roots)")
+    debug: Literal["none", "samples", "comb", "shell_count", "single_shell"] = Field(
+        "none", description="debug view instead of the fur (see FUR_DEBUG_VIEWS)")
 
     @model_validator(mode="after")
     def _check_fur(self) -> FurParams:
@@ -92,8 +94,26 @@ FUR_UNIFORM_OVERRIDES: dict[str, Any] = {
     "shells": None, "min_shells": None, "lod_error": None, "pattern": None,
     "thickness_base": None, "thickness_tip": None, "length_variation": None, "seed": None,
     "strand_softness": None, "fins": None, "fin_band": None, "shell_range": None,
-    "density": None,
+    "density": None, "debug": None,
 }
+
+
+# Debug views of the fur technique (``deferred render --view <material>.<name>``), like the fur
+# debug switches of Lumberyard's legacy renderer: what each shows, and the parameters it sets.
+FUR_DEBUG_VIEWS: dict[str, tuple[str, dict[str, Any]]] = {
+    "samples": ("light samples each shell and fin fragment used: green base, blue outer "
+                "(stipple), cyan both, red none", {"debug": "samples"}),
+    "comb": ("comb direction on the skin, tangent space (x red, y green, up blue)",
+             {"debug": "comb"}),
+    "shell_count": ("shells drawn per object: blue few .. red the most (`shells`)",
+                    {"debug": "shell_count"}),
+    "single_shell": ("only the middle shell (of those in shell_range), strands cut through "
+                     "opaque", {"debug": "single_shell"}),
+}
+
+
+def debug_defines(params: FurParams) -> dict[str, str]:
+    return {} if params.debug == "none" else {f"FUR_DEBUG_{params.debug.upper()}": "1"}
 
 
 def fur_pattern(params: FurParams) -> FurPattern:
@@ -173,14 +193,18 @@ def shell_count(frame: Frame, obj: SceneObject, params: FurParams) -> float:
                          params.shells))
 
 
-def shell_layout(count: float, shell_range: tuple[float, float] = (0.0, 1.0)
-                 ) -> list[tuple[float, float] | None]:
-    """(depth, fade) of each shell drawn for a continuous count (None: outside the range)."""
+def shell_layout(count: float, shell_range: tuple[float, float] = (0.0, 1.0),
+                 debug: str = "none") -> list[tuple[float, float] | None]:
+    """(depth, fade) of each shell drawn for a continuous count (None: not drawn: outside the
+    range, or not shown by the debug view)."""
     drawn = math.ceil(count - 1e-9)
-    shells: list[tuple[float, float] | None] = []
-    for k in range(drawn):
-        depth = k / count
-        fade = 1.0 if k < drawn - 1 else count - (drawn - 1)
-        low, high = shell_range
-        shells.append((depth, fade) if low <= depth <= high else None)
-    return shells
+    low, high = shell_range
+    in_range = [k for k in range(drawn) if low <= k / count <= high]
+    if debug in ("comb", "shell_count"):
+        shown = {0}  # drawn on the root shell, the skin
+    elif debug == "single_shell":
+        shown = {in_range[len(in_range) // 2]} if in_range else set()
+    else:
+        shown = set(in_range)
+    return [(k / count, 1.0 if k < drawn - 1 else count - (drawn - 1)) if k in shown else None
+            for k in range(drawn)]

@@ -23,6 +23,7 @@ import moderngl
 import numpy as np
 
 PATTERNS = ("fine", "coarse", "patchy")
+VOLUME_LAYERS = 16  # slices through the fur layer
 
 
 @dataclass(frozen=True)
@@ -37,7 +38,7 @@ class FurPattern:
     patches: float = 0.0  # > 0: strand length scaled by a tileable low-frequency noise
     seed: int = 1
     size: int = 128  # texels per tile side
-    layers: int = 16
+    layers: int = VOLUME_LAYERS
 
 
 def pattern(name: str, **overrides) -> FurPattern:
@@ -125,7 +126,7 @@ def strand_volume(p: FurPattern) -> np.ndarray:
     return volume
 
 
-def heightfield_volume(heights: np.ndarray, layers: int = 16,
+def heightfield_volume(heights: np.ndarray, layers: int = VOLUME_LAYERS,
                        softness: float = 0.1) -> np.ndarray:
     """A heightfield image (strand height per texel, Revie 2.4.1) as a volume: a texel is covered
     in the slices below its height, faded over ``softness`` as the chapter's smoothstep."""

@@ -13,6 +13,7 @@ from deferred.gbuffer import DEPTH
 from deferred.passes import ObjectPass, Order
 
 from .fur import shell_count, shell_layout
+from .fur_volume import VOLUME_LAYERS
 
 
 class ShellPass(ObjectPass):
@@ -31,7 +32,8 @@ class ShellPass(ObjectPass):
 
     def draws(self, frame) -> int:
         params = self.obj.material.params
-        self._layout = shell_layout(shell_count(frame, self.obj, params), params.shell_range)
+        self._count = shell_count(frame, self.obj, params)
+        self._layout = shell_layout(self._count, params.shell_range, params.debug)
         return len(self._layout)
 
     def draw_uniforms(self, frame, index: int, count: int) -> dict[str, Any] | None:
@@ -39,4 +41,7 @@ class ShellPass(ObjectPass):
         if shell is None:
             return None
         depth, fade = shell
-        return {"u_shell_depth": depth, "u_shell_fade": fade, "u_root_shell": index == 0}
+        params = self.obj.material.params
+        return {"u_shell_depth": depth, "u_shell_fade": fade, "u_root_shell": index == 0,
+                "u_shell_weight": VOLUME_LAYERS / self._count,
+                "u_shell_count": self._count / max(params.shells, 1)}

@@ -38,6 +38,13 @@ vec2 fur_sample(vec3 fur_position, vec3 fur_normal, float h) {
     return s;
 }
 
+// A shell's opacity from the volume's coverage: each shell stands for 1/n of the layer, so with
+// n shells coverage c becomes 1 - (1 - c)^(slices / n) (`weight`): the fur's optical depth, and
+// so its colour, stays the same whatever the level of detail draws.
+float shell_opacity(float coverage, float weight) {
+    return 1.0 - pow(max(1.0 - coverage, 0.0), weight);
+}
+
 // Silva et al.'s shadow factor gamma = (K - 1 + h) / K: self-shadowing of the lower fur.
 float fur_shadow(float h) {
     return (u_self_shadow - 1.0 + h) / u_self_shadow;

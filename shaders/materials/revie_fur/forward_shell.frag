@@ -12,6 +12,8 @@ uniform vec3 u_albedo_base;
 uniform float u_rim_strength;
 uniform float u_rim_falloff;
 uniform float u_shell_fade;
+uniform float u_shell_weight;  // slices of the fur volume per shell (shell_opacity)
+uniform float u_shell_count;   // shells drawn / the most (the shell_count debug view)
 uniform bool u_root_shell;  // the first shell: the skin, opaque, with the strands' roots on it
 
 in float v_shell_depth;
@@ -24,9 +26,19 @@ out vec4 out_color;
 
 void main() {
     vec2 strands = fur_sample(v_fur_position, v_fur_normal, v_shell_depth);
-    float alpha = u_root_shell ? 1.0 : strands.x * u_shell_fade;
+    float alpha = u_root_shell ? 1.0 : shell_opacity(strands.x, u_shell_weight) * u_shell_fade;
 #ifdef FUR_FINS
     alpha *= v_fin_fade;
+#endif
+#if defined(FUR_DEBUG_COMB)
+    out_color = vec4(v_comb.xyz, 1.0);  // tangent-space comb, packed as the vertex colour
+    return;
+#elif defined(FUR_DEBUG_SHELL_COUNT)
+    out_color = vec4(mix(vec3(0.1, 0.2, 1.0), vec3(1.0, 0.15, 0.1), u_shell_count), 1.0);
+    return;
+#endif
+#ifdef FUR_DEBUG_SINGLE_SHELL
+    alpha = strands.x > 0.02 ? 1.0 : 0.0;  // the cut through the strands, opaque
 #endif
     if (alpha < 0.5 / 255.0) discard;
     SurfaceInput i = surface_input();

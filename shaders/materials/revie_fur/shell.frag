@@ -22,6 +22,8 @@ uniform float u_surface_id;
 uniform vec3 u_albedo_base;
 uniform vec3 u_albedo_tip;
 uniform float u_shell_fade;
+uniform float u_shell_weight;  // slices of the fur volume per shell (shell_opacity)
+uniform float u_shell_count;   // shells drawn / the most (the shell_count debug view)
 uniform bool u_root_shell;  // the first shell: the skin, opaque, with the strands' roots on it  // the outermost shell fades in with the level of detail
 
 in vec4 v_base_clip;
@@ -32,6 +34,7 @@ in float v_fur_extent;
 in float v_shell_depth;
 in vec3 v_fur_position;
 in vec3 v_fur_normal;
+in vec4 v_comb;
 #ifdef FUR_FINS
 in float v_fin_fade;
 #endif
@@ -64,10 +67,16 @@ vec3 irradiance_at(ivec2 pixel) {
 const ivec2 AROUND[8] = ivec2[](ivec2(1, 0), ivec2(-1, 0), ivec2(0, 1), ivec2(0, -1),
                                 ivec2(1, 1), ivec2(-1, 1), ivec2(1, -1), ivec2(-1, -1));
 
-// The base sample: the pixel under the base point or the first neighbour holding the base.
+// The base sample: the pixel under the base point or the first neighbour holding the base. A
+// pixel of this fur's stipple class holds its outer-shell sample, not the base: skipped.
 bool base_irradiance(ivec2 pixel, float tolerance, out vec3 irradiance) {
     irradiance = vec3(0.0);
-    if (holds_fur(pixel, v_base_depth, tolerance)) {
+#ifdef FUR_STIPPLE
+    bool stipple_pixel = stipple_sample(pixel);
+#else
+    bool stipple_pixel = false;
+#endif
+    if (!stipple_pixel && holds_fur(pixel, v_base_depth, tolerance)) {
         irradiance = irradiance_at(pixel);
         return true;
     }
@@ -82,9 +91,19 @@ bool base_irradiance(ivec2 pixel, float tolerance, out vec3 irradiance) {
 
 void main() {
     vec2 strands = fur_sample(v_fur_position, v_fur_normal, v_shell_depth);
-    float alpha = u_root_shell ? 1.0 : strands.x * u_shell_fade;
+    float alpha = u_root_shell ? 1.0 : shell_opacity(strands.x, u_shell_weight) * u_shell_fade;
 #ifdef FUR_FINS
     alpha *= v_fin_fade;
+#endif
+#if defined(FUR_DEBUG_COMB)
+    out_color = vec4(v_comb.xyz, 1.0);  // tangent-space comb, packed as the vertex colour
+    return;
+#elif defined(FUR_DEBUG_SHELL_COUNT)
+    out_color = vec4(mix(vec3(0.1, 0.2, 1.0), vec3(1.0, 0.15, 0.1), u_shell_count), 1.0);
+    return;
+#endif
+#ifdef FUR_DEBUG_SINGLE_SHELL
+    alpha = strands.x > 0.02 ? 1.0 : 0.0;  // the cut through the strands, opaque
 #endif
     if (alpha < 0.5 / 255.0) discard;
     float tolerance = 0.5 * v_fur_extent + 0.002 * v_base_depth;
@@ -96,6 +115,11 @@ void main() {
     ivec2 tip = stipple_pixel_of(pixel_of(v_tip_clip));
     tip_valid = holds_fur(tip, v_tip_depth, tolerance);
     if (tip_valid) tip_light = irradiance_at(tip);
+#endif
+#ifdef FUR_DEBUG_SAMPLES
+    out_color = vec4(base_valid || tip_valid ? 0.0 : 1.0, base_valid ? 1.0 : 0.0,
+                     tip_valid ? 1.0 : 0.0, 1.0);
+    return;
 #endif
     if (!base_valid && !tip_valid) discard;  // both samples hidden: the strand's light is unknown
     vec3 irradiance = base_valid && tip_valid ? max(base_light, tip_light)
