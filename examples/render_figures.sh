@@ -7,3 +7,4 @@ for scene in examples/*.toml; do
     deferred render "$scene" -o "docs/figures/$(basename "$scene" .toml).png"
 done
 deferred render -o docs/figures/demo.png --size 960x540
+python examples/fur_figures.py

@@ -1,8 +1,12 @@
 """Reusable building blocks of materials (passes and data), each from a paper's technique.
 
+- :mod:`.fur`: the shared fur technique: parameters, density, level of detail, root shell and
+  self-shadowing (Lengyel et al. 2001; Revie 2.3.1; Silva et al.'s shadow factor)
+- :mod:`.fur_volume`: the mip-mapped volume of tapered strands the shells and fins sample
+- :mod:`.heightfield`: a strand heightfield image as a fur volume (Revie 2.4.1)
+- :mod:`.shells`: concentric shells, n offset draws of a mesh (Revie 2.3.1)
+- :mod:`.fins`: fins at silhouette edges from a geometry shader (Lengyel et al. 2001)
 - :mod:`.stipple`: stippled G-buffer writes and their obliteration (Revie 2.3.4, 2.4.4)
-- :mod:`.shells`: concentric-shell rendering, N offset passes of a mesh (Revie 2.3.1)
-- :mod:`.heightfield`: the strand heightfield shells fade against (Revie 2.4.1)
 
 Their GLSL lives in ``shaders/techniques/``.
 """

@@ -27,14 +27,8 @@ from pydantic import Field, model_validator
 from deferred.errors import InputError
 from deferred.material import MaterialParams
 
-from .fur_volume import (
-    FurPattern,
-    heightfield_volume,
-    pattern,
-    strand_volume,
-    volume_texture,
-)
-from .heightfield import load_heightfield
+from .fur_volume import FurPattern, pattern, strand_volume, volume_texture
+from .heightfield import heightfield_volume, load_heightfield
 
 if TYPE_CHECKING:
     from deferred.frame import Frame

@@ -126,17 +126,6 @@ def strand_volume(p: FurPattern) -> np.ndarray:
     return volume
 
 
-def heightfield_volume(heights: np.ndarray, layers: int = VOLUME_LAYERS,
-                       softness: float = 0.1) -> np.ndarray:
-    """A heightfield image (strand height per texel, Revie 2.4.1) as a volume: a texel is covered
-    in the slices below its height, faded over ``softness`` as the chapter's smoothstep."""
-    h = (np.arange(layers) + 0.5) / layers
-    t = np.clip((h[:, None, None] - (heights[None] - softness)) / softness, 0.0, 1.0)
-    coverage = 1.0 - t * t * (3.0 - 2.0 * t)
-    volume = np.stack([coverage, np.ones_like(coverage)], -1).astype(np.float32)
-    return volume
-
-
 def volume_texture(ctx: moderngl.Context, volume: np.ndarray) -> moderngl.TextureArray:
     """The volume as a mip-mapped, repeating RGBA8 2D array texture (see the module doc)."""
     layers, height, width, _ = volume.shape

@@ -10,11 +10,11 @@ from deferred.materials.techniques.fins import edge_adjacency
 from deferred.materials.techniques.fur import shell_layout
 from deferred.materials.techniques.fur_volume import (
     FurPattern,
-    heightfield_volume,
     mean_coverage,
     pattern,
     strand_volume,
 )
+from deferred.materials.techniques.heightfield import heightfield_volume
 from deferred.mesh import load_mesh
 from deferred.renderer import Renderer
 from deferred.scene import scene_from_dict

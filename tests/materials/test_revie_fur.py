@@ -172,7 +172,7 @@ def test_fur_widens_the_silhouette_and_every_shell_runs(render):
     changed = []
     for shells in (1, 4, 16):
         _, _, shots = capture(render, fur_scene({"fur_length": 0.3, "shells": shells,
-                                                 "lod_error": 1e-3}),
+                                                 "lod_error": 1e-3, "fins": False}),
                               ["composite"])
         before = shots["fur.stipple_obliteration"]["composite"]
         after = shots["fur.shells"]["composite"]
