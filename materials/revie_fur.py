@@ -34,7 +34,7 @@ from .techniques.fur import (
     FurParams,
     check_heightfield,
     debug_defines,
-    fur_object_uniforms,
+    fur_scale,
     fur_volume_texture,
     tiles_per_unit,
 )
@@ -102,7 +102,7 @@ class RevieFurMaterial(Material):
     debug_views = FUR_DEBUG_VIEWS
 
     def check_files(self, where: str | None) -> None:
-        check_heightfield(self.params, self.heightfield_path(), where)
+        check_heightfield(self.heightfield_path(), where)
 
     def heightfield_path(self):
         return None if self.params.heightfield is None else \
@@ -128,7 +128,7 @@ class RevieFurMaterial(Material):
     @staticmethod
     def vertex_constants(obj: SceneObject, shell_depth: float | None = None) -> dict[str, Any]:
         """Uniforms of the fur vertex shader fixed for the object (and the shell depth)."""
-        constants = {"u_fur_scale": fur_object_uniforms(obj, obj.material.params)["u_fur_scale"]}
+        constants = {"u_fur_scale": fur_scale(obj)}
         if shell_depth is not None:
             constants["u_shell_depth"] = shell_depth
         return constants

@@ -20,12 +20,22 @@ def edge_adjacency(mesh: MeshData, tolerance: float = 1e-6) -> np.ndarray:
     """(E, 4) uint32 ``[c1, a, b, c2]`` per interior edge: its endpoints as triangle 1 winds
     them and the vertices opposite the edge in its two triangles (lines_adjacency order).
     Vertices split at UV seams are welded by position, so seams are interior edges too; edges
-    with one face, or more than two, get no fin."""
+    with one face, or more than two, get no fin; zero-area faces are left out."""
     positions = np.asarray(mesh.positions, dtype=np.float64)
     keys = np.round(positions / tolerance).astype(np.int64)
     _, welded = np.unique(keys, axis=0, return_inverse=True)
     welded = welded.reshape(-1)
     faces = np.asarray(mesh.indices, dtype=np.int64).reshape(-1, 3)
+    # zero-area triangles (the poles of a UV sphere) border nothing: they would make their
+    # edges look shared by three faces
+    corners = positions[faces]
+    area = np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]),
+                          axis=-1)
+    welded_faces = welded[faces]
+    faces = faces[(area > tolerance * tolerance) &
+                  (welded_faces[:, 0] != welded_faces[:, 1]) &
+                  (welded_faces[:, 1] != welded_faces[:, 2]) &
+                  (welded_faces[:, 2] != welded_faces[:, 0])]
     # every directed edge (a -> b) of every face, with the vertex opposite it
     a = faces.reshape(-1)
     b = faces[:, [1, 2, 0]].reshape(-1)
@@ -50,7 +60,7 @@ class FinGeometry:
 
     def __init__(self, ctx: moderngl.Context, gpu_mesh: GpuMesh, edges: np.ndarray):
         self.ctx = ctx
-        self.gpu_mesh = gpu_mesh
+        self.gpu_mesh = gpu_mesh  # holds its MeshData: the cache key's id() stays unique
         self.count = int(edges.size)
         self.ibo = ctx.buffer(np.ascontiguousarray(edges).tobytes())
         self._arrays: dict[int, moderngl.VertexArray] = {}

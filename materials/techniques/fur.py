@@ -6,11 +6,12 @@ clumping shell fur will: they differ in how fur is lit and shaped, not in how sh
 - **Density** is strands per square world unit: the volume tiles ``sqrt(density / strands per
   tile)`` times per world unit along the surface, looked up triplanar in the object's axes scaled
   to world size, so charts, seams and poles of an unwrap play no part.
-- **Root shell and skin**: shell ``k`` of ``n`` sits at depth ``k / n``, the first at the root;
-  the skin under the strands is the root colour darkened by Silva et al.'s shadow factor
-  ``gamma(h) = (K - 1 + h) / K`` (``self_shadow`` = K), which darkens every shell toward the roots.
+- **Root shell and skin**: the first shell lies on the skin, opaque, root-coloured; the other
+  ``n - 1`` sit at the middles of the ``n - 1`` slabs the layer is cut into, each as opaque as
+  its slab (``1 - (1 - coverage)^(slices / (n - 1))``). Silva et al.'s shadow factor
+  ``gamma(h) = (K - 1 + h) / K`` (``self_shadow`` = K) darkens every shell toward the roots.
 - **Level of detail**: the shell count follows the fur layer's projected thickness,
-  ``n = clamp(pixels / lod_error, min_shells, shells)``, continuous; shells sit at ``k / n`` and
+  ``n = clamp(pixels / lod_error, min_shells, shells)``, continuous; the depths move with it and
   the outermost fades by the fraction, so a dolly never pops (:func:`shell_count`).
 """
 
@@ -45,7 +46,7 @@ class FurParams(MaterialParams):
                               description="strand length, object units (x vertex colour alpha)")
     shells: int = Field(16, ge=0, le=256, description="most concentric shells (close up)")
     min_shells: int = Field(2, ge=1, le=256,
-                            description="fewest shells (far away; at most `shells`)")
+                            description="fewest shells (far away; capped at `shells`)")
     lod_error: float = Field(1.0, gt=0.0, le=64.0,
                              description="projected fur thickness per shell, pixels")
     density: float = Field(12000.0, gt=0.0, le=1e7,
@@ -96,7 +97,8 @@ FUR_UNIFORM_OVERRIDES: dict[str, Any] = {
 # debug switches of Lumberyard's legacy renderer: what each shows, and the parameters it sets.
 FUR_DEBUG_VIEWS: dict[str, tuple[str, dict[str, Any]]] = {
     "samples": ("light samples each shell and fin fragment used: green base, blue outer "
-                "(stipple), cyan both, red none", {"debug": "samples"}),
+                "(stipple), cyan both, yellow its own pixel, red none; white in the forward "
+                "pipeline, which lights every fragment", {"debug": "samples"}),
     "comb": ("comb direction on the skin, tangent space (x red, y green, up blue)",
              {"debug": "comb"}),
     "shell_count": ("shells drawn per object: blue few .. red the most (`shells`)",
@@ -128,7 +130,7 @@ def tiles_per_unit(params: FurParams) -> float:
     return math.sqrt(params.density / strands_per_tile(params))
 
 
-def check_heightfield(params: FurParams, path: Path | None, where: str | None) -> None:
+def check_heightfield(path: Path | None, where: str | None) -> None:
     """Bad input for a heightfield image that is missing or unreadable (before GL work)."""
     if path is None:
         return
@@ -161,10 +163,9 @@ def object_scale(obj: SceneObject) -> np.ndarray:
     return np.linalg.norm(obj.model[:3, :3], axis=0)
 
 
-def fur_object_uniforms(obj: SceneObject, params: FurParams) -> dict[str, Any]:
-    """Per-object uniforms of the fur vertex stage and volume lookups."""
-    return {"u_fur_scale": tuple(float(s) for s in object_scale(obj)),
-            "u_fur_tiles": tiles_per_unit(params)}
+def fur_scale(obj: SceneObject) -> tuple[float, float, float]:
+    """``u_fur_scale``: the object's axes to world units, for the volume lookups."""
+    return tuple(float(s) for s in object_scale(obj))
 
 
 def projected_fur_pixels(frame: Frame, obj: SceneObject, fur_length: float) -> float:
@@ -187,18 +188,26 @@ def shell_count(frame: Frame, obj: SceneObject, params: FurParams) -> float:
                          params.shells))
 
 
+def shell_depth(k: int, count: float) -> float:
+    """Depth of shell ``k`` of a continuous count: the root shell (0) on the skin, the others at
+    the middle of the slabs the rest of the layer is cut into (``count - 1`` of them)."""
+    if k == 0:
+        return 0.0
+    return min((k - 0.5) / max(count - 1.0, 1e-6), 1.0)
+
+
 def shell_layout(count: float, shell_range: tuple[float, float] = (0.0, 1.0),
                  debug: str = "none") -> list[tuple[float, float] | None]:
     """(depth, fade) of each shell drawn for a continuous count (None: not drawn: outside the
-    range, or not shown by the debug view)."""
+    range, or not shown by the debug view). The outermost fades with the count's fraction."""
     drawn = math.ceil(count - 1e-9)
     low, high = shell_range
-    in_range = [k for k in range(drawn) if low <= k / count <= high]
+    in_range = [k for k in range(drawn) if low <= shell_depth(k, count) <= high]
     if debug in ("comb", "shell_count"):
         shown = {0}  # drawn on the root shell, the skin
     elif debug == "single_shell":
         shown = {in_range[len(in_range) // 2]} if in_range else set()
     else:
         shown = set(in_range)
-    return [(k / count, 1.0 if k < drawn - 1 else count - (drawn - 1)) if k in shown else None
-            for k in range(drawn)]
+    return [(shell_depth(k, count), 1.0 if k < drawn - 1 else count - (drawn - 1))
+            if k in shown else None for k in range(drawn)]

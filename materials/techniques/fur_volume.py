@@ -22,7 +22,6 @@ from dataclasses import dataclass
 import moderngl
 import numpy as np
 
-PATTERNS = ("fine", "coarse", "patchy")
 VOLUME_LAYERS = 16  # slices through the fur layer
 
 
@@ -37,7 +36,7 @@ class FurPattern:
     lean: float = 0.6  # how far a tip wanders from above its root, in strand spacings
     patches: float = 0.0  # > 0: strand length scaled by a tileable low-frequency noise
     seed: int = 1
-    size: int = 128  # texels per tile side
+    size: int = 256  # texels per tile side: about 8 across the spacing of fine strands
     layers: int = VOLUME_LAYERS
 
 
@@ -141,6 +140,3 @@ def volume_texture(ctx: moderngl.Context, volume: np.ndarray) -> moderngl.Textur
     return texture
 
 
-def mean_coverage(volume: np.ndarray) -> np.ndarray:
-    """Per slice, the fraction of the tile strands cover (what the coarsest mip holds)."""
-    return volume[..., 0].mean(axis=(1, 2))

@@ -1,8 +1,8 @@
 """Concentric shells (Revie 2.3.1; Lengyel et al. 2001): a mesh drawn n times, each pushed further
 out, blended. The count follows the level of detail of the fur technique (``fur.shell_count``):
-shell ``k`` sits at depth ``k / n`` of the fur layer (the first at the root), the outermost fades
-with the fraction of ``n``; the vertex shader offsets it with ``shell_offset``
-(``techniques/shells.glsl``, Listing 2.1).
+the first shell lies on the root, the others at the middles of the slabs of the layer
+(``fur.shell_depth``), the outermost fades with the fraction of ``n``; the vertex shader offsets
+them with ``shell_offset`` (``techniques/shells.glsl``, Listing 2.1).
 """
 
 from __future__ import annotations
@@ -15,6 +15,8 @@ from deferred.passes import ObjectPass, Order
 from .fur import shell_count, shell_layout
 from .fur_volume import VOLUME_LAYERS
 
+ROOT_OFFSET = (-1.0, -2.0)  # glPolygonOffset (factor, units) of the root shell
+
 
 class ShellPass(ObjectPass):
     """Draw the object's shells, innermost first, alpha-blended over the target. The object's
@@ -26,9 +28,6 @@ class ShellPass(ObjectPass):
     depth_write = False
     blend = "alpha"
     order = Order.VOLUME
-    # The root shell lies on the base mesh: pulled toward the eye it wins the depth test even
-    # where obliteration restored a neighbour's depth.
-    depth_offset = (-1.0, -2.0)
 
     def draws(self, frame) -> int:
         params = self.obj.material.params
@@ -42,6 +41,15 @@ class ShellPass(ObjectPass):
             return None
         depth, fade = shell
         params = self.obj.material.params
-        return {"u_shell_depth": depth, "u_shell_fade": fade, "u_root_shell": index == 0,
-                "u_shell_weight": VOLUME_LAYERS / self._count,
+        self._root = index == 0
+        return {"u_shell_depth": depth, "u_shell_fade": fade, "u_root_shell": self._root,
+                "u_shell_weight": VOLUME_LAYERS / max(self._count - 1.0, 1e-6),
                 "u_shell_count": self._count / max(params.shells, 1)}
+
+    def draw(self, frame, program) -> None:
+        # The root shell lies on the base mesh: pulled toward the eye it wins the depth test
+        # even where obliteration restored a neighbour's depth. Only it: an offset on the
+        # outer shells would pull them through occluders at grazing angles.
+        frame.ctx.polygon_offset = ROOT_OFFSET if self._root else (0.0, 0.0)
+        super().draw(frame, program)
+        frame.ctx.polygon_offset = (0.0, 0.0)

@@ -62,15 +62,23 @@ void emit(int i, bool tip, float fade) {
     EmitVertex();
 }
 
+vec3 safe_normalize(vec3 v) {
+    float length_squared = dot(v, v);
+    return length_squared > 1e-20 ? v * inversesqrt(length_squared) : vec3(0.0);
+}
+
 void main() {
     vec3 a = vs_position[1];
     vec3 b = vs_position[2];
-    vec3 n1 = normalize(cross(b - a, vs_position[0] - a));
-    vec3 n2 = normalize(cross(a - b, vs_position[3] - b));
-    vec3 V = normalize(-0.5 * (a + b));
+    vec3 n1 = safe_normalize(cross(b - a, vs_position[0] - a));
+    vec3 n2 = safe_normalize(cross(a - b, vs_position[3] - b));
+    vec3 V = safe_normalize(-0.5 * (a + b));
     vec3 edge_normal = n1 + n2;
-    if (dot(edge_normal, edge_normal) < 1e-8) return;  // a knife edge: no side to grow from
+    if (dot(edge_normal, edge_normal) < 1e-8) return;  // a knife edge or a degenerate face
     float fade = 1.0 - smoothstep(0.0, u_fin_band, abs(dot(normalize(edge_normal), V)));
+    // A fin seen along its edge is a line: fade it as its plane turns edge-on to the eye.
+    vec3 fin_normal = safe_normalize(cross(b - a, vs_tip_position[1] - a));
+    fade *= smoothstep(0.1, 0.4, abs(dot(fin_normal, V)));
     if (fade <= 0.0) return;
     emit(1, false, fade);
     emit(2, false, fade);

@@ -28,6 +28,13 @@ ivec2 stipple_pixel_of(ivec2 pixel) {
 #endif
 }
 
+// stipple_pixel_of, stepped into the frame: at the left or bottom border a parity class other
+// than (0, 0) has its tile's sample at -1; the next sample of the class is 2 pixels on.
+ivec2 stipple_pixel_in(ivec2 pixel) {
+    ivec2 sample_pixel = stipple_pixel_of(pixel);
+    return sample_pixel + 2 * ivec2(lessThan(sample_pixel, ivec2(0)));
+}
+
 // Window-space depth of a linear view depth (the inverse of what the G-buffer stores).
 float window_depth(float linear_depth, mat4 projection) {
     if (linear_depth <= 0.0) return 1.0;  // background

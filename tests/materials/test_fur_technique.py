@@ -10,7 +10,6 @@ from deferred.materials.techniques.fins import edge_adjacency
 from deferred.materials.techniques.fur import shell_layout
 from deferred.materials.techniques.fur_volume import (
     FurPattern,
-    mean_coverage,
     pattern,
     strand_volume,
 )
@@ -50,6 +49,10 @@ def linear_to_srgb(c):
 
 # -- the fur volume ----------------------------------------------------------------------------
 
+def mean_coverage(volume):
+    return volume[..., 0].mean(axis=(1, 2))
+
+
 def test_strands_taper_and_the_volume_is_seeded_and_tileable():
     spec = pattern("fine", seed=3)
     volume = strand_volume(spec)
@@ -75,7 +78,7 @@ def test_patterns_differ_and_patchy_has_bald_patches():
     # patchy: the top half of the layer is emptier in some regions than in others
     def block_coverage(volume):
         top = volume[8:, ..., 0].mean(axis=0)
-        return top.reshape(8, 16, 8, 16).mean(axis=(1, 3))
+        return top.reshape(8, top.shape[0] // 8, 8, top.shape[1] // 8).mean(axis=(1, 3))
     assert block_coverage(patchy).std() > 2.0 * block_coverage(fine).std()
 
 
@@ -90,17 +93,22 @@ def test_a_heightfield_image_becomes_a_volume():
 
 
 def test_shell_layout_has_a_root_shell_and_fades_the_outermost():
-    layout = shell_layout(4.0)
-    assert [s[0] for s in layout] == [0.0, 0.25, 0.5, 0.75] and layout[-1][1] == 1.0
-    layout = shell_layout(4.25)
-    assert len(layout) == 5 and layout[-1][1] == pytest.approx(0.25)
-    assert layout[-1][0] == pytest.approx(4 / 4.25)
-    # continuous: just below an integer the extra shell is almost transparent, near the tip
-    almost = shell_layout(4.0 + 1e-6)
-    assert almost[-1][1] < 1e-5 and almost[-1][0] > 0.999
-    assert shell_layout(3.0, (0.3, 0.7)) == [None, (1 / 3, 1.0), (2 / 3, 1.0)]
-    assert shell_layout(6.0, debug="single_shell") == [None] * 3 + [(0.5, 1.0)] + [None] * 2
-    assert shell_layout(6.0, (0.0, 0.1), "single_shell")[0] == (0.0, 1.0)
+    layout = shell_layout(5.0)  # the root and 4 slabs of a quarter of the layer
+    assert [s[0] for s in layout] == [0.0, 0.125, 0.375, 0.625, 0.875]
+    assert all(s[1] == 1.0 for s in layout)
+    layout = shell_layout(5.25)
+    assert len(layout) == 6 and layout[-1][1] == pytest.approx(0.25)
+    assert layout[-1][0] == 1.0  # beyond the last slab: at the tips, fading in
+    # continuous: just above an integer the extra shell is almost transparent and the others
+    # have barely moved
+    almost = shell_layout(5.0 + 1e-6)
+    assert almost[-1][1] < 1e-5
+    assert [s[0] for s in almost[:-1]] == pytest.approx([s[0] for s in shell_layout(5.0)],
+                                                        abs=1e-5)
+    assert shell_layout(4.0, (0.3, 0.7)) == [None, None, (0.5, 1.0), None]
+    single = shell_layout(7.0, debug="single_shell")
+    assert sum(s is not None for s in single) == 1 and single[3] == pytest.approx((5 / 12, 1.0))
+    assert shell_layout(6.0, (0.0, 0.05), "single_shell")[0] == (0.0, 1.0)
 
 
 # -- distance: filtering and level of detail ---------------------------------------------------

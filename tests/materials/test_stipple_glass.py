@@ -111,3 +111,26 @@ def test_glass_and_fur_samples_coexist(render, pattern):
     # every fur-class pixel behind the glass still holds the fur (its stipple sample)
     assert fur[behind_glass & fur_class].all()
     assert not (glass & fur_class).any()
+
+
+@pytest.mark.parametrize("pattern", [2, 4])
+def test_glass_covers_the_frame_border(render, pattern):
+    """Glass's parity class has no sample in the first row or column of the frame: the border
+    pixels take the next sample of the class instead of losing the glass."""
+    big = {"name": "glass", "mesh": "builtin:cube", "position": [0.0, 0.0, 0.5],
+           "scale": [4.0, 4.0, 0.02], "material": "stipple_glass",
+           "params": {"pattern": pattern, "opacity": 0.4, "color": [0.2, 0.4, 0.9],
+                      "specular_intensity": 0.0}}
+    scene = scene_from_dict({"size": [160, 120], "tonemap": "none",
+                             "camera": {"position": [0.0, 0.0, 3.0], "target": [0, 0, 0]},
+                             "object": [{
+                                 "name": "wall", "mesh": "builtin:cube",
+                                 "position": [0.0, 0.0, -1.0], "scale": [9.0, 9.0, 0.1],
+                                 "params": {"color": [0.9, 0.1, 0.1],
+                                            "specular_intensity": 0.0}}, big],
+                             "light": [{"type": "ambient", "color": [1.0, 1.0, 1.0],
+                                        "ground": [1.0, 1.0, 1.0]}]})
+    result, _ = render(scene)
+    want = 0.6 * np.array([0.9, 0.1, 0.1]) + 0.4 * np.array([0.2, 0.4, 0.9])
+    border = np.concatenate([result.hdr[-1, :, :3], result.hdr[:, 0, :3]])  # bottom, left
+    np.testing.assert_allclose(border, np.broadcast_to(want, border.shape), atol=2e-3)

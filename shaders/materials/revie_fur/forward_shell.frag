@@ -28,7 +28,9 @@ void main() {
     vec2 strands = fur_sample(v_fur_position, v_fur_normal, v_shell_depth);
     float alpha = u_root_shell ? 1.0 : shell_opacity(strands.x, u_shell_weight) * u_shell_fade;
 #ifdef FUR_FINS
-    alpha *= v_fin_fade;
+    // Fins show the strands above the shells' rims; their roots sit inside the fur in front
+    // and, drawn edge-on and dark, would read as spikes.
+    alpha *= v_fin_fade * smoothstep(0.0, 0.35, v_shell_depth);
 #endif
 #if defined(FUR_DEBUG_COMB)
     out_color = vec4(v_comb.xyz, 1.0);  // tangent-space comb, packed as the vertex colour
@@ -41,6 +43,10 @@ void main() {
     alpha = strands.x > 0.02 ? 1.0 : 0.0;  // the cut through the strands, opaque
 #endif
     if (alpha < 0.5 / 255.0) discard;
+#ifdef FUR_DEBUG_SAMPLES
+    out_color = vec4(1.0);  // forward: every fragment is lit directly, no samples (white)
+    return;
+#endif
     SurfaceInput i = surface_input();
     Surface s = evaluate_surface(i);
     vec3 V = normalize(-i.position);

@@ -21,10 +21,10 @@ uniform vec2 u_resolution;
 uniform float u_surface_id;
 uniform vec3 u_albedo_base;
 uniform vec3 u_albedo_tip;
-uniform float u_shell_fade;
+uniform float u_shell_fade;    // the outermost shell fades in with the level of detail
 uniform float u_shell_weight;  // slices of the fur volume per shell (shell_opacity)
 uniform float u_shell_count;   // shells drawn / the most (the shell_count debug view)
-uniform bool u_root_shell;  // the first shell: the skin, opaque, with the strands' roots on it  // the outermost shell fades in with the level of detail
+uniform bool u_root_shell;     // the first shell: the skin, opaque, with the roots on it
 
 in vec4 v_base_clip;
 in vec4 v_tip_clip;
@@ -67,8 +67,8 @@ vec3 irradiance_at(ivec2 pixel) {
 const ivec2 AROUND[8] = ivec2[](ivec2(1, 0), ivec2(-1, 0), ivec2(0, 1), ivec2(0, -1),
                                 ivec2(1, 1), ivec2(-1, 1), ivec2(1, -1), ivec2(-1, -1));
 
-// The base sample: the pixel under the base point or the first neighbour holding the base. A
-// pixel of this fur's stipple class holds its outer-shell sample, not the base: skipped.
+// The base sample: the pixel under the base point or the first neighbour holding the base.
+// Pixels of this fur's stipple class hold its outer-shell samples, not the base: skipped.
 bool base_irradiance(ivec2 pixel, float tolerance, out vec3 irradiance) {
     irradiance = vec3(0.0);
 #ifdef FUR_STIPPLE
@@ -81,8 +81,12 @@ bool base_irradiance(ivec2 pixel, float tolerance, out vec3 irradiance) {
         return true;
     }
     for (int k = 0; k < 8; ++k) {
-        if (holds_fur(pixel + AROUND[k], v_base_depth, tolerance)) {
-            irradiance = irradiance_at(pixel + AROUND[k]);
+        ivec2 q = pixel + AROUND[k];
+#ifdef FUR_STIPPLE
+        if (stipple_sample(q)) continue;
+#endif
+        if (holds_fur(q, v_base_depth, tolerance)) {
+            irradiance = irradiance_at(q);
             return true;
         }
     }
@@ -93,7 +97,9 @@ void main() {
     vec2 strands = fur_sample(v_fur_position, v_fur_normal, v_shell_depth);
     float alpha = u_root_shell ? 1.0 : shell_opacity(strands.x, u_shell_weight) * u_shell_fade;
 #ifdef FUR_FINS
-    alpha *= v_fin_fade;
+    // Fins show the strands above the shells' rims; their roots sit inside the fur in front
+    // and, drawn edge-on and dark, would read as spikes.
+    alpha *= v_fin_fade * smoothstep(0.0, 0.35, v_shell_depth);
 #endif
 #if defined(FUR_DEBUG_COMB)
     out_color = vec4(v_comb.xyz, 1.0);  // tangent-space comb, packed as the vertex colour
@@ -112,18 +118,24 @@ void main() {
     bool base_valid = base_irradiance(pixel_of(v_base_clip), tolerance, base_light);
     bool tip_valid = false;
 #ifdef FUR_STIPPLE
-    ivec2 tip = stipple_pixel_of(pixel_of(v_tip_clip));
+    ivec2 tip = stipple_pixel_in(pixel_of(v_tip_clip));
     tip_valid = holds_fur(tip, v_tip_depth, tolerance);
     if (tip_valid) tip_light = irradiance_at(tip);
 #endif
+    // Both hidden (the base off-screen, the tip occluded): the light of the fur under this
+    // fragment itself, if its pixel holds this fur, rather than a hole onto the dark skin.
+    ivec2 own = ivec2(gl_FragCoord.xy);
+    bool own_valid = !base_valid && !tip_valid &&
+        same_surface(texelFetch(u_normal_exponent_id, own, 0).w, u_surface_id);
 #ifdef FUR_DEBUG_SAMPLES
-    out_color = vec4(base_valid || tip_valid ? 0.0 : 1.0, base_valid ? 1.0 : 0.0,
-                     tip_valid ? 1.0 : 0.0, 1.0);
+    bool none = !base_valid && !tip_valid && !own_valid;
+    out_color = vec4(none || own_valid ? 1.0 : 0.0, base_valid || own_valid ? 1.0 : 0.0,
+                     tip_valid ? 1.0 : 0.0, 1.0);  // own pixel: yellow
     return;
 #endif
-    if (!base_valid && !tip_valid) discard;  // both samples hidden: the strand's light is unknown
+    if (!base_valid && !tip_valid && !own_valid) discard;  // the strand's light is unknown
     vec3 irradiance = base_valid && tip_valid ? max(base_light, tip_light)
-                    : (base_valid ? base_light : tip_light);
+                    : (base_valid ? base_light : (tip_valid ? tip_light : irradiance_at(own)));
     // strands' own brightness where they cover; the skin between them on the root shell
     float brightness = mix(1.0, strands.y / max(strands.x, 1e-4), min(strands.x, 1.0));
     vec3 albedo = mix(u_albedo_base, u_albedo_tip, v_shell_depth) * fur_shadow(v_shell_depth);

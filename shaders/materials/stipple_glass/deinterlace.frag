@@ -16,8 +16,7 @@ in vec3 v_position;
 out vec4 out_color;
 
 void main() {
-    ivec2 glass = clamp(stipple_pixel_of(ivec2(gl_FragCoord.xy)), ivec2(0),
-                        ivec2(u_resolution) - 1);
+    ivec2 glass = min(stipple_pixel_in(ivec2(gl_FragCoord.xy)), ivec2(u_resolution) - 1);
     // The tile's sample must be this glass (an edge tile may hold something else).
     float depth = texelFetch(u_linear_depth, glass, 0).r;
     if (!same_surface(texelFetch(u_normal_exponent_id, glass, 0).w, u_surface_id)) discard;
