@@ -137,20 +137,24 @@ def test_distant_fur_matches_its_supersampled_render(gl, pipeline):
 
 
 def test_a_dolly_from_near_to_far_never_pops(gl):
+    """30 frames from close up (24 shells) to far (3): no frame-to-frame change spikes above 3x
+    the median. The change is measured per pixel of the object (the object shrinks as the
+    camera pulls back), so a shell popping in or out would stand out; measured: at most 1.23x."""
     distances = np.geomspace(1.6, 14.0, 30)
-    frames = []
+    frames, counts = [], []
     for distance in distances:
         scene = fur_scene({"fur_length": 0.15, "shells": 24},
                           camera={"position": [0.0, 0.2, float(distance)],
                                   "target": [0.0, 0.0, 0.0], "fov": 40.0})
-        with Renderer(scene, gl=gl) as renderer:
-            frames.append(renderer.render().image[..., :3].astype(np.float64))
-            if distance in (distances[0], distances[-1]):
-                frames_drawn = renderer.last_frame.stats.draws_by_pass["fur.shells"]
-                assert frames_drawn == (24 if distance == distances[0] else frames_drawn)
-    differences = np.array([np.abs(b - a).mean() for a, b in zip(frames, frames[1:],
-                                                                  strict=False)])
-    assert differences.max() <= 3.0 * np.median(differences)
+        result = render_image(gl, scene)
+        frames.append(result.image[..., :3].astype(np.float64))
+        counts.append(result.draws_by_pass["fur.shells"])
+    assert counts[0] == 24 and counts[-1] <= 4  # the level of detail did change
+    background = frames[-1][0, 0]
+    covered = [np.abs(frame - background).sum(-1) > 3.0 for frame in frames]
+    changes = np.array([np.abs(b - a).sum() / max(ca.sum(), cb.sum()) for a, b, ca, cb
+                        in zip(frames, frames[1:], covered, covered[1:], strict=False)])
+    assert changes.max() <= 3.0 * np.median(changes)
 
 
 def test_the_level_of_detail_drops_shells_with_distance(gl):
