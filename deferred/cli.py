@@ -53,6 +53,10 @@ def cli(debug: bool) -> None:
 @click.option("--size", help="WIDTHxHEIGHT, overrides the scene's size.")
 @click.option("--frames", type=click.IntRange(min=1), default=1, show_default=True,
               help="Render this many frames (timing); the last one is written.")
+@click.option("--light-path", metavar="PATH",
+              help="How lights reach the pixels: volumes, tiled or clustered (deferred); naive "
+                   "or tiled, i.e. Forward+ (forward). Default: the scene's light_path, else "
+                   "tiled where compute shaders exist.")
 @click.option("--strict", is_flag=True,
               help="Fail on a uniform set by name that its program does not declare.")
 @click.option("--view", "view_name", metavar="BUFFER",
@@ -61,7 +65,7 @@ def cli(debug: bool) -> None:
                    "PASS:TARGET) or a material's debug view (MATERIAL.VIEW, e.g. "
                    "revie_fur.samples). '--view help' lists them.")
 def render(scene: str | None, output: str, pipeline: str, size: str | None, frames: int,
-           strict: bool, view_name: str | None) -> None:
+           light_path: str | None, strict: bool, view_name: str | None) -> None:
     """Render SCENE (a TOML file; the built-in demo when omitted) to an image."""
     from .buffer_views import (
         resolve_view,
@@ -71,11 +75,14 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
         write_view,
     )
     from .capture import capture_frame
-    from .renderer import Renderer
+    from .light_lists import resolve_light_path
+    from .renderer import FULL_FEATURES, Renderer
 
     if view_name == "help":
         loaded = _scene(scene)
-        passes = PIPELINES[pipeline]().passes(loaded)
+        passes = PIPELINES[pipeline](
+            resolve_light_path(pipeline, light_path or loaded.light_path, FULL_FEATURES)
+        ).passes(loaded)
         for name, doc in view_catalogue(passes, loaded):
             click.echo(f"{name:<36} {doc}")
         return
@@ -86,7 +93,8 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
         debug_scene = with_material_view(loaded, view_name)
         if debug_scene is not None:  # the material draws the view: the frame shows it
             loaded, view_name = debug_scene, None
-    with Renderer(loaded, pipeline, _size_option(size), strict=strict or None) as renderer:
+    with Renderer(loaded, pipeline, _size_option(size), strict=strict or None,
+                  light_path=light_path) as renderer:
         if view_name is not None:
             view_pass, _ = resolve_view(view_name, renderer.passes)  # bad names fail here
         times = []
@@ -107,7 +115,8 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
     timing = f"{min(times):.1f} ms" if frames == 1 else \
         f"median {sorted(times)[len(times) // 2]:.1f} ms over {frames} frames"
     shown = f", view {shown_name}" if shown_name is not None else ""
-    stderr.print(f"wrote {out} ({width}x{height}, {pipeline}{shown}, {timing})")
+    stderr.print(f"wrote {out} ({width}x{height}, {pipeline}, {renderer.light_path} lights"
+                 f"{shown}, {timing})")
 
 
 @cli.command()
@@ -124,12 +133,16 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
 @click.option("--pixel", metavar="X,Y",
               help="Print every pass that wrote this pixel (top-down coordinates) and what it "
                    "wrote; recorded in the manifest too.")
+@click.option("--light-path", metavar="PATH",
+              help="How lights reach the pixels: volumes, tiled or clustered (deferred); naive "
+                   "or tiled, i.e. Forward+ (forward). Default: the scene's light_path, else "
+                   "tiled where compute shaders exist.")
 @click.option("--strict", is_flag=True,
               help="Fail on a uniform set by name that its program does not declare.")
 @click.option("--compare", nargs=2, type=click.Path(), metavar="DIR_A DIR_B",
               help="Compare two dumps: per-buffer max/mean differences and difference images.")
 def dump(scene: str | None, output: str | None, pipeline: str, size: str | None,
-         passes: str | None, pixel: str | None, strict: bool,
+         passes: str | None, pixel: str | None, light_path: str | None, strict: bool,
          compare: tuple[str, str] | None) -> None:
     """Write every buffer of every pass of one frame of SCENE as EXR, plus a contact sheet and
     a manifest (DESIGN.md, "Dumps")."""
@@ -153,7 +166,8 @@ def dump(scene: str | None, output: str | None, pipeline: str, size: str | None,
         raise InputError("exists and is not a folder", str(out_dir))
     loaded = _scene(scene)
     patterns = [p.strip() for p in passes.split(",") if p.strip()] if passes is not None else None
-    with Renderer(loaded, pipeline, _size_option(size), strict=strict or None) as renderer:
+    with Renderer(loaded, pipeline, _size_option(size), strict=strict or None,
+                  light_path=light_path) as renderer:
         chosen = select_passes(renderer.passes, patterns)  # bad input fails before any file
         where = parse_pixel(pixel, renderer.size) if pixel is not None else None
         with Progress(SpinnerColumn(), TextColumn("{task.description}"), console=stderr,

@@ -18,6 +18,7 @@ from .shaderlib import ShaderLibrary
 from .targets import FrameTargets
 
 if TYPE_CHECKING:
+    from .light_lists import LightLists
     from .lightbuffer import LightBuffer
     from .material import Material
     from .passes import RenderPass
@@ -133,8 +134,9 @@ class Frame:
 
     def __init__(self, gl: GLContext, shaders: ShaderLibrary, targets: FrameTargets,
                  resources: Resources, scene: Scene, light_buffer: LightBuffer,
-                 strict: bool = False):
+                 strict: bool = False, light_lists: LightLists | None = None):
         self.gl = gl
+        self.light_lists = light_lists
         self.strict = strict
         self.ctx = gl.ctx
         self.shaders = shaders
@@ -253,6 +255,32 @@ class Frame:
             program[name].value = unit
             unit += 1
         self.light_buffer.bind(program, unit)
+        if self.light_lists is not None:
+            self.light_lists.bind(program)
+
+    def bind_compute(self, shader: moderngl.ComputeShader, uniforms: dict[str, Any],
+                     textures: dict[str, moderngl.Texture], *,
+                     offered: dict[str, Any] | None = None) -> None:
+        """Set a compute shader's uniforms and samplers (strict mode as :meth:`bind`)."""
+        if self.strict:
+            declared = self.shaders.declared_uniforms(shader)
+            unknown = [n for n in [*uniforms, *textures] if n not in declared]
+            if unknown:
+                raise RenderError(f"compute shader {self.shaders.describe(shader)} declares "
+                                  f"no uniform {', '.join(repr(n) for n in unknown)}")
+        for name, value in {**(offered or {}), **uniforms}.items():
+            if name not in shader:
+                continue
+            if isinstance(value, np.ndarray) and value.ndim == 2:
+                shader[name].write(gl_bytes(value))
+            elif isinstance(value, np.ndarray):
+                shader[name].value = tuple(float(v) for v in value)
+            else:
+                shader[name].value = value
+        for unit, (name, texture) in enumerate(textures.items()):
+            if name in shader:
+                texture.use(location=unit)
+                shader[name].value = unit
 
     def check_material_uniforms(self) -> None:
         """Strict mode, at the end of a frame: every uniform a material sets is declared by at

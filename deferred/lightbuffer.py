@@ -1,9 +1,12 @@
 """All lights of a frame packed into one GPU buffer, read by both pipelines.
 
-Each light is four vec4s (``Light.record``), its type id stored in ``color.w``; lights are grouped
-by type so each deferred lighting pass draws one contiguous range. With GL 4.3 the records live in a
-shader storage buffer (``LightBuffer`` block); on GL 3.3 in an RGBA32F texture, one row per light
-(``u_lights``). ``common/light_buffer.glsl`` reads both.
+Each light is four vec4s (``Light.record``), its type id stored in ``color.w``. Full-screen lights
+(ambient, directional) come first, then volume lights, each group by type, so each deferred
+lighting pass draws one contiguous range and the tiled paths loop ``[0, global_count)`` for the
+lights every pixel gets. Volume lights whose sphere lies outside the view frustum are dropped on
+the CPU before anything is uploaded (:func:`visible_spheres`, vectorised). With GL 4.3 the records
+live in a shader storage buffer (``LightBuffer`` block); on GL 3.3 in an RGBA32F texture, one row
+per light (``u_lights``). ``common/light_buffer.glsl`` reads both.
 """
 
 from __future__ import annotations
@@ -17,32 +20,62 @@ from .light import Light
 RECORD_VEC4S = 4
 
 
+def visible_spheres(records: np.ndarray, projection: np.ndarray) -> np.ndarray:
+    """Which view-space spheres (``records[:, 1]``: centre xyz, radius w) touch the frustum of
+    ``projection``: the planes of the frustum from its rows (Gribb and Hartmann), all at once."""
+    if len(records) == 0:
+        return np.zeros(0, bool)
+    rows = np.asarray(projection, dtype=np.float64)
+    planes = np.stack([rows[3] + rows[0], rows[3] - rows[0], rows[3] + rows[1],
+                       rows[3] - rows[1], rows[3] + rows[2], rows[3] - rows[2]])
+    planes /= np.linalg.norm(planes[:, :3], axis=1, keepdims=True)
+    centres = np.c_[records[:, 1, :3].astype(np.float64), np.ones(len(records))]
+    distance = centres @ planes.T  # (lights, planes), positive inside
+    return np.all(distance >= -records[:, 1, 3:4].astype(np.float64), axis=1)
+
+
 class LightBuffer:
     def __init__(self, ctx: moderngl.Context, features: Features):
         self.ctx = ctx
         self.storage = features.storage_buffers
         self.count = 0
+        self.global_count = 0  # full-screen lights, first in the buffer
+        self.culled = 0  # volume lights dropped this frame: outside the view
         self.ranges: dict[type[Light], tuple[int, int]] = {}
         self._buffer: moderngl.Buffer | None = None
         self._texture: moderngl.Texture | None = None
         self._capacity = 0
 
     @staticmethod
-    def pack(lights: list[Light], view: np.ndarray) -> tuple[np.ndarray, dict]:
-        ordered = sorted(lights, key=lambda light: light.type_id)  # stable: scene order kept
-        records = np.zeros((max(len(ordered), 1), RECORD_VEC4S, 4), dtype=np.float32)
+    def pack(lights: list[Light], view: np.ndarray, projection: np.ndarray | None = None
+             ) -> tuple[np.ndarray, dict, int]:
+        """(records, type -> (offset, count), full-screen light count): full-screen lights
+        first, then volume lights inside the frustum of ``projection`` (all when None)."""
+        ordered = sorted(lights, key=lambda light: (light.volume != "fullscreen",
+                                                    light.type_id))  # stable: scene order kept
+        records = np.zeros((len(ordered), RECORD_VEC4S, 4), dtype=np.float32)
+        for index, light in enumerate(ordered):
+            records[index] = np.asarray(light.record(view), dtype=np.float32).reshape(
+                RECORD_VEC4S, 4)
+            records[index, 0, 3] = float(light.type_id)
+        keep = np.ones(len(ordered), bool)
+        volumes = np.array([light.volume != "fullscreen" for light in ordered], bool)
+        if projection is not None and volumes.any():
+            keep[volumes] = visible_spheres(records[volumes], projection)
+        ordered = [light for light, kept in zip(ordered, keep, strict=True) if kept]
+        records = records[keep] if keep.any() else np.zeros((1, RECORD_VEC4S, 4), np.float32)
         ranges: dict[type[Light], tuple[int, int]] = {}
         for index, light in enumerate(ordered):
-            record = np.asarray(light.record(view), dtype=np.float32).reshape(RECORD_VEC4S, 4)
-            records[index] = record
-            records[index, 0, 3] = float(light.type_id)
             start, count = ranges.get(type(light), (index, 0))
             ranges[type(light)] = (start, count + 1)
-        return records, ranges
+        global_count = sum(1 for light in ordered if light.volume == "fullscreen")
+        return records, ranges, global_count
 
-    def upload(self, lights: list[Light], view: np.ndarray) -> None:
-        records, self.ranges = self.pack(lights, view)
-        self.count = len(lights)
+    def upload(self, lights: list[Light], view: np.ndarray,
+               projection: np.ndarray | None = None) -> None:
+        records, self.ranges, self.global_count = self.pack(lights, view, projection)
+        self.count = sum(count for _, count in self.ranges.values())
+        self.culled = len(lights) - self.count
         rows = len(records)
         if rows > self._capacity:
             self._release_storage()
@@ -60,9 +93,21 @@ class LightBuffer:
     def range(self, light_type: type[Light]) -> tuple[int, int]:
         return self.ranges.get(light_type, (0, 0))
 
+    @property
+    def local_count(self) -> int:
+        """Volume lights (after culling), right after the full-screen ones."""
+        return self.count - self.global_count
+
+    def bind_storage(self) -> None:
+        """Bind the records to storage binding 0 (``layout(binding = 0)``: compute shaders)."""
+        if self.storage and self._buffer is not None:
+            self._buffer.bind_to_storage_buffer(0)
+
     def bind(self, program: moderngl.Program, texture_unit: int) -> None:
         if "u_light_count" in program:
             program["u_light_count"].value = self.count
+        if "u_global_light_count" in program:
+            program["u_global_light_count"].value = self.global_count
         if self.storage and "LightBuffer" in program:
             self._buffer.bind_to_storage_buffer(0)
             program["LightBuffer"].binding = 0

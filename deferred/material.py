@@ -58,11 +58,13 @@ class GBufferPass(ObjectPass):
 
 
 class ForwardLitPass(ObjectPass):
-    """Forward pipeline: the material's surface lit by every light in one pass."""
+    """Forward pipeline: the material's surface lit by every light in one pass (``lequal``:
+    Forward+ lays the same depth down in its pre-pass first)."""
 
     fragment = "forward/lit.frag"
     colors = (COMPOSITE,)
     depth = DEPTH
+    depth_func = "lequal"
 
 
 class Material:

@@ -21,10 +21,12 @@ import numpy as np
 
 from .effect import AMBIENT_OCCLUSION
 from .errors import InputError
-from .gbuffer import DEPTH, GBUFFER_TARGETS, NORMAL_EXPONENT_ID
+from .gbuffer import DEPTH, GBUFFER_TARGETS, LINEAR_DEPTH, NORMAL_EXPONENT_ID
 from .graph import compile_graph
 from .light import LightTypePass
-from .passes import ClearPass, FullscreenPass, Order, Phase, RenderPass, copy_pass
+from .light_lists import LightCullPass, list_shading_pass
+from .material import ForwardLitPass
+from .passes import ClearPass, FullscreenPass, ObjectPass, Order, Phase, RenderPass, copy_pass
 from .scene import Scene
 from .targets import (
     COMPOSITE,
@@ -98,10 +100,23 @@ def phase_passes(scene: Scene, phase: Phase, fixed: list[RenderPass],
 
 
 class Pipeline:
+    """A pipeline for one light path (:mod:`deferred.light_lists`)."""
+
     name = ""
+    light_paths: tuple[str, ...] = ()
+
+    def __init__(self, light_path: str | None = None):
+        self.light_path = light_path or self.light_paths[0]
+        if self.light_path not in self.light_paths:
+            raise InputError(f"the {self.name} pipeline has no light path '{self.light_path}' "
+                             f"(choose from {', '.join(self.light_paths)})", "--light-path")
 
     def build(self, scene: Scene) -> list[RenderPass]:
         raise NotImplementedError
+
+    def shader_defines(self) -> dict[str, str]:
+        """Defines every program of this pipeline gets (the light path's)."""
+        return {}
 
     def passes(self, scene: Scene) -> list[RenderPass]:
         """The pass list for ``scene``, checked (:func:`deferred.graph.compile_graph`)."""
@@ -110,6 +125,7 @@ class Pipeline:
 
 class DeferredPipeline(Pipeline):
     name = "deferred"
+    light_paths = ("tiled", "clustered", "volumes")
 
     def build(self, scene: Scene) -> list[RenderPass]:
         layout = scene.gbuffer_layout()
@@ -125,8 +141,15 @@ class DeferredPipeline(Pipeline):
             {"u_normal_exponent_id": NORMAL_EXPONENT_ID}, (LIGHT_ACCUMULATION,),
             creates={LIGHT_ACCUMULATION: LIGHT_ACCUMULATION_SPEC}, order=Order.FIRST,
             uniforms=lambda frame: {"u_background": frame.scene.background})
-        lights = [LightTypePass(cls, occlusion, layout.color_targets)
-                  for cls in scene.light_types()]
+        if self.light_path == "volumes":
+            lights = [LightTypePass(cls, occlusion, layout.color_targets)
+                      for cls in scene.light_types()]
+        else:
+            clustered = self.light_path == "clustered"
+            lights = [LightCullPass(f"lighting.cull_{'clusters' if clustered else 'tiles'}",
+                                    Phase.LIGHTING, clustered),
+                      list_shading_pass(f"lighting.{self.light_path}", clustered,
+                                        layout.color_targets, occlusion)]
         passes += phase_passes(scene, Phase.LIGHTING, [background, *lights], wide)
         composite = copy_pass("material.composite_copy", Phase.MATERIAL, LIGHT_ACCUMULATION,
                               COMPOSITE, COMPOSITE_SPEC, order=Order.FIRST)
@@ -137,15 +160,35 @@ class DeferredPipeline(Pipeline):
 
 class ForwardPipeline(Pipeline):
     name = "forward"
+    light_paths = ("tiled", "naive")
 
     def build(self, scene: Scene) -> list[RenderPass]:
         wide = scene_passes(scene, self.name)
-        clear = ClearPass("forward.clear", Phase.FORWARD, {
-            COMPOSITE: replace(COMPOSITE_SPEC, clear=(*scene.background, 0.0)),
-            DEPTH: GBUFFER_TARGETS[DEPTH]})
-        passes = phase_passes(scene, Phase.FORWARD, [clear], wide)
+        creates = {COMPOSITE: replace(COMPOSITE_SPEC, clear=(*scene.background, 0.0)),
+                   DEPTH: GBUFFER_TARGETS[DEPTH]}
+        fixed: list[RenderPass] = []
+        if self.light_path == "tiled":  # Forward+: depth pre-pass, tiled culling
+            creates[LINEAR_DEPTH] = GBUFFER_TARGETS[LINEAR_DEPTH]
+            fixed += [depth_prepass(p) for obj in scene.objects
+                      for p in obj.material.passes(Phase.FORWARD, obj)
+                      if isinstance(p, ForwardLitPass)]
+            fixed.append(LightCullPass("forward.cull_tiles", Phase.FORWARD, clustered=False,
+                                       from_near=True))
+        clear = ClearPass("forward.clear", Phase.FORWARD, creates)
+        passes = phase_passes(scene, Phase.FORWARD, [clear, *fixed], wide)
         passes += phase_passes(scene, Phase.POST, [tonemap_pass()], wide)
         return passes
+
+    def shader_defines(self) -> dict[str, str]:
+        return {"FORWARD_PLUS": "1"} if self.light_path == "tiled" else {}
+
+
+def depth_prepass(lit: ForwardLitPass) -> RenderPass:
+    """Forward+'s depth pre-pass twin of an object's lit pass: the same vertex stage and
+    constants, depth and linear depth only."""
+    return ObjectPass(f"{lit.obj.label}.depth_prepass", Phase.FORWARD, lit.obj,
+                      vertex=lit.vertex, fragment="forward/depth_prepass.frag",
+                      colors=(LINEAR_DEPTH,), constants=lit.constants, order=Order.FIRST)
 
 
 PIPELINES: dict[str, type[Pipeline]] = {"deferred": DeferredPipeline,

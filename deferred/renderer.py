@@ -9,11 +9,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .context import GLContext, create_context
+from .context import Features, GLContext, create_context
 from .errors import InputError
 from .frame import Frame, Resources
 from .generated import generated_glsl
 from .graph import PassGraph, PassGraphError, compile_graph
+from .light_lists import LightLists, resolve_light_path
 from .lightbuffer import LightBuffer
 from .passes import RenderPass
 from .pipeline import PIPELINES
@@ -22,6 +23,7 @@ from .shaderlib import ShaderLibrary
 from .targets import COMPOSITE, FINAL, FrameTargets
 
 PassCallback = Callable[[RenderPass, Frame], None]
+FULL_FEATURES = Features(storage_buffers=True, compute_shaders=True)
 
 
 @dataclass
@@ -41,12 +43,14 @@ class Renderer:
     """Renders one scene with one pipeline; reuse it for many frames, then ``release()``.
 
     ``strict`` turns a uniform set by name that a program does not declare into an error
-    (default: the ``DEFERRED_STRICT`` environment variable).
+    (default: the ``DEFERRED_STRICT`` environment variable). ``light_path`` chooses how lights
+    reach the pixels (:mod:`deferred.light_lists`; default: the scene's ``light_path``, else
+    the fastest the context allows).
     """
 
     def __init__(self, scene: Scene, pipeline: str = "deferred",
                  size: tuple[int, int] | None = None, gl: GLContext | None = None,
-                 strict: bool | None = None):
+                 strict: bool | None = None, light_path: str | None = None):
         if pipeline not in PIPELINES:
             raise InputError(f"unknown pipeline '{pipeline}' (choose from "
                              f"{', '.join(PIPELINES)})", "--pipeline")
@@ -55,8 +59,12 @@ class Renderer:
         self.strict = strict_default() if strict is None else strict
         self.size = check_size(size or scene.size, "size")
         # The pass graph and the generated GLSL are built and checked before any GL object
-        # exists: bad input never leaves a context behind.
-        self.graph: PassGraph = compile_graph(PIPELINES[pipeline]().build(scene))
+        # exists: bad input never leaves a context behind. The light path is checked by name
+        # now and against the context's features once it exists; the provisional graph (the
+        # requested path, else tiled) only changes where the context cannot run that path.
+        requested = light_path if light_path is not None else scene.light_path
+        provisional = resolve_light_path(pipeline, requested, FULL_FEATURES)
+        self.graph: PassGraph = compile_graph(PIPELINES[pipeline](provisional).build(scene))
         light_types = scene.light_types()
         shading_models = scene.shading_models()
         generated = generated_glsl(light_types, shading_models, scene.gbuffer_layout(),
@@ -69,7 +77,17 @@ class Renderer:
         self.gl.make_current()
         ctx = self.gl.ctx
         features = self.gl.features
+        try:
+            self.light_path = resolve_light_path(pipeline, requested, features)
+        except InputError:
+            if self._owns_context:
+                self.gl.release()
+            raise
+        self.pipeline = PIPELINES[pipeline](self.light_path)
+        if self.light_path != provisional:
+            self.graph = compile_graph(self.pipeline.build(scene))
         defines = {"DEFERRED_STORAGE_BUFFERS": "1"} if features.storage_buffers else {}
+        defines.update(self.pipeline.shader_defines())
         self.shaders = ShaderLibrary(ctx, features.glsl_version(), defines)
         for root in roots:
             self.shaders.add_root(root)
@@ -79,6 +97,7 @@ class Renderer:
         self._declare_targets()
         self.resources = Resources(ctx)
         self.light_buffer = LightBuffer(ctx, features)
+        self.light_lists = LightLists(ctx) if features.compute_shaders else None
         self.last_frame: Frame | None = None
 
     @property
@@ -113,8 +132,8 @@ class Renderer:
         ``readback=False`` skips reading the images back (timing loops)."""
         self.gl.make_current()
         frame = Frame(self.gl, self.shaders, self.targets, self.resources, self.scene,
-                      self.light_buffer, strict=self.strict)
-        self.light_buffer.upload(self.scene.lights, frame.view)
+                      self.light_buffer, strict=self.strict, light_lists=self.light_lists)
+        self.light_buffer.upload(self.scene.lights, frame.view, frame.projection)
         for render_pass in self.passes:
             render_pass.prepare(frame)
         ctx = self.gl.ctx
@@ -146,6 +165,8 @@ class Renderer:
         self.gl.make_current()
         self.gl.park()
         self.light_buffer.release()
+        if self.light_lists is not None:
+            self.light_lists.release()
         self.resources.release()
         self.targets.release()
         self.shaders.release()

@@ -90,6 +90,9 @@ class SceneModel(_Strict):
     background: Vec3 = Field((0.02, 0.02, 0.025), description="linear RGB behind everything")
     exposure: float = Field(1.0, gt=0.0)
     tonemap: Literal["reinhard", "aces", "none"] = "aces"
+    light_path: Literal["volumes", "tiled", "clustered", "naive"] | None = Field(
+        None, description="how lights reach the pixels (deferred.light_lists); default the "
+                          "fastest the context allows")
     camera: CameraModel = Field(default_factory=CameraModel)
     ssao: dict[str, Any] | None = Field(
         None, description="screen-space ambient occlusion (the same as [[effect]] type 'ssao')")
@@ -117,6 +120,7 @@ class Scene:
     background: tuple[float, float, float] = (0.02, 0.02, 0.025)
     exposure: float = 1.0
     tonemap: str = "aces"
+    light_path: str | None = None
     effects: list[Effect] = field(default_factory=list)
     source: str = "<memory>"
 
@@ -206,7 +210,7 @@ def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
     c = model.camera
     scene = Scene(camera=Camera(c.position, c.target, c.up, c.fov, c.near, c.far),
                   size=model.size, background=model.background, exposure=model.exposure,
-                  tonemap=model.tonemap, source=name)
+                  tonemap=model.tonemap, light_path=model.light_path, source=name)
     meshes: dict[str, MeshData] = {}
     for index, obj in enumerate(model.object):
         where = f"{name}: object[{index}]"

@@ -192,12 +192,22 @@ class ShaderLibrary:
         return self._labels.get(program.glo, "<program>")
 
     def compute(self, name: str, defines: dict[str, str] | None = None) -> moderngl.ComputeShader:
+        """Compile (or return the cached) compute shader of this file with these defines."""
+        defines = dict(defines or {})
+        key = ("compute", name, tuple(sorted(defines.items())), tuple(sorted(self.virtual_files)))
+        cached = self._programs.get(key)
+        if cached is not None:
+            return cached
         source = self.assemble(name, defines)
         try:
-            return self.ctx.compute_shader(source.text)
+            shader = self.ctx.compute_shader(source.text)
         except moderngl.Error as exc:
             raise ShaderError(self._map_error(str(exc), {"compute_shader": source},
                                               {"compute_shader": name})) from None
+        self._programs[key] = shader
+        self._declared[shader.glo] = frozenset(declared_uniforms(source.text))
+        self._labels[shader.glo] = name
+        return shader
 
     @staticmethod
     def _map_error(message: str, sources: dict[str, Source], stages: dict[str, str | None]) -> str:

@@ -36,7 +36,7 @@ def run(capsys, *args):
 
 def standard_scene():
     return scene_from_dict({
-        "size": [64, 36],
+        "size": [64, 36], "light_path": "volumes",
         "camera": {"position": [0.0, 1.5, 3.0], "target": [0.0, 0.0, 0.0]},
         "object": [{"mesh": "builtin:plane", "scale": 2.0},
                    {"mesh": "builtin:sphere", "position": [0.0, 0.5, 0.0], "scale": 0.5}],

@@ -25,7 +25,7 @@ SIZE = (160, 120)
 def small_scene(ball_color=(0.8, 0.3, 0.2), lights=None, objects=None):
     """A floor filling the lower part of the frame and a ball in front of it."""
     return scene_from_dict({
-        "size": list(SIZE),
+        "size": list(SIZE), "light_path": "volumes",  # a pass per light type
         "camera": {"position": [0.0, 1.2, 3.0], "target": [0.0, 0.4, 0.0]},
         "object": objects or [
             {"name": "floor", "mesh": "builtin:plane", "scale": 4.0,
@@ -387,7 +387,9 @@ def test_cli_dump_writes_the_folder(tmp_path, capsys):
                                                "passes"}
     manifest = json.loads((out / "manifest.json").read_text())
     assert manifest["scene"] == "builtin:demo.toml" and manifest["size"] == [96, 64]
-    assert len(list((out / "passes").glob("*.exr"))) == len(manifest["passes"])
+    # a file for every pass that writes a target (light culling fills a buffer, no target)
+    assert len(list((out / "passes").glob("*.exr"))) == \
+        sum(1 for p in manifest["passes"] if p["outputs"])
     # again into the same folder, fewer passes: no stale pass file is left to mislead, and
     # files the dump did not make are left alone
     (out / "passes" / "notes.exr").write_bytes(b"mine")
@@ -436,6 +438,7 @@ def test_cli_compare(tmp_path, capsys):
 
 
 SCENE_TOML = """size = [64, 36]
+light_path = "volumes"
 [[object]]
 name = "ball"
 mesh = "builtin:sphere"
@@ -499,7 +502,8 @@ def test_cli_render_view(tmp_path, capsys):
     assert read_image(png).shape == (36, 64, 4)
 
     lit = tmp_path / "lit.exr"
-    code, _, err = run(capsys, "render", "--view", "lighting.spot", "--size", "64x36",
+    code, _, err = run(capsys, "render", "--view", "lighting.spot", "--light-path", "volumes",
+                       "--size", "64x36",
                        "--frames", "2", "-o", lit)
     assert code == 0, err
     pixels, names, _ = read_channels(lit)

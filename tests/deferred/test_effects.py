@@ -155,7 +155,7 @@ def test_bad_effect_tables_name_the_key(effect, message):
 
 
 def test_the_ssao_table_still_works_and_is_not_given_twice(gl):
-    _, targets, names = render(gl, scene(ssao={"radius": 0.3}))
+    _, targets, names = render(gl, scene(ssao={"radius": 0.3}, light_path="volumes"))
     assert names.index("screen.ssao") < names.index("screen.ssao_blur") < \
         names.index("lighting.ambient")
     assert targets["ssao"].min() < 0.9

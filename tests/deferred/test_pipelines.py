@@ -26,7 +26,7 @@ ALL_LIGHTS = [
 
 def standard_scene(lights=ALL_LIGHTS, size=(200, 150)):
     return scene_from_dict({
-        "size": list(size),
+        "size": list(size), "light_path": "volumes",
         "camera": {"position": [0.0, 1.5, 3.6], "target": [0.0, 0.4, 0.0]},
         "object": [
             {"mesh": "builtin:plane", "scale": 4.0, "params": {"color": [0.4, 0.4, 0.4]}},

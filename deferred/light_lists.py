@@ -1,0 +1,205 @@
+"""Light paths: how lights reach the pixels (Olsson and Assarsson 2011, "Tiled Shading";
+Olsson, Billeter and Assarsson 2012, "Clustered Deferred and Forward Shading").
+
+Deferred:
+
+- ``volumes``: one instanced pass per light type, each light drawn as its bounding sphere (or a
+  full-screen triangle), re-reading the G-buffer and blending into the light accumulation for
+  every pixel it covers. Needs GL 3.3 only.
+- ``tiled``: a compute pass culls the volume lights per 16x16 tile against the tile's frustum and
+  depth bounds (``lights/cull_tiles.comp``); one full-screen pass then reads the G-buffer once
+  per pixel and loops the full-screen lights and its tile's list (``lights/list_shading.frag``).
+- ``clustered``: the same shading, from lists of view-space clusters (32x32 tiles x 16
+  exponential depth slices) filled light by light (``lights/cull_clusters.comp``).
+
+Forward:
+
+- ``naive``: every fragment loops every light.
+- ``tiled`` (Forward+): a depth pre-pass, the tiled culling (depth bounds from the near plane, so
+  blended surfaces in front of the opaque ones are covered), and the lit passes loop their
+  tile's list (``common/forward_lighting.glsl``).
+
+The lists live in one storage buffer (``lights/light_lists.glsl``): a count per list, then
+``capacity`` slots per list. Capacity is the frame's volume light count, so no list overflows.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import moderngl
+import numpy as np
+
+from .errors import InputError, RenderError
+from .gbuffer import LINEAR_DEPTH
+from .passes import FullscreenPass, Order, Phase, RenderPass
+
+if TYPE_CHECKING:
+    from .context import Features
+    from .frame import Frame
+
+DEFERRED_PATHS = ("volumes", "tiled", "clustered")
+FORWARD_PATHS = ("naive", "tiled")
+# A path named for one pipeline, in the other: forward has no volumes or clusters.
+FORWARD_EQUIVALENT = {"volumes": "naive", "clustered": "tiled"}
+DEFERRED_EQUIVALENT = {"naive": "volumes"}
+TILE = 16  # pixels per tile side (tiled, Forward+): the culling work group
+CLUSTER_TILE = 32  # pixels per cluster side
+CLUSTER_SLICES = 16  # exponential depth slices between the near and far planes
+MAX_LIST_BYTES = 512 * 1024 * 1024
+
+
+def resolve_light_path(pipeline: str, requested: str | None, features: Features,
+                       where: str = "--light-path") -> str:
+    """The light path a pipeline runs: ``requested`` (either pipeline's name of it), or the
+    fastest this context allows (tiled when compute shaders exist; volumes and naive on GL 3.3,
+    where they are the only ones)."""
+    if requested is None:
+        return "tiled" if features.compute_shaders else \
+            ("volumes" if pipeline == "deferred" else "naive")
+    names = DEFERRED_PATHS + FORWARD_PATHS
+    if requested not in names:
+        raise InputError(f"unknown light path '{requested}' (choose from "
+                         f"{', '.join(dict.fromkeys(names))})", where)
+    path = FORWARD_EQUIVALENT.get(requested, requested) if pipeline == "forward" else \
+        DEFERRED_EQUIVALENT.get(requested, requested)
+    if path in ("tiled", "clustered") and not features.compute_shaders:
+        raise InputError(f"light path '{requested}' needs compute shaders (GL 4.3); this context "
+                         "has the GL 3.3 paths only (volumes, naive)", where)
+    return path
+
+
+@dataclass(frozen=True)
+class ListGrid:
+    """The lists of one frame: tiles across and down, depth slices, pixels per tile."""
+
+    columns: int
+    rows: int
+    slices: int
+    tile: int
+
+    @property
+    def count(self) -> int:
+        return self.columns * self.rows * self.slices
+
+
+def list_grid(width: int, height: int, clustered: bool) -> ListGrid:
+    tile = CLUSTER_TILE if clustered else TILE
+    return ListGrid(math.ceil(width / tile), math.ceil(height / tile),
+                    CLUSTER_SLICES if clustered else 1, tile)
+
+
+class LightLists:
+    """The storage buffer of a frame's light lists, grown as needed."""
+
+    def __init__(self, ctx: moderngl.Context):
+        self.ctx = ctx
+        self.buffer: moderngl.Buffer | None = None
+        self.grid: ListGrid | None = None
+        self.capacity = 1
+        self.clustered = False
+        self.depth_scale = (1.0, 1.0)
+
+    def prepare(self, grid: ListGrid, capacity: int, near: float, far: float) -> None:
+        self.grid = grid
+        self.capacity = max(capacity, 1)
+        self.clustered = grid.slices > 1
+        self.depth_scale = (near, grid.slices / math.log(far / near))
+        size = 4 * grid.count * (1 + self.capacity)
+        if size > MAX_LIST_BYTES:
+            raise RenderError(f"{capacity} lights need {size >> 20} MiB of light lists at this "
+                              f"size ({grid.count} lists); the limit is "
+                              f"{MAX_LIST_BYTES >> 20} MiB: use fewer lights or the volumes path")
+        if self.buffer is None or self.buffer.size < size:
+            if self.buffer is not None:
+                self.buffer.release()
+            self.buffer = self.ctx.buffer(reserve=size)
+        self.buffer.bind_to_storage_buffer(1)
+
+    def clear_counts(self) -> None:
+        assert self.buffer is not None and self.grid is not None
+        self.buffer.clear(size=4 * self.grid.count)
+
+    def uniforms(self) -> dict[str, Any]:
+        assert self.grid is not None
+        return {"u_list_count": self.grid.count, "u_list_capacity": self.capacity,
+                "u_list_grid": (self.grid.columns, self.grid.rows, self.grid.slices),
+                "u_list_tile": self.grid.tile, "u_list_depth": self.depth_scale}
+
+    def bind(self, program) -> None:
+        """Set the list uniforms and bind the buffer for a program reading the lists."""
+        if self.buffer is None or "u_list_count" not in program:
+            return
+        self.buffer.bind_to_storage_buffer(1)
+        for name, value in self.uniforms().items():
+            if name in program:
+                program[name].value = value
+
+    def counts(self) -> np.ndarray:
+        """The list lengths of the last frame (host copy; tests and statistics)."""
+        assert self.buffer is not None and self.grid is not None
+        data = np.frombuffer(self.buffer.read(size=4 * self.grid.count), dtype=np.uint32)
+        return np.minimum(data, self.capacity)
+
+    def release(self) -> None:
+        if self.buffer is not None:
+            self.buffer.release()
+            self.buffer = None
+
+
+class LightCullPass(RenderPass):
+    """Fill the light lists with a compute shader (tiles or clusters)."""
+
+    def __init__(self, name: str, phase: Phase, clustered: bool, from_near: bool = False):
+        self.name = name
+        self.phase = phase
+        self.clustered = clustered
+        self.from_near = from_near
+        self.order = Order.FIRST
+        # tiles read the depth bounds; clusters need no depth
+        self.reads = () if clustered else (LINEAR_DEPTH,)
+        self.samples = self.reads
+
+    def execute(self, frame: Frame) -> None:
+        lights = frame.light_buffer
+        grid = list_grid(frame.width, frame.height, self.clustered)
+        camera = frame.scene.camera
+        frame.light_lists.prepare(grid, lights.local_count, camera.near, camera.far)
+        defines = {"CULL_FROM_NEAR": "1"} if self.from_near else {}
+        if self.clustered:
+            defines["LIGHT_LISTS_CLUSTERED"] = "1"
+            frame.light_lists.clear_counts()
+        shader = frame.shaders.compute(
+            "lights/cull_clusters.comp" if self.clustered else "lights/cull_tiles.comp",
+            defines)
+        uniforms = {**frame.light_lists.uniforms(), "u_light_count": lights.count,
+                    "u_global_light_count": lights.global_count}
+        textures = {} if self.clustered else {"u_linear_depth": frame.target(LINEAR_DEPTH)}
+        frame.bind_compute(shader, uniforms, textures, offered=frame.camera_uniforms())
+        lights.bind_storage()
+        if self.clustered:
+            groups = (max(1, math.ceil(lights.local_count / 64)), 1, 1)
+        else:
+            groups = (grid.columns, grid.rows, 1)
+        if lights.local_count > 0 or not self.clustered:
+            shader.run(*groups)
+        frame.ctx.memory_barrier()
+        frame.count_draw()
+
+
+def list_shading_pass(name: str, clustered: bool, gbuffer: tuple[str, ...],
+                      occlusion: str | None) -> FullscreenPass:
+    """The deferred lighting of every light from the lists: one full-screen pass."""
+    inputs = {f"u_{target}": target for target in gbuffer}
+    defines = {}
+    if occlusion:
+        inputs["u_ssao"] = occlusion
+        defines["HAS_SSAO"] = "1"
+    if clustered:
+        defines["LIGHT_LISTS_CLUSTERED"] = "1"
+    from .targets import LIGHT_ACCUMULATION
+
+    return FullscreenPass(name, Phase.LIGHTING, "lights/list_shading.frag", inputs,
+                          (LIGHT_ACCUMULATION,), blend="add", defines=defines)

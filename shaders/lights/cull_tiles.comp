@@ -1,0 +1,98 @@
+// Tiled light culling (Andersson 2009, Olsson and Assarsson 2011): a work group per 16x16 tile
+// finds the tile's depth bounds in the linear depth, then its threads test every volume light's
+// sphere against the tile's frustum (four side planes through the eye, and the depth bounds)
+// and append the ones that touch it to the tile's list.
+// CULL_FROM_NEAR (Forward+): the bounds run from the near plane to the farthest depth, or to the
+// far plane on tiles of background, since blended surfaces (fur shells) lie in front of it.
+layout(local_size_x = 16, local_size_y = 16) in;
+
+#include "common/light_buffer.glsl"
+#include "lights/light_lists.glsl"
+
+uniform sampler2D u_linear_depth;
+uniform mat4 u_inverse_projection;
+uniform vec2 u_resolution;
+uniform vec2 u_near_far;
+uniform int u_global_light_count;
+
+shared uint s_min_bits;
+shared uint s_max_bits;
+shared float s_near_depth;
+shared float s_far_depth;
+shared bool s_empty;
+shared vec3 s_planes[4];
+shared uint s_count;
+
+vec3 view_ray(vec2 pixel) {
+    vec2 ndc = pixel / u_resolution * 2.0 - 1.0;
+    vec4 ray = u_inverse_projection * vec4(ndc, 1.0, 1.0);
+    return ray.xyz / ray.w;
+}
+
+void main() {
+    ivec2 tile = ivec2(gl_WorkGroupID.xy);
+    int list = tile.y * u_list_grid.x + tile.x;
+    if (gl_LocalInvocationIndex == 0u) {
+        s_min_bits = 0x7f7fffffu;  // the largest float's bits: positive floats order as uints
+        s_max_bits = 0u;
+    }
+    barrier();
+    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    if (all(lessThan(pixel, ivec2(u_resolution)))) {
+        float depth = texelFetch(u_linear_depth, pixel, 0).r;
+        if (depth > 0.0) {
+            atomicMin(s_min_bits, floatBitsToUint(depth));
+            atomicMax(s_max_bits, floatBitsToUint(depth));
+        }
+    }
+    barrier();
+    if (gl_LocalInvocationIndex == 0u) {
+        // One invocation sets the tile's bounds and planes up for all: invocations are SIMD
+        // lanes of a loop where compute runs on the CPU (llvmpipe).
+        float low = uintBitsToFloat(s_min_bits);
+        float high = uintBitsToFloat(s_max_bits);
+        ivec2 origin = tile * u_list_tile;
+        ivec2 end = min(origin + u_list_tile, ivec2(u_resolution));
+        s_empty = high <= 0.0;
+        s_near_depth = low;
+        s_far_depth = high;
+#ifdef CULL_FROM_NEAR
+        s_near_depth = u_near_far.x;
+        s_far_depth = s_empty ? u_near_far.y : high;
+        s_empty = false;
+#endif
+        // the tile's side planes, through the eye, normals pointing into the tile
+        vec2 low_corner = vec2(origin);
+        vec2 high_corner = vec2(end);
+        vec3 r00 = view_ray(low_corner);
+        vec3 r10 = view_ray(vec2(high_corner.x, low_corner.y));
+        vec3 r01 = view_ray(vec2(low_corner.x, high_corner.y));
+        vec3 r11 = view_ray(high_corner);
+        vec3 centre = r00 + r10 + r01 + r11;
+        s_planes[0] = normalize(cross(r01, r00));
+        s_planes[1] = normalize(cross(r10, r11));
+        s_planes[2] = normalize(cross(r00, r10));
+        s_planes[3] = normalize(cross(r11, r01));
+        for (int k = 0; k < 4; ++k)
+            if (dot(s_planes[k], centre) < 0.0) s_planes[k] = -s_planes[k];
+        s_count = 0u;
+    }
+    barrier();
+    if (!s_empty) {
+        int local_count = u_light_count - u_global_light_count;
+        for (int i = int(gl_LocalInvocationIndex); i < local_count; i += 256) {
+            int index = u_global_light_count + i;
+            vec4 sphere = fetch_light_sphere(index);
+            float z = -sphere.z;
+            if (z + sphere.w < s_near_depth || z - sphere.w > s_far_depth) continue;
+            if (dot(s_planes[0], sphere.xyz) < -sphere.w || dot(s_planes[1], sphere.xyz) < -sphere.w ||
+                dot(s_planes[2], sphere.xyz) < -sphere.w || dot(s_planes[3], sphere.xyz) < -sphere.w)
+                continue;
+            uint slot = atomicAdd(s_count, 1u);
+            if (int(slot) < u_list_capacity)
+                light_list_data[u_list_count + list * u_list_capacity + int(slot)] = uint(index);
+        }
+    }
+    barrier();
+    if (gl_LocalInvocationIndex == 0u) light_list_data[list] = s_count;
+}

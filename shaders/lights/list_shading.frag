@@ -1,0 +1,37 @@
+// Deferred lighting from light lists (the tiled and clustered paths): each pixel reads the
+// G-buffer once and loops over the full-screen lights and the volume lights of its tile or
+// cluster, adding the sum into the light accumulation - one pass for every light.
+#include "gbuffer/fetch.glsl"
+#include "common/light_buffer.glsl"
+#include "generated/lights.glsl"
+#include "lights/light_lists.glsl"
+
+#ifdef HAS_SSAO
+uniform sampler2D u_ssao;
+#endif
+uniform vec2 u_resolution;
+uniform mat4 u_inverse_projection;
+uniform int u_global_light_count;
+
+out vec4 out_light;
+
+void main() {
+    ivec2 pixel = ivec2(gl_FragCoord.xy);
+    GBufferSample g = gbuffer_fetch(pixel);
+    if (g.surface_id <= 0.0) discard;
+#ifdef HAS_SSAO
+    g.surface.occlusion = texelFetch(u_ssao, pixel, 0).r;
+#endif
+    vec3 P = view_position(gl_FragCoord.xy, g.linear_depth, u_resolution, u_inverse_projection);
+    vec3 V = normalize(-P);
+    vec3 total = vec3(0.0);
+    for (int k = 0; k < u_global_light_count; ++k)
+        total += evaluate_light(fetch_light(k), g.surface, P, V);
+    int list = light_list_of(pixel, g.linear_depth);
+    int length = light_list_length(list);
+    for (int k = 0; k < length; ++k) {
+        int index = light_list_light(list, k);
+        if (light_reaches(index, P)) total += evaluate_light(fetch_light(index), g.surface, P, V);
+    }
+    out_light = vec4(total, 0.0);
+}

@@ -1,0 +1,157 @@
+"""Light paths: tiled and clustered deferred lighting and Forward+ give the image of the volumes
+and naive paths; the light lists hold every light that reaches a pixel; lights off screen are
+culled on the CPU; a context without compute shaders runs volumes and naive."""
+
+import numpy as np
+import pytest
+
+from deferred.bench import with_extra_lights
+from deferred.context import Features, GLContext
+from deferred.errors import InputError
+from deferred.lightbuffer import visible_spheres
+from deferred.renderer import Renderer
+from deferred.scene import load_scene, scene_from_dict
+
+ALL_TYPES = [
+    {"type": "ambient", "color": [0.2, 0.22, 0.25], "ground": [0.1, 0.08, 0.06]},
+    {"type": "directional", "direction": [-0.5, -1.0, -0.3], "intensity": 0.8},
+    {"type": "point", "position": [0.5, 1.0, 1.0], "radius": 3.0, "intensity": 4.0},
+    {"type": "spot", "position": [-1.0, 2.0, 1.0], "direction": [0.4, -1.0, -0.3],
+     "radius": 5.0, "intensity": 6.0, "inner_angle": 15.0, "outer_angle": 30.0},
+]
+
+
+def scene_with(lights_extra: int):
+    scene = scene_from_dict({
+        "size": [160, 96], "tonemap": "none",
+        "camera": {"position": [0.0, 1.6, 4.2], "target": [0.0, 0.4, 0.0]},
+        "object": [{"mesh": "builtin:plane", "scale": 6.0},
+                   {"mesh": "builtin:sphere", "position": [-0.9, 0.6, 0.0], "scale": 0.6},
+                   {"mesh": "builtin:cube", "position": [0.9, 0.5, -0.5], "scale": 0.5},
+                   {"mesh": "builtin:torus", "position": [0.2, 0.3, 1.2], "scale": 0.4}],
+        "light": ALL_TYPES})
+    return with_extra_lights(scene, lights_extra, 160 / 96)
+
+
+def render(gl, scene, pipeline, light_path):
+    if not gl.features.compute_shaders and light_path in ("tiled", "clustered"):
+        pytest.skip("the driver has no compute shaders")
+    with Renderer(scene, pipeline, gl=gl, light_path=light_path) as renderer:
+        result = renderer.render()
+        return result, renderer.light_path
+
+
+def psnr(a, b, peak):
+    mse = float(np.mean((a.astype(np.float64) - b.astype(np.float64)) ** 2))
+    return float("inf") if mse == 0.0 else 10.0 * np.log10(peak * peak / mse)
+
+
+@pytest.mark.parametrize("extra", [0, 16, 200])
+@pytest.mark.parametrize("path", ["tiled", "clustered"])
+def test_deferred_paths_give_the_volumes_image(gl, extra, path):
+    scene = scene_with(extra)
+    reference, _ = render(gl, scene, "deferred", "volumes")
+    result, used = render(gl, scene, "deferred", path)
+    assert used == path
+    peak = float(reference.hdr[..., :3].max())
+    assert psnr(result.hdr[..., :3], reference.hdr[..., :3], peak) >= 40.0
+    assert "lighting.point" in reference.draws_by_pass
+    assert f"lighting.{path}" in result.draws_by_pass and \
+        "lighting.point" not in result.draws_by_pass  # one pass for every light
+
+
+@pytest.mark.parametrize("extra", [0, 16, 200])
+def test_forward_plus_gives_the_naive_image(gl, extra):
+    scene = scene_with(extra)
+    reference, _ = render(gl, scene, "forward", "naive")
+    result, used = render(gl, scene, "forward", "tiled")
+    assert used == "tiled" and "forward.cull_tiles" in result.draws_by_pass
+    peak = float(reference.hdr[..., :3].max())
+    assert psnr(result.hdr[..., :3], reference.hdr[..., :3], peak) >= 40.0
+
+
+def test_forward_plus_lights_fur_shells_in_front_of_the_opaque_depth(gl):
+    demo = with_extra_lights(load_scene(None), 24, 16 / 9)
+    images = []
+    for path in ("naive", "tiled"):
+        with Renderer(demo, "forward", (160, 90), gl=gl, light_path=path) as renderer:
+            images.append(renderer.render().image[..., :3])
+    assert psnr(images[0], images[1], 255.0) >= 40.0
+
+
+def test_tile_lists_hold_every_light_that_reaches_a_pixel(gl):
+    if not gl.features.compute_shaders:
+        pytest.skip("the driver has no compute shaders")
+    scene = scene_with(120)
+    with Renderer(scene, "deferred", gl=gl, light_path="tiled") as renderer:
+        frame_result = renderer.render()
+        assert frame_result is not None
+        lists = renderer.light_lists
+        grid = lists.grid
+        data = np.frombuffer(lists.buffer.read(), dtype=np.uint32)
+        records = np.frombuffer(renderer.light_buffer._buffer.read(), dtype=np.float32)
+        records = records.reshape(-1, 4, 4)[:renderer.light_buffer.count]
+        depth = renderer.targets.read("linear_depth")[..., 0]
+        frame = renderer.last_frame
+        inverse = frame.inverse_projection
+        global_count = renderer.light_buffer.global_count
+    height, width = depth.shape
+    ys, xs = np.nonzero(depth > 0.0)
+    ndc = np.stack([(xs + 0.5) / width * 2 - 1, (ys + 0.5) / height * 2 - 1,
+                    np.ones(len(xs)), np.ones(len(xs))], -1)
+    rays = ndc @ inverse.T
+    rays = rays[:, :3] / rays[:, 3:]
+    points = rays * (depth[ys, xs] / -rays[:, 2])[:, None]
+    spheres = records[global_count:, 1]
+    reach = np.linalg.norm(points[:, None, :] - spheres[None, :, :3], axis=-1) <= \
+        spheres[None, :, 3] * 0.999
+    assert reach.sum() > 1000  # the lights do light the scene
+    tile = (ys // grid.tile) * grid.columns + xs // grid.tile
+    counts = data[:grid.count]
+    missing = 0
+    for pixel in np.nonzero(reach.any(axis=1))[0]:
+        listed = data[grid.count + tile[pixel] * lists.capacity:][:counts[tile[pixel]]]
+        needed = np.nonzero(reach[pixel])[0] + global_count
+        missing += len(set(needed.tolist()) - set(listed.tolist()))
+    assert missing == 0
+    # and the lists are far shorter than every light
+    assert counts.mean() < 0.25 * (len(records) - global_count)
+
+
+def test_lights_outside_the_view_are_culled_on_the_cpu(gl):
+    from deferred.camera import Camera
+
+    view_projection = Camera(fov=90.0, near=0.1, far=50.0).projection(1.0)
+    records = np.zeros((4, 4, 4), np.float32)
+    records[:, 1] = [[0.0, 0.0, -5.0, 1.0],   # straight ahead
+                     [0.0, 0.0, 5.0, 1.0],    # behind the eye
+                     [7.0, 0.0, -5.0, 1.0],   # off to the side
+                     [5.5, 0.0, -5.0, 1.0]]   # off to the side, but its sphere reaches in
+    assert visible_spheres(records, view_projection).tolist() == [True, False, False, True]
+    scene = scene_with(0)
+    behind = scene_from_dict({"light": [{"type": "point", "position": [0.0, 1.0, 20.0],
+                                         "radius": 2.0}]}).lights
+    scene.lights = [*scene.lights, *behind]
+    with Renderer(scene, gl=gl) as renderer:
+        renderer.render()
+        assert renderer.light_buffer.culled == 1
+        assert renderer.light_buffer.count == len(ALL_TYPES)
+
+
+def test_without_compute_shaders_the_gl33_paths_run(gl):
+    gl33 = GLContext(gl.ctx, Features(storage_buffers=False, compute_shaders=False))
+    scene = scene_with(4)
+    with Renderer(scene, gl=gl33) as renderer:
+        assert renderer.light_path == "volumes"
+    with Renderer(scene, "forward", gl=gl33) as renderer:
+        assert renderer.light_path == "naive"
+    with pytest.raises(InputError, match="--light-path: light path 'tiled' needs compute "
+                                         "shaders"):
+        Renderer(scene, gl=gl33, light_path="tiled")
+
+
+def test_unknown_light_path_is_bad_input(gl):
+    with pytest.raises(InputError, match="unknown light path 'fast'"):
+        Renderer(scene_with(0), gl=gl, light_path="fast")
+    with pytest.raises(InputError, match="light_path"):
+        scene_from_dict({"light_path": "fast"})
