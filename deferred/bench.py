@@ -12,10 +12,19 @@ of the view at its depth, so every light touches the screen whatever the scene's
 lights of a smaller count are the first lights of a larger one. The shell sweep sets ``shells``
 on every object whose material has that parameter (``revie_fur``).
 
-JSON: ``{"renderer": {...}, "results": [{"pipeline", "lights", "shells", "width", "height",
-"runs", "median_ms", "mean_ms", "min_ms", "max_ms", "stddev_ms", "times_ms", "passes_ms"}]}``.
-``lights`` counts the extra lights; ``renderer`` also records the G-buffer bytes per pixel, the
-CPU count and the scene. CSV: the same columns, ``times_ms`` and ``passes_ms`` as JSON text.
+Every light path of each pipeline runs (``light_path``: ``volumes``, ``tiled``, ``clustered``
+for deferred, ``naive`` and ``tiled`` (Forward+) for forward), unless ``--light-paths`` picks.
+Besides wall-clock times, each row holds the framework's own CPU time per frame and per draw
+call (``time.thread_time`` of the rendering thread around ``render()`` without ``finish()``:
+llvmpipe rasterises in worker threads, so this is the Python code and the driver's command
+submission, not the drawing), and per-pass GL timer-query times where the driver answers
+them (``gpu_passes_ms``; llvmpipe does not).
+
+JSON: ``{"renderer": {...}, "results": [{"pipeline", "light_path", "lights", "shells", "width",
+"height", "runs", "median_ms", "mean_ms", "min_ms", "max_ms", "stddev_ms", "times_ms",
+"passes_ms", "cpu_ms", "draw_calls", "cpu_us_per_draw", "gpu_passes_ms"}]}``. ``lights`` counts
+the extra lights; ``renderer`` also records the G-buffer layout and bytes per pixel, the CPU
+count and the scene. CSV: the same columns, the lists and mappings as JSON text.
 """
 
 from __future__ import annotations
@@ -53,8 +62,10 @@ LIGHT_VIEW_SHARE = 0.3
 LIGHT_INTENSITY = 2.0
 SHELLS = "shells"
 MIN_SHELLS = "min_shells"
-COLUMNS = ("pipeline", "lights", "shells", "width", "height", "runs", "median_ms", "mean_ms",
-           "min_ms", "max_ms", "stddev_ms", "times_ms", "passes_ms")
+COLUMNS = ("pipeline", "light_path", "lights", "shells", "width", "height", "runs", "median_ms",
+           "mean_ms", "min_ms", "max_ms", "stddev_ms", "times_ms", "passes_ms", "cpu_ms",
+           "draw_calls", "cpu_us_per_draw", "gpu_passes_ms")
+JSON_COLUMNS = ("times_ms", "passes_ms", "gpu_passes_ms")
 OUTPUT_SUFFIXES = {"--json": ".json", "--csv": ".csv", "--plot": ".png"}
 
 
@@ -72,6 +83,32 @@ def parse_counts(text: str, where: str) -> list[int]:
     if negative:
         raise InputError(f"counts must be 0 or more, got {negative[0]}", where)
     return sorted(set(counts))
+
+
+def parse_light_paths(text: str, where: str = "--light-paths") -> list[str] | None:
+    """``"all"`` (None: every path of each pipeline) or path names, checked."""
+    from .light_lists import DEFERRED_PATHS, FORWARD_PATHS
+
+    if text.strip() == "all":
+        return None
+    names = [p.strip() for p in text.split(",") if p.strip()]
+    known = dict.fromkeys(DEFERRED_PATHS + FORWARD_PATHS)
+    for name in names:
+        if name not in known:
+            raise InputError(f"unknown light path '{name}' (choose from all, "
+                             f"{', '.join(known)})", where)
+    if not names:
+        raise InputError(f"expected light paths such as tiled,volumes, got '{text}'", where)
+    return list(dict.fromkeys(names))
+
+
+def pipeline_paths(pipeline: str, light_paths: Sequence[str] | None) -> list[str]:
+    """The light paths a sweep runs for ``pipeline``: every one of its own, or those named that
+    it has."""
+    from .light_lists import DEFERRED_PATHS, FORWARD_PATHS
+
+    own = DEFERRED_PATHS if pipeline == "deferred" else FORWARD_PATHS
+    return list(own) if light_paths is None else [p for p in own if p in light_paths]
 
 
 def parse_pipelines(text: str, where: str = "--pipelines") -> list[str]:
@@ -208,6 +245,56 @@ def time_frames(renderer, runs: int, warmup: int) -> list[float]:
     return times
 
 
+def time_cpu(renderer, runs: int) -> tuple[float, int]:
+    """Median CPU milliseconds of the rendering thread per frame, without waiting for GL, and
+    the draw calls of a frame (see the module documentation)."""
+    ctx = renderer.gl.ctx
+    samples = []
+    draws = 0
+    for _ in range(runs):
+        ctx.finish()
+        start = time.thread_time()
+        result = renderer.render(readback=False)
+        samples.append((time.thread_time() - start) * 1000.0)
+        draws = result.draw_calls
+    ctx.finish()
+    return statistics.median(samples), draws
+
+
+def timer_queries_work(gl: GLContext) -> bool:
+    """Whether the driver answers GL timer queries (llvmpipe reads 0)."""
+    ctx = gl.ctx
+    query = ctx.query(time=True)
+    fbo = ctx.simple_framebuffer((64, 64))
+    with query:
+        for _ in range(8):
+            fbo.clear(0.5, 0.5, 0.5, 1.0)
+    ctx.finish()
+    elapsed = query.elapsed
+    fbo.release()
+    return elapsed > 0
+
+
+def time_passes_gpu(renderer, runs: int) -> dict[str, float]:
+    """Median GL timer-query milliseconds of each pass (drivers that answer them)."""
+    ctx = renderer.gl.ctx
+    samples: dict[str, list[float]] = {p.name: [] for p in renderer.passes}
+    queries = {p.name: ctx.query(time=True) for p in renderer.passes}
+
+    def before(render_pass, frame) -> None:
+        queries[render_pass.name].__enter__()
+
+    def after(render_pass, frame) -> None:
+        queries[render_pass.name].__exit__(None, None, None)
+
+    for _ in range(runs):
+        renderer.render(before_pass=before, on_pass=after, readback=False)
+        ctx.finish()
+        for name, query in queries.items():
+            samples[name].append(query.elapsed / 1e6)
+    return {name: statistics.median(values) for name, values in samples.items()}
+
+
 def time_passes(renderer, runs: int) -> dict[str, float]:
     """Median milliseconds of each pass, in pass order, over ``runs`` frames.
 
@@ -235,7 +322,7 @@ def time_passes(renderer, runs: int) -> dict[str, float]:
 
 @dataclass
 class BenchResult:
-    """One (pipeline, lights, shells) point of a sweep; times in milliseconds."""
+    """One (pipeline, light path, lights, shells) point of a sweep; times in milliseconds."""
 
     pipeline: str
     lights: int
@@ -244,6 +331,14 @@ class BenchResult:
     height: int
     times_ms: list[float]
     passes_ms: dict[str, float] = field(default_factory=dict)
+    light_path: str = ""
+    cpu_ms: float = 0.0
+    draw_calls: int = 0
+    gpu_passes_ms: dict[str, float] | None = None
+
+    @property
+    def cpu_us_per_draw(self) -> float:
+        return 1000.0 * self.cpu_ms / max(self.draw_calls, 1)
 
     @property
     def runs(self) -> int:
@@ -270,11 +365,13 @@ class BenchResult:
         return statistics.stdev(self.times_ms) if self.runs > 1 else 0.0
 
     def to_dict(self) -> dict[str, Any]:
-        return {"pipeline": self.pipeline, "lights": self.lights, "shells": self.shells,
-                "width": self.width, "height": self.height, "runs": self.runs,
-                "median_ms": self.median_ms, "mean_ms": self.mean_ms, "min_ms": self.min_ms,
-                "max_ms": self.max_ms, "stddev_ms": self.stddev_ms,
-                "times_ms": list(self.times_ms), "passes_ms": dict(self.passes_ms)}
+        return {"pipeline": self.pipeline, "light_path": self.light_path, "lights": self.lights,
+                "shells": self.shells, "width": self.width, "height": self.height,
+                "runs": self.runs, "median_ms": self.median_ms, "mean_ms": self.mean_ms,
+                "min_ms": self.min_ms, "max_ms": self.max_ms, "stddev_ms": self.stddev_ms,
+                "times_ms": list(self.times_ms), "passes_ms": dict(self.passes_ms),
+                "cpu_ms": self.cpu_ms, "draw_calls": self.draw_calls,
+                "cpu_us_per_draw": self.cpu_us_per_draw, "gpu_passes_ms": self.gpu_passes_ms}
 
 
 @dataclass
@@ -294,8 +391,8 @@ class BenchReport:
         writer.writeheader()
         for result in self.results:
             row = result.to_dict()
-            row["times_ms"] = json.dumps(row["times_ms"])
-            row["passes_ms"] = json.dumps(row["passes_ms"])
+            for column in JSON_COLUMNS:
+                row[column] = json.dumps(row[column])
             writer.writerow(row)
         return out.getvalue()
 
@@ -305,6 +402,7 @@ class Sweep:
     lights: Sequence[int] = DEFAULT_LIGHTS
     shells: Sequence[int] = DEFAULT_SHELLS
     pipelines: Sequence[str] = ("deferred", "forward")
+    light_paths: Sequence[str] | None = None  # None: every path of each pipeline
     size: tuple[int, int] | None = None  # None: the scene's size
     runs: int = 10
     warmup: int = 2
@@ -337,23 +435,32 @@ def run_bench(scene: Scene, sweep: Sweep, gl: GLContext | None = None,
     variants = [with_shells(scene, s) if shell_objects(scene) else scene for s in shell_counts]
     owns = gl is None
     gl = gl or create_context()
+    runs = [(pipeline, path) for pipeline in sweep.pipelines
+            for path in pipeline_paths(pipeline, sweep.light_paths)]
+    if not runs:
+        raise InputError("no light path of the pipelines chosen is in --light-paths",
+                         "--light-paths")
     results = []
     try:
+        timers = timer_queries_work(gl)
         for shells, shelled in zip(shell_counts, variants, strict=True):
             for lights in sweep.lights:
                 variant = with_extra_lights(shelled, lights, aspect)
-                for pipeline in sweep.pipelines:
+                for pipeline, path in runs:
                     if progress:
-                        progress(f"{pipeline}, {lights} lights, {shells} shells")
-                    renderer = Renderer(variant, pipeline, size, gl=gl)
+                        progress(f"{pipeline} ({path}), {lights} lights, {shells} shells")
+                    renderer = Renderer(variant, pipeline, size, gl=gl, light_path=path)
                     try:
                         times = time_frames(renderer, sweep.runs, sweep.warmup)
                         passes = time_passes(renderer, sweep.runs)
+                        cpu, draws = time_cpu(renderer, sweep.runs)
+                        gpu = time_passes_gpu(renderer, sweep.runs) if timers else None
                     finally:
                         renderer.release()
                     results.append(BenchResult(pipeline, lights, shells, *renderer.size,
-                                               times, passes))
-        info = renderer_info(gl, scene)
+                                               times, passes, renderer.light_path, cpu, draws,
+                                               gpu))
+        info = {**renderer_info(gl, scene), "gl_timer_queries": timers}
     finally:
         if owns:
             gl.release()
@@ -387,18 +494,19 @@ def plot_image(report: BenchReport, title: str | None = None) -> np.ndarray:
     from matplotlib.ticker import NullLocator, ScalarFormatter
 
     shells = sorted({r.shells for r in report.results})
-    pipelines = list(dict.fromkeys(r.pipeline for r in report.results))
+    series = list(dict.fromkeys((r.pipeline, r.light_path) for r in report.results))
     figure = Figure(figsize=(4.2 * len(shells) + 0.6, 3.8), dpi=100, layout="constrained")
     FigureCanvasAgg(figure)  # Agg without pyplot: no global backend state, no display needed
     # Shared log y: times span decades, and panels compare at a glance.
     axes = figure.subplots(1, len(shells), squeeze=False, sharey=True)[0]
     for ax, count in zip(axes, shells, strict=True):
-        for pipeline in pipelines:
-            rows = sorted((r for r in report.results
-                           if r.shells == count and r.pipeline == pipeline),
+        for pipeline, path in series:
+            rows = sorted((r for r in report.results if r.shells == count and
+                           (r.pipeline, r.light_path) == (pipeline, path)),
                           key=lambda r: r.lights)
             x = [r.lights for r in rows]
-            line, = ax.plot(x, [r.median_ms for r in rows], marker="o", label=pipeline)
+            label = f"{pipeline} ({path})" if path else pipeline
+            line, = ax.plot(x, [r.median_ms for r in rows], marker="o", label=label)
             ax.fill_between(x, [r.min_ms for r in rows], [r.max_ms for r in rows],
                             color=line.get_color(), alpha=0.2, linewidth=0)
         ax.set_xscale("symlog", linthresh=1)  # light counts span decades and may include 0
@@ -434,13 +542,50 @@ def results_table(report: BenchReport):
     from rich.table import Table
 
     table = Table(title=plot_title(report), title_justify="left")
-    for column in ("pipeline", "lights", "shells", "median ms", "min ms", "max ms", "stddev",
-                   "slowest pass"):
-        table.add_column(column, no_wrap=True,
-                         justify="left" if column in ("pipeline", "slowest pass") else "right")
+    for column in ("pipeline", "path", "lights", "shells", "median ms", "min ms", "max ms",
+                   "stddev", "cpu ms", "us/draw", "slowest pass"):
+        table.add_column(column, no_wrap=True, justify="left" if column in (
+            "pipeline", "path", "slowest pass") else "right")
     for r in report.results:
         slowest = max(r.passes_ms.items(), key=lambda item: item[1], default=None)
-        table.add_row(r.pipeline, str(r.lights), str(r.shells), f"{r.median_ms:.2f}",
-                      f"{r.min_ms:.2f}", f"{r.max_ms:.2f}", f"{r.stddev_ms:.2f}",
+        table.add_row(r.pipeline, r.light_path, str(r.lights), str(r.shells),
+                      f"{r.median_ms:.2f}", f"{r.min_ms:.2f}", f"{r.max_ms:.2f}",
+                      f"{r.stddev_ms:.2f}", f"{r.cpu_ms:.2f}", f"{r.cpu_us_per_draw:.1f}",
                       f"{slowest[0]} {slowest[1]:.2f} ms" if slowest else "")
     return table
+
+
+def _fastest(rows: list[BenchResult], pipeline: str, lights: int,
+             paths: Sequence[str] | None = None) -> BenchResult | None:
+    found = [r for r in rows if r.pipeline == pipeline and r.lights == lights and
+             (paths is None or r.light_path in paths)]
+    return min(found, key=lambda r: r.median_ms, default=None)
+
+
+def crossovers(report: BenchReport) -> list[str]:
+    """Per shell count: the fewest extra lights from which the fastest deferred path beats
+    naive forward (and every forward path), as lines to print."""
+    lines = []
+    for shells in sorted({r.shells for r in report.results}):
+        rows = [r for r in report.results if r.shells == shells]
+        counts = sorted({r.lights for r in rows})
+
+        for against, paths in (("naive forward", ("naive",)), ("every forward path", None)):
+            crossing = None
+            for lights in counts:
+                deferred = _fastest(rows, "deferred", lights)
+                forward = _fastest(rows, "forward", lights, paths)
+                if deferred is None or forward is None:
+                    continue
+                if deferred.median_ms < forward.median_ms:
+                    crossing = crossing if crossing is not None else (lights, deferred)
+                else:
+                    crossing = None
+            if crossing is None:
+                lines.append(f"{shells} shells: deferred never beats {against} from some "
+                             "light count on")
+            else:
+                lights, deferred = crossing
+                lines.append(f"{shells} shells: deferred ({deferred.light_path}) beats "
+                             f"{against} from {lights} extra lights on")
+    return lines

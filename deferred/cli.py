@@ -221,11 +221,14 @@ def _compare(first: str, second: str, output: str | None) -> None:
 @click.option("--warmup", type=click.IntRange(min=0), default=2, show_default=True,
               help="Untimed frames first (shader compilation, first uploads).")
 @click.option("--pipelines", default="deferred,forward", show_default=True, metavar="NAME,...")
+@click.option("--light-paths", default="all", show_default=True, metavar="PATH,...",
+              help="Light paths to time: all (every path of each pipeline), or names: "
+                   "volumes, tiled, clustered (deferred), naive, tiled (forward).")
 @click.option("--json", "json_path", metavar="FILE.json", help="Results as JSON ('-': stdout).")
 @click.option("--csv", "csv_path", metavar="FILE.csv", help="Results as CSV.")
 @click.option("--plot", "plot_path", metavar="FILE.png", help="ms against light count.")
 def bench(scene: str | None, lights: str, shells: str, size: str | None, runs: int, warmup: int,
-          pipelines: str, json_path: str | None, csv_path: str | None,
+          pipelines: str, light_paths: str, json_path: str | None, csv_path: str | None,
           plot_path: str | None) -> None:
     """Time SCENE (the built-in demo when omitted) in each pipeline over a sweep of light and
     shell counts (DESIGN.md, "Benchmarks")."""
@@ -237,6 +240,7 @@ def bench(scene: str | None, lights: str, shells: str, size: str | None, runs: i
     sweep = benchmark.Sweep(lights=benchmark.parse_counts(lights, "--lights"),
                             shells=benchmark.parse_counts(shells, "--shells"),
                             pipelines=benchmark.parse_pipelines(pipelines),
+                            light_paths=benchmark.parse_light_paths(light_paths),
                             size=_size_option(size), runs=runs, warmup=warmup)
     writers = {"--json": benchmark.write_json, "--csv": benchmark.write_csv,
                "--plot": benchmark.write_plot}
@@ -263,6 +267,8 @@ def bench(scene: str | None, lights: str, shells: str, size: str | None, runs: i
     # Not squeezed to 80 columns when stderr is a pipe or a file.
     table_console = stderr if stderr.is_terminal else Console(stderr=True, width=160)
     table_console.print(benchmark.results_table(report))
+    for line in benchmark.crossovers(report):
+        stderr.print(line)
     if json_path == "-":
         click.echo(report.to_json(), nl=False)
     for where, path in outputs.items():

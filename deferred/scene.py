@@ -177,11 +177,25 @@ def check_size(size: tuple[int, int], where: str) -> tuple[int, int]:
     return width, height
 
 
+def builtin_scenes() -> list[str]:
+    """Names of the scenes shipped with the package (``builtin:<name>``)."""
+    folder = resources.files("deferred").joinpath("scenes")
+    return sorted(entry.name.removesuffix(".toml") for entry in folder.iterdir()
+                  if entry.name.endswith(".toml"))
+
+
 def load_scene(path: str | Path | None = None) -> Scene:
-    """Load a scene file; ``None`` loads the built-in demo scene."""
+    """Load a scene file; ``None`` loads the built-in demo scene, ``builtin:<name>`` another
+    scene shipped with the package (``builtin:overdraw``, the bench scene with overdraw)."""
     if path is None:
-        text = resources.files("deferred").joinpath("scenes", DEMO_SCENE).read_text("utf-8")
-        return scene_from_toml(text, name=f"builtin:{DEMO_SCENE}", base_dir=None)
+        path = f"builtin:{DEMO_SCENE.removesuffix('.toml')}"
+    if isinstance(path, str) and path.startswith("builtin:"):
+        name = path.removeprefix("builtin:").removesuffix(".toml")
+        if name not in builtin_scenes():
+            raise InputError(f"no built-in scene '{name}' (choose from "
+                             f"{', '.join(builtin_scenes())})", path)
+        text = resources.files("deferred").joinpath("scenes", f"{name}.toml").read_text("utf-8")
+        return scene_from_toml(text, name=f"builtin:{name}.toml", base_dir=None)
     path = Path(path)
     if not path.is_file():
         raise InputError("scene file not found", str(path))

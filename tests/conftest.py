@@ -28,13 +28,14 @@ def gl():
 
 @pytest.fixture
 def render(gl):
-    """render(scene, pipeline='deferred', size=None) -> (RenderResult, Renderer) released later."""
+    """render(scene, pipeline='deferred', size=None, light_path=None) -> (RenderResult, Renderer)
+    released later."""
     from deferred.renderer import Renderer
 
     made = []
 
-    def _render(scene, pipeline="deferred", size=None, **kwargs):
-        renderer = Renderer(scene, pipeline, size, gl=gl)
+    def _render(scene, pipeline="deferred", size=None, light_path=None, **kwargs):
+        renderer = Renderer(scene, pipeline, size, gl=gl, light_path=light_path)
         made.append(renderer)
         return renderer.render(**kwargs), renderer
 

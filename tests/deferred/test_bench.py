@@ -1,7 +1,6 @@
 """deferred bench: sweep structure, scene variants, outputs, bad input. Never timings."""
 
 import csv
-import itertools
 import json
 from collections import Counter
 from pathlib import Path
@@ -47,6 +46,7 @@ def standard_scene():
 def test_cli_sweep_writes_json_csv_plot(tmp_path, capsys):
     out = {s: tmp_path / f"bench.{s}" for s in ("json", "csv", "png")}
     code, stdout, err = run(capsys, "bench", *FAST, "--lights", "3,0", "--shells", "0,4",
+                            "--light-paths", "volumes,tiled,naive",
                             "--json", str(out["json"]), "--csv", str(out["csv"]),
                             "--plot", str(out["png"]))
     assert code == 0, err
@@ -64,9 +64,14 @@ def test_cli_sweep_writes_json_csv_plot(tmp_path, capsys):
     assert list(layout) == ["albedo_specular", "normal_exponent_id", "linear_depth", "depth"]
     assert sum(entry["bytes_per_pixel"] for entry in layout.values()) == 20
     results = report["results"]
-    combos = Counter((r["pipeline"], r["lights"], r["shells"]) for r in results)
-    assert set(combos) == set(itertools.product(("deferred", "forward"), (0, 3), (0, 4)))
+    combos = Counter((r["pipeline"], r["light_path"], r["lights"], r["shells"])
+                     for r in results)
+    paths = [("deferred", "volumes"), ("deferred", "tiled"), ("forward", "tiled"),
+             ("forward", "naive")]
+    assert set(combos) == {(*p, lights, shells) for p in paths for lights in (0, 3)
+                           for shells in (0, 4)}
     assert set(combos.values()) == {1}
+    assert "shells: deferred" in err  # the crossover lines
 
     demo = load_scene(None)
     for r in results:
@@ -78,11 +83,15 @@ def test_cli_sweep_writes_json_csv_plot(tmp_path, capsys):
         assert r["min_ms"] == min(r["times_ms"]) and r["max_ms"] == max(r["times_ms"])
         assert r["stddev_ms"] >= 0.0
         variant = with_extra_lights(with_shells(demo, r["shells"]), r["lights"], 64 / 36)
-        names = [p.name for p in PIPELINES[r["pipeline"]]().passes(variant)]
+        names = [p.name for p in PIPELINES[r["pipeline"]](r["light_path"]).passes(variant)]
         assert list(r["passes_ms"]) == names
         assert all(t > 0.0 for t in r["passes_ms"].values())
         shell_pass = "torus.shells" if r["pipeline"] == "deferred" else "torus.forward_shells"
         assert (shell_pass in r["passes_ms"]) == (r["shells"] > 0)
+        # the framework's CPU time: per frame, and per draw call
+        assert r["cpu_ms"] > 0.0 and r["draw_calls"] > 0
+        assert r["cpu_us_per_draw"] == pytest.approx(1000.0 * r["cpu_ms"] / r["draw_calls"])
+        assert r["gpu_passes_ms"] is None or set(r["gpu_passes_ms"]) == set(names)
 
     with out["csv"].open(newline="") as f:
         rows = list(csv.DictReader(f))
@@ -103,18 +112,19 @@ def test_cli_sweep_writes_json_csv_plot(tmp_path, capsys):
 def test_json_dash_goes_to_stdout(tmp_path, capsys, monkeypatch):
     monkeypatch.chdir(tmp_path)
     code, stdout, err = run(capsys, "bench", str(LIGHTS_SCENE), *FAST, "--lights", "2",
-                            "--pipelines", "forward", "--json", "-")
+                            "--pipelines", "forward", "--light-paths", "naive", "--json", "-")
     assert code == 0, err
     report = json.loads(stdout)
-    assert [(r["pipeline"], r["lights"], r["shells"]) for r in report["results"]] == \
-        [("forward", 2, 0)]
+    assert [(r["pipeline"], r["light_path"], r["lights"], r["shells"])
+            for r in report["results"]] == [("forward", "naive", 2, 0)]
     assert list(tmp_path.iterdir()) == []
 
 
 def test_scene_without_shells_sweeps_one_value(gl, capsys):
     scene = standard_scene()
     assert shell_objects(scene) == []
-    report = run_bench(scene, Sweep(lights=[0, 2], shells=[0, 16, 64], runs=1, warmup=0), gl=gl)
+    report = run_bench(scene, Sweep(lights=[0, 2], shells=[0, 16, 64], runs=1, warmup=0,
+                                    light_paths=["volumes", "naive"]), gl=gl)
     assert [(r.pipeline, r.lights, r.shells) for r in report.results] == [
         ("deferred", 0, 0), ("forward", 0, 0), ("deferred", 2, 0), ("forward", 2, 0)]
     assert all(r.runs == 1 and r.stddev_ms == 0.0 for r in report.results)
@@ -184,6 +194,9 @@ def test_shells_out_of_the_materials_range_is_bad_input():
     (["--lights", "20000"], "--lights: at most 16384 lights"),
     (["--shells", "-2"], "--shells: counts must be 0 or more"),
     (["--shells", "0,999"], "--shells: Input should be less than or equal to 256"),
+    (["--light-paths", "fast"], "--light-paths: unknown light path 'fast'"),
+    (["--light-paths", "clustered", "--pipelines", "forward"],
+     "--light-paths: no light path of the pipelines chosen"),
     (["--runs", "0"], "Invalid value for '--runs'"),
     (["--warmup", "-1"], "Invalid value for '--warmup'"),
     (["--pipelines", "deferred,raytrace"], "--pipelines: unknown pipeline 'raytrace'"),
@@ -213,3 +226,13 @@ def test_bad_input_exits_2_with_one_line_and_no_files(tmp_path, capsys, monkeypa
     assert stdout == ""
     assert [p.name for p in tmp_path.iterdir()] == ["folder.json"]
     assert list((tmp_path / "folder.json").iterdir()) == []
+
+
+def test_builtin_overdraw_scene_has_objects_at_several_depths(render):
+    scene = load_scene("builtin:overdraw")
+    depths = {round(float(obj.model[2, 3]), 1) for obj in scene.objects[1:]}
+    assert len(scene.objects) > 30 and len(depths) >= 5
+    result, _ = render(scene, "forward", size=(96, 54), light_path="naive")
+    assert result.draws_by_pass["floor.forward"] == 1 and np.isfinite(result.hdr).all()
+    with pytest.raises(InputError, match="no built-in scene 'nope'"):
+        load_scene("builtin:nope")
