@@ -15,10 +15,9 @@ on every object whose material has that parameter (``revie_fur``).
 Every light path of each pipeline runs (``light_path``: ``volumes``, ``tiled``, ``clustered``
 for deferred, ``naive`` and ``tiled`` (Forward+) for forward), unless ``--light-paths`` picks.
 Besides wall-clock times, each row holds the framework's own CPU time per frame and per draw
-call (``time.thread_time`` of the rendering thread around ``render()`` without ``finish()``:
-llvmpipe rasterises in worker threads, so this is the Python code and the driver's command
-submission, not the drawing), and per-pass GL timer-query times where the driver answers
-them (``gpu_passes_ms``; llvmpipe does not).
+call (the rendering thread's CPU time over ``render()``, less its time inside the drawing GL
+calls, where llvmpipe does vertex work on the calling thread: :func:`time_cpu`), and per-pass GL
+timer-query times where the driver answers them (``gpu_passes_ms``; llvmpipe does not).
 
 JSON: ``{"renderer": {...}, "results": [{"pipeline", "light_path", "lights", "shells", "width",
 "height", "runs", "median_ms", "mean_ms", "min_ms", "max_ms", "stddev_ms", "times_ms",
@@ -246,8 +245,11 @@ def time_frames(renderer, runs: int, warmup: int) -> list[float]:
 
 
 def time_cpu(renderer, runs: int) -> tuple[float, int]:
-    """Median CPU milliseconds of the rendering thread per frame, without waiting for GL, and
-    the draw calls of a frame (see the module documentation)."""
+    """Median milliseconds per frame of the framework's own CPU work, and the draw calls of a
+    frame: the rendering thread's CPU time (``time.thread_time``: waits for the driver and the
+    rasteriser's worker threads are not in it) over ``render()``, less its CPU time inside the
+    drawing GL calls (draws, dispatches, clears; ``FrameStats.gl_call_seconds``), where llvmpipe
+    runs vertex work and binning on the calling thread."""
     ctx = renderer.gl.ctx
     samples = []
     draws = 0
@@ -255,7 +257,8 @@ def time_cpu(renderer, runs: int) -> tuple[float, int]:
         ctx.finish()
         start = time.thread_time()
         result = renderer.render(readback=False)
-        samples.append((time.thread_time() - start) * 1000.0)
+        elapsed = time.thread_time() - start
+        samples.append((elapsed - result.gl_call_seconds) * 1000.0)
         draws = result.draw_calls
     ctx.finish()
     return statistics.median(samples), draws

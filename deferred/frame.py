@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -109,6 +110,10 @@ class Resources:
 class FrameStats:
     draw_calls: int = 0
     draws_by_pass: dict[str, int] = field(default_factory=dict)
+    # CPU seconds of this thread inside the GL calls that do the drawing (draws, dispatches,
+    # clears; llvmpipe runs vertex work and binning there): the bench subtracts them from the
+    # frame's thread time to get the framework's own CPU time
+    gl_call_seconds: float = 0.0
 
 
 @dataclass
@@ -152,6 +157,7 @@ class Frame:
         self.stats = FrameStats()
         self.current_pass: RenderPass | None = None
         self._materials: dict[int, MaterialInputs] = {}
+        self._objects: dict[int, dict[str, Any]] = {}
         self._shading_textures: dict[str, moderngl.Texture] | None = None
 
     # -- passes --------------------------------------------------------------------------------
@@ -160,7 +166,7 @@ class Frame:
         self.current_pass = render_pass
         try:
             for name in render_pass.creates:
-                self.targets.clear(name)
+                self.gl_call(lambda name=name: self.targets.clear(name))
             render_pass.execute(self)
         except InputError:
             raise
@@ -185,15 +191,28 @@ class Frame:
         }
 
     def object_uniforms(self, obj: SceneObject) -> dict[str, Any]:
-        model_view = self.view @ obj.model
-        normal_matrix = np.linalg.inv(model_view[:3, :3]).T
-        return {
-            "u_model": obj.model,
-            "u_model_view": model_view,
-            "u_normal_matrix": normal_matrix,
-            "u_surface_id": float(obj.material.surface_id()),
-            **self.camera_uniforms(),
-        }
+        """The object's transforms and id with the camera's (computed once per frame)."""
+        if not self._objects:
+            self._object_transforms()
+        return self._objects[id(obj)]
+
+    def _object_transforms(self) -> None:
+        """Every object's transforms at once (one batched inverse, matrices as GL bytes)."""
+        camera = self.camera_uniforms()
+        camera = {name: gl_bytes(value) if isinstance(value, np.ndarray) else value
+                  for name, value in camera.items()}
+        objects = self.scene.objects
+        if not objects:
+            return
+        models = np.stack([obj.model for obj in objects])
+        model_views = np.einsum("ij,njk->nik", self.view, models)
+        normals = np.transpose(np.linalg.inv(model_views[:, :3, :3]), (0, 2, 1))
+        for obj, model, model_view, normal in zip(objects, models, model_views, normals,
+                                                   strict=True):
+            self._objects[id(obj)] = {
+                "u_model": gl_bytes(model), "u_model_view": gl_bytes(model_view),
+                "u_normal_matrix": gl_bytes(normal),
+                "u_surface_id": float(obj.material.surface_id()), **camera}
 
     def shading_textures(self) -> dict[str, moderngl.Texture]:
         """Samplers of the scene's shading models (ramps...), offered wherever lights run."""
@@ -237,26 +256,35 @@ class Frame:
             samplers.update(material.textures)
         values.update(uniforms or {})
         samplers.update(textures or {})
+        members = self.shaders.members(program)
+        self.set_uniforms(program, values, members)
+        unit = 0
+        for name, texture in samplers.items():
+            if name not in members:
+                continue
+            texture.use(location=unit)
+            program[name].value = unit
+            unit += 1
+        self.light_buffer.bind(program, unit, members)
+        if self.light_lists is not None:
+            self.light_lists.bind(program, members)
+
+    def set_uniforms(self, program: moderngl.Program, values: dict[str, Any],
+                     members: frozenset[str] | None = None) -> None:
+        """Set the values ``program`` has (no strict check: :meth:`bind` does that)."""
+        members = self.shaders.members(program) if members is None else members
         for name, value in values.items():
-            if name not in program:
+            if name not in members:
                 continue
             member = program[name]
-            if isinstance(value, np.ndarray) and value.ndim == 2:
+            if isinstance(value, bytes):  # a matrix already in GL order
+                member.write(value)
+            elif isinstance(value, np.ndarray) and value.ndim == 2:
                 member.write(gl_bytes(value))
             elif isinstance(value, np.ndarray):
                 member.value = tuple(float(v) for v in value)
             else:
                 member.value = value
-        unit = 0
-        for name, texture in samplers.items():
-            if name not in program:
-                continue
-            texture.use(location=unit)
-            program[name].value = unit
-            unit += 1
-        self.light_buffer.bind(program, unit)
-        if self.light_lists is not None:
-            self.light_lists.bind(program)
 
     def bind_compute(self, shader: moderngl.ComputeShader, uniforms: dict[str, Any],
                      textures: dict[str, moderngl.Texture], *,
@@ -322,13 +350,22 @@ class Frame:
         name = self.current_pass.name if self.current_pass is not None else ""
         self.stats.draws_by_pass[name] = self.stats.draws_by_pass.get(name, 0) + 1
 
+    def gl_call(self, call: Callable[[], Any]) -> Any:
+        """Run a drawing GL call, its time counted apart (``FrameStats.gl_call_seconds``)."""
+        start = time.thread_time()
+        try:
+            return call()
+        finally:
+            self.stats.gl_call_seconds += time.thread_time() - start
+
     def draw_mesh(self, mesh: MeshData, program: moderngl.Program, instances: int = 1) -> None:
-        self.resources.gpu_mesh(mesh).render(program, instances=instances)
+        gpu = self.resources.gpu_mesh(mesh)
+        self.gl_call(lambda: gpu.render(program, instances=instances))
         self.count_draw()
 
     def draw_fullscreen(self, program: moderngl.Program, instances: int = 1) -> None:
         vao = self.resources.fullscreen_vertex_array(program)
-        vao.render(moderngl.TRIANGLES, vertices=3, instances=instances)
+        self.gl_call(lambda: vao.render(moderngl.TRIANGLES, vertices=3, instances=instances))
         self.count_draw()
 
     def use_framebuffer(self, colors: tuple[str, ...] | list[str], depth: str | None = None,

@@ -128,13 +128,14 @@ class LightLists:
                 "u_list_grid": (self.grid.columns, self.grid.rows, self.grid.slices),
                 "u_list_tile": self.grid.tile, "u_list_depth": self.depth_scale}
 
-    def bind(self, program) -> None:
+    def bind(self, program, members: frozenset[str] | None = None) -> None:
         """Set the list uniforms and bind the buffer for a program reading the lists."""
-        if self.buffer is None or "u_list_count" not in program:
+        members = frozenset(program) if members is None else members
+        if self.buffer is None or "u_list_count" not in members:
             return
         self.buffer.bind_to_storage_buffer(1)
         for name, value in self.uniforms().items():
-            if name in program:
+            if name in members:
                 program[name].value = value
 
     def counts(self) -> np.ndarray:
@@ -184,7 +185,7 @@ class LightCullPass(RenderPass):
         else:
             groups = (grid.columns, grid.rows, 1)
         if lights.local_count > 0 or not self.clustered:
-            shader.run(*groups)
+            frame.gl_call(lambda: shader.run(*groups))
         frame.ctx.memory_barrier()
         frame.count_draw()
 

@@ -103,15 +103,17 @@ class LightBuffer:
         if self.storage and self._buffer is not None:
             self._buffer.bind_to_storage_buffer(0)
 
-    def bind(self, program: moderngl.Program, texture_unit: int) -> None:
-        if "u_light_count" in program:
+    def bind(self, program: moderngl.Program, texture_unit: int,
+             members: frozenset[str] | None = None) -> None:
+        members = frozenset(program) if members is None else members
+        if "u_light_count" in members:
             program["u_light_count"].value = self.count
-        if "u_global_light_count" in program:
+        if "u_global_light_count" in members:
             program["u_global_light_count"].value = self.global_count
-        if self.storage and "LightBuffer" in program:
+        if self.storage and "LightBuffer" in members:
             self._buffer.bind_to_storage_buffer(0)
             program["LightBuffer"].binding = 0
-        elif not self.storage and "u_lights" in program:
+        elif not self.storage and "u_lights" in members:
             self._texture.use(location=texture_unit)
             program["u_lights"].value = texture_unit
 

@@ -233,10 +233,15 @@ class ObjectPass(RenderPass):
         textures = self.textures(frame)
         offered = frame.object_uniforms(self.obj)
         count = self.draws(frame)
+        bound = False
         for index in range(count):
             per_draw = self.draw_uniforms(frame, index, count)
             if per_draw is None:
                 continue
-            frame.bind(program, {**uniforms, **per_draw}, textures, offered=offered,
-                       material=material)
+            if bound:  # everything else is set already: only what changes per draw
+                frame.set_uniforms(program, per_draw)
+            else:
+                frame.bind(program, {**uniforms, **per_draw}, textures, offered=offered,
+                           material=material)
+                bound = True
             self.draw(frame, program)

@@ -32,6 +32,7 @@ class RenderResult:
     hdr: np.ndarray | None  # (H, W, 4) float32, linear composite, top row first
     draw_calls: int
     draws_by_pass: dict[str, int]
+    gl_call_seconds: float = 0.0  # inside drawing GL calls (FrameStats)
 
 
 def strict_default() -> bool:
@@ -152,7 +153,8 @@ class Renderer:
             frame.check_material_uniforms()
         self.last_frame = frame
         image, hdr = (self.read_final(), self.read_hdr()) if readback else (None, None)
-        return RenderResult(image, hdr, frame.stats.draw_calls, dict(frame.stats.draws_by_pass))
+        return RenderResult(image, hdr, frame.stats.draw_calls, dict(frame.stats.draws_by_pass),
+                            frame.stats.gl_call_seconds)
 
     def read_final(self) -> np.ndarray:
         data = np.frombuffer(self.targets[FINAL].read(alignment=1), dtype=np.uint8)

@@ -75,6 +75,7 @@ class ShaderLibrary:
         self._programs: dict[tuple, moderngl.Program] = {}
         self._declared: dict[int, frozenset[str]] = {}  # program glo -> declared uniform names
         self._labels: dict[int, str] = {}  # program glo -> its files, for messages
+        self._members: dict[int, frozenset[str]] = {}  # program glo -> active member names
 
     # -- files -------------------------------------------------------------------------------
     def add_root(self, root: Traversable | Path) -> None:
@@ -159,6 +160,7 @@ class ShaderLibrary:
         self._declared[program.glo] = frozenset(
             name for source in sources.values() for name in declared_uniforms(source.text))
         self._labels[program.glo] = " + ".join(n for n in stages.values() if n is not None)
+        self._members[program.glo] = frozenset(program)
         return program
 
     def declared_uniforms(self, program: moderngl.Program) -> frozenset[str]:
@@ -188,6 +190,13 @@ class ShaderLibrary:
                     pending.append(match.group(1) or match.group(2))
         return frozenset(names)
 
+    def members(self, program) -> frozenset[str]:
+        """The program's active uniforms and blocks (``name in program`` walks them all)."""
+        members = self._members.get(program.glo)
+        if members is None:
+            members = self._members[program.glo] = frozenset(program)
+        return members
+
     def describe(self, program: moderngl.Program) -> str:
         return self._labels.get(program.glo, "<program>")
 
@@ -207,6 +216,8 @@ class ShaderLibrary:
         self._programs[key] = shader
         self._declared[shader.glo] = frozenset(declared_uniforms(source.text))
         self._labels[shader.glo] = name
+        self._members[shader.glo] = frozenset(
+            name for name in declared_uniforms(source.text) if name in shader)
         return shader
 
     @staticmethod
@@ -246,6 +257,7 @@ class ShaderLibrary:
         self._programs.clear()
         self._declared.clear()
         self._labels.clear()
+        self._members.clear()
 
 
 def _folder_entries(root: Traversable | Path, folder: str) -> list[Traversable]:

@@ -133,7 +133,15 @@ class GBufferLayout:
 
 
 def material_data(material: Material) -> tuple[GBufferData, ...]:
-    """The data ``material``'s objects write: its own and its shading model's, by name."""
+    """The data ``material``'s objects write: its own and its shading model's, by name
+    (kept on the material: its class, model and parameters never change)."""
+    cached = material.__dict__.get("_gbuffer_data")
+    if cached is None:
+        cached = material.__dict__["_gbuffer_data"] = _material_data(material)
+    return cached
+
+
+def _material_data(material: Material) -> tuple[GBufferData, ...]:
     from . import registry
 
     model = registry.shading_models.get(material.shading_model)

@@ -111,5 +111,5 @@ class FinPass(ObjectPass):
         geometry = frame.resources.cached(
             ("fins", id(mesh)),
             lambda ctx: FinGeometry(ctx, frame.resources.gpu_mesh(mesh), edge_adjacency(mesh)))
-        geometry.render(program)
+        frame.gl_call(lambda: geometry.render(program))
         frame.count_draw()

@@ -27,11 +27,17 @@ void main() {
     vec3 total = vec3(0.0);
     for (int k = 0; k < u_global_light_count; ++k)
         total += evaluate_light(fetch_light(k), g.surface, P, V);
+#ifdef ALL_LIGHTS
+    // brute force (benchmarks/brute_force.py): every volume light at every pixel, no lists
+    for (int k = u_global_light_count; k < u_light_count; ++k)
+        total += evaluate_light(fetch_light(k), g.surface, P, V);
+#else
     int list = light_list_of(pixel, g.linear_depth);
     int length = light_list_length(list);
     for (int k = 0; k < length; ++k) {
         int index = light_list_light(list, k);
         if (light_reaches(index, P)) total += evaluate_light(fetch_light(index), g.surface, P, V);
     }
+#endif
     out_light = vec4(total, 0.0);
 }
