@@ -11,14 +11,8 @@
 // the stipple pattern, so no dot grid appears where the outer sample is off-screen or occluded.
 #include "techniques/stipple.glsl"
 #include "techniques/fur.glsl"
-#include "gbuffer/layout.glsl"
+#include "techniques/accumulated_light.glsl"
 
-uniform sampler2D u_light_accumulation;
-uniform sampler2D u_albedo_specular;
-uniform sampler2D u_normal_exponent_id;
-uniform sampler2D u_linear_depth;
-uniform vec2 u_resolution;
-uniform float u_surface_id;
 uniform vec3 u_albedo_base;
 uniform vec3 u_albedo_tip;
 uniform float u_shell_fade;    // the outermost shell fades in with the level of detail
@@ -40,58 +34,6 @@ in float v_fin_fade;
 #endif
 
 out vec4 out_color;
-
-ivec2 pixel_of(vec4 clip) {
-    return ivec2(floor((clip.xy / clip.w * 0.5 + 0.5) * u_resolution));
-}
-
-bool inside(ivec2 pixel) {
-    return all(greaterThanEqual(pixel, ivec2(0))) && all(lessThan(pixel, ivec2(u_resolution)));
-}
-
-// Whether `pixel` holds this fur within `tolerance` of `expected` linear depth.
-bool holds_fur(ivec2 pixel, float expected, float tolerance) {
-    if (!inside(pixel)) return false;
-#ifdef FUR_OCCLUSION_TEST
-    if (!same_surface(texelFetch(u_normal_exponent_id, pixel, 0).w, u_surface_id)) return false;
-    if (abs(texelFetch(u_linear_depth, pixel, 0).r - expected) > tolerance) return false;
-#endif
-    return true;
-}
-
-vec3 irradiance_at(ivec2 pixel) {
-    vec3 albedo = max(texelFetch(u_albedo_specular, pixel, 0).rgb, vec3(1.0 / 255.0));
-    return texelFetch(u_light_accumulation, pixel, 0).rgb / albedo;
-}
-
-const ivec2 AROUND[8] = ivec2[](ivec2(1, 0), ivec2(-1, 0), ivec2(0, 1), ivec2(0, -1),
-                                ivec2(1, 1), ivec2(-1, 1), ivec2(1, -1), ivec2(-1, -1));
-
-// The base sample: the pixel under the base point or the first neighbour holding the base.
-// Pixels of this fur's stipple class hold its outer-shell samples, not the base: skipped.
-bool base_irradiance(ivec2 pixel, float tolerance, out vec3 irradiance) {
-    irradiance = vec3(0.0);
-#ifdef FUR_STIPPLE
-    bool stipple_pixel = stipple_sample(pixel);
-#else
-    bool stipple_pixel = false;
-#endif
-    if (!stipple_pixel && holds_fur(pixel, v_base_depth, tolerance)) {
-        irradiance = irradiance_at(pixel);
-        return true;
-    }
-    for (int k = 0; k < 8; ++k) {
-        ivec2 q = pixel + AROUND[k];
-#ifdef FUR_STIPPLE
-        if (stipple_sample(q)) continue;
-#endif
-        if (holds_fur(q, v_base_depth, tolerance)) {
-            irradiance = irradiance_at(q);
-            return true;
-        }
-    }
-    return false;
-}
 
 void main() {
     vec2 strands = fur_sample(v_fur_position, v_fur_normal, v_shell_depth);
@@ -115,7 +57,7 @@ void main() {
     float tolerance = 0.5 * v_fur_extent + 0.002 * v_base_depth;
     vec3 base_light;
     vec3 tip_light = vec3(0.0);
-    bool base_valid = base_irradiance(pixel_of(v_base_clip), tolerance, base_light);
+    bool base_valid = base_irradiance(pixel_of(v_base_clip), v_base_depth, tolerance, base_light);
     bool tip_valid = false;
 #ifdef FUR_STIPPLE
     ivec2 tip = stipple_pixel_in(pixel_of(v_tip_clip));
@@ -125,8 +67,7 @@ void main() {
     // Both hidden (the base off-screen, the tip occluded): the light of the fur under this
     // fragment itself, if its pixel holds this fur, rather than a hole onto the dark skin.
     ivec2 own = ivec2(gl_FragCoord.xy);
-    bool own_valid = !base_valid && !tip_valid &&
-        same_surface(texelFetch(u_normal_exponent_id, own, 0).w, u_surface_id);
+    bool own_valid = !base_valid && !tip_valid && own_pixel_holds_fur();
 #ifdef FUR_DEBUG_SAMPLES
     bool none = !base_valid && !tip_valid && !own_valid;
     out_color = vec4(none || own_valid ? 1.0 : 0.0, base_valid || own_valid ? 1.0 : 0.0,
