@@ -9,6 +9,7 @@ xatlas unwrap, tangent frames are built from the UVs.
 
 from __future__ import annotations
 
+import inspect
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -267,15 +268,74 @@ _BUILTINS = {"sphere": builtin_sphere, "torus": builtin_torus, "plane": builtin_
 
 # -- loading -----------------------------------------------------------------------------------
 
+# Bounds of the built-in shapes' integer arguments (subdivision counts); float arguments
+# (sizes, radii) must be finite and positive.
+BUILTIN_COUNT_RANGE = (3, 4096)
+
+
+def builtin_arguments(spec: str, where: str | None = None) -> tuple[str, dict[str, int | float]]:
+    """``builtin:torus?segments=78&sides=60`` -> ``("torus", {"segments": 78, "sides": 60})``.
+
+    The arguments are keyword arguments of the shape's function (``builtin_torus``...), each
+    parsed as its annotation says (int or float); an unknown shape or key, a bad number or a
+    value out of range is an ``InputError`` naming ``where`` (default: the spec).
+    """
+    where = where or spec
+    shape, _, query = spec.removeprefix(BUILTIN_PREFIX).partition("?")
+    if shape not in _BUILTINS:
+        raise InputError(f"unknown built-in mesh '{BUILTIN_PREFIX}{shape}' (choose from "
+                         f"{', '.join(BUILTIN_PREFIX + n for n in BUILTIN_MESHES)})", where)
+    parameters = inspect.signature(_BUILTINS[shape], eval_str=True).parameters
+    kinds = {name: parameter.annotation for name, parameter in parameters.items()}
+    arguments: dict[str, int | float] = {}
+    for item in filter(None, query.split("&")):
+        key, equals, text = (part.strip() for part in item.partition("="))
+        if key not in kinds:
+            raise InputError(f"builtin:{shape} has no parameter '{key}' (parameters: "
+                             f"{', '.join(kinds)})", where)
+        if not equals or not text:
+            raise InputError(f"builtin:{shape} parameter '{key}' has no value "
+                             f"(write {key}=NUMBER)", where)
+        if key in arguments:
+            raise InputError(f"builtin:{shape} parameter '{key}' is given twice", where)
+        arguments[key] = _builtin_argument(shape, key, text, kinds[key], where)
+    return shape, arguments
+
+
+def _builtin_argument(shape: str, key: str, text: str, kind: type, where: str) -> int | float:
+    if kind is int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise InputError(f"builtin:{shape} parameter '{key}' must be an integer, got "
+                             f"'{text}'", where) from None
+        low, high = BUILTIN_COUNT_RANGE
+        if not low <= value <= high:
+            raise InputError(f"builtin:{shape} parameter '{key}' must be {low}..{high}, got "
+                             f"{value}", where)
+        return value
+    try:
+        number = float(text)
+    except ValueError:
+        raise InputError(f"builtin:{shape} parameter '{key}' must be a number, got '{text}'",
+                         where) from None
+    if not math.isfinite(number) or number <= 0.0:
+        raise InputError(f"builtin:{shape} parameter '{key}' must be finite and greater than "
+                         f"0, got {text}", where)
+    return number
+
+
 def load_mesh(spec: str, base_dir: Path | None = None, where: str | None = None) -> MeshData:
-    """Load ``builtin:<name>`` or a mesh file (relative paths resolve against ``base_dir``)."""
+    """Load ``builtin:<name>`` or a mesh file (relative paths resolve against ``base_dir``).
+
+    Built-in shapes take their function's keyword arguments as a query:
+    ``builtin:torus?segments=78&sides=60`` (see :func:`builtin_arguments`); the mesh is still
+    named ``builtin:torus``.
+    """
     where = where or spec
     if spec.startswith(BUILTIN_PREFIX):
-        shape = spec[len(BUILTIN_PREFIX):]
-        if shape not in _BUILTINS:
-            raise InputError(f"unknown built-in mesh '{spec}' (choose from "
-                             f"{', '.join(BUILTIN_PREFIX + n for n in BUILTIN_MESHES)})", where)
-        return _BUILTINS[shape]()
+        shape, arguments = builtin_arguments(spec, where)
+        return _BUILTINS[shape](**arguments)
     path = Path(spec)
     if not path.is_absolute() and base_dir is not None:
         path = base_dir / path

@@ -122,3 +122,41 @@ def test_obj_with_uvs_keeps_its_vertex_colour_comb(tmp_path):
     assert mesh.has_comb and not mesh.generated_uvs
     # object +X is the tangent (+U) here: tangent-space (1, 0, 0) packed
     np.testing.assert_allclose(mesh.comb[:, :3], [[1.0, 0.5, 0.5]] * 3, atol=1e-5)
+
+
+def test_builtin_parameters():
+    torus = load_mesh("builtin:torus?segments=78&sides=60")
+    assert torus.name == "builtin:torus"  # labels derived from it stay identifiers (torus0)
+    assert len(torus.indices) == 9360  # 2 * 78 * 60
+    assert torus.vertex_count == 79 * 61
+    assert len(load_mesh("builtin:torus").indices) == 2 * 64 * 32  # no parameters: unchanged
+    thin = load_mesh("builtin:torus?major=1.0&minor=0.1")
+    radii = np.linalg.norm(thin.positions[:, [0, 2]], axis=1)
+    np.testing.assert_allclose([radii.min(), radii.max()], [0.9, 1.1], atol=1e-5)
+    sphere = load_mesh("builtin:sphere?segments=8&rings=4&radius=0.5")
+    assert len(sphere.indices) == 2 * 8 * 4
+    np.testing.assert_allclose(np.linalg.norm(sphere.positions, axis=1), 0.5, atol=1e-6)
+    assert len(load_mesh("builtin:plane?divisions=3&size=4").indices) == 2 * 3 * 3
+    np.testing.assert_allclose(load_mesh("builtin:cube?size=3").bounds()[1], [1.5] * 3)
+
+
+@pytest.mark.parametrize("spec, fragment", [
+    ("builtin:torus?twist=3", "builtin:torus has no parameter 'twist' (parameters: segments, "
+                              "sides, major, minor)"),
+    ("builtin:torus?segments=2", "'segments' must be 3..4096, got 2"),
+    ("builtin:sphere?rings=5000", "'rings' must be 3..4096, got 5000"),
+    ("builtin:plane?divisions=4.5", "'divisions' must be an integer, got '4.5'"),
+    ("builtin:torus?major=big", "'major' must be a number, got 'big'"),
+    ("builtin:cube?size=0", "'size' must be finite and greater than 0, got 0"),
+    ("builtin:sphere?radius=inf", "'radius' must be finite and greater than 0, got inf"),
+    ("builtin:sphere?radius=nan", "'radius' must be finite and greater than 0, got nan"),
+    ("builtin:torus?sides", "'sides' has no value"),
+    ("builtin:torus?sides=8&sides=9", "'sides' is given twice"),
+    ("builtin:teapot?size=1", "unknown built-in mesh 'builtin:teapot'"),
+])
+def test_builtin_parameter_errors_name_the_mesh_key(spec, fragment):
+    with pytest.raises(InputError) as info:
+        load_mesh(spec, where="scene.toml: object[0].mesh")
+    message = str(info.value)
+    assert message.startswith("scene.toml: object[0].mesh: ") and fragment in message, message
+    assert "\n" not in message
