@@ -214,15 +214,16 @@ def with_shells(scene: Scene, shells: int, where: str = "--shells") -> Scene:
             try:
                 # Validated, not model_copy(update=...): each material's range applies.
                 # The sweep fixes the count: a level of detail's minimum (if any) goes with it.
-                values = {**params.model_dump(), SHELLS: shells}
-                if MIN_SHELLS in values and shells > 0:
-                    values[MIN_SHELLS] = shells
-                new_params = type(params).model_validate(values)
+                overrides = {SHELLS: shells}
+                if MIN_SHELLS in type(params).model_fields and shells > 0:
+                    overrides[MIN_SHELLS] = shells
+                new_params = type(params).model_validate({**params.model_dump(), **overrides})
             except ValidationError as exc:
                 problem = exc.errors()[0]["msg"]
                 raise InputError(f"{problem} for {obj.label} ({material.name}), got {shells}",
                                  where) from None
-            obj = replace(obj, material=type(material)(new_params, material.base_dir))
+            # the count holds at every time of the object's timeline, if it has one
+            obj = obj.with_material(type(material)(new_params, material.base_dir), overrides)
         objects.append(obj)
     return replace(scene, objects=objects)
 

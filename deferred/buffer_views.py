@@ -72,7 +72,7 @@ def with_material_view(scene: Scene, name: str) -> Scene | None:
             overrides = material.debug_views[view_name][1]
             params = type(material.params).model_validate(
                 {**material.params.model_dump(), **overrides})
-            obj = replace(obj, material=type(material)(params, material.base_dir))
+            obj = obj.with_material(type(material)(params, material.base_dir), overrides)
             found = True
         objects.append(obj)
     return replace(scene, objects=objects) if found else None

@@ -7,9 +7,9 @@ time (``ctx.finish()`` on both sides: GL timer queries read nothing on llvmpipe)
 from __future__ import annotations
 
 import fnmatch
-import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from time import perf_counter
 
 import numpy as np
 
@@ -165,8 +165,9 @@ def select_passes(passes: Sequence[RenderPass], patterns: Sequence[str] | None) 
 
 
 def capture_frame(renderer: Renderer, passes: Sequence[str] | None = None,
-                  warmup: bool = True) -> FrameCapture:
-    """Render one frame with ``renderer`` and capture what every pass wrote.
+                  warmup: bool = True, time: float = 0.0) -> FrameCapture:
+    """Render the frame at ``time`` (seconds) with ``renderer`` and capture what every pass
+    wrote.
 
     ``passes`` limits which passes' targets are kept (names or globs; all by default; every
     pass still runs and is timed). ``warmup`` renders a one-pixel frame first if the renderer
@@ -178,7 +179,7 @@ def capture_frame(renderer: Renderer, passes: Sequence[str] | None = None,
         # texture, so the times below leave out one-time costs, without shading a whole frame.
         renderer.targets.scissor = (0, 0, 1, 1)
         try:
-            renderer.render()
+            renderer.render(time=time)
         finally:
             renderer.targets.scissor = None
     ctx = renderer.gl.ctx
@@ -188,11 +189,11 @@ def capture_frame(renderer: Renderer, passes: Sequence[str] | None = None,
 
     def before(render_pass: RenderPass, frame) -> None:
         ctx.finish()
-        started.append(time.perf_counter())
+        started.append(perf_counter())
 
     def after(render_pass: RenderPass, frame) -> None:
         ctx.finish()
-        elapsed = (time.perf_counter() - started[-1]) * 1000.0
+        elapsed = (perf_counter() - started[-1]) * 1000.0
         raw = {}
         if render_pass.name in selected:
             raw = {t: targets.read_raw(t)[::-1] for t in dict.fromkeys(render_pass.writes)}
@@ -200,7 +201,7 @@ def capture_frame(renderer: Renderer, passes: Sequence[str] | None = None,
                                     tuple(render_pass.reads), tuple(render_pass.writes),
                                     elapsed, 0, targets.specs, raw))
 
-    result = renderer.render(on_pass=after, before_pass=before)
+    result = renderer.render(on_pass=after, before_pass=before, time=time)
     frame_ms = sum(c.time_ms for c in captures)  # without the read-backs between passes
     for capture in captures:
         capture.draw_calls = result.draws_by_pass.get(capture.name, 0)

@@ -129,7 +129,8 @@ class MaterialInputs:
 
 
 class Frame:
-    """What a pass sees while it runs: GL, shaders, targets, scene, camera and lights.
+    """What a pass sees while it runs: GL, shaders, targets, scene, camera and lights, and the
+    frame's ``time`` in seconds (animated materials read it in ``prepare``).
 
     In ``strict`` mode, a uniform or sampler a pass sets by name that its program does not
     declare is an error, and so is a material uniform that none of the material's programs
@@ -139,8 +140,10 @@ class Frame:
 
     def __init__(self, gl: GLContext, shaders: ShaderLibrary, targets: FrameTargets,
                  resources: Resources, scene: Scene, light_buffer: LightBuffer,
-                 strict: bool = False, light_lists: LightLists | None = None):
+                 strict: bool = False, light_lists: LightLists | None = None,
+                 time: float = 0.0):
         self.gl = gl
+        self.time = float(time)  # seconds: the scene's timeline is applied at this time
         self.light_lists = light_lists
         self.strict = strict
         self.ctx = gl.ctx

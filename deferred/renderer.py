@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import os
 import warnings
 from collections.abc import Callable
@@ -128,12 +129,20 @@ class Renderer:
         self._declare_targets()
 
     def render(self, on_pass: PassCallback | None = None,
-               before_pass: PassCallback | None = None, readback: bool = True) -> RenderResult:
-        """Run every pass once. ``on_pass``/``before_pass`` are called around each pass;
-        ``readback=False`` skips reading the images back (timing loops)."""
+               before_pass: PassCallback | None = None, readback: bool = True,
+               time: float = 0.0) -> RenderResult:
+        """Run every pass once for the frame at ``time`` (seconds: the scene's timeline is
+        applied first, and passes see it as ``frame.time``). ``on_pass``/``before_pass`` are
+        called around each pass; ``readback=False`` skips reading the images back (timing
+        loops)."""
+        time = float(time)
+        if not math.isfinite(time):
+            raise InputError(f"frame time must be a finite number of seconds, got {time}", "time")
+        self.scene.apply_timeline(time)
         self.gl.make_current()
         frame = Frame(self.gl, self.shaders, self.targets, self.resources, self.scene,
-                      self.light_buffer, strict=self.strict, light_lists=self.light_lists)
+                      self.light_buffer, strict=self.strict, light_lists=self.light_lists,
+                      time=time)
         self.light_buffer.upload(self.scene.lights, frame.view, frame.projection)
         for render_pass in self.passes:
             render_pass.prepare(frame)

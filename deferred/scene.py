@@ -2,14 +2,23 @@
 
 The file format is DESIGN.md's. Validation names the file, the key and the problem in one line
 (``demo.toml: object[1].params.shells: Input should be greater than or equal to 0 (got -3)``).
+
+A scene may carry a timeline: ``[[event]]`` tables (``time``, ``object``, ``params``) that change
+an object's material parameters from their time on. :meth:`SceneObject.params_at` gives an
+object's parameters at a time and :meth:`Scene.apply_timeline` sets them on every object with
+events (the renderer does so before each frame).
 """
 
 from __future__ import annotations
 
+import math
 import sys
-from dataclasses import dataclass, field
+from bisect import bisect_right
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
 from importlib import resources
 from pathlib import Path
+from types import MappingProxyType
 from typing import Any, Literal
 
 import numpy as np
@@ -20,8 +29,9 @@ from .camera import Camera, model_matrix
 from .effect import Effect
 from .errors import InputError
 from .light import Light
-from .material import Material
+from .material import Material, MaterialParams
 from .mesh import MeshData, load_mesh
+from .params import validate_params
 from .shading import GBufferLayout, ShadingModel, compose_layout
 from .validation import format_validation_error
 
@@ -78,6 +88,14 @@ class ObjectModel(_Strict):
         return self
 
 
+class EventModel(_Strict):
+    """An ``[[event]]`` table: from ``time`` on, ``object``'s material takes ``params``."""
+
+    time: float = Field(ge=0.0, allow_inf_nan=False, description="seconds")
+    object: str = Field(description="the name (label) of a scene object")
+    params: dict[str, Any] = Field(description="material parameters, merged over the object's")
+
+
 class TypedModel(BaseModel):
     """A ``[[light]]`` or ``[[effect]]`` table: its type, then that type's parameters."""
 
@@ -99,14 +117,98 @@ class SceneModel(_Strict):
     object: list[ObjectModel] = Field(default_factory=list)
     light: list[TypedModel] = Field(default_factory=list)
     effect: list[TypedModel] = Field(default_factory=list)
+    event: list[EventModel] = Field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class TimelineEvent:
+    """From ``time`` (seconds) on, an object's material takes ``params`` (validated, as given);
+    ``where`` names the event in errors (``scene.toml: event[2]``)."""
+
+    time: float
+    params: Mapping[str, Any]
+    where: str | None = None
 
 
 @dataclass(eq=False)  # identity: the model matrix is an array, and objects are unique anyway
 class SceneObject:
+    """A mesh drawn with a material at a transform.
+
+    ``base_params`` are the material's parameters before any event (default: the material's
+    parameters when the object is made); ``events`` its timeline, kept sorted by time (ties in
+    the order given).
+    """
+
     label: str
     mesh: MeshData
     material: Material
     model: np.ndarray
+    base_params: MaterialParams | None = None
+    events: tuple[TimelineEvent, ...] = ()
+    _states: dict[int, MaterialParams] = field(default_factory=dict, init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        if self.base_params is None:
+            self.base_params = self.material.params
+        self.events = tuple(sorted(self.events, key=lambda event: event.time))  # stable
+
+    @property
+    def event_times(self) -> tuple[float, ...]:
+        """The times of this object's events, sorted."""
+        return tuple(event.time for event in self.events)
+
+    def params_at(self, time: float) -> MaterialParams:
+        """The material parameters at ``time``: ``base_params`` updated by every event with
+        ``event.time <= time``, in time order (ties: the order given). Validated once per
+        distinct set of events applied, then cached."""
+        count = bisect_right(self.event_times, time)
+        if count == 0:
+            return self.base_params
+        state = self._states.get(count)
+        if state is None:
+            values = self.base_params.model_dump()
+            for event in self.events[:count]:
+                values.update(event.params)
+            where = self.events[count - 1].where
+            state = validate_params(type(self.base_params), values,
+                                    f"{where}.params" if where else None)
+            self._states[count] = state
+        return state
+
+    def add_event(self, time: float, params: Mapping[str, Any],
+                  where: str | None = None) -> TimelineEvent:
+        """Add an event: from ``time`` (seconds, finite, >= 0) on, the material takes
+        ``params``. ``params`` are checked over ``base_params`` at once, and so is the
+        object's state at every event time from this one on; errors name ``where``."""
+        if not (isinstance(time, int | float) and math.isfinite(time) and time >= 0.0):
+            raise InputError(f"must be a finite number of seconds >= 0, got {time!r}",
+                             f"{where}.time" if where else "time")
+        params_where = f"{where}.params" if where else "params"
+        material_cls = type(self.material)
+        # Every key checked against the material's model over the base (files, too)
+        material_cls.from_dict({**self.base_params.model_dump(), **params},
+                               self.material.base_dir, params_where)
+        event = TimelineEvent(float(time), MappingProxyType(dict(params)), where)
+        previous = self.events
+        self.events = tuple(sorted((*previous, event), key=lambda e: e.time))
+        self._states.clear()
+        try:  # the merged states from its time on (the parameters' own cross-checks)
+            for later in sorted({t for t in self.event_times if t >= event.time}):
+                self.params_at(later)
+        except InputError:
+            self.events = previous
+            self._states.clear()
+            raise
+        return event
+
+    def with_material(self, material: Material,
+                      overrides: Mapping[str, Any] | None = None) -> SceneObject:
+        """A copy of this object drawn with ``material``, whose parameters become the base;
+        ``overrides`` (the parameters that made them) join every event too, so they hold at
+        every time of the timeline (bench sweeps, debug views)."""
+        events = tuple(replace(event, params=MappingProxyType({**event.params, **overrides}))
+                       for event in self.events) if overrides else self.events
+        return replace(self, material=material, base_params=material.params, events=events)
 
 
 @dataclass
@@ -123,6 +225,25 @@ class Scene:
     light_path: str | None = None
     effects: list[Effect] = field(default_factory=list)
     source: str = "<memory>"
+
+    def apply_timeline(self, time: float) -> None:
+        """Set each object's material parameters to those of ``time`` (seconds): objects
+        with events only; the others keep theirs."""
+        for obj in self.objects:
+            if obj.events:
+                obj.material.params = obj.params_at(time)
+
+    def add_event(self, obj: SceneObject | str, time: float, params: Mapping[str, Any],
+                  where: str | None = None) -> TimelineEvent:
+        """:meth:`SceneObject.add_event` for the object ``obj`` or the one labelled so."""
+        if isinstance(obj, str):
+            found = [o for o in self.objects if o.label == obj]
+            if not found:
+                names = ", ".join(o.label for o in self.objects) or "none"
+                raise InputError(f"no object named '{obj}' (objects: {names})",
+                                 f"{where}.object" if where else "object")
+            obj = found[0]
+        return obj.add_event(time, params, where)
 
     def gbuffer_layout(self) -> GBufferLayout:
         """The G-buffer of this scene: the core plus the data its materials declare."""
@@ -256,4 +377,6 @@ def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
         seen.add(kind)
         effect_cls = registry.effects.get(kind, f"{where}.type")
         scene.effects.append(effect_cls.from_dict(values, where))
+    for index, event in enumerate(model.event):
+        scene.add_event(event.object, event.time, event.params, f"{name}: event[{index}]")
     return scene
