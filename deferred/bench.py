@@ -123,7 +123,7 @@ def parse_pipelines(text: str, where: str = "--pipelines") -> list[str]:
 
 def check_output(path: str | Path, where: str) -> Path:
     """An output file named by ``where`` (``--json``...) with that option's suffix."""
-    return check_output_path(path, where, (OUTPUT_SUFFIXES[where],))
+    return check_output_path(path, where, (OUTPUT_SUFFIXES[where],), patterns=False)
 
 
 # -- scene variants ------------------------------------------------------------------------------

@@ -47,12 +47,21 @@ def cli(debug: bool) -> None:
 @cli.command()
 @click.argument("scene", required=False, type=click.Path(dir_okay=False))
 @click.option("-o", "--output", default="render.png", show_default=True,
-              help="Output image: .png (sRGB 8-bit) or .exr (linear float).")
+              help="Output: an image, .png (sRGB 8-bit) or .exr (linear float); a numbered "
+                   "sequence, out_####.png (the run of # becomes the frame number); or a "
+                   "video, .mp4 (H.264) or .gif.")
 @click.option("--pipeline", type=click.Choice(sorted(PIPELINES)), default="deferred",
               show_default=True)
 @click.option("--size", help="WIDTHxHEIGHT, overrides the scene's size.")
 @click.option("--frames", type=click.IntRange(min=1), default=1, show_default=True,
-              help="Render this many frames (timing); the last one is written.")
+              help="Render this many frames, frame i at --time + i / --fps seconds: all of "
+                   "them go to a sequence or a video; an image gets the last (timing).")
+@click.option("--fps", type=click.FloatRange(min=0.0, min_open=True), default=24.0,
+              show_default=True, help="Frames per second: the time step and the video's rate.")
+@click.option("--time", "start_time", type=click.FloatRange(min=0.0), default=0.0,
+              show_default=True, metavar="SECONDS",
+              help="Time of the first frame (the scene's [[event]] timeline, animated "
+                   "materials).")
 @click.option("--light-path", metavar="PATH",
               help="How lights reach the pixels: volumes, tiled or clustered (deferred); naive "
                    "or tiled, i.e. Forward+ (forward). Default: the scene's light_path, else "
@@ -65,8 +74,11 @@ def cli(debug: bool) -> None:
                    "PASS:TARGET) or a material's debug view (MATERIAL.VIEW, e.g. "
                    "revie_fur.samples). '--view help' lists them.")
 def render(scene: str | None, output: str, pipeline: str, size: str | None, frames: int,
-           light_path: str | None, strict: bool, view_name: str | None) -> None:
-    """Render SCENE (a TOML file; the built-in demo when omitted) to an image."""
+           fps: float, start_time: float, light_path: str | None, strict: bool,
+           view_name: str | None) -> None:
+    """Render SCENE (a TOML file; the built-in demo when omitted) to an image, a numbered
+    image sequence or a video."""
+    from .animation import check_video_size, frame_times, output_kind
     from .buffer_views import (
         resolve_view,
         view,
@@ -87,36 +99,86 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
             click.echo(f"{name:<36} {doc}")
         return
     out = check_output_path(output)
+    kind = output_kind(out)
+    times = frame_times(frames, fps, start_time)
+    if view_name is not None and kind != "image":
+        raise InputError("writes one buffer to one .png or .exr image, not to a frame "
+                         "pattern or a video", "--view")
     loaded = _scene(scene)
+    size_override = _size_option(size)
+    if kind == "video":
+        check_video_size(out, size_override or loaded.size)
     shown_name = view_name
     if view_name is not None:
         debug_scene = with_material_view(loaded, view_name)
         if debug_scene is not None:  # the material draws the view: the frame shows it
             loaded, view_name = debug_scene, None
-    with Renderer(loaded, pipeline, _size_option(size), strict=strict or None,
+    with Renderer(loaded, pipeline, size_override, strict=strict or None,
                   light_path=light_path) as renderer:
+        if kind != "image":
+            written, frame_ms = _render_animation(renderer, out, times, fps)
+        else:
+            if view_name is not None:
+                view_pass, _ = resolve_view(view_name, renderer.passes)  # bad names fail here
+            frame_ms = []
+            for index, at in enumerate(times):
+                last = index == frames - 1
+                start = time.perf_counter()
+                if view_name is not None and last:
+                    capture = capture_frame(renderer, [view_pass] if view_pass else [],
+                                            warmup=False, time=at)
+                else:
+                    result = renderer.render(readback=last, time=at)
+                renderer.gl.ctx.finish()
+                frame_ms.append((time.perf_counter() - start) * 1000.0)
+    if kind == "image":
         if view_name is not None:
-            view_pass, _ = resolve_view(view_name, renderer.passes)  # bad names fail here
-        times = []
-        for frame in range(frames):
-            start = time.perf_counter()
-            if view_name is not None and frame == frames - 1:
-                capture = capture_frame(renderer, [view_pass] if view_pass else [],
-                                        warmup=False)
-            else:
-                result = renderer.render(readback=frame == frames - 1)
-            renderer.gl.ctx.finish()
-            times.append((time.perf_counter() - start) * 1000.0)
-    if view_name is not None:
-        write_view(out, view(capture, view_name))
-    else:
-        _write_result(out, result)
+            write_view(out, view(capture, view_name))
+        else:
+            _write_result(out, result)
     width, height = renderer.size
-    timing = f"{min(times):.1f} ms" if frames == 1 else \
-        f"median {sorted(times)[len(times) // 2]:.1f} ms over {frames} frames"
+    timing = f"{min(frame_ms):.1f} ms" if frames == 1 else \
+        f"median {sorted(frame_ms)[len(frame_ms) // 2]:.1f} ms over {frames} frames"
     shown = f", view {shown_name}" if shown_name is not None else ""
-    stderr.print(f"wrote {out} ({width}x{height}, {pipeline}, {renderer.light_path} lights"
-                 f"{shown}, {timing})")
+    clock = ""
+    if frames > 1 or start_time > 0.0:
+        clock = f", t = {times[0]:g}" + (f"..{times[-1]:g} s at {fps:g} fps" if frames > 1
+                                         else " s")
+    what = out if kind == "image" else written
+    stderr.print(f"wrote {what} ({width}x{height}, {pipeline}, {renderer.light_path} lights"
+                 f"{shown}{clock}, {timing})", markup=False, highlight=False)
+
+
+def _render_animation(renderer, out: Path, times: list[float],
+                      fps: float) -> tuple[str, list[float]]:
+    """Every frame of ``times`` to the sequence or video ``out``: (what was written, the
+    frame times in ms)."""
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeRemainingColumn,
+    )
+
+    from .animation import AnimationWriter, describe_written
+
+    frame_ms = []
+    with AnimationWriter(out, fps) as writer, \
+            Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+                     TimeRemainingColumn(), console=stderr, transient=True,
+                     disable=len(times) <= 1 or not stderr.is_terminal) as progress:
+        task = progress.add_task(f"rendering {out.name}", total=len(times))
+        for at in times:
+            start = time.perf_counter()
+            renderer.render(readback=False, time=at)
+            renderer.gl.ctx.finish()
+            frame_ms.append((time.perf_counter() - start) * 1000.0)
+            writer.write(renderer.read_hdr() if writer.wants_hdr else renderer.read_final())
+            progress.advance(task)
+        progress.update(task, description=f"writing {out.name}")
+        written = writer.close()
+    return describe_written(written), frame_ms
 
 
 @cli.command()

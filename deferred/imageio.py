@@ -1,4 +1,8 @@
-"""Image files through OpenImageIO: PNG/EXR out (atomically), any OIIO format in."""
+"""Image files through OpenImageIO: PNG/EXR out (atomically), any OIIO format in.
+
+``deferred render`` also writes numbered sequences (``out_####.png``) and videos (``.mp4``,
+``.gif``): :mod:`deferred.animation`.
+"""
 
 from __future__ import annotations
 
@@ -11,7 +15,9 @@ import numpy as np
 
 from .errors import InputError, RenderError
 
-OUTPUT_SUFFIXES = (".png", ".exr")
+IMAGE_SUFFIXES = (".png", ".exr")
+VIDEO_SUFFIXES = (".mp4", ".gif")
+OUTPUT_SUFFIXES = (*IMAGE_SUFFIXES, *VIDEO_SUFFIXES)  # what ``deferred render -o`` writes
 
 
 def srgb_encode(linear: np.ndarray) -> np.ndarray:
@@ -26,17 +32,29 @@ def srgb_decode(encoded: np.ndarray) -> np.ndarray:
 
 
 def check_output_path(path: str | Path, where: str = "-o",
-                      suffixes: tuple[str, ...] = OUTPUT_SUFFIXES) -> Path:
+                      suffixes: tuple[str, ...] = OUTPUT_SUFFIXES,
+                      patterns: bool = True) -> Path:
     """An output file named by option ``where``: one of ``suffixes``, in an existing folder,
-    not itself a folder."""
+    not itself a folder. With ``patterns``, a name with a run of ``#`` is a numbered image
+    sequence (:func:`deferred.animation.expand_pattern`), checked as its first file."""
     path = Path(path)
     if path.suffix.lower() not in suffixes:
-        raise InputError(f"output must end in {' or '.join(suffixes)}: {path}", where)
+        raise InputError(f"output must end in {_either(suffixes)}: {path}", where)
     if not path.parent.is_dir():
         raise InputError(f"output folder does not exist: {path.parent}", where)
-    if path.is_dir():
-        raise InputError(f"output is a folder, not a file: {path}", where)
+    first = path
+    if patterns and "#" in path.name:
+        from .animation import expand_pattern
+
+        first = expand_pattern(path, 0, where)
+    if first.is_dir():
+        raise InputError(f"output is a folder, not a file: {first}", where)
     return path
+
+
+def _either(suffixes: Sequence[str]) -> str:
+    return suffixes[0] if len(suffixes) == 1 else \
+        f"{', '.join(suffixes[:-1])} or {suffixes[-1]}"
 
 
 # OpenEXR stores channels sorted by name; this attribute keeps the order they were written in.
@@ -94,12 +112,19 @@ def write_text(path: str | Path, text: str) -> Path:
     return path
 
 
-def _write_atomically(path: Path, write) -> None:
-    """``write(temporary)`` next to ``path``, then rename over it: readers never see half a file."""
+def temporary_path(path: str | Path) -> Path:
+    """A hidden name next to ``path`` to write to before renaming over it; the suffix stays
+    last so writers pick the format from it."""
+    path = Path(path)
     directory = path.parent if str(path.parent) else Path(".")
     # Not mkstemp: its 0600 mode would survive the rename; the writer creates the file under
-    # the umask like any other output. The suffix stays last so OIIO picks the format.
-    temporary = str(directory / f".{path.stem}.{secrets.token_hex(6)}.tmp{path.suffix}")
+    # the umask like any other output.
+    return directory / f".{path.stem}.{secrets.token_hex(6)}.tmp{path.suffix}"
+
+
+def _write_atomically(path: Path, write) -> None:
+    """``write(temporary)`` next to ``path``, then rename over it: readers never see half a file."""
+    temporary = str(temporary_path(path))
     try:
         write(temporary)
         os.replace(temporary, path)

@@ -171,7 +171,7 @@ class SceneObject:
                 values.update(event.params)
             where = self.events[count - 1].where
             state = validate_params(type(self.base_params), values,
-                                    f"{where}.params" if where else None)
+                                    f"{where}.params" if where else f"{self.label}: params")
             self._states[count] = state
         return state
 
@@ -180,10 +180,11 @@ class SceneObject:
         """Add an event: from ``time`` (seconds, finite, >= 0) on, the material takes
         ``params``. ``params`` are checked over ``base_params`` at once, and so is the
         object's state at every event time from this one on; errors name ``where``."""
+        where = where or f"{self.label}: event"
         if not (isinstance(time, int | float) and math.isfinite(time) and time >= 0.0):
             raise InputError(f"must be a finite number of seconds >= 0, got {time!r}",
-                             f"{where}.time" if where else "time")
-        params_where = f"{where}.params" if where else "params"
+                             f"{where}.time")
+        params_where = f"{where}.params"
         material_cls = type(self.material)
         # Every key checked against the material's model over the base (files, too)
         material_cls.from_dict({**self.base_params.model_dump(), **params},

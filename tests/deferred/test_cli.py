@@ -41,7 +41,7 @@ def test_render_forward_exr_is_linear_float(tmp_path, capsys):
     (["render", "missing.toml"], "missing.toml: scene file not found"),
     (["render", "--size", "0x10"], "--size: size 0x10 is impossible"),
     (["render", "--size", "big"], "--size: expected WIDTHxHEIGHT"),
-    (["render", "-o", "x.jpg"], "-o: output must end in .png or .exr"),
+    (["render", "-o", "x.jpg"], "-o: output must end in .png, .exr, .mp4 or .gif"),
     (["render", "--pipeline", "raytrace"], "Invalid value for '--pipeline'"),
     (["render", "--frames", "0"], "Invalid value for '--frames'"),
     (["render", "-o", "folder.png"], "-o: output is a folder, not a file"),

@@ -1,0 +1,270 @@
+"""Animation: the scene timeline, frame time, numbered sequences and videos from the CLI."""
+
+import numpy as np
+import pytest
+
+from deferred.animation import expand_pattern, frame_times, gif_durations, output_kind
+from deferred.cli import main
+from deferred.errors import InputError
+from deferred.imageio import read_image
+from deferred.scene import scene_from_toml
+
+SCENE = """
+size = [64, 48]
+[camera]
+position = [0.0, 0.0, 3.0]
+target = [0.0, 0.0, 0.0]
+
+[[object]]
+name = "ball"
+mesh = "builtin:sphere?segments=24&rings=12"
+[object.params]
+color = [0.8, 0.1, 0.1]
+
+[[object]]
+mesh = "builtin:cube?size=0.5"
+position = [1.2, 0.0, 0.0]
+
+[[light]]
+type = "directional"
+direction = [-0.3, -0.5, -1.0]
+"""
+
+TIMELINE = """
+[[event]]
+time = 0.2
+object = "ball"
+params = { color = [0.1, 0.1, 0.8] }
+
+[[event]]
+time = 0.1
+object = "ball"
+params = { color = [0.1, 0.8, 0.1], specular_exponent = 8.0 }
+"""
+
+
+def run(capsys, *args):
+    code = main([str(a) for a in args])
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
+
+
+def has_ffmpeg() -> bool:
+    try:
+        import imageio_ffmpeg
+
+        return bool(imageio_ffmpeg.get_ffmpeg_exe())
+    except (ImportError, RuntimeError):
+        return False
+
+
+@pytest.fixture
+def scene_file(tmp_path):
+    path = tmp_path / "s.toml"
+    path.write_text(SCENE + TIMELINE)
+    return path
+
+
+# -- the timeline -------------------------------------------------------------------------------
+
+def test_params_at_before_at_and_after_events():
+    scene = scene_from_toml(SCENE + TIMELINE, "s.toml")
+    ball, cube = scene.objects
+    assert ball.event_times == (0.1, 0.2) and cube.event_times == ()
+    assert ball.params_at(0.0) is ball.base_params
+    assert ball.params_at(0.0).color == (0.8, 0.1, 0.1)
+    assert ball.params_at(0.0999).color == (0.8, 0.1, 0.1)
+    at = ball.params_at(0.1)  # an event applies from its own time on
+    assert at.color == (0.1, 0.8, 0.1) and at.specular_exponent == 8.0
+    later = ball.params_at(0.25)  # both, in time order: the later colour, the earlier exponent
+    assert later.color == (0.1, 0.1, 0.8) and later.specular_exponent == 8.0
+    assert ball.params_at(0.15) is at  # validated once per set of applied events
+    assert ball.params_at(1e6) is later
+    scene.apply_timeline(0.15)
+    assert ball.material.params is at
+    cube_params = cube.material.params
+    scene.apply_timeline(0.3)
+    assert ball.material.params is later and cube.material.params is cube_params
+    scene.apply_timeline(0.0)
+    assert ball.material.params.color == (0.8, 0.1, 0.1)
+
+
+def test_events_at_the_same_time_apply_in_file_order():
+    ties = """
+[[event]]
+time = 0.5
+object = "ball"
+params = { color = [1.0, 0.0, 0.0], specular_intensity = 0.25 }
+[[event]]
+time = 0.5
+object = "ball"
+params = { color = [0.0, 0.0, 1.0] }
+"""
+    ball = scene_from_toml(SCENE + ties, "s.toml").objects[0]
+    assert ball.event_times == (0.5, 0.5)
+    assert ball.params_at(0.5).color == (0.0, 0.0, 1.0)
+    assert ball.params_at(0.5).specular_intensity == 0.25
+    assert ball.params_at(0.49).color == (0.8, 0.1, 0.1)
+
+
+def test_timeline_from_python():
+    scene = scene_from_toml(SCENE, "s.toml")
+    cube = scene.objects[1]
+    assert cube.label == "cube0"
+    scene.add_event("cube0", 1.0, {"color": (0.0, 1.0, 0.0)})
+    assert cube.params_at(1.0).color == (0.0, 1.0, 0.0)
+    with pytest.raises(InputError, match=r"^cube0: event\.params\.specular_intensity: Input "
+                                         "should be less"):
+        scene.add_event(cube, 2.0, {"specular_intensity": 2.0})
+    assert cube.event_times == (1.0,)  # a rejected event is not kept
+    with pytest.raises(InputError, match=r"^cube0: event\.time: must be a finite number"):
+        scene.add_event(cube, float("nan"), {})
+
+
+@pytest.mark.parametrize("event, expected", [
+    ('time = 0.1\nobject = "bal"\nparams = { color = [1.0, 1.0, 1.0] }',
+     "error: s.toml: event[0].object: no object named 'bal' (objects: ball, cube0)"),
+    ('time = 0.1\nobject = "ball"\nparams = { color = [1.0, 1.0] }',
+     "error: s.toml: event[0].params.color"),
+    ('time = 0.1\nobject = "ball"\nparams = { wind = 2.0 }',
+     "error: s.toml: event[0].params.wind: unknown parameter"),
+    ('time = -0.5\nobject = "ball"\nparams = { color = [1.0, 1.0, 1.0] }',
+     "error: s.toml: event[0].time: Input should be greater than or equal to 0"),
+    ('time = inf\nobject = "ball"\nparams = {}', "error: s.toml: event[0].time: "),
+    ('object = "ball"\nparams = {}', "error: s.toml: event[0].time: missing required key"),
+])
+def test_timeline_errors_exit_2_with_one_line(tmp_path, capsys, event, expected):
+    scene = tmp_path / "s.toml"
+    scene.write_text(SCENE + "[[event]]\n" + event + "\n")
+    code, _, err = run(capsys, "render", scene, "-o", tmp_path / "out_##.png", "--frames", 2)
+    assert code == 2
+    assert err.startswith(expected), err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]
+
+
+def test_same_time_same_image_and_frame_time(gl, scene_file):
+    from deferred.renderer import Renderer
+    from deferred.scene import load_scene
+
+    seen = []
+    with Renderer(load_scene(scene_file), gl=gl) as renderer:
+        first = renderer.render(time=0.2).image
+        base = renderer.render(time=0.0).image
+        again = renderer.render(time=0.2, on_pass=lambda p, frame: seen.append(frame.time)).image
+    assert np.array_equal(first, again)
+    assert not np.array_equal(first, base)
+    assert seen and set(seen) == {0.2}
+
+
+# -- outputs ------------------------------------------------------------------------------------
+
+def test_frame_times_and_patterns():
+    assert frame_times(3, 10.0, 0.5) == [0.5, 0.6, 0.7]
+    assert expand_pattern("a/out_####.png", 7).as_posix() == "a/out_0007.png"
+    assert expand_pattern("f#.exr", 12).name == "f12.exr"  # wider numbers keep every digit
+    assert [output_kind(p) for p in ("a.png", "a_#.exr", "a.mp4", "a.GIF")] == \
+        ["image", "sequence", "video", "video"]
+    assert gif_durations(6, 24.0) == [40, 40, 40, 50, 40, 40]
+    assert sum(gif_durations(48, 24.0)) == 2000
+
+
+def test_sequence_writes_every_frame_and_the_timeline_shows(tmp_path, capsys, scene_file):
+    code, out, err = run(capsys, "render", scene_file, "--frames", 3, "--fps", 10,
+                         "-o", tmp_path / "out_##.png")
+    assert code == 0, err
+    assert out == "" and "t = 0..0.2 s at 10 fps" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out_00.png", "out_01.png",
+                                                          "out_02.png", "s.toml"]
+    frames = [read_image(tmp_path / f"out_0{i}.png") for i in range(3)]
+    centre = [f[24, 32, :3] for f in frames]
+    assert centre[0][0] > centre[0][1]  # red, then green from t = 0.1, then blue
+    assert centre[1][1] > centre[1][0] and centre[2][2] > centre[2][1]
+    assert np.array_equal(frames[0][:, 54:], frames[1][:, 54:])  # the cube has no events
+
+
+def test_pattern_single_frame_and_start_time(tmp_path, capsys, scene_file):
+    code, _, err = run(capsys, "render", scene_file, "--time", 0.15, "-o",
+                       tmp_path / "out_####.png")
+    assert code == 0, err
+    assert (tmp_path / "out_0000.png").is_file()
+    assert read_image(tmp_path / "out_0000.png")[24, 32, 1] > 0.5  # green: t = 0.15
+
+
+def test_plain_image_frames_advance_time(tmp_path, capsys, scene_file):
+    code, _, err = run(capsys, "render", scene_file, "--frames", 3, "--fps", 10, "-o",
+                       tmp_path / "last.png")
+    assert code == 0, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["last.png", "s.toml"]
+    pixel = read_image(tmp_path / "last.png")[24, 32]
+    assert pixel[2] > pixel[1]  # the last frame, t = 0.2: blue
+
+
+def test_gif(tmp_path, capsys, scene_file):
+    import imageio.v3 as iio
+
+    out = tmp_path / "anim.gif"
+    code, _, err = run(capsys, "render", scene_file, "--frames", 3, "--fps", 10, "-o", out)
+    assert code == 0, err
+    frames = iio.imread(out, index=None)
+    assert frames.shape[:3] == (3, 48, 64)
+    assert iio.immeta(out)["loop"] == 0 and iio.immeta(out)["duration"] == 100
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["anim.gif", "s.toml"]
+
+
+@pytest.mark.skipif(not has_ffmpeg(), reason="no ffmpeg (imageio-ffmpeg)")
+def test_mp4(tmp_path, capsys, scene_file):
+    import imageio.v2 as iio
+
+    out = tmp_path / "anim.mp4"
+    code, _, err = run(capsys, "render", scene_file, "--frames", 3, "--fps", 10, "-o", out)
+    assert code == 0, err
+    reader = iio.get_reader(out)
+    try:
+        meta = reader.get_meta_data()
+        frames = list(reader.iter_data())
+    finally:
+        reader.close()
+    assert meta["codec"] == "h264" and meta["fps"] == 10.0 and len(frames) == 3
+    assert frames[1][24, 32, 1] > frames[1][24, 32, 0]  # green at t = 0.1
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["anim.mp4", "s.toml"]
+
+
+@pytest.mark.parametrize("suffix", [".gif", pytest.param(".mp4", marks=pytest.mark.skipif(
+    not has_ffmpeg(), reason="no ffmpeg"))])
+def test_ctrl_c_mid_video_leaves_no_file(tmp_path, capsys, scene_file, monkeypatch, suffix):
+    from deferred.renderer import Renderer
+
+    original = Renderer.render
+
+    def failing(self, *args, time=0.0, **kwargs):
+        if time > 0.15:
+            raise KeyboardInterrupt
+        return original(self, *args, time=time, **kwargs)
+
+    monkeypatch.setattr(Renderer, "render", failing)
+    code, _, err = run(capsys, "render", scene_file, "--frames", 3, "--fps", 10,
+                       "-o", tmp_path / f"anim{suffix}")
+    assert code == 1 and "aborted" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]
+
+
+@pytest.mark.parametrize("args, expected", [
+    (["-o", "x.avi"], "error: -o: output must end in .png, .exr, .mp4 or .gif: x.avi"),
+    (["-o", "x_##.mp4"], "error: -o: a frame pattern must end in .png or .exr"),
+    (["-o", "x_#_#.png"], "error: -o: a frame pattern has one run of '#'"),
+    (["-o", "x.mp4", "--size", "65x48"], "error: -o: an .mp4 (H.264, yuv420p) needs an even "
+                                          "width and height, got 65x48; render at --size 66x48"),
+    (["-o", "x_#.png", "--view", "albedo"], "error: --view: writes one buffer"),
+    (["--fps", "0"], "error: Invalid value for '--fps'"),
+    (["--fps", "nan"], "error: --fps: must be a finite number > 0"),
+    (["--time", "-1"], "error: Invalid value for '--time'"),
+])
+def test_bad_animation_options_exit_2(tmp_path, capsys, monkeypatch, scene_file, args,
+                                      expected):
+    monkeypatch.chdir(tmp_path)
+    code, _, err = run(capsys, "render", scene_file, "--frames", 2, *args)
+    assert code == 2
+    assert err.startswith(expected), err
+    assert len(err.strip().splitlines()) == 1
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]
