@@ -192,6 +192,6 @@ class Renderer:
 
 
 def render_scene(scene: Scene, pipeline: str = "deferred", size: tuple[int, int] | None = None,
-                 gl: GLContext | None = None) -> RenderResult:
+                 gl: GLContext | None = None, time: float = 0.0) -> RenderResult:
     with Renderer(scene, pipeline, size, gl) as renderer:
-        return renderer.render()
+        return renderer.render(time=time)

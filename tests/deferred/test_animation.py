@@ -268,3 +268,21 @@ def test_bad_animation_options_exit_2(tmp_path, capsys, monkeypatch, scene_file,
     assert err.startswith(expected), err
     assert len(err.strip().splitlines()) == 1
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]
+
+
+def test_bench_shell_sweep_holds_over_a_timeline():
+    from deferred.bench import with_shells
+
+    text = SCENE.replace('name = "ball"', 'name = "ball"\nmaterial = "revie_fur"').replace(
+        "color = [0.8, 0.1, 0.1]", "shells = 8") + """
+[[event]]
+time = 1.0
+object = "ball"
+params = { shells = 32, fur_length = 0.3 }
+"""
+    scene = scene_from_toml(text, "s.toml")
+    assert scene.objects[0].params_at(1.0).shells == 32
+    swept = with_shells(scene, 4).objects[0]
+    assert swept.params_at(0.0).shells == 4
+    assert swept.params_at(1.0).shells == 4 and swept.params_at(1.0).fur_length == 0.3
+    assert scene.objects[0].params_at(1.0).shells == 32  # the original keeps its timeline
