@@ -5,6 +5,7 @@
 // vs_ names (FUR_FINS). An edge gets a fin where the surface is edge-on to the viewer: the
 // fin fades in as |N.V| of the edge's normal (the mean of its faces') drops below u_fin_band,
 // fully opaque at the silhouette, so fins never pop as the silhouette moves across the mesh.
+// With FIN_STRAND_TANGENT the vertices' vs_strand_tangent passes through (strand shading).
 layout(lines_adjacency) in;
 layout(triangle_strip, max_vertices = 4) out;
 
@@ -23,6 +24,10 @@ in float vs_shell_depth[];
 in vec3 vs_fur_position[];
 in vec3 vs_fur_normal[];
 in vec3 vs_tip_position[];
+#ifdef FIN_STRAND_TANGENT
+in vec3 vs_strand_tangent[];
+out vec3 v_strand_tangent;
+#endif
 
 uniform float u_fin_band;  // |N.V| below which an edge grows a fin
 
@@ -58,6 +63,9 @@ void emit(int i, bool tip, float fade) {
     v_fur_position = vs_fur_position[i];
     v_fur_normal = vs_fur_normal[i];
     v_fin_fade = fade;
+#ifdef FIN_STRAND_TANGENT
+    v_strand_tangent = vs_strand_tangent[i];
+#endif
     gl_Position = tip ? vs_tip_clip[i] : vs_base_clip[i];
     EmitVertex();
 }

@@ -1,0 +1,461 @@
+"""Curling and clumping shell fur (P. Silva, Y. Bando, B.-Y. Chen, T. Nishita, "Curling and
+Clumping Fur Represented by Texture Layers").
+
+The fur is N texture layers over the mesh (section 4; the shared fur technique's volume, level
+of detail and fins, ``techniques/fur.py``), layer n at normalized length h = (1 + n)/N over an
+opaque skin, each displaced in the vertex shader by the strand's bend and curl (Eq. 1, 4) and
+clumped in the fragment shader (Eq. 5, Algorithm 2); lit with Kajiya-Kay and the shadow factor
+gamma (Eq. 6). Per object and over time (:class:`ShellFurState`): the wetness mask (3.1,
+Algorithm 1; ``techniques/wetness.py``), built from random droplets or an image and drying at
+``dry_rate``, and one mass-spring strand per triangle (3.2.1, Eq. 2, 3;
+``techniques/strands.py``) under gravity and gusting wind.
+
+Pipelines:
+- deferred: the base mesh goes to the G-buffer with the ``kajiya_kay`` shading model and the
+  strand's chord as its ``strand_tangent``; the lights shade it; the layers are material-phase
+  passes taking their light from the light accumulation at the root under them (as Revie's
+  shells do), so their cost does not grow with the number of lights;
+- forward: every layer fragment is lit by every light with its own strand tangent.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Literal
+
+import moderngl
+import numpy as np
+from pydantic import Field
+
+from deferred.errors import InputError
+from deferred.gbuffer import ALBEDO_SPECULAR, LINEAR_DEPTH, NORMAL_EXPONENT_ID
+from deferred.imageio import read_image
+from deferred.material import BlinnPhongParams, ForwardLitPass, GBufferPass, Material
+from deferred.passes import Phase, RenderPass
+from deferred.registry import materials
+from deferred.targets import COMPOSITE, LIGHT_ACCUMULATION
+
+from .techniques.fins import FinPass
+from .techniques.fur import (
+    FUR_DEBUG_VIEWS,
+    FUR_UNIFORM_OVERRIDES,
+    FurParams,
+    check_heightfield,
+    debug_defines,
+    fur_scale,
+    fur_volume_texture,
+    shell_count,
+    tiles_per_unit,
+)
+from .techniques.fur_volume import VOLUME_LAYERS
+from .techniques.shells import ShellPass
+from .techniques.strands import StrandForces, StrandSimulation, VertexAverage, triangle_strands
+from .techniques.wetness import blend_droplet, dry_mask, dry_out, load_wetness_mask, random_droplets
+
+if TYPE_CHECKING:
+    from deferred.frame import Frame
+    from deferred.scene import SceneObject
+
+Vec3 = tuple[float, float, float]
+FUR_VERTEX = "materials/shell_fur/fur.vert"
+SHELL_FRAGMENT = "materials/shell_fur/shell.frag"
+FORWARD_SHELL_FRAGMENT = "materials/shell_fur/forward_shell.frag"
+TIPS_WIDTH = 1024  # texels per row of the per-vertex strand tip texture
+COLOR_MAP_SIZE = 256
+GUST_WAVELENGTH = 1.0  # world units between gust fronts along the wind
+
+
+class ShellFurParams(FurParams, BlinnPhongParams):
+    # Eq. 6
+    specular_intensity: float = Field(0.3, ge=0.0, le=1.0, description="K_s, Kajiya-Kay")
+    specular_exponent: float = Field(40.0, ge=1.0, le=2048.0, description="p_phong")
+    # colour (section 4, Fig. 3)
+    color: Vec3 = Field((0.55, 0.36, 0.20), description="fur colour (tints the texture)")
+    color_texture: str | None = Field(None, description="colour image over the mesh's UVs "
+                                                        "(sRGB) instead of the pattern")
+    color_pattern: Literal["none", "stripes", "spots"] = Field(
+        "none", description="generated colour texture (Fig. 3a)")
+    pattern_color: Vec3 = Field((0.12, 0.07, 0.04), description="the pattern's second colour")
+    color_scale: float = Field(1.0, gt=0.0, le=256.0,
+                               description="repeats of the colour texture across the UVs")
+    # curl (3.2.2, Eq. 4)
+    curl_radius: float = Field(0.0, ge=0.0, le=4.0, description="K_alpha, object units")
+    curl_frequency: float = Field(0.0, ge=0.0, le=1000.0,
+                                  description="w, radians along the strand")
+    # clump (3.3, Eq. 5)
+    clump_shape: float = Field(0.5, ge=0.0, le=1.0,
+                               description="w: 0 leans straight to the centre, 1 bends in")
+    clump_strength: float = Field(1.0, ge=0.0, le=8.0,
+                                  description="1 gathers wet tips into half the radius")
+    # wetness (3.1, Algorithm 1)
+    droplets: int = Field(0, ge=0, le=100000,
+                          description="random droplets fallen so far (seeded by `seed`)")
+    droplet_radius: float = Field(0.08, gt=0.0, le=100.0, description="world units")
+    droplet_wetness: float = Field(0.8, ge=0.0, le=1.0, description="rho of a droplet")
+    wetness_mask: str | None = Field(None, description="wetness mask image (R, G centre, "
+                                                       "B radius, A wetness) under the droplets")
+    mask_size: int = Field(256, ge=16, le=4096, description="wetness mask texels per side")
+    dry_rate: float = Field(0.0, ge=0.0, le=100.0, description="wetness lost per second")
+    # strand dynamics (3.2.1, Eq. 2, 3)
+    stiffness: float = Field(2.0, gt=0.0, le=1e6, description="k, spring constant")
+    mass: float = Field(0.01, gt=0.0, le=1e3, description="m, mass at the strand tip")
+    damping: float = Field(0.05, ge=0.0, le=1e6, description="c, force per unit velocity")
+    gravity: Vec3 = Field((0.0, -9.81, 0.0), description="world acceleration")
+    wind: Vec3 = Field((0.0, 0.0, 0.0), description="world force on each strand tip")
+    gust: float = Field(0.0, ge=0.0, le=8.0,
+                        description="wind varies by +- this fraction in travelling gusts")
+    gust_frequency: float = Field(0.5, ge=0.0, le=100.0, description="gusts per second")
+    time_step: float = Field(1.0 / 240.0, gt=0.0, le=0.1, description="simulation step, s")
+    settle: float = Field(2.0, ge=0.0, le=60.0,
+                          description="seconds simulated before t = 0 (strands at rest)")
+    debug: Literal["none", "samples", "shell_count", "single_shell", "wetness"] = Field(
+        "none", description="debug view instead of the fur (shell_fur's debug_views)")
+
+
+def _layers_uniform(shells: int) -> dict[str, Any]:
+    return {"u_layers": float(max(shells, 1))}
+
+
+NOT_UNIFORMS = ("color_texture", "color_pattern", "pattern_color", "droplets", "droplet_radius",
+                "droplet_wetness", "wetness_mask", "mask_size", "dry_rate", "stiffness", "mass",
+                "damping", "gravity", "wind", "gust", "gust_frequency", "time_step", "settle",
+                "heightfield")
+
+
+# -- colour texture --------------------------------------------------------------------------
+
+def color_pattern(name: str, size: int = COLOR_MAP_SIZE, seed: int = 1) -> np.ndarray:
+    """(size, size) weight of the pattern colour over the UV square, tileable: ``stripes``
+    (wavy bands across u, a tabby's), ``spots`` (round blotches), ``none`` (zeros)."""
+    t = (np.arange(size) + 0.5) / size
+    v, u = np.meshgrid(t, t, indexing="ij")
+    if name == "none":
+        return np.zeros((size, size))
+    if name == "stripes":
+        wave = u * 6.0 + 0.35 * np.sin(2.0 * np.pi * v * 2.0) + 0.1 * np.sin(2.0 * np.pi * v * 7.0)
+        s = 0.5 + 0.5 * np.cos(2.0 * np.pi * wave)
+        return np.clip((s - 0.55) / 0.15, 0.0, 1.0)
+    if name == "spots":
+        rng = np.random.default_rng(seed)
+        centres = rng.uniform(0.0, 1.0, (40, 2))
+        radii = rng.uniform(0.03, 0.06, 40)
+        weight = np.zeros((size, size))
+        for (cu, cv), r in zip(centres, radii, strict=True):
+            du = (u - cu + 0.5) % 1.0 - 0.5  # tileable distance
+            dv = (v - cv + 0.5) % 1.0 - 0.5
+            weight = np.maximum(weight, np.clip((r - np.sqrt(du * du + dv * dv)) / 0.008,
+                                                0.0, 1.0))
+        return weight
+    raise ValueError(f"unknown colour pattern '{name}'")
+
+
+def pattern_texture(ctx: moderngl.Context, params: ShellFurParams) -> moderngl.Texture:
+    """The generated colour texture: white, blended to pattern_color / color where the pattern
+    is (the tint ``color`` multiplies the whole)."""
+    weight = color_pattern(params.color_pattern, seed=params.seed)[..., None]
+    ratio = np.asarray(params.pattern_color) / np.maximum(np.asarray(params.color), 1e-3)
+    rgb = (1.0 - weight) + weight * ratio[None, None, :]
+    rgba = np.concatenate([rgb, np.ones(rgb.shape[:2] + (1,))], -1).astype(np.float16)
+    texture = ctx.texture((rgb.shape[1], rgb.shape[0]), 4, rgba.tobytes(), dtype="f2")
+    texture.build_mipmaps()
+    texture.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+    return texture
+
+
+# -- per-object state over time ----------------------------------------------------------------
+
+def _float_texture(ctx: moderngl.Context, width: int, height: int) -> moderngl.Texture:
+    texture = ctx.texture((width, height), 4, dtype="f4")
+    texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+    return texture
+
+
+class ShellFurState:
+    """An object's wetness mask and strands at the renderer's current time, with their textures
+    (``u_wetness_mask``, ``u_strand_tips``). Time moves forward in fixed steps; asked for an
+    earlier time, the state starts over from t = 0 (the same time always gives the same
+    frame). Parameters are read at each interval's start (``SceneObject.params_at``): between
+    timeline events they do not change."""
+
+    def __init__(self, ctx: moderngl.Context, obj: SceneObject, material: ShellFurMaterial):
+        self.obj = obj
+        self.material = material
+        params = material.params
+        self.linear_inverse = np.linalg.inv(obj.model[:3, :3])
+        self.strands = StrandSimulation(*triangle_strands(obj.mesh, obj.model, params.fur_length))
+        self.average = VertexAverage(obj.mesh)
+        self.size = params.mask_size
+        vertices = obj.mesh.vertex_count
+        self.tip_rows = max(1, math.ceil(vertices / TIPS_WIDTH))
+        self.mask_texture = _float_texture(ctx, self.size, self.size)
+        self.mask_texture.repeat_x = self.mask_texture.repeat_y = True
+        self.tips_texture = _float_texture(ctx, TIPS_WIDTH, self.tip_rows)
+        self.time: float | None = None
+        self.mask = dry_mask(self.size)
+        self.fallen = 0
+
+    def params_at(self, time: float) -> ShellFurParams:
+        params_at = getattr(self.obj, "params_at", None)
+        return params_at(time) if params_at is not None else self.material.params
+
+    def event_times(self) -> tuple[float, ...]:
+        return tuple(getattr(self.obj, "event_times", ()))
+
+    def advance(self, time: float) -> None:
+        """Bring the state to ``time`` (seconds) and upload it."""
+        if self.time is None or time < self.time:
+            self._start()
+        if time > self.time:
+            cuts = sorted({t for t in self.event_times() if self.time < t < time} | {time})
+            for end in cuts:
+                self._run(self.time, end)
+        self._upload()
+
+    def _start(self) -> None:
+        params = self.params_at(0.0)
+        self.mask = self._initial_mask(params)
+        self.fallen = 0
+        self._rain(params)
+        self.strands.reset()
+        steps = int(round(params.settle / params.time_step))
+        for k in range(steps):
+            self.strands.step(params.time_step, self._forces(params, -params.settle
+                                                              + k * params.time_step))
+        self.time = 0.0
+
+    def _initial_mask(self, params: ShellFurParams) -> np.ndarray:
+        path = self.material.wetness_mask_path()
+        return load_wetness_mask(path, self.size) if path is not None else dry_mask(self.size)
+
+    def _rain(self, params: ShellFurParams) -> None:
+        """Blend the droplets that fell since last time (the ``droplets`` count grew)."""
+        if params.droplets > self.fallen:
+            for droplet in random_droplets(self.obj.mesh, self.obj.model,
+                                           params.droplets - self.fallen, params.droplet_radius,
+                                           params.droplet_wetness, params.seed,
+                                           start=self.fallen):
+                blend_droplet(self.mask, droplet)
+            self.fallen = params.droplets
+
+    def _forces(self, params: ShellFurParams, time: float) -> StrandForces:
+        wind = np.asarray(params.wind, np.float64)
+        strength = float(np.linalg.norm(wind))
+        if params.gust > 0.0 and strength > 0.0:
+            along = self.strands.roots @ (wind / strength) / GUST_WAVELENGTH
+            phase = 2.0 * np.pi * (params.gust_frequency * time - along)
+            wind = wind[None, :] * (1.0 + params.gust * np.sin(phase))[:, None]
+        return StrandForces(params.stiffness, params.mass, params.damping,
+                            np.asarray(params.gravity, np.float64), wind)
+
+    def _run(self, start: float, end: float) -> None:
+        params = self.params_at(start)
+        self._rain(params)
+        dt = params.time_step
+        steps = int(round((end - start) / dt))
+        for k in range(steps):
+            self.strands.step(dt, self._forces(params, start + k * dt))
+        dry_out(self.mask, params.dry_rate * (end - start))
+        self.time = end
+        self._rain(self.params_at(end))
+
+    def _upload(self) -> None:
+        self.mask_texture.write(np.ascontiguousarray(self.mask, np.float32).tobytes())
+        deflection = self.average(self.strands.deflections()) @ self.linear_inverse.T
+        tips = np.zeros((self.tip_rows * TIPS_WIDTH, 4), np.float32)
+        tips[:len(deflection), :3] = deflection
+        self.tips_texture.write(tips.tobytes())
+
+    def release(self) -> None:
+        self.mask_texture.release()
+        self.tips_texture.release()
+
+
+# -- passes -------------------------------------------------------------------------------------
+
+class ObjectStateInputs:
+    """Passes of a shell_fur object bind its state's textures (at the frame's time)."""
+
+    obj: SceneObject
+
+    def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
+        state = self.obj.material.state(frame, self.obj)
+        return {**super().textures(frame), "u_wetness_mask": state.mask_texture,
+                "u_strand_tips": state.tips_texture}
+
+
+def layer_layout(count: float, shell_range: tuple[float, float] = (0.0, 1.0),
+                 debug: str = "none") -> list[tuple[float, float] | None]:
+    """(h, fade) of each layer drawn for a continuous layer count N: the skin (h = 0, index 0),
+    then Silva's layers h = (1 + n)/N, n = 0 .. ceil(N) - 1, the last kept at h <= 1 and faded
+    by N's fraction, so the level of detail never pops. None: not drawn (outside shell_range, or
+    hidden by a debug view)."""
+    drawn = math.ceil(count - 1e-9)
+    layers = [(0.0, 1.0)] + [(min((1 + n) / count, 1.0),
+                              1.0 if n < drawn - 1 else count - (drawn - 1))
+                             for n in range(drawn)]
+    low, high = shell_range
+    if debug in ("shell_count", "wetness"):
+        return [layers[0]] + [None] * drawn
+    in_range = [k for k, (h, _) in enumerate(layers) if low <= h <= high]
+    if debug == "single_shell":
+        shown = {in_range[len(in_range) // 2]} if in_range else set()
+    else:
+        shown = set(in_range)
+    return [layer if k in shown else None for k, layer in enumerate(layers)]
+
+
+class ShellFurLayerPass(ObjectStateInputs, ShellPass):
+    """The skin and the N layers (Silva's spacing, :func:`layer_layout`)."""
+
+    vertex = FUR_VERTEX
+
+    def draws(self, frame: Frame) -> int:
+        params = self.obj.material.params
+        self._count = shell_count(frame, self.obj, params) if params.shells > 0 else 0.0
+        self._layout = layer_layout(self._count, params.shell_range, params.debug) \
+            if self._count > 0 else []
+        return len(self._layout)
+
+    def draw_uniforms(self, frame: Frame, index: int, count: int) -> dict[str, Any] | None:
+        layer = self._layout[index]
+        if layer is None:
+            return None
+        h, fade = layer
+        self._root = index == 0
+        params = self.obj.material.params
+        # each layer stands for 1/N of the fur: the volume's slices per layer
+        return {"u_shell_depth": h, "u_shell_fade": fade, "u_root_shell": self._root,
+                "u_shell_weight": VOLUME_LAYERS / max(self._count, 1e-6),
+                "u_shell_count": self._count / max(params.shells, 1)}
+
+
+class ShellFurFinPass(ObjectStateInputs, FinPass):
+    vertex = FUR_VERTEX
+
+    def draws(self, frame: Frame) -> int:
+        return 0 if self.obj.material.params.debug == "wetness" else super().draws(frame)
+
+    def defines(self, frame: Frame) -> dict[str, str]:
+        return {**super().defines(frame), "FIN_STRAND_TANGENT": "1", "STRAND_CHORD": "1"}
+
+
+class ShellFurBasePass(ObjectStateInputs, GBufferPass):
+    vertex = FUR_VERTEX
+
+
+class ShellFurForwardBasePass(ObjectStateInputs, ForwardLitPass):
+    vertex = FUR_VERTEX
+
+
+LIGHT_SAMPLES = (LIGHT_ACCUMULATION, ALBEDO_SPECULAR, NORMAL_EXPONENT_ID, LINEAR_DEPTH)
+CHORD = {"STRAND_CHORD": "1"}
+
+
+@materials.register
+class ShellFurMaterial(Material):
+    name = "shell_fur"
+    Params = ShellFurParams
+    surface_shader = "materials/shell_fur/surface.glsl"
+    shading_model = "kajiya_kay"
+    uniform_overrides = {**FUR_UNIFORM_OVERRIDES, **{key: None for key in NOT_UNIFORMS},
+                         "shells": _layers_uniform}
+    debug_views = {
+        **{name: view for name, view in FUR_DEBUG_VIEWS.items() if name != "comb"},
+        "wetness": ("the wetness mask on the skin: a colour per clump, as bright as it is "
+                    "wet; black dry (Silva et al. Fig. 11's inset)", {"debug": "wetness"}),
+    }
+
+    def check_files(self, where: str | None) -> None:
+        check_heightfield(self.heightfield_path(), where)
+        for key in ("color_texture", "wetness_mask"):
+            value = getattr(self.params, key)
+            if value is None:
+                continue
+            path = self.resolve_path(value)
+            name = f"{where}.{key}" if where else key
+            if not path.is_file():
+                raise InputError(f"image not found: {path}", name)
+            try:
+                pixels = read_image(path)
+            except InputError as exc:
+                raise InputError(f"cannot read image {path.name}: {exc.message}", name) from None
+            if key == "wetness_mask" and pixels.shape[-1] < 4:
+                raise InputError(f"wetness mask {path.name} needs 4 channels (R, G centre, "
+                                 f"B radius, A wetness), it has {pixels.shape[-1]}", name)
+
+    def heightfield_path(self) -> Path | None:
+        return None if self.params.heightfield is None else \
+            self.resolve_path(self.params.heightfield)
+
+    def wetness_mask_path(self) -> Path | None:
+        return None if self.params.wetness_mask is None else \
+            self.resolve_path(self.params.wetness_mask)
+
+    def defines(self, obj: SceneObject) -> dict[str, str]:
+        # layers reject light samples the G-buffer shows occluded (Revie's Figure 2.8 fix)
+        return {**super().defines(obj), "FUR_OCCLUSION_TEST": "1", **debug_defines(self.params)}
+
+    def uniforms(self, frame: Frame) -> dict[str, Any]:
+        return {**super().uniforms(frame), "u_fur_tiles": tiles_per_unit(self.params)}
+
+    def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
+        params = self.params
+        if params.color_texture is not None:
+            color_map = frame.resources.image_texture(self.resolve_path(params.color_texture))
+        else:
+            color_map = frame.resources.texture(
+                ("shell_fur_pattern", params.color_pattern, params.seed, params.color,
+                 params.pattern_color), lambda ctx: pattern_texture(ctx, params))
+        return {"u_fur_volume": fur_volume_texture(frame, params, self.heightfield_path()),
+                "u_color_map": color_map}
+
+    def state(self, frame: Frame, obj: SceneObject) -> ShellFurState:
+        """The object's state, advanced to the frame's time."""
+        state = frame.resources.cached(("shell_fur_state", id(obj)),
+                                       lambda ctx: ShellFurState(ctx, obj, self))
+        state.advance(float(getattr(frame, "time", 0.0)))
+        return state
+
+    @staticmethod
+    def vertex_constants(obj: SceneObject, shell_depth: float | None = None) -> dict[str, Any]:
+        constants = {"u_fur_scale": fur_scale(obj)}
+        if shell_depth is not None:
+            constants["u_shell_depth"] = shell_depth
+        return constants
+
+    # -- passes ------------------------------------------------------------------------------
+    def geometry_passes(self, obj: SceneObject) -> list[RenderPass]:
+        return [ShellFurBasePass(f"{obj.label}.gbuffer", Phase.GEOMETRY, obj,
+                                 constants=self.vertex_constants(obj, 0.0), extra_defines=CHORD)]
+
+    def material_passes(self, obj: SceneObject) -> list[RenderPass]:
+        if self.params.shells == 0:
+            return []
+        passes: list[RenderPass] = []
+        if self.params.fins:
+            passes.append(ShellFurFinPass(f"{obj.label}.fins", Phase.MATERIAL, obj,
+                                          fragment=SHELL_FRAGMENT, colors=(COMPOSITE,),
+                                          extra_reads=LIGHT_SAMPLES,
+                                          constants=self.vertex_constants(obj)))
+        passes.append(ShellFurLayerPass(f"{obj.label}.layers", Phase.MATERIAL, obj,
+                                        fragment=SHELL_FRAGMENT, colors=(COMPOSITE,),
+                                        extra_reads=LIGHT_SAMPLES,
+                                        constants=self.vertex_constants(obj)))
+        return passes
+
+    def forward_passes(self, obj: SceneObject) -> list[RenderPass]:
+        passes: list[RenderPass] = [
+            ShellFurForwardBasePass(f"{obj.label}.forward", Phase.FORWARD, obj,
+                                    constants=self.vertex_constants(obj, 0.0),
+                                    extra_defines=CHORD)]
+        if self.params.shells == 0:
+            return passes
+        if self.params.fins:
+            passes.append(ShellFurFinPass(f"{obj.label}.forward_fins", Phase.FORWARD, obj,
+                                          fragment=FORWARD_SHELL_FRAGMENT, colors=(COMPOSITE,),
+                                          constants=self.vertex_constants(obj)))
+        passes.append(ShellFurLayerPass(f"{obj.label}.forward_layers", Phase.FORWARD, obj,
+                                        fragment=FORWARD_SHELL_FRAGMENT, colors=(COMPOSITE,),
+                                        constants=self.vertex_constants(obj)))
+        return passes

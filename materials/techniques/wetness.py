@@ -1,0 +1,181 @@
+"""The wetness mask (Silva et al., "Curling and Clumping Fur Represented by Texture Layers",
+section 3.1, Algorithm 1): a texture over the mesh's UVs whose texels say which clump of wet fur
+they belong to: (R, G) the clump centre, B its radius (both in UV units), A the wetness rho.
+
+Droplets are blended in one at a time with Algorithm 1, over the texels the droplet covers (UV
+distance to its centre at most its radius). A droplet whose centre is within its radius of a
+texel's clump centre joins that clump (centre and radius move toward the droplet's by its share
+of the wetness, the wetness adds up); any other texel it covers becomes part of a new clump: the
+droplet's. Dry texels hold no clump: their centre lies far outside UV space (``DRY_CENTRE``), so a
+droplet never mistakes the UV origin for the centre of a dry texel's clump, and a texel whose
+wetness dries to 0 is reset to dry (drying brings the curl back and dissolves the clump).
+
+The array is (size, size, 4) float32, row ``i`` at ``v = (i + 0.5) / size`` (GL's texel order:
+uploaded as it is), column ``j`` at ``u = (j + 0.5) / size``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from deferred.errors import InputError
+from deferred.imageio import read_image
+from deferred.mesh import MeshData
+
+DRY_CENTRE = -8.0  # the (R, G) of a dry texel: no clump centre is ever within reach of it
+
+
+@dataclass(frozen=True)
+class Droplet:
+    """A droplet in the mask's UV space: centre (u, v), radius (UV units), wetness in [0, 1]."""
+
+    centre: tuple[float, float]
+    radius: float
+    wetness: float
+
+
+def dry_mask(size: int) -> np.ndarray:
+    """A mask of dry fur: no clumps, wetness 0."""
+    mask = np.zeros((size, size, 4), np.float32)
+    mask[..., 0:2] = DRY_CENTRE
+    return mask
+
+
+def texel_centres(size: int) -> tuple[np.ndarray, np.ndarray]:
+    """(u, v) of every texel centre, each (size, size)."""
+    t = (np.arange(size) + 0.5) / size
+    v, u = np.meshgrid(t, t, indexing="ij")
+    return u, v
+
+
+def blend_droplet(mask: np.ndarray, droplet: Droplet) -> None:
+    """Blend ``droplet`` into ``mask`` in place with Algorithm 1, at every texel it covers."""
+    size = mask.shape[0]
+    cu, cv = droplet.centre
+    r = droplet.radius
+    # the texels whose centres can lie within r of the droplet's centre
+    j0, j1 = max(int(np.floor((cu - r) * size)), 0), min(int(np.ceil((cu + r) * size)), size)
+    i0, i1 = max(int(np.floor((cv - r) * size)), 0), min(int(np.ceil((cv + r) * size)), size)
+    if j0 >= j1 or i0 >= i1:
+        return
+    block = mask[i0:i1, j0:j1]
+    u = (np.arange(j0, j1) + 0.5) / size
+    v = (np.arange(i0, i1) + 0.5) / size
+    covered = (u[None, :] - cu) ** 2 + (v[:, None] - cv) ** 2 <= r * r
+
+    c_mask = block[..., 0:2].astype(np.float64)
+    r_mask = block[..., 2].astype(np.float64)
+    rho_mask = block[..., 3].astype(np.float64)
+    c_drop = np.array([cu, cv])
+    rho_drop = droplet.wetness
+    near = np.linalg.norm(c_mask - c_drop, axis=-1) <= r  # ||c_mask - c_drop|| <= r_drop
+    # joins the texel's clump where that clump is wet
+    joins = covered & near & (rho_mask != 0.0)
+    rho_total = np.clip(rho_mask + rho_drop, 0.0, 1.0)
+    merge = joins & (rho_total != 0.0)
+    alpha = np.where(merge, rho_drop / np.where(rho_total != 0.0, rho_total, 1.0), 0.0)
+    new_c = (1.0 - alpha)[..., None] * c_mask + alpha[..., None] * c_drop
+    new_r = (1.0 - alpha) * r_mask + alpha * r
+    # a new clump (the droplet's) where the texel's centre is out of reach
+    replace = covered & ~near
+    block[..., 0:2] = np.where(merge[..., None], new_c, block[..., 0:2])
+    block[..., 2] = np.where(merge, new_r, block[..., 2])
+    block[..., 3] = np.where(joins, rho_total, block[..., 3])
+    block[..., 0:2] = np.where(replace[..., None], c_drop, block[..., 0:2])
+    block[..., 2] = np.where(replace, r, block[..., 2])
+    block[..., 3] = np.where(replace, rho_drop, block[..., 3])
+    _reset_dry(block)
+
+
+def _reset_dry(mask: np.ndarray) -> None:
+    dry = mask[..., 3] <= 0.0
+    mask[..., 0:2][dry] = DRY_CENTRE
+    mask[..., 2][dry] = 0.0
+    mask[..., 3][dry] = 0.0
+
+
+def dry_out(mask: np.ndarray, amount: float) -> None:
+    """Lower every texel's wetness by ``amount`` (drying); texels reaching 0 become dry."""
+    if amount <= 0.0:
+        return
+    wet = mask[..., 3] > 0.0
+    mask[..., 3][wet] = np.maximum(mask[..., 3][wet] - amount, 0.0)
+    _reset_dry(mask)
+
+
+def uv_scale(mesh: MeshData, model: np.ndarray) -> np.ndarray:
+    """World units per UV unit of each triangle (sqrt of world area over UV area); 0 where the
+    triangle has no UV area."""
+    faces = np.asarray(mesh.indices, dtype=np.int64).reshape(-1, 3)
+    world = np.asarray(mesh.positions, np.float64) @ model[:3, :3].T
+    p = world[faces]
+    t = np.asarray(mesh.uvs, np.float64)[faces]
+    world_area = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=-1)
+    e1, e2 = t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]
+    uv_area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+    return np.where(uv_area > 1e-12, np.sqrt(world_area / np.maximum(uv_area, 1e-12)), 0.0)
+
+
+def random_droplets(mesh: MeshData, model: np.ndarray, count: int, radius: float,
+                    wetness: float, seed: int, start: int = 0) -> list[Droplet]:
+    """Droplets ``start .. start + count - 1`` of the object's seeded sequence: each hits the
+    surface at a uniformly random point (by world area), with a radius of ``radius`` world units
+    times a random 0.7 .. 1, converted to UV units by the hit triangle's UV scale."""
+    if count <= 0:
+        return []
+    faces = np.asarray(mesh.indices, dtype=np.int64).reshape(-1, 3)
+    world = np.asarray(mesh.positions, np.float64) @ model[:3, :3].T
+    p = world[faces]
+    area = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=-1)
+    scale = uv_scale(mesh, model)
+    weights = np.where(scale > 0.0, area, 0.0)
+    if weights.sum() <= 0.0:
+        raise InputError(f"mesh {mesh.name} has no UV area for droplets to land on")
+    rng = np.random.default_rng([seed, 0x5EED])
+    # the whole sequence up to the last droplet asked for, so droplet k is the same whatever
+    # the batch it falls in
+    total = start + count
+    tri = rng.choice(len(faces), size=total, p=weights / weights.sum())
+    a, b = rng.uniform(0.0, 1.0, (2, total))
+    flip = a + b > 1.0
+    a, b = np.where(flip, 1.0 - a, a), np.where(flip, 1.0 - b, b)
+    jitter = rng.uniform(0.7, 1.0, total)
+    uv = np.asarray(mesh.uvs, np.float64)[faces[tri]]
+    centres = uv[:, 0] + a[:, None] * (uv[:, 1] - uv[:, 0]) + b[:, None] * (uv[:, 2] - uv[:, 0])
+    radii = radius * jitter / scale[tri]
+    return [Droplet((float(c[0]), float(c[1])), float(r), float(wetness))
+            for c, r in zip(centres[start:], radii[start:], strict=True)]
+
+
+def load_wetness_mask(path: Path, size: int) -> np.ndarray:
+    """A wetness mask image (R, G clump centre, B radius, A wetness; as stored, no sRGB
+    decoding; top row first as images are) as a mask array of ``size``. Texels of wetness 0 are
+    dry. The image is resampled (nearest) to ``size``: centres must never be interpolated."""
+    pixels = read_image(path)
+    if pixels.shape[-1] < 4:
+        raise InputError(f"wetness mask {path.name} needs 4 channels (R, G centre, B radius, "
+                         f"A wetness), it has {pixels.shape[-1]}")
+    height, width = pixels.shape[:2]
+    rows = (np.arange(size) + 0.5) / size * height
+    cols = (np.arange(size) + 0.5) / size * width
+    # the image's top row is v = 1: the mask's last row
+    image_rows = (height - 1 - np.floor(rows).astype(int)).clip(0, height - 1)
+    image_cols = np.floor(cols).astype(int).clip(0, width - 1)
+    mask = np.ascontiguousarray(pixels[image_rows][:, image_cols, :4], dtype=np.float32)
+    if not np.isfinite(mask).all():
+        raise InputError(f"wetness mask {path.name} holds values that are not finite")
+    mask[..., 3] = np.clip(mask[..., 3], 0.0, 1.0)
+    _reset_dry(mask)
+    return mask
+
+
+def mask_image(mask: np.ndarray) -> np.ndarray:
+    """The mask as an image to save (top row first, dry texels black): the inverse of
+    :func:`load_wetness_mask` for masks of wet texels with centres in [0, 1]."""
+    image = mask[::-1].copy()
+    dry = image[..., 3] <= 0.0
+    image[dry] = 0.0
+    return image

@@ -1,0 +1,49 @@
+// Fur clumping (Silva et al. 3.3, Eq. 5, Algorithm 2) in the fragment shader: texture
+// coordinates of a wet layer fragment are displaced away from its clump's centre, so the fur it
+// shows comes from nearer the rim and the strands seem to gather toward the centre with height.
+//
+// The wetness mask (materials/techniques/wetness.py): (R, G) clump centre, B radius (UV units),
+// A wetness rho; sampled nearest (a centre is never interpolated).
+//
+// Eq. 5: d = ((1 - w) h + w (1 + ln(h) / ln N)) rho s (c_pixel - c_mask).
+//  - The printed k = -ln N makes the log term 2 at the first layer (h = 1/N) and 1 at the tip,
+//    the reverse of the straight term and of Fig. 9; with k = ln N it rises from 0 to 1 like the
+//    straight term, bending in early (Fig. 9 c, d), which is what we use.
+//  - The printed factor r_mask is read as measuring the offset in clump radii, where it cancels:
+//    a clump gathers the same share of its radius whatever its size (Fig. 13). s, the
+//    clump_strength, scales it: 1 gathers the tips of fully wet fur into half the radius.
+// Algorithm 2 ignores a displaced coordinate that falls on dry fur; we also ignore one that
+// falls in another clump (a centre more than half a radius away): without it neighbouring wet
+// clumps run into each other and fur wet all over shows no clumps at all.
+
+uniform sampler2D u_wetness_mask;
+uniform float u_clump_shape;     // w
+uniform float u_clump_strength;  // s
+uniform float u_layers;          // N, the most layers (shells)
+
+// (1 - w) h + w (1 + ln(h) / ln N), h kept to the layers' range [1/N, 1].
+float clump_profile(float h, float w, float layers) {
+    float n = max(layers, 2.0);
+    float hh = clamp(h, 1.0 / n, 1.0);
+    return (1.0 - w) * hh + w * (1.0 + log(hh) / log(n));
+}
+
+// Eq. 5 for a texel of the mask.
+vec2 clump_displacement(float h, vec4 mask, vec2 c_pixel, float w, float layers, float strength) {
+    return clump_profile(h, w, layers) * mask.a * strength * (c_pixel - mask.rg);
+}
+
+// Algorithm 2 at texture coordinate `uv` and height h: the displacement d to add to the colour
+// and fur coordinates, and whether the fragment is kept (false: it belongs to another clump, or
+// its displaced coordinate falls on dry fur). Dry fragments keep their coordinates.
+bool clump_fur(vec2 uv, float h, out vec2 d) {
+    d = vec2(0.0);
+    vec4 mask = textureLod(u_wetness_mask, uv, 0.0);
+    if (mask.a == 0.0) return true;
+    d = clump_displacement(h, mask, uv, u_clump_shape, u_layers, u_clump_strength);
+    if (distance(uv, mask.rg) > mask.b) return false;        // from a different clump
+    vec4 there = textureLod(u_wetness_mask, uv + d, 0.0);
+    if (there.a == 0.0) return false;                                 // from a dry area
+    if (distance(there.rg, mask.rg) > 0.5 * mask.b) return false;    // from another clump
+    return true;
+}

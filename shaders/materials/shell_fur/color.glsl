@@ -1,0 +1,9 @@
+// The fur's colour (Silva et al. section 4, Fig. 3): the colour texture (an image, or a generated
+// pattern) over the mesh's UVs, tinted.
+uniform sampler2D u_color_map;  // linear RGB (an sRGB image is decoded on load)
+uniform vec3 u_color;           // tint
+uniform float u_color_scale;    // repeats of the texture across the UV square
+
+vec3 fur_color(vec2 uv) {
+    return u_color * texture(u_color_map, uv * u_color_scale).rgb;
+}

@@ -1,0 +1,56 @@
+// shell_fur, forward pipeline: each layer (and fin) fragment lit by every light directly, with
+// Kajiya-Kay along the strand's own tangent at this layer (Silva et al. Eq. 6: C_frag =
+// gamma(C_d + C_s)); colour and strands from the clumped coordinates as in the deferred layers.
+#include "common/surface_input.glsl"
+#include "common/forward_lighting.glsl"
+#include "techniques/fur.glsl"
+#include "techniques/strand_tangent.glsl"
+#include "materials/shell_fur/layer.glsl"
+#include "materials/shell_fur/color.glsl"
+#include "materials/shell_fur/debug.glsl"
+// the surface file (which declares v_strand_tangent)
+#include SURFACE_FILE
+
+uniform float u_shell_fade;
+uniform float u_shell_weight;
+uniform float u_shell_count;
+uniform bool u_root_shell;
+
+in float v_shell_depth;
+in vec3 v_fur_position;
+in vec3 v_fur_normal;
+#ifdef FUR_FINS
+in float v_fin_fade;
+#endif
+out vec4 out_color;
+
+void main() {
+    FurLayer layer = fur_layer(v_uv, v_fur_position, v_shell_depth, u_root_shell);
+    vec2 strands = fur_sample(layer.fur_position, v_fur_normal, v_shell_depth);
+    vec3 albedo = fur_color(layer.color_uv);
+    float alpha = u_root_shell ? 1.0 : shell_opacity(strands.x, u_shell_weight) * u_shell_fade;
+#ifdef FUR_FINS
+    alpha *= v_fin_fade * smoothstep(0.0, 0.35, v_shell_depth);
+#endif
+    vec4 debug;
+    if (fur_debug_view(v_uv, strands, u_shell_count, alpha, debug)) {
+        out_color = debug;
+        return;
+    }
+    if (!layer.kept || alpha < 0.5 / 255.0) discard;
+#ifdef FUR_DEBUG_SAMPLES
+    out_color = vec4(1.0);  // forward: every fragment is lit directly, no samples (white)
+    return;
+#endif
+    Surface s;
+    s.albedo = albedo;
+    s.specular_intensity = u_specular_intensity;
+    s.specular_exponent = u_specular_exponent;
+    s.normal = normalize(v_normal);
+    s.occlusion = 1.0;
+    s.shading_model = surface_shading_model(u_surface_id);
+    s.data.strand_tangent = strand_tangent_encode(v_strand_tangent);
+    vec3 light = forward_lighting(s, v_position, normalize(-v_position));
+    float brightness = mix(1.0, strands.y / max(strands.x, 1e-4), min(strands.x, 1.0));
+    out_color = vec4(light * fur_shadow(v_shell_depth) * brightness, alpha);
+}

@@ -1,0 +1,112 @@
+// shell_fur: the mesh as the fur layer at normalized length h = u_shell_depth (0 the skin),
+// displaced by Silva et al.'s v_offset(h) = beta(h) + phi(h) (Eq. 1; strand.glsl): the Bezier
+// of the vertex's simulated strand (the tip deflection p - p_0 of its triangles, averaged, in
+// u_strand_tips at the vertex's index) and the curl, which the wetness at the vertex undoes.
+// v_strand_tangent is the strand's direction there (d v_offset / dh), or with STRAND_CHORD the
+// strand's chord, root to simulated tip (the base surface, the skin and the fins: one direction
+// for the whole strand, the curl averaged out). With FUR_FINS the outputs feed the fin geometry
+// shader (techniques/fins.geom) under vs_ names.
+#include "materials/shell_fur/strand.glsl"
+
+in vec3 in_position;
+in vec3 in_normal;
+in vec2 in_uv;
+in vec3 in_tangent;
+in vec3 in_binormal;
+in vec4 in_comb;
+
+uniform mat4 u_model_view;
+uniform mat4 u_projection;
+uniform mat3 u_normal_matrix;
+uniform float u_shell_depth;    // h
+uniform float u_fur_length;     // object units, scaled per vertex by the vertex colour alpha
+uniform vec3 u_fur_scale;       // object axes to world units (the model matrix's scale)
+uniform float u_curl_radius;    // K, object units
+uniform float u_curl_frequency; // w, radians over the strand
+uniform sampler2D u_wetness_mask;
+uniform sampler2D u_strand_tips;  // RGBA32F: per vertex p - p_0, object space
+
+#ifdef FUR_FINS
+#define v_position vs_position
+#define v_normal vs_normal
+#define v_tangent vs_tangent
+#define v_binormal vs_binormal
+#define v_uv vs_uv
+#define v_comb vs_comb
+#define v_base_clip vs_base_clip
+#define v_tip_clip vs_tip_clip
+#define v_base_depth vs_base_depth
+#define v_tip_depth vs_tip_depth
+#define v_fur_extent vs_fur_extent
+#define v_shell_depth vs_shell_depth
+#define v_fur_position vs_fur_position
+#define v_fur_normal vs_fur_normal
+#define v_tip_position vs_tip_position
+#define v_strand_tangent vs_strand_tangent
+#endif
+
+out vec3 v_position;
+out vec3 v_normal;
+out vec3 v_tangent;
+out vec3 v_binormal;
+out vec2 v_uv;
+out vec4 v_comb;
+out vec4 v_base_clip;     // the root under this layer point (its light sample)
+out vec4 v_tip_clip;      // the strand's tip (fins)
+out float v_base_depth;   // linear view depths of those two points
+out float v_tip_depth;
+out float v_fur_extent;   // view-space length of the strand at this vertex
+out float v_shell_depth;
+out vec3 v_fur_position;  // the root in world-scaled object space (fur volume lookups)
+out vec3 v_fur_normal;    // object-space normal (triplanar weights)
+out vec3 v_tip_position;  // view space (fins)
+out vec3 v_strand_tangent;  // view space
+
+invariant gl_Position;
+
+vec3 strand_offset(float h, vec3 rest_tip, vec3 tip, float wetness) {
+    return strand_bend(in_position, rest_tip, tip, h)
+         + curl_offset(h, wetness, u_curl_radius, u_curl_frequency, in_tangent, in_binormal);
+}
+
+void main() {
+    float fur_length = u_fur_length * in_comb.a;
+    vec3 rest_tip = in_position + in_normal * fur_length;  // p_0
+    int width = textureSize(u_strand_tips, 0).x;
+    vec3 deflection = texelFetch(u_strand_tips, ivec2(gl_VertexID % width, gl_VertexID / width),
+                                 0).xyz;
+    vec3 tip = constrain_tip(in_position, in_normal, fur_length, rest_tip + deflection);
+    float wetness = textureLod(u_wetness_mask, in_uv, 0.0).a;
+
+    float h = u_shell_depth;
+    vec3 layer = in_position + strand_offset(h, rest_tip, tip, wetness);
+    vec3 tip_point = in_position + strand_offset(1.0, rest_tip, tip, wetness);
+#ifdef STRAND_CHORD
+    vec3 direction = tip - in_position;
+#else
+    vec3 direction = strand_bend_derivative(in_position, rest_tip, tip, h)
+        + curl_derivative(h, wetness, u_curl_radius, u_curl_frequency, in_tangent, in_binormal);
+#endif
+    direction = dot(direction, direction) > 1e-20 ? direction : in_normal;
+
+    vec4 position = u_model_view * vec4(layer, 1.0);
+    vec4 base_view = u_model_view * vec4(in_position, 1.0);
+    vec4 tip_view = u_model_view * vec4(tip_point, 1.0);
+    v_position = position.xyz;
+    v_normal = normalize(u_normal_matrix * in_normal);
+    v_tangent = normalize(mat3(u_model_view) * in_tangent);
+    v_binormal = normalize(mat3(u_model_view) * in_binormal);
+    v_uv = in_uv;
+    v_comb = in_comb;
+    v_base_clip = u_projection * base_view;
+    v_tip_clip = u_projection * tip_view;
+    v_base_depth = -base_view.z;
+    v_tip_depth = -tip_view.z;
+    v_fur_extent = length(tip_view.xyz - base_view.xyz);
+    v_shell_depth = h;
+    v_fur_position = in_position * u_fur_scale;
+    v_fur_normal = in_normal;
+    v_tip_position = tip_view.xyz;
+    v_strand_tangent = normalize(mat3(u_model_view) * direction);
+    gl_Position = u_projection * position;
+}

@@ -1,0 +1,62 @@
+// shell_fur, deferred material phase: the layers (and fins) of Silva et al.'s fur, composited
+// over the lit scene. A fragment's strands and colour come from its clumped coordinates
+// (Algorithm 2, layer.glsl); its light from the light accumulation at the root under it (the
+// lights shaded the base surface with kajiya_kay along the strand's chord, the G-buffer's
+// strand_tangent), divided by the base albedo and multiplied by this layer's colour and the
+// shadow factor gamma(h) (Eq. 6). So the layers cost the same whatever the number of lights;
+// what they lose against the forward pipeline is the tangent of each layer (one per strand
+// here) and the light's variation between the root and the layer.
+#include "techniques/fur.glsl"
+#include "techniques/accumulated_light.glsl"
+#include "materials/shell_fur/layer.glsl"
+#include "materials/shell_fur/color.glsl"
+#include "materials/shell_fur/debug.glsl"
+
+uniform float u_shell_fade;    // the outermost layer fades in with the level of detail
+uniform float u_shell_weight;  // slices of the fur volume per layer (shell_opacity)
+uniform float u_shell_count;   // layers drawn / the most (the shell_count debug view)
+uniform bool u_root_shell;     // the skin: opaque, with the roots on it
+
+in vec2 v_uv;
+in vec4 v_base_clip;
+in float v_base_depth;
+in float v_fur_extent;
+in float v_shell_depth;
+in vec3 v_fur_position;
+in vec3 v_fur_normal;
+#ifdef FUR_FINS
+in float v_fin_fade;
+#endif
+
+out vec4 out_color;
+
+void main() {
+    FurLayer layer = fur_layer(v_uv, v_fur_position, v_shell_depth, u_root_shell);
+    vec2 strands = fur_sample(layer.fur_position, v_fur_normal, v_shell_depth);
+    vec3 albedo = fur_color(layer.color_uv) * fur_shadow(v_shell_depth);
+    float alpha = u_root_shell ? 1.0 : shell_opacity(strands.x, u_shell_weight) * u_shell_fade;
+#ifdef FUR_FINS
+    alpha *= v_fin_fade * smoothstep(0.0, 0.35, v_shell_depth);
+#endif
+    vec4 debug;
+    if (fur_debug_view(v_uv, strands, u_shell_count, alpha, debug)) {
+        out_color = debug;
+        return;
+    }
+    if (!layer.kept || alpha < 0.5 / 255.0) discard;
+    float tolerance = 0.5 * v_fur_extent + 0.002 * v_base_depth;
+    vec3 irradiance;
+    bool base_valid = base_irradiance(pixel_of(v_base_clip), v_base_depth, tolerance,
+                                      irradiance);
+    bool own_valid = !base_valid && own_pixel_holds_fur();
+#ifdef FUR_DEBUG_SAMPLES
+    out_color = vec4(own_valid || !base_valid ? 1.0 : 0.0, base_valid || own_valid ? 1.0 : 0.0,
+                     0.0, 1.0);
+    return;
+#endif
+    if (!base_valid && !own_valid) discard;  // the strand's light is unknown
+    if (own_valid) irradiance = irradiance_at(ivec2(gl_FragCoord.xy));
+    // strands' own brightness where they cover; the skin between them on the root layer
+    float brightness = mix(1.0, strands.y / max(strands.x, 1e-4), min(strands.x, 1.0));
+    out_color = vec4(irradiance * albedo * brightness, alpha);
+}

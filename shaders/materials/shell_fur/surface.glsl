@@ -1,0 +1,22 @@
+// shell_fur's base surface (the G-buffer and the forward base pass): the colour texture, the
+// Kajiya-Kay specular, and the strand's chord as the G-buffer's strand_tangent (fur.vert with
+// STRAND_CHORD), which the lights shade and the deferred layers take their light from. What
+// shows of it is the skin drawn over it.
+#include "common/surface.glsl"
+#include "techniques/strand_tangent.glsl"
+#include "materials/shell_fur/color.glsl"
+
+uniform float u_specular_intensity;  // K_s
+uniform float u_specular_exponent;   // p_phong
+
+in vec3 v_strand_tangent;
+
+Surface material_surface(SurfaceInput i) {
+    Surface s;
+    s.albedo = fur_color(i.uv);
+    s.specular_intensity = u_specular_intensity;
+    s.specular_exponent = u_specular_exponent;
+    s.normal = i.normal;
+    s.data.strand_tangent = strand_tangent_encode(v_strand_tangent);
+    return s;
+}
