@@ -51,7 +51,14 @@ from .techniques.fur import (
 from .techniques.fur_volume import VOLUME_LAYERS
 from .techniques.shells import ShellPass
 from .techniques.strands import StrandForces, StrandSimulation, VertexAverage, triangle_strands
-from .techniques.wetness import blend_droplet, dry_mask, dry_out, load_wetness_mask, random_droplets
+from .techniques.wetness import (
+    blend_droplet,
+    dry_mask,
+    dry_out,
+    load_wetness_mask,
+    random_droplets,
+    read_mask_image,
+)
 
 if TYPE_CHECKING:
     from deferred.frame import Frame
@@ -377,12 +384,9 @@ class ShellFurMaterial(Material):
             if not path.is_file():
                 raise InputError(f"image not found: {path}", name)
             try:
-                pixels = read_image(path)
+                read_mask_image(path) if key == "wetness_mask" else read_image(path)
             except InputError as exc:
-                raise InputError(f"cannot read image {path.name}: {exc.message}", name) from None
-            if key == "wetness_mask" and pixels.shape[-1] < 4:
-                raise InputError(f"wetness mask {path.name} needs 4 channels (R, G centre, "
-                                 f"B radius, A wetness), it has {pixels.shape[-1]}", name)
+                raise InputError(exc.message, name) from None
 
     def heightfield_path(self) -> Path | None:
         return None if self.params.heightfield is None else \

@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from deferred.errors import InputError
-from deferred.imageio import read_image
+from deferred.imageio import read_channels, read_image
 from deferred.mesh import MeshData
 
 DRY_CENTRE = -8.0  # the (R, G) of a dry texel: no clump centre is ever within reach of it
@@ -150,14 +150,22 @@ def random_droplets(mesh: MeshData, model: np.ndarray, count: int, radius: float
             for c, r in zip(centres[start:], radii[start:], strict=True)]
 
 
+def read_mask_image(path: Path) -> np.ndarray:
+    """A wetness mask image's pixels, (H, W, 4) RGBA as stored (no sRGB decoding), top row
+    first; ``InputError`` unless it has the four channels (an RGB image is not a mask with
+    wetness 1 everywhere)."""
+    _, names, _ = read_channels(path)
+    if len(names) < 4:
+        raise InputError(f"wetness mask {path.name} needs 4 channels (R, G centre, B radius, "
+                         f"A wetness), it has {len(names)}")
+    return read_image(path)
+
+
 def load_wetness_mask(path: Path, size: int) -> np.ndarray:
     """A wetness mask image (R, G clump centre, B radius, A wetness; as stored, no sRGB
     decoding; top row first as images are) as a mask array of ``size``. Texels of wetness 0 are
     dry. The image is resampled (nearest) to ``size``: centres must never be interpolated."""
-    pixels = read_image(path)
-    if pixels.shape[-1] < 4:
-        raise InputError(f"wetness mask {path.name} needs 4 channels (R, G centre, B radius, "
-                         f"A wetness), it has {pixels.shape[-1]}")
+    pixels = read_mask_image(path)
     height, width = pixels.shape[:2]
     rows = (np.arange(size) + 0.5) / size * height
     cols = (np.arange(size) + 0.5) / size * width

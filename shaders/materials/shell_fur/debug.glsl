@@ -8,7 +8,7 @@ vec3 clump_hue(vec2 centre) {
     return 0.25 + 0.75 * h;
 }
 
-bool fur_debug_view(vec2 uv, vec2 strands, float shell_count, float alpha, out vec4 color) {
+bool fur_debug_view(vec2 uv, vec2 strands, bool kept, float shell_count, out vec4 color) {
     color = vec4(0.0);
 #if defined(FUR_DEBUG_WETNESS)
     // the wetness mask on the skin: a colour per clump, as bright as it is wet; dry black
@@ -19,8 +19,8 @@ bool fur_debug_view(vec2 uv, vec2 strands, float shell_count, float alpha, out v
     color = vec4(mix(vec3(0.1, 0.2, 1.0), vec3(1.0, 0.15, 0.1), shell_count), 1.0);
     return true;
 #elif defined(FUR_DEBUG_SINGLE_SHELL)
-    // the cut through the strands, opaque (after clumping)
-    if (strands.x <= 0.02) discard;
+    // the cut through the strands, opaque, after clumping (Algorithm 2's ignored fragments too)
+    if (!kept || strands.x <= 0.02) discard;
     color = vec4(vec3(1.0), 1.0);
     return true;
 #else

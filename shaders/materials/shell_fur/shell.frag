@@ -39,7 +39,7 @@ void main() {
     alpha *= v_fin_fade * smoothstep(0.0, 0.35, v_shell_depth);
 #endif
     vec4 debug;
-    if (fur_debug_view(v_uv, strands, u_shell_count, alpha, debug)) {
+    if (fur_debug_view(v_uv, strands, layer.kept, u_shell_count, debug)) {
         out_color = debug;
         return;
     }

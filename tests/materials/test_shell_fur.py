@@ -1,0 +1,539 @@
+"""shell_fur (Silva et al., "Curling and Clumping Fur Represented by Texture Layers"): the
+paper's algorithms and equations against independent numpy references, the GLSL through
+transform feedback, and the behaviour of the rendered fur."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import moderngl
+import numpy as np
+import pytest
+
+from deferred.imageio import write_image
+from deferred.materials.shell_fur import ShellFurMaterial, ShellFurState, layer_layout
+from deferred.materials.techniques.strands import StrandForces, StrandSimulation, triangle_strands
+from deferred.materials.techniques.wetness import (
+    DRY_CENTRE,
+    Droplet,
+    blend_droplet,
+    dry_mask,
+    dry_out,
+    load_wetness_mask,
+    mask_image,
+)
+from deferred.mesh import builtin_plane, builtin_sphere
+from deferred.scene import scene_from_dict
+from deferred.shaderlib import ShaderLibrary
+
+HARNESS = Path(__file__).parents[1] / "fixtures" / "shell_fur_harness"
+
+
+# -- Algorithm 1 ------------------------------------------------------------------------------
+
+def algorithm1_reference(mask: np.ndarray, c_drop, r_drop: float, rho_drop: float) -> np.ndarray:
+    """Algorithm 1 as printed, texel by texel, over the texels within r_drop of c_drop."""
+    out = mask.astype(np.float64).copy()
+    size = mask.shape[0]
+    c_drop = np.asarray(c_drop, np.float64)
+    for i in range(size):
+        for j in range(size):
+            texel = np.array([(j + 0.5) / size, (i + 0.5) / size])
+            if np.linalg.norm(texel - c_drop) > r_drop:
+                continue
+            c_mask, r_mask, rho_mask = out[i, j, :2].copy(), out[i, j, 2], out[i, j, 3]
+            if np.linalg.norm(c_mask - c_drop) <= r_drop:
+                if rho_mask != 0.0:
+                    rho_total = min(max(rho_mask + rho_drop, 0.0), 1.0)
+                    if rho_total != 0.0:
+                        alpha = rho_drop / rho_total
+                        c_mask = (1.0 - alpha) * c_mask + alpha * c_drop
+                        r_mask = (1.0 - alpha) * r_mask + alpha * r_drop
+                    rho_mask = rho_total
+            else:
+                c_mask, rho_mask, r_mask = c_drop.copy(), rho_drop, r_drop
+            out[i, j] = (*c_mask, r_mask, rho_mask)
+    return out
+
+
+def assert_masks_match(mask: np.ndarray, reference: np.ndarray) -> None:
+    """Same wetness everywhere; same clump (centre, radius) wherever the fur is wet (a texel of
+    wetness 0 holds no clump, whatever centre it was given)."""
+    np.testing.assert_allclose(mask[..., 3], reference[..., 3], atol=1e-6)
+    wet = reference[..., 3] > 0.0
+    np.testing.assert_allclose(mask[wet][:, :3], reference[wet][:, :3], atol=1e-6)
+
+
+@pytest.mark.parametrize("case", ["no_overlap", "overlap_merges", "overlap_new_clump",
+                                  "zero_wetness", "saturates"])
+def test_algorithm1_against_the_printed_algorithm(case):
+    size = 32
+    droplets = {
+        "no_overlap": [Droplet((0.25, 0.25), 0.1, 0.6), Droplet((0.75, 0.7), 0.12, 0.3)],
+        # the second centre lies within its radius of the first's: one clump, moved
+        "overlap_merges": [Droplet((0.4, 0.5), 0.2, 0.6), Droplet((0.5, 0.5), 0.15, 0.3)],
+        # centres farther apart than the radius: the overlap becomes the second's clump
+        "overlap_new_clump": [Droplet((0.3, 0.5), 0.2, 0.5), Droplet((0.6, 0.5), 0.2, 0.4)],
+        "zero_wetness": [Droplet((0.5, 0.5), 0.2, 0.0), Droplet((0.3, 0.3), 0.15, 0.7),
+                         Droplet((0.32, 0.3), 0.15, 0.0)],
+        "saturates": [Droplet((0.5, 0.5), 0.2, 0.8), Droplet((0.52, 0.5), 0.2, 0.8)],
+    }[case]
+    mask = dry_mask(size)
+    reference = dry_mask(size).astype(np.float64)
+    for droplet in droplets:
+        blend_droplet(mask, droplet)
+        reference = algorithm1_reference(reference, droplet.centre, droplet.radius,
+                                         droplet.wetness)
+    assert_masks_match(mask, reference)
+    wet = mask[..., 3] > 0
+    if case == "zero_wetness":
+        # a droplet of wetness 0 wets nothing and leaves a wet clump as it was
+        only_second = dry_mask(size)
+        blend_droplet(only_second, droplets[1])
+        np.testing.assert_array_equal(mask, only_second)
+    if case == "overlap_merges":
+        # by hand: alpha = 0.3 / 0.9 of the way to the second centre, wetness 0.9
+        both = wet & (np.abs(mask[..., 3] - 0.9) < 1e-6)
+        assert both.sum() > 50
+        np.testing.assert_allclose(mask[both][:, 0], 0.4 + (0.1 / 3.0), atol=1e-6)
+        np.testing.assert_allclose(mask[both][:, 2], 0.2 + (0.15 - 0.2) / 3.0, atol=1e-6)
+    if case == "overlap_new_clump":
+        centres = {(round(float(c[0]), 5), round(float(c[1]), 5)) for c in mask[wet][:, :2]}
+        assert centres == {(0.3, 0.5), (0.6, 0.5)}
+    if case == "saturates":
+        assert mask[..., 3].max() == pytest.approx(1.0)
+    assert (mask[~wet][:, :2] == DRY_CENTRE).all()
+
+
+def test_drying_resets_texels_to_dry_and_rewets():
+    mask = dry_mask(16)
+    blend_droplet(mask, Droplet((0.5, 0.5), 0.3, 0.5))
+    dry_out(mask, 0.2)
+    assert mask[..., 3].max() == pytest.approx(0.3)
+    dry_out(mask, 0.5)
+    np.testing.assert_array_equal(mask, dry_mask(16))
+    # dried fur takes a new droplet at the same place (its old clump is gone)
+    blend_droplet(mask, Droplet((0.5, 0.5), 0.3, 0.5))
+    assert mask[..., 3].max() == pytest.approx(0.5)
+
+
+def test_wetness_mask_image_round_trip(tmp_path):
+    mask = dry_mask(32)
+    blend_droplet(mask, Droplet((0.25, 0.75), 0.15, 1.0))
+    path = tmp_path / "mask.exr"
+    write_image(path, mask_image(mask))
+    loaded = load_wetness_mask(path, 32)
+    assert_masks_match(loaded, mask)
+    # the clump stays in the top-left quarter of the image (v = 1 is the top row)
+    image = mask_image(mask)
+    rows, cols = np.nonzero(image[..., 3] > 0)
+    assert rows.mean() < 16 and cols.mean() < 16
+
+
+# -- strands: Eq. 2 and 3 ----------------------------------------------------------------------
+
+def one_strand(normal=(0.0, 1.0, 0.0), length=0.2) -> StrandSimulation:
+    return StrandSimulation(np.zeros((1, 3)), np.array([normal], float), np.array([length]))
+
+
+def settle(sim: StrandSimulation, forces: StrandForces, seconds=20.0, dt=1.0 / 240.0):
+    for _ in range(int(seconds / dt)):
+        sim.step(dt, forces)
+
+
+def test_strand_under_gravity_settles_where_the_spring_balances_the_weight():
+    k, m, g = 3.0, 0.02, 9.81
+    sim = one_strand()
+    settle(sim, StrandForces(k, m, 0.2, np.array([0.0, -g, 0.0]), np.zeros(3)))
+    # inside the region: the spring alone holds the weight, k (p - p0) = m g
+    np.testing.assert_allclose(sim.tips[0], [0.0, 0.2 - m * g / k, 0.0], atol=1e-6)
+    np.testing.assert_allclose(sim.velocities[0], 0.0, atol=1e-6)
+
+
+def test_strand_pulled_sideways_rests_on_the_length_constraint_balanced():
+    k, m = 3.0, 0.02
+    gravity = np.array([9.81, 0.0, 0.0])  # along the surface
+    sim = one_strand()
+    settle(sim, StrandForces(k, m, 0.2, gravity, np.zeros(3)))
+    r = sim.tips[0] - sim.roots[0]
+    assert np.linalg.norm(r) == pytest.approx(0.2, abs=1e-9)  # on the sphere of Eq. 3
+    force = -k * (sim.tips[0] - sim.rest[0]) + m * gravity
+    radial = r / np.linalg.norm(r)
+    tangential = force - (force @ radial) * radial
+    assert np.linalg.norm(tangential) < 1e-6 * np.linalg.norm(force)  # no force along it
+    assert force @ radial > 0.0  # it pushes outward: the constraint holds it
+    assert sim.tips[0, 0] > 0.0
+
+
+def test_strands_never_leave_the_region_of_eq3_in_strong_wind():
+    mesh = builtin_sphere(24, 12)
+    sim = StrandSimulation(*triangle_strands(mesh, np.eye(4), 0.15))
+    rng = np.random.default_rng(3)
+    dt = 1.0 / 240.0
+    for _ in range(600):
+        wind = rng.normal(0.0, 50.0, (len(sim.roots), 3))  # violent, different per strand
+        sim.step(dt, StrandForces(2.0, 0.01, 0.0, np.array([0.0, -9.81, 0.0]), wind))
+        offset = sim.tips - sim.roots
+        assert (np.linalg.norm(offset, axis=1) <= sim.lengths * (1 + 1e-9) + 1e-12).all()
+        assert (np.einsum("ij,ij->i", offset, sim.normals) >= -1e-12).all()
+    # the wind did move them
+    assert np.linalg.norm(sim.tips - sim.rest, axis=1).mean() > 0.05
+
+
+def test_triangle_strands_point_outward_and_scale_to_world():
+    mesh = builtin_sphere(16, 8)
+    model = np.diag([2.0, 2.0, 2.0, 1.0])
+    roots, normals, lengths = triangle_strands(mesh, model, 0.1)
+    live = lengths > 0
+    assert (np.einsum("ij,ij->i", roots[live], normals[live]) > 0).all()
+    np.testing.assert_allclose(lengths[live], 0.2, rtol=1e-6)
+
+
+# -- GLSL through transform feedback -------------------------------------------------------------
+
+@pytest.fixture
+def shaders(gl):
+    lib = ShaderLibrary(gl.ctx, 330)
+    lib.add_root(HARNESS)
+    yield lib
+    lib.release()
+
+
+def float_texture(ctx, array: np.ndarray, repeat=True) -> moderngl.Texture:
+    height, width = array.shape[:2]
+    texture = ctx.texture((width, height), 4, np.ascontiguousarray(array, np.float32).tobytes(),
+                          dtype="f4")
+    texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+    texture.repeat_x = texture.repeat_y = repeat
+    return texture
+
+
+def transform(gl, program, buffers, count: int, floats: int) -> np.ndarray:
+    """Run ``program``'s vertex shader over ``count`` vertices; its varyings, interleaved."""
+    ctx = gl.ctx
+    gl.park()  # a draw needs a framebuffer bound, even with rasterization off
+    out = ctx.buffer(reserve=count * floats * 4)
+    vao = ctx.vertex_array(program, buffers)
+    vao.transform(out, moderngl.POINTS, vertices=count)
+    result = np.frombuffer(out.read(), np.float32).reshape(count, floats).astype(np.float64)
+    vao.release()
+    out.release()
+    return result
+
+
+def eq5_reference(h, mask, pixel, w, layers, strength):
+    """Eq. 5 with k = ln N (the clump.glsl note) and h within the layers' [1/N, 1]."""
+    h = np.clip(h, 1.0 / layers, 1.0)
+    profile = (1.0 - w) * h + w * (1.0 + np.log(h) / np.log(layers))
+    return profile, (profile * mask[:, 3] * strength)[:, None] * (pixel - mask[:, :2])
+
+
+def test_eq5_and_algorithm2_in_glsl_against_numpy(gl, shaders):
+    ctx = gl.ctx
+    source = shaders.assemble("clump.vert").text
+    program = ctx.program(vertex_shader=source,
+                          varyings=["out_profile", "out_d", "out_fur_d", "out_kept"])
+    rng = np.random.default_rng(5)
+    n = 64
+    h = np.concatenate([[0.0, 1.0 / 16.0, 0.5, 1.0], rng.uniform(0.0, 1.0, n - 4)])
+    mask = np.column_stack([rng.uniform(0.3, 0.7, (n, 2)), rng.uniform(0.05, 0.2, n),
+                            rng.uniform(0.0, 1.0, n)])
+    mask[:8, 3] = 0.0  # dry texels
+    pixel = mask[:, :2] + rng.uniform(-0.2, 0.2, (n, 2))
+
+    # a wetness mask with one clump: centre (0.5, 0.5), radius 0.25, wetness 0.8
+    size = 64
+    image = dry_mask(size)
+    blend_droplet(image, Droplet((0.5, 0.5), 0.25, 0.8))
+    # and a texel row whose stored centre lies farther than its radius (another clump's)
+    image[8, :, :] = (0.5, 0.9, 0.05, 0.5)
+    texture = float_texture(ctx, image)
+    texture.use(0)
+    w, layers, strength = 0.7, 16.0, 1.5
+    for name, value in (("u_clump_shape", w), ("u_layers", layers),
+                        ("u_clump_strength", strength), ("u_wetness_mask", 0)):
+        program[name].value = value
+    data = np.column_stack([h, mask, pixel]).astype(np.float32)
+    vbo = ctx.buffer(data.tobytes())
+    out = transform(gl, program, [(vbo, "1f 4f 2f", "in_h", "in_mask", "in_pixel")], n, 6)
+
+    profile, d = eq5_reference(h, mask, pixel, w, layers, strength)
+    np.testing.assert_allclose(out[:, 0], profile, atol=1e-5)
+    np.testing.assert_allclose(out[:, 1:3], d, atol=1e-5)
+    # the profile runs from (1 - w)/N at the first layer to 1 at the tip, for any w
+    assert out[1, 0] == pytest.approx((1.0 - w) / layers, abs=1e-6)
+    assert out[3, 0] == pytest.approx(1.0, abs=1e-6)
+    np.testing.assert_allclose(out[:8, 1:3], 0.0)  # dry: no displacement
+
+    # Algorithm 2 against the mask texture, by hand
+    def texel(uv):
+        j = int(np.floor(uv[0] % 1.0 * size))
+        i = int(np.floor(uv[1] % 1.0 * size))
+        return image[i, j]
+
+    kept = out[:, 5] > 0.5
+    for k in range(n):
+        m = texel(pixel[k])
+        if m[3] == 0.0:
+            assert kept[k] and np.allclose(out[k, 3:5], 0.0), k
+            continue
+        want_d = eq5_reference(h[k:k + 1], m[None], pixel[k:k + 1], w, layers, strength)[1][0]
+        np.testing.assert_allclose(out[k, 3:5], want_d, atol=1e-5)
+        there = texel(pixel[k] + want_d)
+        expect = (np.linalg.norm(pixel[k] - m[:2]) <= m[2] and there[3] != 0.0
+                  and np.linalg.norm(there[:2] - m[:2]) <= 0.5 * m[2])
+        assert kept[k] == expect, k
+    vbo.release()
+    texture.release()
+    program.release()
+
+
+def fur_vertex_program(ctx, shaders):
+    source = shaders.assemble("materials/shell_fur/fur.vert").text
+    return ctx.program(vertex_shader=source, varyings=["v_position", "v_strand_tangent"])
+
+
+def layer_positions(gl, shaders, mesh, h, wetness, curl_radius, curl_frequency, fur_length,
+                    deflection=None):
+    """fur.vert's layer positions and strand tangents (object space: identity transforms)."""
+    from deferred.mesh import GpuMesh
+
+    ctx = gl.ctx
+    program = fur_vertex_program(ctx, shaders)
+    program["u_model_view"].write(np.eye(4, dtype=np.float32).tobytes())
+    for name, value in (("u_shell_depth", h), ("u_fur_length", fur_length),
+                        ("u_curl_radius", curl_radius), ("u_curl_frequency", curl_frequency)):
+        program[name].value = value
+    mask = float_texture(ctx, np.full((4, 4, 4), (0.5, 0.5, 0.5, wetness), np.float32))
+    tips = np.zeros((1, 1024, 4), np.float32)
+    if deflection is not None:
+        tips[0, :len(deflection), :3] = deflection
+    tips_texture = float_texture(ctx, tips, repeat=False)
+    mask.use(0)
+    tips_texture.use(1)
+    program["u_wetness_mask"].value = 0
+    program["u_strand_tips"].value = 1
+    gpu = GpuMesh(ctx, mesh)
+    out = transform(gl, program, [gpu.vertex_buffer(program)], mesh.vertex_count, 6)
+    gpu.release()
+    mask.release()
+    tips_texture.release()
+    program.release()
+    return out[:, :3], out[:, 3:]
+
+
+@pytest.mark.parametrize("wetness", [0.0, 0.4, 1.0])
+@pytest.mark.parametrize("h", [0.0, 0.3, 1.0])
+def test_curl_offsets_of_layer_h_match_eq4(gl, shaders, h, wetness):
+    mesh = builtin_sphere(12, 6)
+    K, w, L = 0.05, 9.0, 0.2
+    positions, tangents = layer_positions(gl, shaders, mesh, h, wetness, K, w, L)
+    n = mesh.normals.astype(np.float64)
+    u = mesh.tangents.astype(np.float64)
+    v = mesh.binormals.astype(np.float64)
+    alpha = (1.0 - wetness) * K * h
+    curl = alpha * (np.cos(w * h) * u + np.sin(w * h) * v)  # Eq. 4
+    straight = h * L * n  # beta(h) of an unbent strand: the layers evenly along the normal
+    np.testing.assert_allclose(positions - mesh.positions, straight + curl, atol=2e-5)
+    if wetness == 1.0:  # wet fur loses its curl
+        np.testing.assert_allclose(positions - mesh.positions, straight, atol=2e-5)
+    # the strand tangent is d(v_offset)/dh
+    k = (1.0 - wetness) * K
+    derivative = L * n + k * ((np.cos(w * h) - w * h * np.sin(w * h)) * u
+                              + (np.sin(w * h) + w * h * np.cos(w * h)) * v)
+    derivative /= np.linalg.norm(derivative, axis=1, keepdims=True)
+    np.testing.assert_allclose(tangents, derivative, atol=1e-4)
+
+
+def test_layers_follow_the_bezier_of_the_simulated_strand(gl, shaders):
+    mesh = builtin_plane(2, 2.0)
+    L = 0.3
+    deflection = np.tile([0.12, -0.05, 0.0], (mesh.vertex_count, 1))
+    root = mesh.positions.astype(np.float64)
+    n = mesh.normals.astype(np.float64)
+    rest = root + L * n
+    tip = rest + deflection
+    # Eq. 3 keeps the tip within L of the root
+    offset = tip - root
+    tip = root + offset * np.minimum(1.0, L / np.linalg.norm(offset, axis=1))[:, None]
+    for h in (0.0, 0.25, 0.6, 1.0):
+        positions, _ = layer_positions(gl, shaders, mesh, h, 0.0, 0.0, 0.0, L, deflection)
+        t = 1.0 - math.sqrt(1.0 - h)
+        bezier = (1 - t) ** 2 * root + 2 * (1 - t) * t * rest + t * t * tip
+        np.testing.assert_allclose(positions, bezier, atol=2e-5)
+
+
+# -- the layers ------------------------------------------------------------------------------
+
+def test_layer_layout_is_silvas_spacing():
+    layout = layer_layout(4.0)
+    assert layout == [(0.0, 1.0), (0.25, 1.0), (0.5, 1.0), (0.75, 1.0), (1.0, 1.0)]
+    # a fractional count: h = (1 + n) / N, the last layer kept at the tip and faded
+    layout = layer_layout(3.5)
+    assert [h for h, _ in layout] == pytest.approx([0.0, 1 / 3.5, 2 / 3.5, 3 / 3.5, 1.0])
+    assert layout[-1][1] == pytest.approx(0.5)
+    assert layer_layout(4.0, debug="wetness")[1:] == [None] * 4
+
+
+# -- rendered behaviour -------------------------------------------------------------------------
+
+def clump_scene(params: dict, size=(128, 128)) -> dict:
+    """A plane seen from straight above (almost orthographic), unlit: only what a debug view
+    draws shows."""
+    return {
+        "size": list(size), "background": [0.0, 0.0, 0.0], "tonemap": "none",
+        "camera": {"position": [0.0, 20.0, 0.0], "target": [0.0, 0.0, 0.0],
+                   "up": [0.0, 0.0, -1.0], "fov": 5.8},
+        "object": [{"mesh": "builtin:plane", "material": "shell_fur",
+                    "params": {"fur_length": 0.2, "shells": 16, "lod_error": 0.01,
+                               "fins": False, "gravity": [0.0, 0.0, 0.0], "density": 100,
+                               "pattern": "coarse", **params}}],
+    }
+
+
+def test_wet_clump_gathers_fur_into_its_centre_and_leaves_dry_fur_alone(render, tmp_path):
+    mask = dry_mask(128)
+    blend_droplet(mask, Droplet((0.5, 0.5), 0.2, 1.0))
+    path = tmp_path / "clump.exr"
+    write_image(path, mask_image(mask))
+    top = {"debug": "single_shell", "shell_range": [0.6, 0.7]}  # a layer at h 0.625, opaque
+    wet, _ = render(scene_from_dict(clump_scene({**top, "wetness_mask": str(path)}), "wet"))
+    dry, _ = render(scene_from_dict(clump_scene(top), "dry"))
+    covered_wet = wet.image[..., 0] > 128
+    covered_dry = dry.image[..., 0] > 128
+    # the plane (2 units) fills the 128-pixel frame: the clump is centred, 0.2 * 128 px
+    ys, xs = np.mgrid[0:128, 0:128] + 0.5
+    radius = np.hypot(xs - 64, ys - 64) / (0.2 * 128)
+    inner, ring = radius < 0.5, (radius > 0.55) & (radius < 0.95)
+    assert covered_dry[inner].mean() > 0.2  # the dry tips cover some of the plane
+    assert covered_wet[inner].mean() > 2.0 * covered_wet[ring].mean()
+    assert covered_wet[ring].mean() < 0.5 * covered_dry[ring].mean()
+    # outside the clump nothing changed
+    outside = radius > 1.05
+    assert (covered_wet[outside] == covered_dry[outside]).mean() > 0.999
+
+
+def test_forward_and_deferred_agree_on_straight_fur(render):
+    scene = {
+        "size": [160, 120], "background": [0.02, 0.02, 0.03],
+        "camera": {"position": [0.0, 1.2, 2.6], "target": [0.0, 0.0, 0.0], "fov": 40.0},
+        "object": [{"mesh": "builtin:sphere", "material": "shell_fur",
+                    "params": {"fur_length": 0.12, "shells": 12, "fins": False}}],
+        "light": [{"type": "directional", "direction": [-0.4, -1.0, -0.5], "intensity": 1.5},
+                  {"type": "ambient", "color": [0.3, 0.3, 0.35], "intensity": 0.5}],
+    }
+    from conftest import psnr
+
+    deferred, _ = render(scene_from_dict(scene, "s"), "deferred")
+    forward, _ = render(scene_from_dict(scene, "s"), "forward")
+    a = deferred.image[..., :3] / 255.0
+    b = forward.image[..., :3] / 255.0
+    assert psnr(a, b) > 25.0  # measured 27.8 dB: one tangent per strand in deferred
+    covered = (a.sum(-1) > 0.1)
+    assert covered.mean() > 0.3
+
+
+def state_at(gl, scene_dict, times):
+    scene = scene_from_dict(scene_dict, "anim")
+    obj = scene.objects[0]
+    material: ShellFurMaterial = obj.material
+    state = ShellFurState(gl.ctx, obj, material)
+    out = []
+    for t in times:
+        scene.apply_timeline(t)
+        state.advance(t)
+        out.append((state.mask.copy(), state.strands.deflections().copy()))
+    state.release()
+    return out
+
+
+def anim_scene(params: dict, events=()):
+    return {"size": [64, 64],
+            "object": [{"name": "fur", "mesh": "builtin:plane", "material": "shell_fur",
+                        "params": {"fur_length": 0.2, "mask_size": 64, "seed": 4, **params}}],
+            "event": [{"time": t, "object": "fur", "params": p} for t, p in events]}
+
+
+def test_droplets_fall_on_the_timeline_and_dry_at_dry_rate(gl):
+    scene = anim_scene({"droplet_wetness": 0.8, "dry_rate": 0.5, "droplet_radius": 0.3},
+                       [(1.0, {"droplets": 10})])
+    states = state_at(gl, scene, [0.5, 1.0, 1.5, 2.0, 3.1])
+    wetness = [mask[..., 3] for mask, _ in states]
+    assert wetness[0].max() == 0.0  # before the rain
+    assert wetness[1].max() > 0.5
+    assert wetness[2].max() == pytest.approx(wetness[1].max() - 0.25, abs=1e-5)
+    assert wetness[3].max() < wetness[2].max()
+    assert wetness[4].max() == 0.0  # dried: at most 1 (overlaps), gone after 2 s at 0.5 / s
+
+
+def test_wind_from_a_time_bends_the_strands_and_time_is_deterministic(gl):
+    scene = anim_scene({"gravity": [0.0, 0.0, 0.0], "damping": 0.2},
+                       [(1.0, {"wind": [0.05, 0.0, 0.0]})])
+    before, after, later = state_at(gl, scene, [0.9, 2.0, 3.0])
+    assert np.abs(before[1][:, 0]).max() < 1e-9  # no force yet: strands at rest
+    shift = after[1][:, 0] - before[1][:, 0]
+    assert shift.min() > 0.005  # every strand leans with the wind (+x)
+    # the same time again, after a later one, gives the same state
+    again = state_at(gl, scene, [3.0, 2.0])[1]
+    np.testing.assert_array_equal(again[1], after[1])
+    np.testing.assert_array_equal(again[0], after[0])
+
+
+def test_render_at_the_same_time_twice_is_identical(render):
+    scene = anim_scene({"droplets": 8, "wind": [0.03, 0.0, 0.0], "gust": 0.5, "shells": 6,
+                        "dry_rate": 0.1})
+    scene["camera"] = {"position": [0.0, 1.5, 1.5], "target": [0.0, 0.0, 0.0]}
+    scene["light"] = [{"type": "ambient", "intensity": 1.0}]
+    first, _ = render(scene_from_dict(scene, "s"), time=1.3)
+    second, renderer = render(scene_from_dict(scene, "s"), time=2.0)
+    repeat = renderer.render(time=1.3)
+    np.testing.assert_array_equal(first.image, repeat.image)
+    assert not np.array_equal(first.image, second.image)
+
+
+# -- bad input ---------------------------------------------------------------------------------
+
+def cli(capsys, *args) -> tuple[int, str]:
+    from deferred.cli import main
+
+    code = main(list(args))
+    captured = capsys.readouterr()
+    return code, captured.out + captured.err
+
+
+def write_scene(path: Path, params: str) -> Path:
+    path.write_text(f"""size = [32, 32]
+[[object]]
+mesh = "builtin:plane"
+material = "shell_fur"
+[object.params]
+{params}
+""")
+    return path
+
+
+@pytest.mark.parametrize("params, message", [
+    ('wetness_mask = "missing.png"', "object[0].params.wetness_mask: image not found"),
+    ('color_texture = "nope.png"', "object[0].params.color_texture: image not found"),
+    ('color_pattern = "tartan"', "object[0].params.color_pattern"),
+    ("curl_radius = -1.0", "object[0].params.curl_radius"),
+    ("droplets = 1.5", "object[0].params.droplets"),
+    ("clump_shape = 2.0", "object[0].params.clump_shape"),
+])
+def test_bad_parameters_are_one_line_errors(tmp_path, capsys, params, message):
+    scene = write_scene(tmp_path / "s.toml", params)
+    out = tmp_path / "out.png"
+    code, output = cli(capsys, "render", str(scene), "-o", str(out))
+    assert code == 2, output
+    assert message in output
+    assert len(output.strip().splitlines()) == 1 and "Traceback" not in output
+    assert not out.exists()
+
+
+def test_a_wetness_mask_needs_four_channels(tmp_path, capsys):
+    write_image(tmp_path / "rgb.png", np.zeros((8, 8, 3), np.float32))
+    scene = write_scene(tmp_path / "s.toml", 'wetness_mask = "rgb.png"')
+    code, output = cli(capsys, "render", str(scene), "-o", str(tmp_path / "out.png"))
+    assert code == 2
+    assert "wetness_mask: wetness mask rgb.png needs 4 channels" in output
