@@ -368,7 +368,11 @@ class ShellFurMaterial(Material):
     uniform_overrides = {**FUR_UNIFORM_OVERRIDES, **{key: None for key in NOT_UNIFORMS},
                          "shells": _layers_uniform}
     debug_views = {
-        **{name: view for name, view in FUR_DEBUG_VIEWS.items() if name != "comb"},
+        **{name: view for name, view in FUR_DEBUG_VIEWS.items() if name not in ("comb",
+                                                                                 "samples")},
+        "samples": ("the light sample each layer and fin fragment used: green its root's "
+                    "pixel (or a neighbour), yellow its own pixel, red none; white in the "
+                    "forward pipeline, which lights every fragment", {"debug": "samples"}),
         "wetness": ("the wetness mask on the skin: a colour per clump, as bright as it is "
                     "wet; black dry (Silva et al. Fig. 11's inset)", {"debug": "wetness"}),
     }
