@@ -133,12 +133,18 @@ def _write_atomically(path: Path, write) -> None:
             os.unlink(temporary)
 
 
-def read_image(path: str | Path, srgb_to_linear: bool = False) -> np.ndarray:
-    """Read an image as float32 RGBA (H, W, 4), top row first."""
+def read_image(path: str | Path, srgb_to_linear: bool = False,
+               unassociated_alpha: bool = False) -> np.ndarray:
+    """Read an image as float32 RGBA (H, W, 4), top row first. ``unassociated_alpha`` keeps the
+    colour channels as stored where a format would associate them with alpha (PNG: data in
+    RGBA channels, such as a wetness mask, must not be premultiplied)."""
     import OpenImageIO as oiio
 
     path = Path(path)
-    image = oiio.ImageInput.open(str(path))
+    config = oiio.ImageSpec()
+    if unassociated_alpha:
+        config.attribute("oiio:UnassociatedAlpha", 1)
+    image = oiio.ImageInput.open(str(path), config)
     if image is None:
         raise InputError(f"cannot read image: {oiio.geterror() or 'unknown format'}", str(path))
     try:

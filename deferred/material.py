@@ -77,6 +77,9 @@ class Material:
     gbuffer_data: tuple[GBufferData, ...] = ()  # extra per-pixel data (deferred.shading)
     # field -> None (not a uniform) or value -> {uniform: value} (see the module documentation)
     uniform_overrides: ClassVar[UniformOverrides] = {}
+    # parameters the material reads once, at t = 0 (a simulation's set-up): a scene timeline
+    # may not change them
+    timeline_fixed: ClassVar[tuple[str, ...]] = ()
     # debug views (``deferred render --view <material>.<name>``): name -> (what it shows, the
     # parameters that make the material draw it)
     debug_views: ClassVar[dict[str, tuple[str, dict[str, Any]]]] = {}

@@ -186,6 +186,10 @@ class SceneObject:
                              f"{where}.time")
         params_where = f"{where}.params"
         material_cls = type(self.material)
+        for key in material_cls.timeline_fixed:
+            if key in params and params[key] != getattr(self.base_params, key, None):
+                raise InputError(f"{material_cls.name} reads {key} once, at t = 0: a timeline "
+                                 "cannot change it", f"{params_where}.{key}")
         # Every key checked against the material's model over the base (files, too)
         material_cls.from_dict({**self.base_params.model_dump(), **params},
                                self.material.base_dir, params_where)

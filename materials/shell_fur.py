@@ -50,7 +50,13 @@ from .techniques.fur import (
 )
 from .techniques.fur_volume import VOLUME_LAYERS
 from .techniques.shells import ShellPass
-from .techniques.strands import StrandForces, StrandSimulation, VertexAverage, triangle_strands
+from .techniques.strands import (
+    StrandForces,
+    StrandSimulation,
+    VertexAverage,
+    curl_frames,
+    triangle_strands,
+)
 from .techniques.wetness import (
     blend_droplet,
     dry_mask,
@@ -68,7 +74,7 @@ Vec3 = tuple[float, float, float]
 FUR_VERTEX = "materials/shell_fur/fur.vert"
 SHELL_FRAGMENT = "materials/shell_fur/shell.frag"
 FORWARD_SHELL_FRAGMENT = "materials/shell_fur/forward_shell.frag"
-TIPS_WIDTH = 1024  # texels per row of the per-vertex strand tip texture
+TIPS_WIDTH = 1024  # texels per row of the per-vertex strand texture
 COLOR_MAP_SIZE = 256
 GUST_WAVELENGTH = 1.0  # world units between gust fronts along the wind
 
@@ -179,61 +185,78 @@ def _float_texture(ctx: moderngl.Context, width: int, height: int) -> moderngl.T
 
 
 class ShellFurState:
-    """An object's wetness mask and strands at the renderer's current time, with their textures
-    (``u_wetness_mask``, ``u_strand_tips``). Time moves forward in fixed steps; asked for an
-    earlier time, the state starts over from t = 0 (the same time always gives the same
-    frame). Parameters are read at each interval's start (``SceneObject.params_at``): between
-    timeline events they do not change."""
+    """An object's wetness mask and strands over time, with their textures (``u_wetness_mask``,
+    ``u_strand_tips``).
+
+    Time is a count of fixed steps from t = 0: the state at time t is that after step
+    ``floor(t / time_step)`` whatever frames came before, so the same time gives the same frame
+    (asked for an earlier time, the state starts over). Step n runs with the parameters at
+    ``n * time_step`` (``SceneObject.params_at``); droplets fall at the first step at or after
+    their event; drying removes ``dry_rate * time_step`` per step. Before t = 0 the strands
+    settle for ``settle`` seconds with the parameters at 0. Parameters the material reads once
+    (``TIMELINE_FIXED``) are the ones at t = 0: a timeline may not change them."""
 
     def __init__(self, ctx: moderngl.Context, obj: SceneObject, material: ShellFurMaterial):
         self.obj = obj
         self.material = material
-        params = material.params
+        params = self.params_at(0.0)
+        self.dt = params.time_step
         self.linear_inverse = np.linalg.inv(obj.model[:3, :3])
         self.strands = StrandSimulation(*triangle_strands(obj.mesh, obj.model, params.fur_length))
         self.average = VertexAverage(obj.mesh)
         self.size = params.mask_size
-        vertices = obj.mesh.vertex_count
-        self.tip_rows = max(1, math.ceil(vertices / TIPS_WIDTH))
         self.mask_texture = _float_texture(ctx, self.size, self.size)
         self.mask_texture.repeat_x = self.mask_texture.repeat_y = True
-        self.tips_texture = _float_texture(ctx, TIPS_WIDTH, self.tip_rows)
-        self.time: float | None = None
+        # three texels per vertex: tip deflection, curl u, curl v (fur.vert)
+        vertices = obj.mesh.vertex_count
+        self.strand_data = np.zeros((max(1, math.ceil(3 * vertices / TIPS_WIDTH)) * TIPS_WIDTH,
+                                     4), np.float32)
+        curl_u, curl_v = curl_frames(obj.mesh, self.average.welded)
+        self.strand_data[1:3 * vertices:3, :3] = curl_u
+        self.strand_data[2:3 * vertices:3, :3] = curl_v
+        self.tips_texture = _float_texture(ctx, TIPS_WIDTH, len(self.strand_data) // TIPS_WIDTH)
+        self.step: int | None = None  # steps taken since t = 0
         self.mask = dry_mask(self.size)
         self.fallen = 0
+        self._uploaded: int | None = None
 
     def params_at(self, time: float) -> ShellFurParams:
         params_at = getattr(self.obj, "params_at", None)
         return params_at(time) if params_at is not None else self.material.params
 
-    def event_times(self) -> tuple[float, ...]:
-        return tuple(getattr(self.obj, "event_times", ()))
-
     def advance(self, time: float) -> None:
-        """Bring the state to ``time`` (seconds) and upload it."""
-        if self.time is None or time < self.time:
+        """Bring the state to ``time`` (seconds) and upload it if it changed."""
+        target = int(math.floor(time / self.dt + 1e-9))
+        if self.step is None or target < self.step:
             self._start()
-        if time > self.time:
-            cuts = sorted({t for t in self.event_times() if self.time < t < time} | {time})
-            for end in cuts:
-                self._run(self.time, end)
-        self._upload()
+        events = [t for t in getattr(self.obj, "event_times", ()) if t > 0.0]
+        while self.step < target:
+            now = self.step * self.dt
+            params = self.params_at(now)
+            self._rain(params)
+            # run to the first step at or after the next event (its parameters differ)
+            later = [math.ceil(t / self.dt - 1e-9) for t in events if t > now + 1e-12]
+            end = min([target, *[n for n in later if n > self.step]])
+            for n in range(self.step, end):
+                self.strands.step(self.dt, self._forces(params, n * self.dt))
+            dry_out(self.mask, params.dry_rate * self.dt * (end - self.step))
+            self.step = end
+        self._rain(self.params_at(self.step * self.dt))
+        if self._uploaded != self.step:
+            self._upload()
 
     def _start(self) -> None:
         params = self.params_at(0.0)
-        self.mask = self._initial_mask(params)
+        path = self.material.wetness_mask_path(params)
+        self.mask = load_wetness_mask(path, self.size) if path is not None \
+            else dry_mask(self.size)
         self.fallen = 0
-        self._rain(params)
         self.strands.reset()
-        steps = int(round(params.settle / params.time_step))
+        steps = int(round(params.settle / self.dt))
         for k in range(steps):
-            self.strands.step(params.time_step, self._forces(params, -params.settle
-                                                              + k * params.time_step))
-        self.time = 0.0
-
-    def _initial_mask(self, params: ShellFurParams) -> np.ndarray:
-        path = self.material.wetness_mask_path()
-        return load_wetness_mask(path, self.size) if path is not None else dry_mask(self.size)
+            self.strands.step(self.dt, self._forces(params, (k - steps) * self.dt))
+        self.step = 0
+        self._uploaded = None
 
     def _rain(self, params: ShellFurParams) -> None:
         """Blend the droplets that fell since last time (the ``droplets`` count grew)."""
@@ -244,6 +267,7 @@ class ShellFurState:
                                            start=self.fallen):
                 blend_droplet(self.mask, droplet)
             self.fallen = params.droplets
+            self._uploaded = None
 
     def _forces(self, params: ShellFurParams, time: float) -> StrandForces:
         wind = np.asarray(params.wind, np.float64)
@@ -255,23 +279,16 @@ class ShellFurState:
         return StrandForces(params.stiffness, params.mass, params.damping,
                             np.asarray(params.gravity, np.float64), wind)
 
-    def _run(self, start: float, end: float) -> None:
-        params = self.params_at(start)
-        self._rain(params)
-        dt = params.time_step
-        steps = int(round((end - start) / dt))
-        for k in range(steps):
-            self.strands.step(dt, self._forces(params, start + k * dt))
-        dry_out(self.mask, params.dry_rate * (end - start))
-        self.time = end
-        self._rain(self.params_at(end))
+    def vertex_deflections(self) -> np.ndarray:
+        """(V, 3) each vertex's tip deflection ``p - p_0`` in object space."""
+        return self.average(self.strands.deflections()) @ self.linear_inverse.T
 
     def _upload(self) -> None:
         self.mask_texture.write(np.ascontiguousarray(self.mask, np.float32).tobytes())
-        deflection = self.average(self.strands.deflections()) @ self.linear_inverse.T
-        tips = np.zeros((self.tip_rows * TIPS_WIDTH, 4), np.float32)
-        tips[:len(deflection), :3] = deflection
-        self.tips_texture.write(tips.tobytes())
+        vertices = self.obj.mesh.vertex_count
+        self.strand_data[0:3 * vertices:3, :3] = self.vertex_deflections()
+        self.tips_texture.write(self.strand_data.tobytes())
+        self._uploaded = self.step
 
     def release(self) -> None:
         self.mask_texture.release()
@@ -367,6 +384,9 @@ class ShellFurMaterial(Material):
     shading_model = "kajiya_kay"
     uniform_overrides = {**FUR_UNIFORM_OVERRIDES, **{key: None for key in NOT_UNIFORMS},
                          "shells": _layers_uniform}
+    # the simulation's set-up (ShellFurState), and the passes built once
+    timeline_fixed = ("fur_length", "mask_size", "wetness_mask", "time_step", "settle", "seed",
+                      "fins")
     debug_views = {
         **{name: view for name, view in FUR_DEBUG_VIEWS.items() if name not in ("comb",
                                                                                  "samples")},
@@ -396,9 +416,9 @@ class ShellFurMaterial(Material):
         return None if self.params.heightfield is None else \
             self.resolve_path(self.params.heightfield)
 
-    def wetness_mask_path(self) -> Path | None:
-        return None if self.params.wetness_mask is None else \
-            self.resolve_path(self.params.wetness_mask)
+    def wetness_mask_path(self, params: ShellFurParams | None = None) -> Path | None:
+        params = params or self.params
+        return None if params.wetness_mask is None else self.resolve_path(params.wetness_mask)
 
     def defines(self, obj: SceneObject) -> dict[str, str]:
         # layers reject light samples the G-buffer shows occluded (Revie's Figure 2.8 fix)

@@ -3,15 +3,19 @@
 Each triangle carries one virtual strand: its root ``p_root`` at the triangle's centroid, its rest
 tip ``p_0 = p_root + n L_0`` along the face normal, and a particle of mass ``m`` at the tip,
 pulled back toward ``p_0`` by a spring of constant ``k``. External forces (gravity, wind) move
-it by Newton's law (Eq. 2), integrated with semi-implicit Euler at a fixed time step; a linear
-damping force ``-c v`` (not in the paper, whose spring alone would ring forever) lets it settle.
-After every step the tip is projected back into the region of Eq. 3: no farther than ``L_0``
-from the root and never below the surface, ``(p - p_root) . n >= 0``; its velocity is what the
-projected step moved it.
+it by Newton's law (Eq. 2), integrated at a fixed time step, the spring and a linear damping
+force ``-c v`` (not in the paper, whose spring alone would ring forever) taken implicitly:
 
-The layers of the fur follow the quadratic Bezier through ``p_root``, ``p_0`` and ``p`` (the
-vertex shader, ``shaders/materials/shell_fur/strand.glsl``). The shader receives each vertex's
-tip deflection ``p - p_0``: the area-weighted mean of its triangles', in object space.
+    v' = (v + dt (f_ext / m - (k / m)(p - p_0))) / (1 + dt c / m + dt^2 k / m),  p' = p + dt v'
+
+which is stable for any stiffness, damping and step (explicit damping diverges once
+dt c / m > 2) and rests exactly where ``k (p - p_0) = f_ext``. After every step the tip is
+projected back into the region of Eq. 3: no farther than ``L_0`` from the root and never below
+the surface, ``(p - p_root) . n >= 0``; its velocity is what the projected step moved it.
+
+The layers of the fur follow a quadratic Bezier from ``p_root`` to ``p`` (the vertex shader,
+``shaders/materials/shell_fur/strand.glsl``). The shader receives each vertex's tip deflection
+``p - p_0``: the area-weighted mean of its triangles', in object space.
 
 All positions are world space, vectorised over triangles (numpy).
 """
@@ -51,12 +55,13 @@ class StrandSimulation:
         self.velocities = np.zeros_like(self.tips)
 
     def step(self, dt: float, forces: StrandForces) -> None:
-        """Advance by ``dt`` (Eq. 2), then constrain (Eq. 3)."""
-        spring = -forces.stiffness * (self.tips - self.rest)
-        total = spring + forces.mass * forces.gravity + forces.wind \
-            - forces.damping * self.velocities
-        self.velocities = self.velocities + dt * total / forces.mass
-        moved = self.tips + dt * self.velocities
+        """Advance by ``dt`` (Eq. 2, see the module documentation), then constrain (Eq. 3)."""
+        m = forces.mass
+        external = forces.mass * forces.gravity + forces.wind
+        spring = forces.stiffness * (self.tips - self.rest)
+        velocities = (self.velocities + dt * (external - spring) / m) / \
+            (1.0 + dt * forces.damping / m + dt * dt * forces.stiffness / m)
+        moved = self.tips + dt * velocities
         constrained = self.constrain(moved)
         self.velocities = (constrained - self.tips) / dt
         self.tips = constrained
@@ -111,6 +116,29 @@ def weld(positions: np.ndarray, tolerance: float = 1e-6) -> np.ndarray:
     keys = np.round(np.asarray(positions, np.float64) / tolerance).astype(np.int64)
     _, welded = np.unique(keys, axis=0, return_inverse=True)
     return welded.reshape(-1)
+
+
+def curl_frames(mesh: MeshData, welded: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(V, 3) u and v per vertex spanning the tangent plane (Eq. 4's u, v): orthonormal, and the
+    same for every copy of a vertex split at a UV seam (the mean of the copies' tangents and
+    normals), so a curled layer does not crack along the seams of an unwrap."""
+    groups = int(welded.max()) + 1
+    normals = np.asarray(mesh.normals, np.float64)
+    tangents = np.asarray(mesh.tangents, np.float64)
+    mean_normal = np.stack([np.bincount(welded, normals[:, c], minlength=groups)
+                            for c in range(3)], -1)
+    mean_tangent = np.stack([np.bincount(welded, tangents[:, c], minlength=groups)
+                             for c in range(3)], -1)
+    n = mean_normal / np.maximum(np.linalg.norm(mean_normal, axis=1, keepdims=True), 1e-300)
+    t = mean_tangent - np.einsum("ij,ij->i", mean_tangent, n)[:, None] * n
+    length = np.linalg.norm(t, axis=1)
+    # no usable tangent (copies cancel, a pole): any direction in the plane
+    fallback = np.where(np.abs(n[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
+    fallback = fallback - np.einsum("ij,ij->i", fallback, n)[:, None] * n
+    t = np.where(length[:, None] > 1e-8, t, fallback)
+    u = t / np.linalg.norm(t, axis=1, keepdims=True)
+    v = np.cross(n, u)
+    return u[welded], v[welded]
 
 
 class VertexAverage:

@@ -134,20 +134,21 @@ def random_droplets(mesh: MeshData, model: np.ndarray, count: int, radius: float
     weights = np.where(scale > 0.0, area, 0.0)
     if weights.sum() <= 0.0:
         raise InputError(f"mesh {mesh.name} has no UV area for droplets to land on")
+    # four numbers per droplet, drawn in sequence order: droplet k is the same whatever the
+    # batch it falls in
     rng = np.random.default_rng([seed, 0x5EED])
-    # the whole sequence up to the last droplet asked for, so droplet k is the same whatever
-    # the batch it falls in
-    total = start + count
-    tri = rng.choice(len(faces), size=total, p=weights / weights.sum())
-    a, b = rng.uniform(0.0, 1.0, (2, total))
+    numbers = rng.uniform(0.0, 1.0, (start + count, 4))[start:]
+    cumulative = np.cumsum(weights / weights.sum())
+    tri = np.minimum(np.searchsorted(cumulative, numbers[:, 0], side="right"), len(faces) - 1)
+    a, b = numbers[:, 1], numbers[:, 2]
     flip = a + b > 1.0
     a, b = np.where(flip, 1.0 - a, a), np.where(flip, 1.0 - b, b)
-    jitter = rng.uniform(0.7, 1.0, total)
+    jitter = 0.7 + 0.3 * numbers[:, 3]
     uv = np.asarray(mesh.uvs, np.float64)[faces[tri]]
     centres = uv[:, 0] + a[:, None] * (uv[:, 1] - uv[:, 0]) + b[:, None] * (uv[:, 2] - uv[:, 0])
     radii = radius * jitter / scale[tri]
     return [Droplet((float(c[0]), float(c[1])), float(r), float(wetness))
-            for c, r in zip(centres[start:], radii[start:], strict=True)]
+            for c, r in zip(centres, radii, strict=True)]
 
 
 def read_mask_image(path: Path) -> np.ndarray:
@@ -158,7 +159,8 @@ def read_mask_image(path: Path) -> np.ndarray:
     if len(names) < 4:
         raise InputError(f"wetness mask {path.name} needs 4 channels (R, G centre, B radius, "
                          f"A wetness), it has {len(names)}")
-    return read_image(path)
+    # unassociated: the colour channels are data, not colour premultiplied by the alpha
+    return read_image(path, unassociated_alpha=True)
 
 
 def load_wetness_mask(path: Path, size: int) -> np.ndarray:

@@ -23,12 +23,12 @@ vec2 fur_slices(vec2 coord, vec2 dx, vec2 dy, float h) {
 }
 
 // (coverage, brightness * coverage) at the fur position (world units, object axes) and
-// object-space normal of a base-mesh point, at height h.
-vec2 fur_sample(vec3 fur_position, vec3 fur_normal, float h) {
+// object-space normal of a base-mesh point, at height h, with the screen gradients of the fur
+// position (they choose the mip level).
+vec2 fur_sample_grad(vec3 fur_position, vec3 fur_normal, float h, vec3 dx, vec3 dy) {
     vec3 p = fur_position * u_fur_tiles;
-    // Derivatives in uniform control flow; the branches below only skip negligible planes.
-    vec3 px = dFdx(p);
-    vec3 py = dFdy(p);
+    vec3 px = dx * u_fur_tiles;
+    vec3 py = dy * u_fur_tiles;
     vec3 w = pow(abs(fur_normal), vec3(8.0));
     w /= max(w.x + w.y + w.z, 1e-6);
     vec2 s = vec2(0.0);
@@ -36,6 +36,12 @@ vec2 fur_sample(vec3 fur_position, vec3 fur_normal, float h) {
     if (w.y > 0.01) s += w.y * fur_slices(p.zx, px.zx, py.zx, h);
     if (w.z > 0.01) s += w.z * fur_slices(p.xy, px.xy, py.xy, h);
     return s;
+}
+
+// The same with the gradients of fur_position itself. Derivatives in uniform control flow; the
+// branches above only skip negligible planes.
+vec2 fur_sample(vec3 fur_position, vec3 fur_normal, float h) {
+    return fur_sample_grad(fur_position, fur_normal, h, dFdx(fur_position), dFdy(fur_position));
 }
 
 // A shell's opacity from the volume's coverage: each shell stands for 1/n of the layer, so with

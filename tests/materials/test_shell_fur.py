@@ -4,7 +4,6 @@ transform feedback, and the behaviour of the rendered fur."""
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import moderngl
@@ -106,6 +105,23 @@ def test_algorithm1_against_the_printed_algorithm(case):
     assert (mask[~wet][:, :2] == DRY_CENTRE).all()
 
 
+def test_a_zero_wetness_stamp_holds_no_clump():
+    """The one departure from Algorithm 1 as printed: texels a droplet of wetness 0 covered stay
+    dry (no clump), so a later droplet near that spot wets them; as printed they would keep the
+    dry droplet's centre and refuse it (rho_mask = 0)."""
+    mask = dry_mask(32)
+    blend_droplet(mask, Droplet((0.5, 0.5), 0.2, 0.0))
+    blend_droplet(mask, Droplet((0.55, 0.5), 0.2, 0.7))
+    printed = np.zeros((32, 32, 4))
+    printed = algorithm1_reference(printed, (0.5, 0.5), 0.2, 0.0)
+    printed = algorithm1_reference(printed, (0.55, 0.5), 0.2, 0.7)
+    covered = (mask[..., 3] > 0).sum()
+    assert covered > 3 * (printed[..., 3] > 0).sum()
+    fresh = dry_mask(32)
+    blend_droplet(fresh, Droplet((0.55, 0.5), 0.2, 0.7))
+    np.testing.assert_array_equal(mask, fresh)
+
+
 def test_drying_resets_texels_to_dry_and_rewets():
     mask = dry_mask(16)
     blend_droplet(mask, Droplet((0.5, 0.5), 0.3, 0.5))
@@ -118,13 +134,20 @@ def test_drying_resets_texels_to_dry_and_rewets():
     assert mask[..., 3].max() == pytest.approx(0.5)
 
 
-def test_wetness_mask_image_round_trip(tmp_path):
+@pytest.mark.parametrize("suffix", ["exr", "png"])
+def test_wetness_mask_image_round_trip(tmp_path, suffix):
     mask = dry_mask(32)
-    blend_droplet(mask, Droplet((0.25, 0.75), 0.15, 1.0))
-    path = tmp_path / "mask.exr"
-    write_image(path, mask_image(mask))
+    # wetness below the centre's coordinates: a PNG reader must not premultiply them
+    blend_droplet(mask, Droplet((0.25, 0.75), 0.15, 0.5))
+    path = tmp_path / f"mask.{suffix}"
+    image = mask_image(mask)
+    # the channels are data, not colour premultiplied by alpha
+    write_image(path, image, attributes={"oiio:UnassociatedAlpha": 1})
     loaded = load_wetness_mask(path, 32)
-    assert_masks_match(loaded, mask)
+    wet = mask[..., 3] > 0
+    step = 1.0 / 255.0 if suffix == "png" else 1e-3  # 8-bit PNG
+    np.testing.assert_allclose(loaded[..., 3], mask[..., 3], atol=step)
+    np.testing.assert_allclose(loaded[wet][:, :3], mask[wet][:, :3], atol=step)
     # the clump stays in the top-left quarter of the image (v = 1 is the top row)
     image = mask_image(mask)
     rows, cols = np.nonzero(image[..., 3] > 0)
@@ -181,6 +204,21 @@ def test_strands_never_leave_the_region_of_eq3_in_strong_wind():
     assert np.linalg.norm(sim.tips - sim.rest, axis=1).mean() > 0.05
 
 
+def test_strands_are_stable_for_any_stiffness_and_damping():
+    sim = one_strand()
+    forces = StrandForces(1e5, 0.01, 1e3, np.array([0.0, -9.81, 0.0]), np.zeros(3))
+    settle(sim, forces, seconds=1.0)
+    assert np.isfinite(sim.tips).all()
+    np.testing.assert_allclose(sim.tips[0], [0.0, 0.2 - 0.01 * 9.81 / 1e5, 0.0], atol=1e-6)
+    # heavy damping slows the strand, it does not shake it
+    sim = one_strand()
+    path = []
+    for _ in range(240):
+        sim.step(1.0 / 240.0, StrandForces(2.0, 0.01, 5.0, np.zeros(3), np.array([0.3, 0, 0])))
+        path.append(sim.tips[0, 0])
+    assert (np.diff(path) >= -1e-12).all()
+
+
 def test_triangle_strands_point_outward_and_scale_to_world():
     mesh = builtin_sphere(16, 8)
     model = np.diag([2.0, 2.0, 2.0, 1.0])
@@ -188,6 +226,35 @@ def test_triangle_strands_point_outward_and_scale_to_world():
     live = lengths > 0
     assert (np.einsum("ij,ij->i", roots[live], normals[live]) > 0).all()
     np.testing.assert_allclose(lengths[live], 0.2, rtol=1e-6)
+
+
+def test_curl_frames_are_orthonormal_and_shared_across_seams():
+    from deferred.materials.techniques.strands import curl_frames, weld
+
+    mesh = builtin_sphere(16, 8)  # its u seam splits a column of vertices
+    welded = weld(mesh.positions)
+    u, v = curl_frames(mesh, welded)
+    n = mesh.normals.astype(np.float64)
+    np.testing.assert_allclose(np.linalg.norm(u, axis=1), 1.0, atol=1e-9)
+    np.testing.assert_allclose(np.einsum("ij,ij->i", u, v), 0.0, atol=1e-9)
+    np.testing.assert_allclose(np.abs(np.einsum("ij,ij->i", u, n)), 0.0, atol=1e-6)
+    split = [np.flatnonzero(welded == g) for g in np.unique(welded)]
+    seams = [group for group in split if len(group) > 1]
+    assert seams
+    for group in seams:
+        assert np.abs(u[group] - u[group[0]]).max() < 1e-9
+        assert np.abs(v[group] - v[group[0]]).max() < 1e-9
+
+
+def test_droplet_k_is_the_same_whatever_the_batch():
+    from deferred.materials.techniques.wetness import random_droplets
+
+    mesh = builtin_sphere(16, 8)
+    one_go = random_droplets(mesh, np.eye(4), 12, 0.1, 0.5, seed=3)
+    batched = (random_droplets(mesh, np.eye(4), 5, 0.1, 0.5, seed=3)
+               + random_droplets(mesh, np.eye(4), 7, 0.1, 0.5, seed=3, start=5))
+    assert one_go == batched
+    assert random_droplets(mesh, np.eye(4), 12, 0.1, 0.5, seed=4) != one_go
 
 
 # -- GLSL through transform feedback -------------------------------------------------------------
@@ -241,6 +308,12 @@ def test_eq5_and_algorithm2_in_glsl_against_numpy(gl, shaders):
                             rng.uniform(0.0, 1.0, n)])
     mask[:8, 3] = 0.0  # dry texels
     pixel = mask[:, :2] + rng.uniform(-0.2, 0.2, (n, 2))
+    # hand-made Algorithm 2 cases against the texture below, at the tip (profile 1):
+    # 60: inside the clump near its centre (kept); 61: on the texel row of another clump whose
+    # stored centre is farther than its radius (ignored: a different clump); 62: near the rim,
+    # displaced onto dry fur (ignored); 63: dry fur (kept, not displaced)
+    h[60:] = 1.0
+    pixel[60:] = [(0.52, 0.5), (0.5, 8.5 / 64.0), (0.5, 0.5 + 0.2), (0.05, 0.95)]
 
     # a wetness mask with one clump: centre (0.5, 0.5), radius 0.25, wetness 0.8
     size = 64
@@ -273,6 +346,10 @@ def test_eq5_and_algorithm2_in_glsl_against_numpy(gl, shaders):
         return image[i, j]
 
     kept = out[:, 5] > 0.5
+    # by hand: at the tip d = rho s (c_pixel - c) = 0.8 * 1.5 * (0.02, 0)
+    np.testing.assert_allclose(out[60, 3:5], (0.024, 0.0), atol=1e-6)
+    assert kept[60] and not kept[61] and not kept[62] and kept[63]
+    np.testing.assert_allclose(out[63, 3:5], 0.0)
     for k in range(n):
         m = texel(pixel[k])
         if m[3] == 0.0:
@@ -294,8 +371,17 @@ def fur_vertex_program(ctx, shaders):
     return ctx.program(vertex_shader=source, varyings=["v_position", "v_strand_tangent"])
 
 
+def tangent_frames(mesh):
+    """An orthonormal (u, v) per vertex in its tangent plane (numpy, for the strand texture)."""
+    n = mesh.normals.astype(np.float64)
+    t = mesh.tangents.astype(np.float64)
+    u = t - np.einsum("ij,ij->i", t, n)[:, None] * n
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    return u, np.cross(n, u)
+
+
 def layer_positions(gl, shaders, mesh, h, wetness, curl_radius, curl_frequency, fur_length,
-                    deflection=None):
+                    deflection=None, frames=None):
     """fur.vert's layer positions and strand tangents (object space: identity transforms)."""
     from deferred.mesh import GpuMesh
 
@@ -306,19 +392,24 @@ def layer_positions(gl, shaders, mesh, h, wetness, curl_radius, curl_frequency, 
                         ("u_curl_radius", curl_radius), ("u_curl_frequency", curl_frequency)):
         program[name].value = value
     mask = float_texture(ctx, np.full((4, 4, 4), (0.5, 0.5, 0.5, wetness), np.float32))
-    tips = np.zeros((1, 1024, 4), np.float32)
+    count = mesh.vertex_count
+    strand = np.zeros((1, 1024 * (3 * count // 1024 + 1), 4), np.float32)
+    u, v = frames if frames is not None else tangent_frames(mesh)
     if deflection is not None:
-        tips[0, :len(deflection), :3] = deflection
-    tips_texture = float_texture(ctx, tips, repeat=False)
+        strand[0, 0:3 * count:3, :3] = deflection
+    strand[0, 1:3 * count:3, :3] = u
+    strand[0, 2:3 * count:3, :3] = v
+    strand = strand.reshape(-1, 1024, 4)
+    strand_texture = float_texture(ctx, strand, repeat=False)
     mask.use(0)
-    tips_texture.use(1)
+    strand_texture.use(1)
     program["u_wetness_mask"].value = 0
     program["u_strand_tips"].value = 1
     gpu = GpuMesh(ctx, mesh)
-    out = transform(gl, program, [gpu.vertex_buffer(program)], mesh.vertex_count, 6)
+    out = transform(gl, program, [gpu.vertex_buffer(program)], count, 6)
     gpu.release()
     mask.release()
-    tips_texture.release()
+    strand_texture.release()
     program.release()
     return out[:, :3], out[:, 3:]
 
@@ -330,8 +421,7 @@ def test_curl_offsets_of_layer_h_match_eq4(gl, shaders, h, wetness):
     K, w, L = 0.05, 9.0, 0.2
     positions, tangents = layer_positions(gl, shaders, mesh, h, wetness, K, w, L)
     n = mesh.normals.astype(np.float64)
-    u = mesh.tangents.astype(np.float64)
-    v = mesh.binormals.astype(np.float64)
+    u, v = tangent_frames(mesh)
     alpha = (1.0 - wetness) * K * h
     curl = alpha * (np.cos(w * h) * u + np.sin(w * h) * v)  # Eq. 4
     straight = h * L * n  # beta(h) of an unbent strand: the layers evenly along the normal
@@ -346,22 +436,33 @@ def test_curl_offsets_of_layer_h_match_eq4(gl, shaders, h, wetness):
     np.testing.assert_allclose(tangents, derivative, atol=1e-4)
 
 
-def test_layers_follow_the_bezier_of_the_simulated_strand(gl, shaders):
+@pytest.mark.parametrize("deflection", [(0.12, -0.05, 0.0),   # inside Eq. 3's region
+                                        (0.5, 0.2, 0.1),      # too long: pulled back to L
+                                        (0.1, -0.6, 0.0)])    # below the surface: lifted
+def test_layers_follow_the_bezier_of_the_simulated_strand(gl, shaders, deflection):
     mesh = builtin_plane(2, 2.0)
     L = 0.3
-    deflection = np.tile([0.12, -0.05, 0.0], (mesh.vertex_count, 1))
+    deflection = np.tile(deflection, (mesh.vertex_count, 1))
     root = mesh.positions.astype(np.float64)
     n = mesh.normals.astype(np.float64)
     rest = root + L * n
-    tip = rest + deflection
-    # Eq. 3 keeps the tip within L of the root
-    offset = tip - root
+    # Eq. 3: above the surface, within L of the root
+    offset = rest + deflection - root
+    offset -= np.minimum(np.einsum("ij,ij->i", offset, n), 0.0)[:, None] * n
     tip = root + offset * np.minimum(1.0, L / np.linalg.norm(offset, axis=1))[:, None]
+    assert (np.linalg.norm(tip - root, axis=1) <= L + 1e-9).all()
+    control = (root + rest) / 2.0  # the rest strand's midpoint (strand.glsl)
     for h in (0.0, 0.25, 0.6, 1.0):
-        positions, _ = layer_positions(gl, shaders, mesh, h, 0.0, 0.0, 0.0, L, deflection)
-        t = 1.0 - math.sqrt(1.0 - h)
-        bezier = (1 - t) ** 2 * root + 2 * (1 - t) * t * rest + t * t * tip
+        positions, tangents = layer_positions(gl, shaders, mesh, h, 0.0, 0.0, 0.0, L,
+                                              deflection)
+        bezier = (1 - h) ** 2 * root + 2 * (1 - h) * h * control + h * h * tip
         np.testing.assert_allclose(positions, bezier, atol=2e-5)
+        derivative = 2 * (1 - h) * (control - root) + 2 * h * (tip - control)
+        derivative /= np.linalg.norm(derivative, axis=1, keepdims=True)
+        np.testing.assert_allclose(tangents, derivative, atol=1e-4)
+    # unbent, the layers sit evenly along the normal
+    positions, _ = layer_positions(gl, shaders, mesh, 0.4, 0.0, 0.0, 0.0, L)
+    np.testing.assert_allclose(positions, root + 0.4 * L * n, atol=2e-5)
 
 
 # -- the layers ------------------------------------------------------------------------------
@@ -478,6 +579,51 @@ def test_wind_from_a_time_bends_the_strands_and_time_is_deterministic(gl):
     again = state_at(gl, scene, [3.0, 2.0])[1]
     np.testing.assert_array_equal(again[1], after[1])
     np.testing.assert_array_equal(again[0], after[0])
+
+
+def test_the_state_at_a_time_does_not_depend_on_the_frames_before(gl):
+    scene = anim_scene({"wind": [0.04, 0.0, 0.0], "gust": 0.8, "droplets": 5,
+                        "dry_rate": 0.3, "droplet_radius": 0.3},
+                       [(0.37, {"droplets": 12}), (0.61, {"wind": [0.0, 0.0, -0.04]})])
+    frames = state_at(gl, scene, [k / 25.0 for k in range(26)])[-1]  # 25 fps up to 1 s
+    direct = state_at(gl, scene, [1.0])[0]
+    np.testing.assert_allclose(frames[1], direct[1], atol=1e-12)
+    np.testing.assert_allclose(frames[0], direct[0], atol=1e-6)
+    # frames closer than a step still move the strands (a step is taken when one is due)
+    fine = state_at(gl, scene, [k / 1000.0 for k in range(0, 1001, 1)])[-1]
+    np.testing.assert_allclose(fine[1], direct[1], atol=1e-12)
+
+
+def test_a_timeline_may_not_change_what_the_simulation_reads_once(tmp_path, capsys):
+    scene = write_scene(tmp_path / "s.toml", "fur_length = 0.1")
+    scene.write_text(scene.read_text().replace("[[object]]", "[[object]]\nname = \"fur\"")
+                     + '\n[[event]]\ntime = 1.0\nobject = "fur"\nparams = { fur_length = 0.2 }\n')
+    code, output = cli(capsys, "render", str(scene), "-o", str(tmp_path / "out.png"))
+    assert code == 2
+    assert "event[0].params.fur_length: shell_fur reads fur_length once, at t = 0" in output
+
+
+def test_deflections_come_back_to_object_space(gl):
+    """A plane turned on its side (object +y = world +z) under world gravity: the strands sag
+    along world -y, which is object +z... rotated back by the inverse transform."""
+    scene = {"size": [32, 32],
+             "object": [{"name": "fur", "mesh": "builtin:plane?divisions=4",
+                         "material": "shell_fur", "rotation": [90.0, 0.0, 0.0], "scale": 2.0,
+                         "params": {"fur_length": 0.2, "damping": 0.5}}]}
+    loaded = scene_from_dict(scene, "s")
+    obj = loaded.objects[0]
+    state = ShellFurState(gl.ctx, obj, obj.material)
+    state.advance(0.0)  # settled under gravity
+    deflection = state.vertex_deflections()
+    linear = obj.model[:3, :3]
+    world = deflection @ linear.T
+    down = world / np.linalg.norm(world, axis=1, keepdims=True)
+    # in the world the tips hang down (and a little toward the surface, held at length L)
+    assert (down[:, 1] < -0.9).all()
+    # object units: half the world length (scale 2)
+    sag = np.linalg.norm(world, axis=1)
+    np.testing.assert_allclose(np.linalg.norm(deflection, axis=1), sag / 2.0, rtol=1e-6)
+    state.release()
 
 
 def test_render_at_the_same_time_twice_is_identical(render):

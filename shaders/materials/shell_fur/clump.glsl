@@ -13,8 +13,9 @@
 //    a clump gathers the same share of its radius whatever its size (Fig. 13). s, the
 //    clump_strength, scales it: 1 gathers the tips of fully wet fur into half the radius.
 // Algorithm 2 ignores a displaced coordinate that falls on dry fur; we also ignore one that
-// falls in another clump (a centre more than half a radius away): without it neighbouring wet
-// clumps run into each other and fur wet all over shows no clumps at all.
+// falls in another clump: a texel whose centre is farther than the clump's radius (Algorithm 1
+// merges a droplet into a clump exactly when their centres are that close). Without it
+// neighbouring wet clumps run into each other and fur wet all over shows no clumps at all.
 
 uniform sampler2D u_wetness_mask;
 uniform float u_clump_shape;     // w
@@ -28,22 +29,31 @@ float clump_profile(float h, float w, float layers) {
     return (1.0 - w) * hh + w * (1.0 + log(hh) / log(n));
 }
 
+// Eq. 5's scalar: d = clump_gain (c_pixel - c_mask).
+float clump_gain(float h, vec4 mask, float w, float layers, float strength) {
+    return clump_profile(h, w, layers) * mask.a * strength;
+}
+
 // Eq. 5 for a texel of the mask.
 vec2 clump_displacement(float h, vec4 mask, vec2 c_pixel, float w, float layers, float strength) {
-    return clump_profile(h, w, layers) * mask.a * strength * (c_pixel - mask.rg);
+    return clump_gain(h, mask, w, layers, strength) * (c_pixel - mask.rg);
 }
 
 // Algorithm 2 at texture coordinate `uv` and height h: the displacement d to add to the colour
-// and fur coordinates, and whether the fragment is kept (false: it belongs to another clump, or
-// its displaced coordinate falls on dry fur). Dry fragments keep their coordinates.
-bool clump_fur(vec2 uv, float h, out vec2 d) {
+// and fur coordinates, its gain (within a clump uv + d = uv + gain (uv - c), so lookups there
+// change (1 + gain) times as fast as uv), and whether the fragment is kept (false: it belongs
+// to another clump, or its displaced coordinate falls on dry fur or into another clump). Dry
+// fragments keep their coordinates.
+bool clump_fur(vec2 uv, float h, out vec2 d, out float gain) {
     d = vec2(0.0);
+    gain = 0.0;
     vec4 mask = textureLod(u_wetness_mask, uv, 0.0);
     if (mask.a == 0.0) return true;
-    d = clump_displacement(h, mask, uv, u_clump_shape, u_layers, u_clump_strength);
-    if (distance(uv, mask.rg) > mask.b) return false;        // from a different clump
+    gain = clump_gain(h, mask, u_clump_shape, u_layers, u_clump_strength);
+    d = gain * (uv - mask.rg);
+    if (distance(uv, mask.rg) > mask.b) return false;            // from a different clump
     vec4 there = textureLod(u_wetness_mask, uv + d, 0.0);
-    if (there.a == 0.0) return false;                                 // from a dry area
-    if (distance(there.rg, mask.rg) > 0.5 * mask.b) return false;    // from another clump
+    if (there.a == 0.0) return false;                             // from a dry area
+    if (distance(there.rg, mask.rg) > mask.b) return false;      // from another clump
     return true;
 }

@@ -7,3 +7,9 @@ uniform float u_color_scale;    // repeats of the texture across the UV square
 vec3 fur_color(vec2 uv) {
     return u_color * texture(u_color_map, uv * u_color_scale).rgb;
 }
+
+// With explicit screen gradients of uv (clumped coordinates, layer.glsl).
+vec3 fur_color_grad(vec2 uv, vec2 dx, vec2 dy) {
+    return u_color * textureGrad(u_color_map, uv * u_color_scale, dx * u_color_scale,
+                                 dy * u_color_scale).rgb;
+}

@@ -26,8 +26,9 @@ out vec4 out_color;
 
 void main() {
     FurLayer layer = fur_layer(v_uv, v_fur_position, v_shell_depth, u_root_shell);
-    vec2 strands = fur_sample(layer.fur_position, v_fur_normal, v_shell_depth);
-    vec3 albedo = fur_color(layer.color_uv);
+    vec2 strands = fur_sample_grad(layer.fur_position, v_fur_normal, v_shell_depth,
+                                   layer.fur_dx, layer.fur_dy);
+    vec3 albedo = fur_color_grad(layer.color_uv, layer.color_dx, layer.color_dy);
     float alpha = u_root_shell ? 1.0 : shell_opacity(strands.x, u_shell_weight) * u_shell_fade;
 #ifdef FUR_FINS
     alpha *= v_fin_fade * smoothstep(0.0, 0.35, v_shell_depth);

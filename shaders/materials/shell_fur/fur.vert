@@ -1,7 +1,9 @@
 // shell_fur: the mesh as the fur layer at normalized length h = u_shell_depth (0 the skin),
 // displaced by Silva et al.'s v_offset(h) = beta(h) + phi(h) (Eq. 1; strand.glsl): the Bezier
-// of the vertex's simulated strand (the tip deflection p - p_0 of its triangles, averaged, in
-// u_strand_tips at the vertex's index) and the curl, which the wetness at the vertex undoes.
+// of the vertex's simulated strand and the curl, which the wetness at the vertex undoes.
+// u_strand_tips holds three texels per vertex (at 3 x its index): the tip deflection p - p_0
+// (its triangles', averaged) and the curl's u and v (one frame for all copies of a vertex split
+// at a UV seam).
 // v_strand_tangent is the strand's direction there (d v_offset / dh), or with STRAND_CHORD the
 // strand's chord, root to simulated tip (the base surface, the skin and the fins: one direction
 // for the whole strand, the curl averaged out). With FUR_FINS the outputs feed the fin geometry
@@ -24,7 +26,7 @@ uniform vec3 u_fur_scale;       // object axes to world units (the model matrix'
 uniform float u_curl_radius;    // K, object units
 uniform float u_curl_frequency; // w, radians over the strand
 uniform sampler2D u_wetness_mask;
-uniform sampler2D u_strand_tips;  // RGBA32F: per vertex p - p_0, object space
+uniform sampler2D u_strand_tips;  // RGBA32F: per vertex p - p_0, curl u, curl v; object space
 
 #ifdef FUR_FINS
 #define v_position vs_position
@@ -64,28 +66,33 @@ out vec3 v_strand_tangent;  // view space
 
 invariant gl_Position;
 
-vec3 strand_offset(float h, vec3 rest_tip, vec3 tip, float wetness) {
+vec3 strand_texel(int k) {
+    int index = 3 * gl_VertexID + k;
+    int width = textureSize(u_strand_tips, 0).x;
+    return texelFetch(u_strand_tips, ivec2(index % width, index / width), 0).xyz;
+}
+
+vec3 strand_offset(float h, vec3 rest_tip, vec3 tip, float wetness, vec3 u, vec3 v) {
     return strand_bend(in_position, rest_tip, tip, h)
-         + curl_offset(h, wetness, u_curl_radius, u_curl_frequency, in_tangent, in_binormal);
+         + curl_offset(h, wetness, u_curl_radius, u_curl_frequency, u, v);
 }
 
 void main() {
     float fur_length = u_fur_length * in_comb.a;
     vec3 rest_tip = in_position + in_normal * fur_length;  // p_0
-    int width = textureSize(u_strand_tips, 0).x;
-    vec3 deflection = texelFetch(u_strand_tips, ivec2(gl_VertexID % width, gl_VertexID / width),
-                                 0).xyz;
-    vec3 tip = constrain_tip(in_position, in_normal, fur_length, rest_tip + deflection);
+    vec3 tip = constrain_tip(in_position, in_normal, fur_length, rest_tip + strand_texel(0));
+    vec3 curl_u = strand_texel(1);
+    vec3 curl_v = strand_texel(2);
     float wetness = textureLod(u_wetness_mask, in_uv, 0.0).a;
 
     float h = u_shell_depth;
-    vec3 layer = in_position + strand_offset(h, rest_tip, tip, wetness);
-    vec3 tip_point = in_position + strand_offset(1.0, rest_tip, tip, wetness);
+    vec3 layer = in_position + strand_offset(h, rest_tip, tip, wetness, curl_u, curl_v);
+    vec3 tip_point = in_position + strand_offset(1.0, rest_tip, tip, wetness, curl_u, curl_v);
 #ifdef STRAND_CHORD
     vec3 direction = tip - in_position;
 #else
     vec3 direction = strand_bend_derivative(in_position, rest_tip, tip, h)
-        + curl_derivative(h, wetness, u_curl_radius, u_curl_frequency, in_tangent, in_binormal);
+        + curl_derivative(h, wetness, u_curl_radius, u_curl_frequency, curl_u, curl_v);
 #endif
     direction = dot(direction, direction) > 1e-20 ? direction : in_normal;
 

@@ -1,31 +1,28 @@
 // Silva et al. 3.2: a layer at normalized fur length h is the base surface displaced by
 // v_offset(h) = beta(h) + phi(h) (Eq. 1).
 //
-// beta(h), the strand's bend (3.2.1): the quadratic Bezier through p_root, p_0 (the rest tip,
-// the control point) and p (the simulated tip). It is sampled at t = 1 - sqrt(1 - h), which puts
-// the layers of unbent fur evenly along the normal (B(t) = p_root + (2t - t^2) L n = p_root + h L n
-// when p = p_0), as the fur volume's slices and the shells' opacities assume.
+// beta(h), the strand's bend (3.2.1): a quadratic Bezier from p_root to the simulated tip p. Its
+// control point is the rest strand's midpoint (p_root + p_0) / 2, so the strand leaves the root
+// along the normal, unbent layers sit evenly along it (B(h) = p_root + h L n when p = p_0: the
+// fur volume's slices and the layers' opacities assume even layers), and layer h bends by h^2
+// of the tip's deflection. (With p_0 itself as the control point, unbent layers would bunch at
+// the tip, at heights (2h - h^2) L.)
 //
 // phi(h), the curl (3.2.2, Eq. 4): alpha(h) (cos(w h) u + sin(w h) v) in the surface's tangent
 // plane, alpha(h) = (1 - rho) K h: the strand winds round a widening helix, and wet fur (rho 1)
 // loses its curl.
 
-float bezier_parameter(float h) {
-    return 1.0 - sqrt(max(1.0 - h, 0.0));
-}
-
 // beta(h): the layer's offset from the root along the strand's Bezier.
 vec3 strand_bend(vec3 root, vec3 rest_tip, vec3 tip, float h) {
-    float t = bezier_parameter(h);
-    float s = 1.0 - t;
-    return s * s * root + 2.0 * s * t * rest_tip + t * t * tip - root;
+    vec3 control = 0.5 * (root + rest_tip);
+    float s = 1.0 - h;
+    return s * s * root + 2.0 * s * h * control + h * h * tip - root;
 }
 
-// d beta / dh: dB/dt = 2(1 - t)(p_0 - p_root) + 2t(p - p_0) times dt/dh = 1 / (2(1 - t)); t is
-// kept below 1, where dt/dh grows without bound (only the direction is used).
+// d beta / dh.
 vec3 strand_bend_derivative(vec3 root, vec3 rest_tip, vec3 tip, float h) {
-    float t = min(bezier_parameter(h), 0.98);
-    return (rest_tip - root) + t / (1.0 - t) * (tip - rest_tip);
+    vec3 control = 0.5 * (root + rest_tip);
+    return 2.0 * (1.0 - h) * (control - root) + 2.0 * h * (tip - control);
 }
 
 // phi(h), Eq. 4.
