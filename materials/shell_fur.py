@@ -64,6 +64,7 @@ from .techniques.wetness import (
     load_wetness_mask,
     random_droplets,
     read_mask_image,
+    uv_wrap,
 )
 
 if TYPE_CHECKING:
@@ -122,6 +123,9 @@ class ShellFurParams(FurParams, BlinnPhongParams):
     time_step: float = Field(1.0 / 240.0, gt=0.0, le=0.1, description="simulation step, s")
     settle: float = Field(2.0, ge=0.0, le=60.0,
                           description="seconds simulated before t = 0 (strands at rest)")
+    fins: bool = Field(False, description="fins at silhouette edges (Lengyel 2001; not in the "
+                                          "paper): straight, along the strand's chord, they "
+                                          "suit uncurled fur")
     debug: Literal["none", "samples", "shell_count", "single_shell", "wetness"] = Field(
         "none", description="debug view instead of the fur (shell_fur's debug_views)")
 
@@ -205,6 +209,7 @@ class ShellFurState:
         self.strands = StrandSimulation(*triangle_strands(obj.mesh, obj.model, params.fur_length))
         self.average = VertexAverage(obj.mesh)
         self.size = params.mask_size
+        self.wrap = uv_wrap(obj.mesh)
         self.mask_texture = _float_texture(ctx, self.size, self.size)
         self.mask_texture.repeat_x = self.mask_texture.repeat_y = True
         # three texels per vertex: tip deflection, curl u, curl v (fur.vert)
@@ -265,7 +270,7 @@ class ShellFurState:
                                            params.droplets - self.fallen, params.droplet_radius,
                                            params.droplet_wetness, params.seed,
                                            start=self.fallen):
-                blend_droplet(self.mask, droplet)
+                blend_droplet(self.mask, droplet, self.wrap)
             self.fallen = params.droplets
             self._uploaded = None
 
@@ -298,14 +303,23 @@ class ShellFurState:
 # -- passes -------------------------------------------------------------------------------------
 
 class ObjectStateInputs:
-    """Passes of a shell_fur object bind its state's textures (at the frame's time)."""
+    """Passes of a shell_fur object bind its state's textures (at the frame's time); those that
+    clump (``clumps``) learn whether the mesh's UVs wrap."""
 
     obj: SceneObject
+    clumps = False
 
     def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
         state = self.obj.material.state(frame, self.obj)
         return {**super().textures(frame), "u_wetness_mask": state.mask_texture,
                 "u_strand_tips": state.tips_texture}
+
+    def uniforms(self, frame: Frame) -> dict[str, Any]:
+        uniforms = super().uniforms(frame)
+        if self.clumps:
+            wrap = self.obj.material.state(frame, self.obj).wrap
+            uniforms["u_mask_wrap"] = tuple(float(w) for w in wrap)
+        return uniforms
 
 
 def layer_layout(count: float, shell_range: tuple[float, float] = (0.0, 1.0),
@@ -333,6 +347,7 @@ class ShellFurLayerPass(ObjectStateInputs, ShellPass):
     """The skin and the N layers (Silva's spacing, :func:`layer_layout`)."""
 
     vertex = FUR_VERTEX
+    clumps = True
 
     def draws(self, frame: Frame) -> int:
         params = self.obj.material.params
@@ -356,6 +371,7 @@ class ShellFurLayerPass(ObjectStateInputs, ShellPass):
 
 class ShellFurFinPass(ObjectStateInputs, FinPass):
     vertex = FUR_VERTEX
+    clumps = True
 
     def draws(self, frame: Frame) -> int:
         return 0 if self.obj.material.params.debug == "wetness" else super().draws(frame)

@@ -11,7 +11,9 @@ droplet never mistakes the UV origin for the centre of a dry texel's clump, and 
 wetness dries to 0 is reset to dry (drying brings the curl back and dissolves the clump).
 
 The array is (size, size, 4) float32, row ``i`` at ``v = (i + 0.5) / size`` (GL's texel order:
-uploaded as it is), column ``j`` at ``u = (j + 0.5) / size``.
+uploaded as it is), column ``j`` at ``u = (j + 0.5) / size``. Where a mesh's UVs wrap around
+(the cylindrical unwrap of a sphere or torus: :func:`uv_wrap`), distances in that direction are
+taken round the cylinder, so a droplet on the seam wets both sides and its clump is whole.
 """
 
 from __future__ import annotations
@@ -51,19 +53,39 @@ def texel_centres(size: int) -> tuple[np.ndarray, np.ndarray]:
     return u, v
 
 
-def blend_droplet(mask: np.ndarray, droplet: Droplet) -> None:
-    """Blend ``droplet`` into ``mask`` in place with Algorithm 1, at every texel it covers."""
+def wrap_delta(delta: np.ndarray, wrap: tuple[bool, bool]) -> np.ndarray:
+    """``delta`` (..., 2) in UV units, taken the short way round on wrapped axes."""
+    out = np.array(delta, dtype=np.float64)
+    for axis in (0, 1):
+        if wrap[axis]:
+            out[..., axis] -= np.round(out[..., axis])
+    return out
+
+
+def _texel_range(centre: float, radius: float, size: int, wrap: bool) -> np.ndarray:
+    """Indices of the texels whose centres can lie within ``radius`` of ``centre`` (wrapped
+    axes: possibly outside 0 .. size - 1, to be taken modulo size)."""
+    first, last = int(np.floor((centre - radius) * size)), int(np.ceil((centre + radius) * size))
+    if wrap:
+        return np.arange(first, min(last, first + size))
+    return np.arange(max(first, 0), min(last, size))
+
+
+def blend_droplet(mask: np.ndarray, droplet: Droplet,
+                  wrap: tuple[bool, bool] = (False, False)) -> None:
+    """Blend ``droplet`` into ``mask`` in place with Algorithm 1, at every texel it covers;
+    ``wrap``: whether the UVs wrap around in u, in v."""
     size = mask.shape[0]
     cu, cv = droplet.centre
     r = droplet.radius
-    # the texels whose centres can lie within r of the droplet's centre
-    j0, j1 = max(int(np.floor((cu - r) * size)), 0), min(int(np.ceil((cu + r) * size)), size)
-    i0, i1 = max(int(np.floor((cv - r) * size)), 0), min(int(np.ceil((cv + r) * size)), size)
-    if j0 >= j1 or i0 >= i1:
+    columns = _texel_range(cu, r, size, wrap[0])
+    rows = _texel_range(cv, r, size, wrap[1])
+    if len(columns) == 0 or len(rows) == 0:
         return
-    block = mask[i0:i1, j0:j1]
-    u = (np.arange(j0, j1) + 0.5) / size
-    v = (np.arange(i0, i1) + 0.5) / size
+    index = np.ix_(rows % size, columns % size)
+    block = mask[index]
+    u = (columns + 0.5) / size
+    v = (rows + 0.5) / size
     covered = (u[None, :] - cu) ** 2 + (v[:, None] - cv) ** 2 <= r * r
 
     c_mask = block[..., 0:2].astype(np.float64)
@@ -71,13 +93,19 @@ def blend_droplet(mask: np.ndarray, droplet: Droplet) -> None:
     rho_mask = block[..., 3].astype(np.float64)
     c_drop = np.array([cu, cv])
     rho_drop = droplet.wetness
-    near = np.linalg.norm(c_mask - c_drop, axis=-1) <= r  # ||c_mask - c_drop|| <= r_drop
+    # the texel's centre seen from the droplet's, the short way round wrapped axes
+    toward = wrap_delta(c_mask - c_drop, wrap)
+    near = np.linalg.norm(toward, axis=-1) <= r  # ||c_mask - c_drop|| <= r_drop
     # joins the texel's clump where that clump is wet
     joins = covered & near & (rho_mask != 0.0)
     rho_total = np.clip(rho_mask + rho_drop, 0.0, 1.0)
     merge = joins & (rho_total != 0.0)
     alpha = np.where(merge, rho_drop / np.where(rho_total != 0.0, rho_total, 1.0), 0.0)
-    new_c = (1.0 - alpha)[..., None] * c_mask + alpha[..., None] * c_drop
+    # (1 - alpha) c_mask + alpha c_drop, along the short way between them
+    new_c = c_drop + (1.0 - alpha)[..., None] * toward
+    for axis in (0, 1):
+        if wrap[axis]:
+            new_c[..., axis] %= 1.0
     new_r = (1.0 - alpha) * r_mask + alpha * r
     # a new clump (the droplet's) where the texel's centre is out of reach
     replace = covered & ~near
@@ -88,6 +116,7 @@ def blend_droplet(mask: np.ndarray, droplet: Droplet) -> None:
     block[..., 2] = np.where(replace, r, block[..., 2])
     block[..., 3] = np.where(replace, rho_drop, block[..., 3])
     _reset_dry(block)
+    mask[index] = block
 
 
 def _reset_dry(mask: np.ndarray) -> None:
@@ -104,6 +133,19 @@ def dry_out(mask: np.ndarray, amount: float) -> None:
     wet = mask[..., 3] > 0.0
     mask[..., 3][wet] = np.maximum(mask[..., 3][wet] - amount, 0.0)
     _reset_dry(mask)
+
+
+def uv_wrap(mesh: MeshData, tolerance: float = 1e-3) -> tuple[bool, bool]:
+    """Whether the mesh's UVs wrap around in u and in v: a vertex split at a seam has copies
+    whose u (v) differ by 1 (a cylindrical unwrap, as the built-in sphere and torus have)."""
+    from .strands import weld
+
+    welded = weld(mesh.positions)
+    uvs = np.asarray(mesh.uvs, np.float64)
+    order = np.argsort(welded, kind="stable")
+    same = welded[order][1:] == welded[order][:-1]
+    delta = np.abs(uvs[order][1:] - uvs[order][:-1])[same]
+    return tuple(bool(np.any(np.abs(delta[:, axis] - 1.0) < tolerance)) for axis in (0, 1))
 
 
 def uv_scale(mesh: MeshData, model: np.ndarray) -> np.ndarray:

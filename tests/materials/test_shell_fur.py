@@ -105,6 +105,32 @@ def test_algorithm1_against_the_printed_algorithm(case):
     assert (mask[~wet][:, :2] == DRY_CENTRE).all()
 
 
+def test_droplets_wrap_round_a_cylindrical_unwrap():
+    from deferred.materials.techniques.wetness import uv_wrap
+
+    assert uv_wrap(builtin_sphere(16, 8)) == (True, False)
+    assert uv_wrap(builtin_plane(4)) == (False, False)
+    # a droplet on the seam (u = 0.97) is the droplet at u = 0.47 turned half way round
+    size = 32
+    on_seam, inside = dry_mask(size), dry_mask(size)
+    blend_droplet(on_seam, Droplet((0.97, 0.5), 0.1, 0.6), wrap=(True, False))
+    blend_droplet(inside, Droplet((0.47, 0.5), 0.1, 0.6), wrap=(True, False))
+    turned = np.roll(inside, size // 2, axis=1)
+    wet = turned[..., 3] > 0
+    assert (on_seam[..., 3] > 0).sum() == wet.sum() > 25
+    np.testing.assert_allclose(on_seam[..., 3], turned[..., 3])
+    np.testing.assert_allclose(on_seam[wet][:, 0], 0.97, atol=1e-6)
+    # a second droplet across the seam joins the first's clump, its centre moving the short way
+    blend_droplet(on_seam, Droplet((0.03, 0.5), 0.1, 0.6), wrap=(True, False))
+    merged = np.abs(on_seam[..., 3] - 1.0) < 1e-6
+    centres = on_seam[merged][:, 0]
+    assert merged.sum() > 10 and np.all((centres > 0.99) | (centres < 0.01))
+    # without wrapping the droplet stops at the border
+    clipped = dry_mask(size)
+    blend_droplet(clipped, Droplet((0.97, 0.5), 0.1, 0.6))
+    assert (clipped[..., 3] > 0).sum() < wet.sum()
+
+
 def test_a_zero_wetness_stamp_holds_no_clump():
     """The one departure from Algorithm 1 as printed: texels a droplet of wetness 0 covered stay
     dry (no clump), so a later droplet near that spot wets them; as printed they would keep the

@@ -21,6 +21,13 @@ uniform sampler2D u_wetness_mask;
 uniform float u_clump_shape;     // w
 uniform float u_clump_strength;  // s
 uniform float u_layers;          // N, the most layers (shells)
+uniform vec2 u_mask_wrap;        // 1 where the mesh's UVs wrap around (u, v): distances go round
+
+// a - b in UV units, the short way round wrapped axes.
+vec2 uv_delta(vec2 a, vec2 b) {
+    vec2 d = a - b;
+    return d - u_mask_wrap * floor(d + 0.5);
+}
 
 // (1 - w) h + w (1 + ln(h) / ln N), h kept to the layers' range [1/N, 1].
 float clump_profile(float h, float w, float layers) {
@@ -36,7 +43,7 @@ float clump_gain(float h, vec4 mask, float w, float layers, float strength) {
 
 // Eq. 5 for a texel of the mask.
 vec2 clump_displacement(float h, vec4 mask, vec2 c_pixel, float w, float layers, float strength) {
-    return clump_gain(h, mask, w, layers, strength) * (c_pixel - mask.rg);
+    return clump_gain(h, mask, w, layers, strength) * uv_delta(c_pixel, mask.rg);
 }
 
 // Algorithm 2 at texture coordinate `uv` and height h: the displacement d to add to the colour
@@ -50,10 +57,11 @@ bool clump_fur(vec2 uv, float h, out vec2 d, out float gain) {
     vec4 mask = textureLod(u_wetness_mask, uv, 0.0);
     if (mask.a == 0.0) return true;
     gain = clump_gain(h, mask, u_clump_shape, u_layers, u_clump_strength);
-    d = gain * (uv - mask.rg);
-    if (distance(uv, mask.rg) > mask.b) return false;            // from a different clump
+    vec2 from_centre = uv_delta(uv, mask.rg);
+    d = gain * from_centre;
+    if (length(from_centre) > mask.b) return false;                     // a different clump
     vec4 there = textureLod(u_wetness_mask, uv + d, 0.0);
-    if (there.a == 0.0) return false;                             // from a dry area
-    if (distance(there.rg, mask.rg) > mask.b) return false;      // from another clump
+    if (there.a == 0.0) return false;                                   // from a dry area
+    if (length(uv_delta(there.rg, mask.rg)) > mask.b) return false;    // from another clump
     return true;
 }
