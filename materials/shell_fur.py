@@ -62,6 +62,7 @@ from .techniques.wetness import (
     dry_mask,
     dry_out,
     load_wetness_mask,
+    mean_uv_scale,
     random_droplets,
     read_mask_image,
     uv_wrap,
@@ -123,6 +124,10 @@ class ShellFurParams(FurParams, BlinnPhongParams):
     time_step: float = Field(1.0 / 240.0, gt=0.0, le=0.1, description="simulation step, s")
     settle: float = Field(2.0, ge=0.0, le=60.0,
                           description="seconds simulated before t = 0 (strands at rest)")
+    fur_mapping: Literal["triplanar", "uv"] = Field(
+        "triplanar", description="strands triplanar in world units (the fur technique: no "
+                                 "seams, no poles) or over the mesh's UVs (the paper: a third "
+                                 "of the lookups, the density following the unwrap)")
     fins: bool = Field(False, description="fins at silhouette edges (Lengyel 2001; not in the "
                                           "paper): straight, along the strand's chord, they "
                                           "suit uncurled fur")
@@ -134,10 +139,10 @@ def _layers_uniform(shells: int) -> dict[str, Any]:
     return {"u_layers": float(max(shells, 1))}
 
 
-NOT_UNIFORMS = ("color_texture", "color_pattern", "pattern_color", "droplets", "droplet_radius",
-                "droplet_wetness", "wetness_mask", "mask_size", "dry_rate", "stiffness", "mass",
-                "damping", "gravity", "wind", "gust", "gust_frequency", "time_step", "settle",
-                "heightfield")
+NOT_UNIFORMS = ("fur_mapping", "color_texture", "color_pattern", "pattern_color", "droplets",
+                "droplet_radius", "droplet_wetness", "wetness_mask", "mask_size", "dry_rate",
+                "stiffness", "mass", "damping", "gravity", "wind", "gust", "gust_frequency",
+                "time_step", "settle", "heightfield")
 
 
 # -- colour texture --------------------------------------------------------------------------
@@ -210,6 +215,7 @@ class ShellFurState:
         self.average = VertexAverage(obj.mesh)
         self.size = params.mask_size
         self.wrap = uv_wrap(obj.mesh)
+        self.world_per_uv = mean_uv_scale(obj.mesh, obj.model)
         self.mask_texture = _float_texture(ctx, self.size, self.size)
         self.mask_texture.repeat_x = self.mask_texture.repeat_y = True
         # three texels per vertex: tip deflection, curl u, curl v (fur.vert)
@@ -317,8 +323,11 @@ class ObjectStateInputs:
     def uniforms(self, frame: Frame) -> dict[str, Any]:
         uniforms = super().uniforms(frame)
         if self.clumps:
-            wrap = self.obj.material.state(frame, self.obj).wrap
-            uniforms["u_mask_wrap"] = tuple(float(w) for w in wrap)
+            state = self.obj.material.state(frame, self.obj)
+            uniforms["u_mask_wrap"] = tuple(float(w) for w in state.wrap)
+            # the world density over the UVs: tiles per world unit x world units per UV unit
+            uniforms["u_fur_uv_tiles"] = tiles_per_unit(self.obj.material.params) * \
+                state.world_per_uv
         return uniforms
 
 
@@ -438,7 +447,11 @@ class ShellFurMaterial(Material):
 
     def defines(self, obj: SceneObject) -> dict[str, str]:
         # layers reject light samples the G-buffer shows occluded (Revie's Figure 2.8 fix)
-        return {**super().defines(obj), "FUR_OCCLUSION_TEST": "1", **debug_defines(self.params)}
+        defines = {**super().defines(obj), "FUR_OCCLUSION_TEST": "1",
+                   **debug_defines(self.params)}
+        if self.params.fur_mapping == "uv":
+            defines["FUR_UV_MAPPING"] = "1"
+        return defines
 
     def uniforms(self, frame: Frame) -> dict[str, Any]:
         return {**super().uniforms(frame), "u_fur_tiles": tiles_per_unit(self.params)}

@@ -161,6 +161,22 @@ def uv_scale(mesh: MeshData, model: np.ndarray) -> np.ndarray:
     return np.where(uv_area > 1e-12, np.sqrt(world_area / np.maximum(uv_area, 1e-12)), 0.0)
 
 
+def mean_uv_scale(mesh: MeshData, model: np.ndarray) -> float:
+    """World units per UV unit over the whole mesh: sqrt(world area / UV area)."""
+    faces = np.asarray(mesh.indices, dtype=np.int64).reshape(-1, 3)
+    world = np.asarray(mesh.positions, np.float64) @ model[:3, :3].T
+    p = world[faces]
+    t = np.asarray(mesh.uvs, np.float64)[faces]
+    world_area = 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]),
+                                      axis=-1).sum()
+    e1, e2 = t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]
+    uv_area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]).sum()
+    if uv_area <= 1e-12:
+        raise InputError(f"mesh {mesh.name} has no UV area for fur over its UVs "
+                         "(fur_mapping = \"triplanar\" needs none)")
+    return float(np.sqrt(world_area / uv_area))
+
+
 def random_droplets(mesh: MeshData, model: np.ndarray, count: int, radius: float,
                     wetness: float, seed: int, start: int = 0) -> list[Droplet]:
     """Droplets ``start .. start + count - 1`` of the object's seeded sequence: each hits the

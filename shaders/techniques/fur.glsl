@@ -38,6 +38,13 @@ vec2 fur_sample_grad(vec3 fur_position, vec3 fur_normal, float h, vec3 dx, vec3 
     return s;
 }
 
+// Over the mesh's UVs instead (Silva et al. section 4: the fur texture at (u, v, h)): one lookup
+// pair instead of three, the density following the unwrap; `tiles` volume tiles per UV unit,
+// dx and dy the screen gradients of uv.
+vec2 fur_sample_uv(vec2 uv, float h, float tiles, vec2 dx, vec2 dy) {
+    return fur_slices(uv * tiles, dx * tiles, dy * tiles, h);
+}
+
 // The same with the gradients of fur_position itself. Derivatives in uniform control flow; the
 // branches above only skip negligible planes.
 vec2 fur_sample(vec3 fur_position, vec3 fur_normal, float h) {

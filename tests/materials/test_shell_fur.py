@@ -519,12 +519,15 @@ def clump_scene(params: dict, size=(128, 128)) -> dict:
     }
 
 
-def test_wet_clump_gathers_fur_into_its_centre_and_leaves_dry_fur_alone(render, tmp_path):
+@pytest.mark.parametrize("mapping", ["triplanar", "uv"])
+def test_wet_clump_gathers_fur_into_its_centre_and_leaves_dry_fur_alone(render, tmp_path,
+                                                                         mapping):
     mask = dry_mask(128)
     blend_droplet(mask, Droplet((0.5, 0.5), 0.2, 1.0))
     path = tmp_path / "clump.exr"
     write_image(path, mask_image(mask))
-    top = {"debug": "single_shell", "shell_range": [0.6, 0.7]}  # a layer at h 0.625, opaque
+    top = {"debug": "single_shell", "shell_range": [0.6, 0.7],  # a layer at h 0.625, opaque
+           "fur_mapping": mapping}
     wet, _ = render(scene_from_dict(clump_scene({**top, "wetness_mask": str(path)}), "wet"))
     dry, _ = render(scene_from_dict(clump_scene(top), "dry"))
     covered_wet = wet.image[..., 0] > 128
@@ -539,6 +542,19 @@ def test_wet_clump_gathers_fur_into_its_centre_and_leaves_dry_fur_alone(render, 
     # outside the clump nothing changed
     outside = radius > 1.05
     assert (covered_wet[outside] == covered_dry[outside]).mean() > 0.999
+
+
+def test_uv_mapping_keeps_the_world_density_on_an_even_unwrap(render):
+    """On a plane (UV scale the same everywhere) strands over the UVs cover the layer as much as
+    triplanar strands in world units: the density converts through the mean UV scale."""
+    covered = {}
+    for mapping in ("triplanar", "uv"):
+        scene = clump_scene({"debug": "single_shell", "shell_range": [0.3, 0.4],
+                             "fur_mapping": mapping, "density": 400}, size=(192, 192))
+        result, _ = render(scene_from_dict(scene, mapping))
+        covered[mapping] = (result.image[..., 0] > 128).mean()
+    assert 0.1 < covered["triplanar"] < 0.9
+    assert covered["uv"] == pytest.approx(covered["triplanar"], rel=0.15)
 
 
 def test_forward_and_deferred_agree_on_straight_fur(render):

@@ -11,6 +11,7 @@
 // the surface file (which declares v_strand_tangent)
 #include SURFACE_FILE
 
+uniform float u_fur_uv_tiles;  // volume tiles per UV unit (FUR_UV_MAPPING)
 uniform float u_shell_fade;
 uniform float u_shell_weight;
 uniform float u_shell_count;
@@ -26,8 +27,13 @@ out vec4 out_color;
 
 void main() {
     FurLayer layer = fur_layer(v_uv, v_fur_position, v_shell_depth, u_root_shell);
+#ifdef FUR_UV_MAPPING
+    vec2 strands = fur_sample_uv(layer.color_uv, v_shell_depth, u_fur_uv_tiles, layer.color_dx,
+                                 layer.color_dy);
+#else
     vec2 strands = fur_sample_grad(layer.fur_position, v_fur_normal, v_shell_depth,
                                    layer.fur_dx, layer.fur_dy);
+#endif
     vec3 albedo = fur_color_grad(layer.color_uv, layer.color_dx, layer.color_dy);
     float alpha = u_root_shell ? 1.0 : shell_opacity(strands.x, u_shell_weight) * u_shell_fade;
 #ifdef FUR_FINS

@@ -1,9 +1,10 @@
 // A fragment of a shell_fur layer: where its colour and strands come from after clumping
-// (Algorithm 2), with the clump displacement taken from the mesh's UVs to the fur volume's
-// world-scaled object space (the shared technique looks strands up triplanar there), and the
-// screen gradients of both lookups (within a clump they change 1 + gain times as fast as the
-// undisplaced coordinates: the displacement's own jumps at clump rims must not choose the
-// mip level). Call in uniform control flow: it takes screen derivatives.
+// (Algorithm 2), and the screen gradients of both lookups (within a clump they change 1 + gain
+// times as fast as the undisplaced coordinates: the displacement's own jumps at clump rims must
+// not choose the mip level). With FUR_UV_MAPPING the strands are looked up over the UVs, as
+// the paper does (uv_geo += d); otherwise triplanar in the fur volume's world-scaled object
+// space, the UV displacement carried there through d(position)/d(uv). Call in uniform control
+// flow: it takes screen derivatives.
 #include "materials/shell_fur/clump.glsl"
 
 struct FurLayer {
@@ -17,17 +18,21 @@ struct FurLayer {
 };
 
 FurLayer fur_layer(vec2 uv, vec3 fur_position, float h, bool skin) {
+    vec2 dudx = dFdx(uv);
+    vec2 dudy = dFdy(uv);
+#ifdef FUR_UV_MAPPING
+    vec3 dpdx = vec3(0.0), dpdy = vec3(0.0), dpdu = vec3(0.0), dpdv = vec3(0.0);
+#else
     // d(fur position) / d(uv) from screen derivatives: both are affine over a triangle. Where
     // the UVs do not span the screen footprint (a fin, extruded along constant UVs) there is
     // none, and clumps do not move the fur.
     vec3 dpdx = dFdx(fur_position);
     vec3 dpdy = dFdy(fur_position);
-    vec2 dudx = dFdx(uv);
-    vec2 dudy = dFdy(uv);
     float det = dudx.x * dudy.y - dudy.x * dudx.y;
     bool spans = abs(det) > 1e-4 * length(dudx) * length(dudy);
     vec3 dpdu = spans ? (dpdx * dudy.y - dpdy * dudx.y) / det : vec3(0.0);
     vec3 dpdv = spans ? (dpdy * dudx.x - dpdx * dudy.x) / det : vec3(0.0);
+#endif
     vec2 d = vec2(0.0);
     float gain = 0.0;
     bool kept = skin || clump_fur(uv, h, d, gain);  // the skin under the fur does not clump
