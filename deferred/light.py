@@ -13,6 +13,7 @@ cost follows the pixels a light touches.
 
 from __future__ import annotations
 
+import re
 from functools import lru_cache
 from importlib.resources.abc import Traversable
 from pathlib import Path
@@ -33,6 +34,7 @@ if TYPE_CHECKING:
 Vec3 = tuple[float, float, float]
 DISPATCH_FILE = "generated/lights.glsl"
 SHADING_DISPATCH_FILE = "generated/shading_models.glsl"
+RANGE_UNIFORM_PREFIX = "u_light_range_"
 
 
 class LightParams(Params):
@@ -73,16 +75,47 @@ def view_direction(view: np.ndarray, direction) -> np.ndarray:
     return d / max(np.linalg.norm(d), 1e-12)
 
 
+def light_range_uniform(light_type: type[Light]) -> str:
+    """The ``ivec2`` uniform holding (first record, count) of one light type this frame."""
+    return RANGE_UNIFORM_PREFIX + re.sub(r"\W", "_", light_type.name)
+
+
 def light_dispatch_glsl(light_types: list[type[Light]]) -> str:
-    """GLSL of ``evaluate_light``: include the light types and switch on their type id (and
-    the shading models' dispatch, which the lights call)."""
+    """GLSL of the light dispatch (and the shading models' dispatch, which the lights call):
+
+    - ``evaluate_light``: one light of any type, a switch on its type id;
+    - ``evaluate_volume_light``: the same over the volume types only (the lists' lights);
+    - ``evaluate_fullscreen_lights``, ``evaluate_volume_lights``: every full-screen (or volume)
+      light, one loop per type over its range of the light buffer (sorted by type,
+      :class:`~deferred.lightbuffer.LightBuffer`), each calling its function directly. A SIMD
+      rasteriser that runs both sides of a branch (llvmpipe) pays every type's function per
+      light in a switch; in a loop per type it pays each light's own.
+    """
     lines = [f'#include "{SHADING_DISPATCH_FILE}"']
     lines += [f'#include "{cls.glsl_file}"' for cls in light_types]
-    lines.append("vec3 evaluate_light(LightRecord light, Surface s, vec3 P, vec3 V) {")
-    lines.append("    int kind = int(light.color.w + 0.5);")
-    lines += [f"    if (kind == {cls.type_id}) return {cls.glsl_function}(light, s, P, V);"
-              for cls in light_types]
-    lines += ["    return vec3(0.0);", "}"]
+    lines += [f"uniform ivec2 {light_range_uniform(cls)};" for cls in light_types]
+
+    def switch(name: str, types: list[type[Light]]) -> list[str]:
+        body = [f"vec3 {name}(LightRecord light, Surface s, vec3 P, vec3 V) {{",
+                "    int kind = int(light.color.w + 0.5);"]
+        body += [f"    if (kind == {cls.type_id}) return {cls.glsl_function}(light, s, P, V);"
+                 for cls in types]
+        return [*body, "    return vec3(0.0);", "}"]
+
+    def loops(name: str, types: list[type[Light]]) -> list[str]:
+        body = [f"vec3 {name}(Surface s, vec3 P, vec3 V) {{", "    vec3 total = vec3(0.0);"]
+        for cls in types:
+            r = light_range_uniform(cls)
+            body += [f"    for (int k = {r}.x; k < {r}.x + {r}.y; ++k)",
+                     f"        total += {cls.glsl_function}(fetch_light(k), s, P, V);"]
+        return [*body, "    return total;", "}"]
+
+    fullscreen = [cls for cls in light_types if cls.volume == "fullscreen"]
+    volumes = [cls for cls in light_types if cls.volume != "fullscreen"]
+    lines += switch("evaluate_light", light_types)
+    lines += switch("evaluate_volume_light", volumes)
+    lines += loops("evaluate_fullscreen_lights", fullscreen)
+    lines += loops("evaluate_volume_lights", volumes)
     return "\n".join(lines) + "\n"
 
 

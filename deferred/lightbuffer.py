@@ -15,7 +15,7 @@ import moderngl
 import numpy as np
 
 from .context import Features
-from .light import Light
+from .light import RANGE_UNIFORM_PREFIX, Light, light_range_uniform
 
 RECORD_VEC4S = 4
 
@@ -42,6 +42,7 @@ class LightBuffer:
         self.global_count = 0  # full-screen lights, first in the buffer
         self.culled = 0  # volume lights dropped this frame: outside the view
         self.ranges: dict[type[Light], tuple[int, int]] = {}
+        self._range_uniforms: dict[str, tuple[int, int]] = {}
         self._buffer: moderngl.Buffer | None = None
         self._texture: moderngl.Texture | None = None
         self._capacity = 0
@@ -75,6 +76,8 @@ class LightBuffer:
                projection: np.ndarray | None = None) -> None:
         records, self.ranges, self.global_count = self.pack(lights, view, projection)
         self.count = sum(count for _, count in self.ranges.values())
+        self._range_uniforms = {light_range_uniform(light_type): span
+                                for light_type, span in self.ranges.items()}
         self.culled = len(lights) - self.count
         rows = len(records)
         if rows > self._capacity:
@@ -110,6 +113,10 @@ class LightBuffer:
             program["u_light_count"].value = self.count
         if "u_global_light_count" in members:
             program["u_global_light_count"].value = self.global_count
+        for name in members:
+            # every type's range, (0, 0) for a type with no light this frame (all culled)
+            if name.startswith(RANGE_UNIFORM_PREFIX):
+                program[name].value = self._range_uniforms.get(name, (0, 0))
         if self.storage and "LightBuffer" in members:
             self._buffer.bind_to_storage_buffer(0)
             program["LightBuffer"].binding = 0

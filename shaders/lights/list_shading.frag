@@ -11,7 +11,6 @@ uniform sampler2D u_ssao;
 #endif
 uniform vec2 u_resolution;
 uniform mat4 u_inverse_projection;
-uniform int u_global_light_count;
 
 out vec4 out_light;
 
@@ -24,19 +23,17 @@ void main() {
 #endif
     vec3 P = view_position(gl_FragCoord.xy, g.linear_depth, u_resolution, u_inverse_projection);
     vec3 V = normalize(-P);
-    vec3 total = vec3(0.0);
-    for (int k = 0; k < u_global_light_count; ++k)
-        total += evaluate_light(fetch_light(k), g.surface, P, V);
+    vec3 total = evaluate_fullscreen_lights(g.surface, P, V);
 #ifdef ALL_LIGHTS
     // brute force (benchmarks/brute_force.py): every volume light at every pixel, no lists
-    for (int k = u_global_light_count; k < u_light_count; ++k)
-        total += evaluate_light(fetch_light(k), g.surface, P, V);
+    total += evaluate_volume_lights(g.surface, P, V);
 #else
     int list = light_list_of(pixel, g.linear_depth);
     int length = light_list_length(list);
     for (int k = 0; k < length; ++k) {
         int index = light_list_light(list, k);
-        if (light_reaches(index, P)) total += evaluate_light(fetch_light(index), g.surface, P, V);
+        if (light_reaches(index, P))
+            total += evaluate_volume_light(fetch_light(index), g.surface, P, V);
     }
 #endif
     out_light = vec4(total, 0.0);

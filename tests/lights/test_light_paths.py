@@ -138,6 +138,32 @@ def test_lights_outside_the_view_are_culled_on_the_cpu(gl):
         assert renderer.light_buffer.count == len(ALL_TYPES)
 
 
+@pytest.mark.parametrize("pipeline,path", [("forward", "naive"), ("forward", "tiled"),
+                                           ("deferred", "tiled")])
+def test_a_light_type_culled_in_a_later_frame_adds_no_light(gl, pipeline, path):
+    # The loops per light type read each type's range of the light buffer from a uniform; a
+    # frame in which every light of a type is culled must set its range empty, not keep the
+    # last frame's.
+    def lights(point_z):
+        return scene_from_dict({"light": [
+            {"type": "ambient", "color": [0.1, 0.1, 0.1]},
+            {"type": "point", "position": [0.0, 1.0, point_z], "radius": 3.0,
+             "intensity": 5.0}]}).lights
+
+    scene = scene_with(0)
+    scene.lights = lights(1.0)
+    with Renderer(scene, pipeline, gl=gl, light_path=path) as renderer:
+        lit = renderer.render().hdr
+        renderer.scene.lights = lights(40.0)  # behind the eye: culled
+        later = renderer.render().hdr
+        assert renderer.light_buffer.culled == 1
+    scene.lights = lights(40.0)
+    with Renderer(scene, pipeline, gl=gl, light_path=path) as renderer:
+        fresh = renderer.render().hdr
+    assert lit[..., :3].max() > 2.0 * fresh[..., :3].max()  # the point light did reach it
+    np.testing.assert_array_equal(later, fresh)
+
+
 def test_without_compute_shaders_the_gl33_paths_run(gl):
     gl33 = GLContext(gl.ctx, Features(storage_buffers=False, compute_shaders=False))
     scene = scene_with(4)
