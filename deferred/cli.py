@@ -6,6 +6,7 @@ naming the file/key and the problem; ``--debug`` shows the traceback instead.
 
 from __future__ import annotations
 
+import math
 import sys
 import time
 import traceback
@@ -26,6 +27,18 @@ stderr = Console(stderr=True, soft_wrap=True)  # status lines never wrap on pipe
 
 class Options:
     debug = False
+
+
+class FiniteFloat(click.FloatRange):
+    """A float option within its range that is also finite (click takes "nan" and "inf")."""
+
+    name = "finite float"
+
+    def convert(self, value, param, ctx):
+        number = super().convert(value, param, ctx)
+        if not math.isfinite(number):
+            self.fail(f"{value!r} is not a finite number.", param, ctx)
+        return number
 
 
 def _size_option(value: str | None) -> tuple[int, int] | None:
@@ -56,9 +69,9 @@ def cli(debug: bool) -> None:
 @click.option("--frames", type=click.IntRange(min=1), default=1, show_default=True,
               help="Render this many frames, frame i at --time + i / --fps seconds: all of "
                    "them go to a sequence or a video; an image gets the last (timing).")
-@click.option("--fps", type=click.FloatRange(min=0.0, min_open=True), default=24.0,
+@click.option("--fps", type=FiniteFloat(min=0.0, min_open=True, max=1000.0), default=24.0,
               show_default=True, help="Frames per second: the time step and the video's rate.")
-@click.option("--time", "start_time", type=click.FloatRange(min=0.0), default=0.0,
+@click.option("--time", "start_time", type=FiniteFloat(min=0.0, max=1e6), default=0.0,
               show_default=True, metavar="SECONDS",
               help="Time of the first frame (the scene's [[event]] timeline, animated "
                    "materials).")

@@ -51,6 +51,11 @@ class GLContext:
             "glsl": str(self.features.glsl_version()),
         }
 
+    @property
+    def max_texture_size(self) -> int:
+        """GL_MAX_TEXTURE_SIZE: the widest and tallest 2D texture (images, the GL 3.3 lights)."""
+        return int(self.ctx.info["GL_MAX_TEXTURE_SIZE"])
+
     _parking: moderngl.Framebuffer | None = None
 
     def make_current(self) -> None:

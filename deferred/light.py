@@ -27,6 +27,7 @@ from .mesh import MeshData, build_mesh
 from .params import Params, validate_params
 from .passes import Phase, RenderPass
 from .targets import LIGHT_ACCUMULATION
+from .validation import Radiance
 
 if TYPE_CHECKING:
     from .frame import Frame
@@ -38,7 +39,7 @@ RANGE_UNIFORM_PREFIX = "u_light_range_"
 
 
 class LightParams(Params):
-    color: Vec3 = Field((1.0, 1.0, 1.0), description="linear RGB colour")
+    color: Radiance = Field((1.0, 1.0, 1.0), description="linear RGB colour, each >= 0")
     intensity: float = Field(1.0, ge=0.0, description="multiplier of color")
 
 

@@ -85,6 +85,32 @@ class ListGrid:
         return self.columns * self.rows * self.slices
 
 
+def list_bytes(grid: ListGrid, capacity: int) -> int:
+    """Bytes of the lists' storage buffer: a count and ``capacity`` slots per list."""
+    return 4 * grid.count * (1 + max(capacity, 1))
+
+
+def _too_many_for_lists(lights: int, grid: ListGrid, size: int) -> str:
+    return (f"{lights} lights need {size >> 20} MiB of light lists at this size "
+            f"({grid.count} lists); the limit is {MAX_LIST_BYTES >> 20} MiB: use fewer lights "
+            "or the volumes path")
+
+
+def check_light_limits(light_path: str, size: tuple[int, int], volume_lights: int,
+                       lights: int, storage_buffers: bool, max_texture_size: int) -> None:
+    """Refuse, before any frame, a light count the light path cannot hold: the lists' storage
+    (tiled, clustered: a slot per volume light in every list) and, without storage buffers,
+    the float texture of the GL 3.3 light buffer (a row per light)."""
+    if light_path in ("tiled", "clustered"):
+        grid = list_grid(*size, light_path == "clustered")
+        needed = list_bytes(grid, volume_lights)
+        if needed > MAX_LIST_BYTES:
+            raise InputError(_too_many_for_lists(volume_lights, grid, needed), "light")
+    if not storage_buffers and lights > max_texture_size:
+        raise InputError(f"{lights} lights; this context keeps lights in a texture of at most "
+                         f"{max_texture_size} rows (GL 3.3, no storage buffers)", "light")
+
+
 def list_grid(width: int, height: int, clustered: bool) -> ListGrid:
     tile = CLUSTER_TILE if clustered else TILE
     return ListGrid(math.ceil(width / tile), math.ceil(height / tile),
@@ -107,11 +133,9 @@ class LightLists:
         self.capacity = max(capacity, 1)
         self.clustered = grid.slices > 1
         self.depth_scale = (near, grid.slices / math.log(far / near))
-        size = 4 * grid.count * (1 + self.capacity)
-        if size > MAX_LIST_BYTES:
-            raise RenderError(f"{capacity} lights need {size >> 20} MiB of light lists at this "
-                              f"size ({grid.count} lists); the limit is "
-                              f"{MAX_LIST_BYTES >> 20} MiB: use fewer lights or the volumes path")
+        size = list_bytes(grid, self.capacity)
+        if size > MAX_LIST_BYTES:  # checked before the first frame (check_light_limits)
+            raise RenderError(_too_many_for_lists(capacity, grid, size))
         if self.buffer is None or self.buffer.size < size:
             if self.buffer is not None:
                 self.buffer.release()

@@ -15,6 +15,7 @@ import moderngl
 import numpy as np
 
 from .context import Features
+from .errors import InputError
 from .light import RANGE_UNIFORM_PREFIX, Light, light_range_uniform
 
 RECORD_VEC4S = 4
@@ -80,6 +81,10 @@ class LightBuffer:
                                 for light_type, span in self.ranges.items()}
         self.culled = len(lights) - self.count
         rows = len(records)
+        if not self.storage and rows > int(self.ctx.info["GL_MAX_TEXTURE_SIZE"]):
+            # lights added after the renderer checked them (check_light_limits)
+            raise InputError(f"{rows} lights; this context keeps lights in a texture of at "
+                             f"most {self.ctx.info['GL_MAX_TEXTURE_SIZE']} rows", "light")
         if rows > self._capacity:
             self._release_storage()
             self._capacity = max(rows, 16)

@@ -14,7 +14,7 @@ from typing import Any
 from pydantic import BaseModel, ConfigDict, ValidationError
 
 from .errors import InputError
-from .validation import format_validation_error
+from .validation import StrictValues, format_validation_error
 
 UniformOverrides = dict[str, Callable[[Any], dict[str, Any]] | None]
 
@@ -26,10 +26,11 @@ RESERVED_UNIFORMS = frozenset({
     "u_light_offset", "u_volume_scale"})
 
 
-class Params(BaseModel):
-    """Base of every parameter model: unknown keys are errors, values never change."""
+class Params(StrictValues):
+    """Base of every parameter model: unknown keys are errors, values never change, numbers are
+    finite and nothing is converted from another type (:class:`StrictValues`)."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
 
 def validate_params(model: type[Params], values: dict[str, Any], where: str | None) -> Params:

@@ -15,7 +15,7 @@ from .errors import InputError
 from .frame import Frame, Resources
 from .generated import generated_glsl
 from .graph import PassGraph, PassGraphError, compile_graph
-from .light_lists import LightLists, resolve_light_path
+from .light_lists import LightLists, check_light_limits, resolve_light_path
 from .lightbuffer import LightBuffer
 from .passes import RenderPass
 from .pipeline import PIPELINES
@@ -81,6 +81,9 @@ class Renderer:
         features = self.gl.features
         try:
             self.light_path = resolve_light_path(pipeline, requested, features)
+            volume_lights = sum(1 for light in scene.lights if light.volume != "fullscreen")
+            check_light_limits(self.light_path, self.size, volume_lights, len(scene.lights),
+                               features.storage_buffers, self.gl.max_texture_size)
         except InputError:
             if self._owns_context:
                 self.gl.release()

@@ -33,7 +33,7 @@ from .material import Material, MaterialParams
 from .mesh import MeshData, load_mesh
 from .params import validate_params
 from .shading import GBufferLayout, ShadingModel, compose_layout
-from .validation import format_validation_error
+from .validation import Radiance, StrictValues, format_validation_error
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -45,8 +45,8 @@ MAX_SIZE = 16384
 DEMO_SCENE = "demo.toml"
 
 
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+class _Strict(StrictValues):
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
 
 class CameraModel(_Strict):
@@ -105,7 +105,8 @@ class TypedModel(BaseModel):
 
 class SceneModel(_Strict):
     size: tuple[int, int] = (1280, 720)
-    background: Vec3 = Field((0.02, 0.02, 0.025), description="linear RGB behind everything")
+    background: Radiance = Field((0.02, 0.02, 0.025),
+                                 description="linear RGB behind everything, each >= 0")
     exposure: float = Field(1.0, gt=0.0)
     tonemap: Literal["reinhard", "aces", "none"] = "aces"
     light_path: Literal["volumes", "tiled", "clustered", "naive"] | None = Field(

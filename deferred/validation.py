@@ -2,9 +2,26 @@
 
 from __future__ import annotations
 
-from typing import Annotated
+import math
+import types
+import typing
+from typing import Annotated, Any, Literal
 
-from pydantic import AfterValidator, ValidationError
+from pydantic import (
+    AfterValidator,
+    BaseModel,
+    ConfigDict,
+    Field,
+    ValidationError,
+    ValidationInfo,
+    field_validator,
+)
+
+# Floats beyond this are refused (world units, intensities, rates): float32 shading has lost
+# every digit by then and a product of two overflows to inf.
+FLOAT_LIMIT = 1e9
+# Integers become GLSL ints (32-bit) or array sizes.
+INT_LIMIT = 2**31 - 1
 
 
 def location(loc: tuple) -> str:
@@ -40,7 +57,10 @@ def _message(first: dict, count: int) -> str:
         message = "unknown parameter"
     elif first["type"] == "missing":
         message = "missing required key"
-    elif "input" in first and not isinstance(first["input"], dict):
+    elif first["type"] == "value_error":
+        message = message.removeprefix("Value error, ")
+    if first["type"] not in ("extra_forbidden", "missing") and "input" in first and \
+            not isinstance(first["input"], dict):
         message += f" (got {first['input']!r})"
     if count > 1:
         message += f" (and {count - 1} more problem{'s' if count > 2 else ''})"
@@ -55,3 +75,70 @@ def _nonzero(value: tuple[float, float, float]) -> tuple[float, float, float]:
 
 # A direction: three floats, not all zero (normalised where it is used).
 NonZeroVec3 = Annotated[tuple[float, float, float], AfterValidator(_nonzero)]
+
+
+def lax_problem(value: Any, annotation: Any) -> str | None:
+    """Why ``value`` only fits ``annotation`` through one of pydantic's lax conversions (a
+    boolean as a number, a number or string as a boolean, a string as a number), or a number is
+    not finite or out of bounds; ``None`` when it fits as it is (or pydantic decides)."""
+    origin = typing.get_origin(annotation)
+    if origin is Annotated:
+        return lax_problem(value, typing.get_args(annotation)[0])
+    if origin in (typing.Union, types.UnionType):
+        problems = [lax_problem(value, member) for member in typing.get_args(annotation)]
+        return None if any(problem is None for problem in problems) else problems[0]
+    if annotation is type(None):
+        return None if value is None else f"expected nothing, not {value!r}"
+    if origin is Literal:
+        return None if value in typing.get_args(annotation) else \
+            f"expected one of {', '.join(map(repr, typing.get_args(annotation)))}"
+    if annotation is bool:
+        return None if isinstance(value, bool) else "expected true or false"
+    if annotation in (int, float):
+        if isinstance(value, bool):
+            return "expected a number, not true or false"
+        if isinstance(value, str):
+            return "expected a number, not a string"
+        if isinstance(value, float) and not math.isfinite(value):
+            return "must be a finite number"
+        if isinstance(value, int | float) and annotation is int and abs(value) > INT_LIMIT:
+            return f"must be within +-{INT_LIMIT}"
+        if isinstance(value, int | float) and abs(value) > FLOAT_LIMIT:
+            return f"must be within +-{FLOAT_LIMIT:g}"
+        return None
+    if annotation is str:
+        return None if isinstance(value, str) else "expected a string"
+    if origin in (tuple, list) and not isinstance(value, list | tuple):
+        return f"expected a list, not {type(value).__name__}"
+    if origin in (tuple, list):
+        arguments = typing.get_args(annotation)
+        if origin is list or (len(arguments) == 2 and arguments[1] is Ellipsis):
+            arguments = (arguments[0],) * len(value) if arguments else ()
+        for element, element_type in zip(value, arguments, strict=False):
+            problem = lax_problem(element, element_type)
+            if problem is not None:
+                return problem
+    return None
+
+
+class StrictValues(BaseModel):
+    """Base of every model read from a scene: numbers are finite and bounded, booleans are
+    true or false, nothing is converted from another type (``shells = true`` is not 1)."""
+
+    model_config = ConfigDict(allow_inf_nan=False)
+
+    @field_validator("*", mode="before")
+    @classmethod
+    def _no_lax_conversion(cls, value: Any, info: ValidationInfo) -> Any:
+        field = cls.model_fields.get(info.field_name) if info.field_name else None
+        problem = lax_problem(value, field.annotation) if field is not None else None
+        if problem is not None:
+            raise ValueError(problem)
+        return value
+
+
+# Colours (linear RGB): an albedo or tint reflects at most what arrives; light may be brighter.
+UnitFloat = Annotated[float, Field(ge=0.0, le=1.0)]
+NonNegativeFloat = Annotated[float, Field(ge=0.0)]
+Albedo = tuple[UnitFloat, UnitFloat, UnitFloat]
+Radiance = tuple[NonNegativeFloat, NonNegativeFloat, NonNegativeFloat]

@@ -7,12 +7,12 @@ from pydantic import Field
 
 from deferred.light import Light, LightParams, view_direction
 from deferred.registry import lights
-from deferred.validation import NonZeroVec3
+from deferred.validation import NonZeroVec3, Radiance
 
 
 class AmbientParams(LightParams):
-    color: tuple[float, float, float] = Field((0.3, 0.35, 0.45), description="sky colour")
-    ground: tuple[float, float, float] = Field((0.1, 0.08, 0.06), description="ground colour")
+    color: Radiance = Field((0.3, 0.35, 0.45), description="sky colour, linear RGB >= 0")
+    ground: Radiance = Field((0.1, 0.08, 0.06), description="ground colour, linear RGB >= 0")
     up: NonZeroVec3 = Field((0.0, 1.0, 0.0), description="world up")
 
 

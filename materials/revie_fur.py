@@ -25,7 +25,7 @@ from deferred.material import BlinnPhongParams, ForwardLitPass, GBufferPass, Mat
 from deferred.passes import Phase, RenderPass
 from deferred.registry import materials
 from deferred.targets import COMPOSITE, LIGHT_ACCUMULATION
-from deferred.validation import NonZeroVec3
+from deferred.validation import Albedo, NonZeroVec3
 
 from .techniques.fins import FinPass
 from .techniques.fur import (
@@ -58,8 +58,8 @@ STIPPLE_PARITY = (0, 0)  # the (even, even) pixel of each 2x2 tile, as Listing 2
 
 
 class RevieFurParams(FurParams, BlinnPhongParams):
-    albedo_base: Vec3 = Field((0.10, 0.06, 0.035), description="albedo at the strand roots")
-    albedo_tip: Vec3 = Field((0.78, 0.58, 0.38), description="albedo at the tips (surface)")
+    albedo_base: Albedo = Field((0.10, 0.06, 0.035), description="albedo at the strand roots")
+    albedo_tip: Albedo = Field((0.78, 0.58, 0.38), description="albedo at the tips (surface)")
     specular_intensity: float = Field(0.25, ge=0.0, le=1.0, description="Blinn-Phong intensity")
     specular_exponent: float = Field(24.0, ge=1.0, le=2048.0, description="Blinn-Phong exponent")
     rim_strength: float = Field(1.5, ge=0.0, le=16.0,

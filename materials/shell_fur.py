@@ -35,6 +35,7 @@ from deferred.material import BlinnPhongParams, ForwardLitPass, GBufferPass, Mat
 from deferred.passes import Phase, RenderPass
 from deferred.registry import materials
 from deferred.targets import COMPOSITE, LIGHT_ACCUMULATION
+from deferred.validation import Albedo
 
 from .techniques.fins import FinPass
 from .techniques.fur import (
@@ -86,12 +87,13 @@ class ShellFurParams(FurParams, BlinnPhongParams):
     specular_intensity: float = Field(0.3, ge=0.0, le=1.0, description="K_s, Kajiya-Kay")
     specular_exponent: float = Field(40.0, ge=1.0, le=2048.0, description="p_phong")
     # colour (section 4, Fig. 3)
-    color: Vec3 = Field((0.55, 0.36, 0.20), description="fur colour (tints the texture)")
+    color: Albedo = Field((0.55, 0.36, 0.20), description="fur colour (tints the texture), "
+                                                           "each in [0, 1]")
     color_texture: str | None = Field(None, description="colour image over the mesh's UVs "
                                                         "(sRGB) instead of the pattern")
     color_pattern: Literal["none", "stripes", "spots"] = Field(
         "none", description="generated colour texture (Fig. 3a)")
-    pattern_color: Vec3 = Field((0.12, 0.07, 0.04), description="the pattern's second colour")
+    pattern_color: Albedo = Field((0.12, 0.07, 0.04), description="the pattern's second colour")
     color_scale: float = Field(1.0, gt=0.0, le=256.0,
                                description="repeats of the colour texture across the UVs")
     # curl (3.2.2, Eq. 4)

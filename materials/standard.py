@@ -10,13 +10,14 @@ from pydantic import Field
 from deferred.errors import InputError
 from deferred.material import BlinnPhongParams, Material
 from deferred.registry import materials
+from deferred.validation import Albedo
 
 if TYPE_CHECKING:
     from deferred.frame import Frame
 
 
 class StandardParams(BlinnPhongParams):
-    color: tuple[float, float, float] = Field((0.8, 0.8, 0.8), description="linear RGB albedo")
+    color: Albedo = Field((0.8, 0.8, 0.8), description="linear RGB albedo, each in [0, 1]")
     texture: str | None = Field(None, description="albedo image (sRGB), multiplied by color")
 
 

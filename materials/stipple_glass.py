@@ -19,6 +19,7 @@ from deferred.material import BlinnPhongParams, Material
 from deferred.passes import ObjectPass, Order, Phase, RenderPass
 from deferred.registry import materials
 from deferred.targets import COMPOSITE, LIGHT_ACCUMULATION
+from deferred.validation import Albedo
 
 from .techniques.stipple import (
     StippleObliterationPass,
@@ -32,7 +33,7 @@ if TYPE_CHECKING:
 
 
 class StippleGlassParams(BlinnPhongParams):
-    color: tuple[float, float, float] = Field((0.55, 0.75, 0.85), description="glass tint")
+    color: Albedo = Field((0.55, 0.75, 0.85), description="glass tint, each in [0, 1]")
     opacity: float = Field(0.35, ge=0.0, le=1.0, description="glass over the scene behind")
     pattern: Literal[2, 4] = Field(4, description="stipple density: 1 in 2 or 1 in 4 pixels")
     specular_intensity: float = Field(0.9, ge=0.0, le=1.0, description="Blinn-Phong intensity")

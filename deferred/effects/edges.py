@@ -12,6 +12,7 @@ from ..passes import FullscreenPass, Order, Phase, RenderPass
 from ..registry import effects
 from ..targets import FINAL
 from ..targets_spec import TargetSpec
+from ..validation import Albedo
 
 EDGES_RAW = "edges_raw"
 EDGES = "edges"
@@ -20,7 +21,7 @@ EDGES_SPEC = TargetSpec(1, "f1", "edge mask (1 = line)")
 
 class EdgesParams(EffectParams):
     width: int = Field(1, ge=1, le=16, description="line width in pixels (dilation)")
-    color: tuple[float, float, float] = Field((0.0, 0.0, 0.0), description="linear RGB")
+    color: Albedo = Field((0.0, 0.0, 0.0), description="linear RGB, each in [0, 1]")
     opacity: float = Field(1.0, ge=0.0, le=1.0, description="line opacity")
     depth_threshold: float = Field(0.05, gt=0.0, le=10.0,
                                    description="depth break: relative inverse-depth jump")

@@ -257,7 +257,9 @@ def test_ctrl_c_mid_video_leaves_no_file(tmp_path, capsys, scene_file, monkeypat
                                           "width and height, got 65x48; render at --size 66x48"),
     (["-o", "x_#.png", "--view", "albedo"], "error: --view: writes one buffer"),
     (["--fps", "0"], "error: Invalid value for '--fps'"),
-    (["--fps", "nan"], "error: --fps: must be a finite number > 0"),
+    (["--fps", "nan"], "error: Invalid value for '--fps': 'nan' is not a finite number"),
+    (["--fps", "inf"], "error: Invalid value for '--fps': inf is not in the range"),
+    (["--time", "nan"], "error: Invalid value for '--time': 'nan' is not a finite number"),
     (["--time", "-1"], "error: Invalid value for '--time'"),
 ])
 def test_bad_animation_options_exit_2(tmp_path, capsys, monkeypatch, scene_file, args,

@@ -68,10 +68,10 @@ def test_builtin_demo_scene_loads():
     (lambda t: t.replace("scale = 1.0", "scale = 0.0"), "s.toml: object[0]: "),
     (lambda t: t.replace("size = [320, 200]", "size = [320, 200"), "s.toml: malformed TOML"),
     (lambda t: t.replace("fov = 45.0", "fov = 45.0\nup = [0.0, -0.5, -4.0]"),
-     "s.toml: camera: Value error, up is parallel to the view direction"),
+     "s.toml: camera: up is parallel to the view direction"),
     (lambda t: t.replace('type = "point"', 'type = "ambient"\nup = [0, 0, 0]').replace(
         "radius = 10.0", "").replace("position = [2.0, 3.0, 2.0]", ""),
-     "s.toml: light[0].up: Value error, must not be the zero vector"),
+     "s.toml: light[0].up: must not be the zero vector"),
 ])
 def test_validation_errors_name_file_key_and_problem(edit, expected):
     message = error_of(edit(GOOD))

@@ -181,3 +181,25 @@ def test_unknown_light_path_is_bad_input(gl):
         Renderer(scene_with(0), gl=gl, light_path="fast")
     with pytest.raises(InputError, match="light_path"):
         scene_from_dict({"light_path": "fast"})
+
+
+@pytest.mark.parametrize("path", ["tiled", "clustered"])
+def test_more_lights_than_the_lists_hold_is_refused_before_a_frame(gl, path, monkeypatch):
+    if not gl.features.compute_shaders:
+        pytest.skip("the driver has no compute shaders")
+    import deferred.light_lists as light_lists
+
+    scene = scene_with(40)
+    monkeypatch.setattr(light_lists, "MAX_LIST_BYTES", 4096)
+    with pytest.raises(InputError, match=r"^light: \d+ lights need .* light lists"):
+        Renderer(scene, gl=gl, light_path=path)
+    with Renderer(scene, gl=gl, light_path="volumes") as renderer:  # volumes has no lists
+        assert renderer.render().hdr[..., :3].max() > 0.0
+
+
+def test_more_lights_than_the_gl33_light_texture_holds_is_refused(gl, monkeypatch):
+    gl33 = GLContext(gl.ctx, Features(storage_buffers=False, compute_shaders=False))
+    scene = scene_with(12)
+    monkeypatch.setattr(GLContext, "max_texture_size", property(lambda self: 8))
+    with pytest.raises(InputError, match=r"^light: 16 lights; .* at most 8 rows"):
+        Renderer(scene, gl=gl33)
