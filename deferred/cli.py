@@ -19,6 +19,7 @@ from rich.table import Table
 from . import registry
 from .errors import DeferredError, InputError, RenderError, ShaderError
 from .imageio import check_output_path, write_image
+from .output_safety import interrupt_exit_code, termination_as_interrupt
 from .pipeline import PIPELINES
 from .scene import load_scene, parse_size
 
@@ -118,6 +119,7 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
         raise InputError("writes one buffer to one .png or .exr image, not to a frame "
                          "pattern or a video", "--view")
     loaded = _scene(scene)
+    _check_not_inputs(_render_outputs(out, kind, frames), loaded, scene, "-o")
     size_override = _size_option(size)
     if kind == "video":
         check_video_size(out, size_override or loaded.size)
@@ -224,7 +226,8 @@ def dump(scene: str | None, output: str | None, pipeline: str, size: str | None,
     from rich.progress import Progress, SpinnerColumn, TextColumn
 
     from .capture import select_passes
-    from .dump import dump_scene
+    from .dump import check_dump_folder, check_dump_inputs, dump_scene
+    from .output_safety import scene_inputs
     from .pixel_history import format_history, parse_pixel
     from .renderer import Renderer
 
@@ -236,10 +239,9 @@ def dump(scene: str | None, output: str | None, pipeline: str, size: str | None,
         return
     if not output:
         raise InputError("a dump needs an output folder", "-o")
-    out_dir = Path(output)
-    if out_dir.exists() and not out_dir.is_dir():
-        raise InputError("exists and is not a folder", str(out_dir))
+    out_dir = check_dump_folder(output)  # not a folder of other files: a dump replaces it
     loaded = _scene(scene)
+    check_dump_inputs(out_dir, scene_inputs(loaded, scene))
     patterns = [p.strip() for p in passes.split(",") if p.strip()] if passes is not None else None
     with Renderer(loaded, pipeline, _size_option(size), strict=strict or None,
                   light_path=light_path) as renderer:
@@ -324,6 +326,8 @@ def bench(scene: str | None, lights: str, shells: str, size: str | None, runs: i
         if path is not None and not (where == "--json" and path == "-"):
             outputs[where] = benchmark.check_output(path, where)
     loaded = _scene(scene)
+    for where, path in outputs.items():
+        _check_not_inputs([path], loaded, scene, where)
     shell_counts = benchmark.sweep_shells(loaded, sweep.shells)
     if not benchmark.shell_objects(loaded):
         stderr.print(f"{loaded.source}: no object has a 'shells' parameter; shell sweep "
@@ -350,6 +354,22 @@ def bench(scene: str | None, lights: str, shells: str, size: str | None, runs: i
         writers[where](report, path)
     if outputs:
         stderr.print(f"wrote {', '.join(str(path) for path in outputs.values())}")
+
+
+def _render_outputs(out: Path, kind: str, frames: int) -> list[Path]:
+    """Every file ``render -o`` writes: a sequence's frames, or the one file."""
+    if kind != "sequence":
+        return [out]
+    from .animation import expand_pattern
+
+    return [expand_pattern(out, index) for index in range(frames)]
+
+
+def _check_not_inputs(outputs: list[Path], loaded, scene: str | None, where: str) -> None:
+    """No output may replace a file the scene reads (the scene, a mesh, a texture)."""
+    from .output_safety import check_not_inputs, scene_inputs
+
+    check_not_inputs(outputs, scene_inputs(loaded, scene), where)
 
 
 def _write_result(out: Path, result) -> None:
@@ -404,12 +424,28 @@ def info(scene: str | None) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
+    # SIGTERM unwinds like Ctrl-C, through the finally blocks that remove temporary files.
+    with termination_as_interrupt():
+        try:
+            return _main(argv)
+        except KeyboardInterrupt as exc:
+            return _interrupted(exc)
+
+
+def _interrupted(exc: KeyboardInterrupt) -> int:
+    click.echo("interrupted" if interrupt_exit_code(exc) == 130 else "terminated", err=True)
+    return interrupt_exit_code(exc)
+
+
+def _main(argv: list[str] | None) -> int:
     try:
         cli.main(args=argv, prog_name="deferred", standalone_mode=False)
         return 0
     except click.exceptions.Exit as exc:
         return exc.exit_code
-    except click.exceptions.Abort:
+    except click.exceptions.Abort as exc:
+        if isinstance(exc.__cause__, KeyboardInterrupt):  # click turns Ctrl-C into Abort
+            return _interrupted(exc.__cause__)
         stderr.print("aborted")
         return 1
     except click.ClickException as exc:

@@ -12,8 +12,10 @@ from typing import Any
 
 import numpy as np
 
+from .dump import safe_name
 from .errors import InputError
 from .imageio import read_channels, write_image, write_text
+from .output_safety import same_file
 from .preview import heat_colors, to_uint8
 
 
@@ -39,15 +41,40 @@ class BufferDiff:
 
 def dump_buffers(directory: Path) -> dict[str, Path]:
     """Buffer key -> file of a dump folder; pass files are keyed by pass name, not number, so
-    dumps whose pass lists differ still line up."""
+    dumps whose pass lists differ still line up. The names come from the manifest where there
+    is one: file names shorten long pass names."""
     if not directory.is_dir():
         raise InputError("not a folder", str(directory))
     found = {p.name: p for p in sorted(directory.glob("*.exr"))}
+    named = _manifest_pass_files(directory)
     for path in sorted((directory / "passes").glob("*.exr")):
-        found["passes/" + path.stem.split("_", 1)[-1]] = path
+        found["passes/" + named.get(path.name, path.stem.split("_", 1)[-1])] = path
     if not found:
         raise InputError("no EXR buffers here: not a dump folder", str(directory))
     return found
+
+
+def _manifest_pass_files(directory: Path) -> dict[str, str]:
+    """File name -> pass name, from the dump's manifest (empty without one)."""
+    try:
+        manifest = json.loads((directory / "manifest.json").read_text(encoding="utf-8"))
+        return {Path(entry["file"]).name: str(entry["name"]) for entry in manifest["passes"]
+                if isinstance(entry.get("file"), str)}
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return {}
+
+
+def check_compare_output(first: str | Path, second: str | Path, output: str | Path,
+                         where: str = "-o") -> Path:
+    """The folder for difference images must not be either dump or inside one: its files
+    would replace the buffers being compared. ``InputError`` (exit 2) naming ``where``."""
+    out = Path(output).resolve()
+    for folder in (Path(first), Path(second)):
+        inside = folder.resolve()
+        if out == inside or inside in out.parents or same_file(out, inside):
+            raise InputError(f"{output} is inside the dump {folder} being compared; "
+                             "difference images would overwrite its files", where)
+    return Path(output)
 
 
 def compare_dumps(first: str | Path, second: str | Path,
@@ -59,7 +86,7 @@ def compare_dumps(first: str | Path, second: str | Path,
     (turbo; black where equal). NaN equals NaN; NaN against a number counts as infinite.
     """
     a_files, b_files = dump_buffers(Path(first)), dump_buffers(Path(second))
-    out = Path(output) if output is not None else None
+    out = check_compare_output(first, second, output) if output is not None else None
     if out is not None:
         out.mkdir(parents=True, exist_ok=True)
     results = []
@@ -93,9 +120,17 @@ def _compare_buffer(key: str, path_a: Path, path_b: Path, out: Path | None) -> B
                         int(np.count_nonzero(diff.max(axis=-1))),
                         {n: float(diff[..., k].max()) for k, n in enumerate(names_a)})
     if out is not None and result.max > 0.0:
-        stem = key.removesuffix(".exr")
+        stem = _image_stem(key)
         (out / stem).parent.mkdir(parents=True, exist_ok=True)
         write_image(out / f"{stem}.exr", diff, channels=names_a)
         write_image(out / f"{stem}.png", to_uint8(heat_colors(diff.max(axis=-1))))
         result.image = f"{stem}.exr"
     return result
+
+
+def _image_stem(key: str) -> str:
+    """The difference image's name for a buffer key: a pass name shortened as a dump shortens
+    it (a 300-character object label must not make a file name too long)."""
+    if key.startswith("passes/"):
+        return "passes/" + safe_name(key.removeprefix("passes/"))
+    return safe_name(key.removesuffix(".exr"))

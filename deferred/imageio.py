@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import os
 import secrets
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -47,6 +47,9 @@ def check_output_path(path: str | Path, where: str = "-o",
         from .animation import expand_pattern
 
         first = expand_pattern(path, 0, where)
+    if len(first.name.encode()) > NAME_MAX:
+        # caught here, not after the frame is rendered and written to a temporary name
+        raise InputError(f"file name longer than {NAME_MAX} bytes: {first.name[:40]}...", where)
     if first.is_dir():
         raise InputError(f"output is a folder, not a file: {first}", where)
     return path
@@ -93,44 +96,133 @@ def write_image(path: str | Path, pixels: np.ndarray, channels: Sequence[str] | 
         spec.attribute(key, value)
 
     def write(temporary: str) -> None:
+        def failed(*messages: str) -> RenderError:
+            # the reader knows the file by its name, not by the temporary one
+            reason = _reason(*messages).replace(os.path.basename(temporary), path.name)
+            return RenderError(f"cannot write {path}: {reason}")
+
         output = oiio.ImageOutput.create(temporary)
-        if output is None or not output.open(temporary, spec):
-            raise RenderError(f"cannot write {path}: {oiio.geterror()}")
-        ok = output.write_image(pixels)
-        output.close()
-        if not ok:
-            raise RenderError(f"cannot write {path}: {oiio.geterror()}")
+        if output is None:
+            raise failed(oiio.geterror())
+        try:
+            if not output.open(temporary, spec):
+                raise failed(output.geterror(), oiio.geterror())
+            ok = output.write_image(pixels)
+        finally:
+            closed = output.close()
+        # OIIO's PNG writer returns True from write_image and close on a full disk: only
+        # has_error tells. Collect every signal, then check the file it left.
+        if not ok or not closed or output.has_error:
+            raise failed(output.geterror(), oiio.geterror())
+        _fsync(temporary, path)
+        _check_image_file(temporary, path, width, height, count)
 
     _write_atomically(path, write)
     return path
 
 
+def _reason(*messages: str) -> str:
+    """The first line of the first non-empty writer message: errors are one line, and a
+    failure always says why, even when the writer did not."""
+    for message in messages:
+        lines = [line.strip() for line in (message or "").splitlines() if line.strip()]
+        if lines:
+            return lines[0]
+    return "the writer reported an error without a reason"
+
+
+def _os_reason(exc: OSError) -> str:
+    return exc.strerror or str(exc) or type(exc).__name__
+
+
+def _fsync(temporary: str, path: Path) -> None:
+    """Flush the written file to the disk: delayed allocation and network file systems report
+    a full disk only here, after the writer closed the file without complaint."""
+    try:
+        fd = os.open(temporary, os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+    except OSError as exc:
+        raise RenderError(f"cannot write {path}: {_os_reason(exc)}") from exc
+
+
+def _check_image_file(temporary: str, path: Path, width: int, height: int, count: int) -> None:
+    """Read back the header of a written image: a writer that lost data without saying so
+    leaves an empty or unreadable file, caught here before it replaces the old one."""
+    import OpenImageIO as oiio
+
+    if os.path.getsize(temporary) == 0:
+        raise RenderError(f"cannot write {path}: the writer left an empty file")
+    image = oiio.ImageInput.open(temporary)
+    if image is None:
+        raise RenderError(f"cannot write {path}: the written file does not read back: "
+                          f"{_reason(oiio.geterror())}")
+    try:
+        spec = image.spec()
+        got = (spec.width, spec.height, spec.nchannels)
+    finally:
+        image.close()
+    if got != (width, height, count):
+        raise RenderError(f"cannot write {path}: the written file reads back as "
+                          f"{got[0]}x{got[1]} with {got[2]} channels, not "
+                          f"{width}x{height} with {count}")
+
+
 def write_text(path: str | Path, text: str) -> Path:
-    """Write a text file atomically (JSON manifests, CSV)."""
+    """Write a text file atomically (JSON manifests, CSV), flushed to the disk before the
+    rename so a full disk fails here instead of leaving a short file."""
     path = Path(path)
-    _write_atomically(path, lambda temporary: Path(temporary).write_text(text, encoding="utf-8"))
+
+    def write(temporary: str) -> None:
+        with open(temporary, "w", encoding="utf-8") as handle:
+            handle.write(text)
+            handle.flush()
+            os.fsync(handle.fileno())
+
+    _write_atomically(path, write)
     return path
+
+
+# A file name may hold 255 bytes on the common file systems (ext4, XFS, btrfs, APFS, NTFS).
+NAME_MAX = 255
+# What temporary_path adds to a name: ".", ".", 12 hex digits, ".tmp".
+_TEMPORARY_EXTRA = 18
 
 
 def temporary_path(path: str | Path) -> Path:
     """A hidden name next to ``path`` to write to before renaming over it; the suffix stays
-    last so writers pick the format from it."""
+    last so writers pick the format from it. The stem is shortened where the extra characters
+    would take the name past ``NAME_MAX`` bytes (the random part keeps it unique)."""
     path = Path(path)
     directory = path.parent if str(path.parent) else Path(".")
+    stem = path.stem
+    room = NAME_MAX - _TEMPORARY_EXTRA - len(path.suffix.encode())
+    if len(stem.encode()) > room:
+        stem = stem.encode()[:max(room, 1)].decode(errors="ignore")
     # Not mkstemp: its 0600 mode would survive the rename; the writer creates the file under
     # the umask like any other output.
-    return directory / f".{path.stem}.{secrets.token_hex(6)}.tmp{path.suffix}"
+    return directory / f".{stem}.{secrets.token_hex(6)}.tmp{path.suffix}"
 
 
-def _write_atomically(path: Path, write) -> None:
-    """``write(temporary)`` next to ``path``, then rename over it: readers never see half a file."""
+def _write_atomically(path: Path, write: Callable[[str], None]) -> None:
+    """``write(temporary)`` next to ``path``, then rename over it: readers never see half a file,
+    and a failure (an error, Ctrl-C) leaves the old file as it was and no temporary.
+
+    OS errors become a ``RenderError`` naming the file and the reason."""
     temporary = str(temporary_path(path))
     try:
         write(temporary)
         os.replace(temporary, path)
+    except OSError as exc:
+        raise RenderError(f"cannot write {path}: {_os_reason(exc)}") from exc
     finally:
-        if os.path.exists(temporary):
-            os.unlink(temporary)
+        try:
+            if os.path.lexists(temporary):
+                os.unlink(temporary)
+        except OSError:
+            pass  # the write's own error (or success) is what the caller needs to hear
 
 
 def read_image(path: str | Path, srgb_to_linear: bool = False,

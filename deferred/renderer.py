@@ -22,6 +22,7 @@ from .pipeline import PIPELINES
 from .scene import Scene, check_size
 from .shaderlib import ShaderLibrary
 from .targets import COMPOSITE, FINAL, FrameTargets
+from .targets_spec import targets_bytes
 
 PassCallback = Callable[[RenderPass, Frame], None]
 FULL_FEATURES = Features(storage_buffers=True, compute_shaders=True)
@@ -39,6 +40,20 @@ class RenderResult:
 def strict_default() -> bool:
     """Whether renderers are strict when not told: ``DEFERRED_STRICT=1`` (the tests set it)."""
     return os.environ.get("DEFERRED_STRICT", "") in ("1", "true", "yes")
+
+
+# Render targets live in system memory on llvmpipe: a size whose targets pass this is refused
+# before the context allocates them (one that does not fit would be killed, without a message).
+TARGET_MEMORY_BUDGET = int(os.environ.get("DEFERRED_TARGET_MEMORY", str(4 << 30)))
+
+
+def check_target_memory(graph: PassGraph, size: tuple[int, int], where: str = "size") -> None:
+    """Refuse a frame size whose render targets need more than :data:`TARGET_MEMORY_BUDGET`."""
+    needed = targets_bytes(graph.targets.values(), *size)
+    if needed > TARGET_MEMORY_BUDGET:
+        raise InputError(f"{size[0]}x{size[1]} needs {needed >> 20} MiB of render targets "
+                         f"({len(graph.targets)} targets); the budget is "
+                         f"{TARGET_MEMORY_BUDGET >> 20} MiB (DEFERRED_TARGET_MEMORY)", where)
 
 
 class Renderer:
@@ -59,7 +74,7 @@ class Renderer:
         self.scene = scene
         self.pipeline_name = pipeline
         self.strict = strict_default() if strict is None else strict
-        self.size = check_size(size or scene.size, "size")
+        self.size = check_size(size or scene.size, "size" if size else f"{scene.source}: size")
         # The pass graph and the generated GLSL are built and checked before any GL object
         # exists: bad input never leaves a context behind. The light path is checked by name
         # now and against the context's features once it exists; the provisional graph (the
@@ -67,6 +82,7 @@ class Renderer:
         requested = light_path if light_path is not None else scene.light_path
         provisional = resolve_light_path(pipeline, requested, FULL_FEATURES)
         self.graph: PassGraph = compile_graph(PIPELINES[pipeline](provisional).build(scene))
+        check_target_memory(self.graph, self.size, "size" if size else f"{scene.source}: size")
         light_types = scene.light_types()
         shading_models = scene.shading_models()
         generated = generated_glsl(light_types, shading_models, scene.gbuffer_layout(),

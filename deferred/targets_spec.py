@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import math
 import re
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 _DTYPES = {"8": "f1", "16F": "f2", "32F": "f4"}
@@ -57,3 +59,9 @@ class TargetSpec:
     def same_format(self, other: TargetSpec) -> bool:
         return (self.components, self.dtype, self.depth, self.scale) == \
             (other.components, other.dtype, other.depth, other.scale)
+
+
+def targets_bytes(specs: Iterable[TargetSpec], width: int, height: int) -> int:
+    """Bytes of the render targets ``specs`` at a frame of ``width`` x ``height``."""
+    return sum(spec.bytes_per_pixel * max(1, math.ceil(width * spec.scale)) *
+               max(1, math.ceil(height * spec.scale)) for spec in specs)

@@ -86,7 +86,10 @@ def lax_problem(value: Any, annotation: Any) -> str | None:
         return lax_problem(value, typing.get_args(annotation)[0])
     if origin in (typing.Union, types.UnionType):
         problems = [lax_problem(value, member) for member in typing.get_args(annotation)]
-        return None if any(problem is None for problem in problems) else problems[0]
+        if any(problem is None for problem in problems):
+            return None
+        # the member of the value's shape says what is wrong with it, not "expected a list"
+        return min(problems, key=lambda problem: problem.startswith("expected"))
     if annotation is type(None):
         return None if value is None else f"expected nothing, not {value!r}"
     if origin is Literal:
@@ -99,6 +102,8 @@ def lax_problem(value: Any, annotation: Any) -> str | None:
             return "expected a number, not true or false"
         if isinstance(value, str):
             return "expected a number, not a string"
+        if not isinstance(value, int | float):
+            return f"expected a number, not {type(value).__name__}"
         if isinstance(value, float) and not math.isfinite(value):
             return "must be a finite number"
         if isinstance(value, int | float) and annotation is int and abs(value) > INT_LIMIT:

@@ -1,0 +1,495 @@
+"""Issue #11, the output side: no output is lost or half written, none replaces an input.
+
+Writers that fail (a full disk, a writer that reports success and writes nothing), outputs that
+name an input, dumps into folders of other files, dumps interrupted by Ctrl-C or SIGTERM, two
+dumps into one folder, and object names too long for a file name.
+"""
+
+import errno
+import json
+import os
+import resource
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import OpenImageIO as oiio
+import pytest
+
+import deferred.dump as dump_module
+from deferred.capture import capture_frame
+from deferred.cli import main
+from deferred.dump import is_dump_folder, safe_name, write_dump
+from deferred.errors import InputError, RenderError
+from deferred.imageio import NAME_MAX, temporary_path, write_image, write_text
+from deferred.renderer import Renderer
+from deferred.scene import scene_from_dict
+
+REPO = Path(__file__).parents[2]
+
+
+def run(capsys, *args):
+    code = main([str(a) for a in args])
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
+
+
+def one_line(err: str) -> str:
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in err, err
+    return lines[0]
+
+
+def leftovers(folder: Path) -> list[str]:
+    """Temporary files and folders, lock files: what an interrupted write must not leave."""
+    return sorted(str(p.relative_to(folder)) for p in folder.rglob("*")
+                  if p.name.startswith(".") or ".tmp" in p.name)
+
+
+def assert_whole_dump(folder: Path) -> dict:
+    """A dump folder as a dump writes it: a manifest whose files all exist, and no pass file
+    the manifest does not list."""
+    assert is_dump_folder(folder), sorted(p.name for p in folder.iterdir())
+    manifest = json.loads((folder / "manifest.json").read_text())
+    listed = set(manifest["files"].values()) | \
+        {p["file"] for p in manifest["passes"] if p["file"]}
+    missing = [name for name in listed if not (folder / name).is_file()]
+    assert not missing, missing
+    on_disk = {f"passes/{p.name}" for p in (folder / "passes").glob("*.exr")}
+    assert on_disk <= listed, on_disk - listed
+    return manifest
+
+
+def snapshot(folder: Path) -> dict[str, bytes]:
+    return {str(p.relative_to(folder)): p.read_bytes()
+            for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+def scene_toml(tmp_path: Path, extra_object: str = "", name: str = "scene.toml") -> Path:
+    scene = tmp_path / name
+    scene.write_text('size = [48, 32]\nlight_path = "volumes"\n'
+                     '[[object]]\nname = "ball"\nmesh = "builtin:sphere"\n' + extra_object +
+                     '[[light]]\ntype = "ambient"\n')
+    return scene
+
+
+def textured_scene(tmp_path: Path, texture: str = "tex.png") -> tuple[Path, Path]:
+    path = tmp_path / texture
+    path.parent.mkdir(parents=True, exist_ok=True)
+    write_image(path, np.full((4, 4, 3), 200, np.uint8))
+    scene = scene_toml(tmp_path, '[[object]]\nname = "floor"\nmesh = "builtin:plane"\n'
+                                 f'[object.params]\ntexture = "{texture}"\n')
+    return scene, path
+
+
+# -- writers that fail --------------------------------------------------------------------------
+
+class FakeOutput:
+    """An OIIO ImageOutput that writes through the real one, then misbehaves as told."""
+
+    real = oiio.ImageOutput
+
+    def __init__(self, name, mode):
+        self.inner = self.real.create(name)
+        self.name, self.mode = name, mode
+
+    def open(self, name, spec):
+        return self.inner.open(name, spec)
+
+    def write_image(self, pixels):
+        return self.inner.write_image(pixels)
+
+    def close(self):
+        closed = self.inner.close()
+        if self.mode == "empty":  # success reported, nothing on the disk
+            open(self.name, "wb").close()
+        return closed
+
+    @property
+    def has_error(self):
+        return self.mode == "silent-error" or self.inner.has_error
+
+    def geterror(self):
+        return self.inner.geterror()
+
+
+def fake_writer(monkeypatch, mode):
+    class Output:
+        @staticmethod
+        def create(name):
+            return FakeOutput(name, mode)
+
+    monkeypatch.setattr(oiio, "ImageOutput", Output)
+
+
+def old_file(tmp_path, name="out.png"):
+    path = tmp_path / name
+    path.write_bytes(b"the old file")
+    return path
+
+
+@pytest.mark.parametrize("mode, reason", [
+    ("silent-error", "the writer reported an error without a reason"),
+    ("empty", "the writer left an empty file"),
+])
+def test_image_writer_failure_keeps_the_old_file(tmp_path, monkeypatch, mode, reason):
+    out = old_file(tmp_path)
+    fake_writer(monkeypatch, mode)
+    with pytest.raises(RenderError) as caught:
+        write_image(out, np.zeros((8, 8, 3), np.uint8))
+    assert str(caught.value) == f"cannot write {out}: {reason}"
+    assert out.read_bytes() == b"the old file"
+    assert leftovers(tmp_path) == []
+
+
+@pytest.mark.parametrize("name", ["out.exr", "manifest.json"])
+def test_full_disk_at_the_rename_or_the_flush(tmp_path, monkeypatch, name):
+    """os.replace (images) and os.fsync (text: where delayed allocation reports a full disk)
+    fail with ENOSPC: the old file stays, the temporary goes, the reason is the OS's."""
+    out = old_file(tmp_path, name)
+
+    def no_space(*args):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    if name.endswith(".json"):
+        monkeypatch.setattr(os, "fsync", no_space)
+        call = lambda: write_text(out, "{}\n")  # noqa: E731
+    else:
+        monkeypatch.setattr(os, "replace", no_space)
+        call = lambda: write_image(out, np.zeros((8, 8, 3), np.float32),  # noqa: E731
+                                   channels=("R", "G", "B"))
+    with pytest.raises(RenderError, match=f"^cannot write {out}: No space left on device$"):
+        call()
+    assert out.read_bytes() == b"the old file"
+    assert leftovers(tmp_path) == []
+
+
+def test_an_error_without_a_message_still_says_why(tmp_path, monkeypatch):
+    out = old_file(tmp_path, "data.csv")
+    monkeypatch.setattr(os, "fsync", lambda fd: (_ for _ in ()).throw(OSError()))
+    with pytest.raises(RenderError) as caught:
+        write_text(out, "a,b\n")
+    assert str(caught.value) == f"cannot write {out}: OSError"
+    assert out.read_bytes() == b"the old file"
+
+
+def test_render_on_a_full_disk_exits_1_and_keeps_the_old_image(tmp_path):
+    """A real short write: a file size limit makes write(2) fail (EFBIG) as a full disk makes
+    it fail (ENOSPC). OIIO's PNG writer reports success from write_image and close."""
+    out = tmp_path / "out.png"
+    write_image(out, np.random.default_rng(1).integers(0, 255, (90, 160, 3), dtype=np.uint8))
+    before = out.read_bytes()
+    limit = 4096  # the new frame (about 13 kB) does not fit; the old file is there already
+
+    def small_files():
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+    result = subprocess.run([sys.executable, "-m", "deferred.cli", "render", "-o", str(out),
+                             "--size", "160x90"], preexec_fn=small_files, capture_output=True,
+                            text=True, cwd=tmp_path)
+    assert result.returncode == 1, result.stderr
+    line = one_line(result.stderr)
+    assert line.startswith(f"render failed: cannot write {out}: ")
+    assert len(line) > len(f"render failed: cannot write {out}: ") + 5  # a reason
+    assert out.read_bytes() == before
+    assert leftovers(tmp_path) == []
+
+
+def test_cli_write_failure_exits_1_with_the_reason(tmp_path, capsys, monkeypatch):
+    out = old_file(tmp_path, "out.exr")
+    monkeypatch.setattr(os, "replace", lambda *a: (_ for _ in ()).throw(
+        OSError(errno.ENOSPC, "No space left on device")))
+    code, _, err = run(capsys, "render", "-o", out, "--size", "32x18")
+    assert code == 1
+    assert one_line(err) == f"render failed: cannot write {out}: No space left on device"
+    assert out.read_bytes() == b"the old file"
+
+
+def test_bench_csv_write_failure_exits_1(tmp_path, capsys, monkeypatch):
+    out = old_file(tmp_path, "bench.csv")
+    monkeypatch.setattr(os, "fsync", lambda fd: (_ for _ in ()).throw(
+        OSError(errno.EIO, "Input/output error")))
+    code, _, err = run(capsys, "bench", "--size", "32x18", "--lights", "1", "--shells", "0",
+                       "--runs", "1", "--warmup", "0", "--pipelines", "deferred",
+                       "--light-paths", "volumes", "--csv", out)
+    assert code == 1
+    assert err.strip().splitlines()[-1] == \
+        f"render failed: cannot write {out}: Input/output error"
+    assert out.read_bytes() == b"the old file"
+    assert leftovers(tmp_path) == []
+
+
+# -- outputs that name an input -----------------------------------------------------------------
+
+@pytest.mark.parametrize("case", ["texture", "texture-symlink", "scene-hardlink",
+                                  "mesh-hardlink", "sequence-frame"])
+def test_render_output_that_is_an_input_exits_2(tmp_path, capsys, case):
+    scene, texture = textured_scene(tmp_path)
+    args = ["--size", "32x18"]
+    if case == "texture":
+        out, victim = texture, texture
+    elif case == "texture-symlink":
+        out, victim = tmp_path / "alias.png", texture
+        out.symlink_to(texture)
+    elif case == "scene-hardlink":
+        out, victim = tmp_path / "scene-copy.exr", scene
+        os.link(scene, out)
+    elif case == "mesh-hardlink":
+        mesh = tmp_path / "tri.obj"
+        mesh.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+        scene.write_text(scene.read_text().replace('"builtin:sphere"', '"tri.obj"'))
+        out, victim = tmp_path / "mesh.png", mesh
+        os.link(mesh, out)
+    else:
+        frame = tmp_path / "tex_1.png"
+        os.replace(texture, frame)
+        scene.write_text(scene.read_text().replace('"tex.png"', '"tex_1.png"'))
+        out, victim = tmp_path / "tex_#.png", frame
+        args += ["--frames", "3"]
+    before = victim.read_bytes()
+    code, _, err = run(capsys, "render", scene, "-o", out, *args)
+    assert code == 2
+    assert one_line(err) == f"error: -o: would overwrite {victim}, a file the scene reads"
+    assert victim.read_bytes() == before
+    assert leftovers(tmp_path) == []
+
+
+def test_bench_output_that_is_an_input_exits_2(tmp_path, capsys):
+    scene, texture = textured_scene(tmp_path)
+    before = texture.read_bytes()
+    os.link(scene, tmp_path / "results.json")
+    for option, out, victim in (("--plot", texture, texture),
+                                ("--json", tmp_path / "results.json", scene)):
+        code, _, err = run(capsys, "bench", scene, option, out)
+        assert code == 2
+        assert one_line(err) == f"error: {option}: would overwrite {victim}, a file the " \
+                                "scene reads"
+    assert texture.read_bytes() == before
+    assert scene.read_text().startswith("size = [48, 32]")
+
+
+def fake_dump(folder: Path, value: float) -> None:
+    (folder / "passes").mkdir(parents=True)
+    write_image(folder / "final.exr", np.full((4, 4, 3), value, np.float32),
+                channels=("R", "G", "B"))
+    write_text(folder / "manifest.json", json.dumps({"format": "deferred-dump/1",
+                                                     "files": {}, "passes": []}))
+
+
+@pytest.mark.parametrize("inside", ["a", "a/diff", "b/x/y"])
+def test_compare_output_inside_a_dump_exits_2(tmp_path, capsys, inside):
+    fake_dump(tmp_path / "a", 0.0)
+    fake_dump(tmp_path / "b", 1.0)
+    before = snapshot(tmp_path)
+    code, _, err = run(capsys, "dump", "--compare", tmp_path / "a", tmp_path / "b",
+                       "-o", tmp_path / inside)
+    assert code == 2
+    victim = inside.split("/")[0]
+    assert one_line(err) == f"error: -o: {tmp_path / inside} is inside the dump " \
+                            f"{tmp_path / victim} being compared; difference images would " \
+                            "overwrite its files"
+    assert snapshot(tmp_path) == before
+    assert not (tmp_path / inside).exists() or inside == "a"
+
+
+def test_dump_that_would_replace_a_texture_exits_2(tmp_path, capsys):
+    out = tmp_path / "d"
+    scene = scene_toml(tmp_path)
+    assert run(capsys, "dump", scene, "-o", out)[0] == 0
+    scene.write_text(scene.read_text().replace(
+        '[[light]]', '[object.params]\ntexture = "d/final.png"\n[[light]]'))
+    before = snapshot(out)
+    code, _, err = run(capsys, "dump", scene, "-o", out)
+    assert code == 2
+    assert one_line(err) == f"error: -o: would overwrite {out / 'final.png'}, a file the " \
+                            "scene reads"
+    assert snapshot(out) == before
+
+
+# -- dump folders -------------------------------------------------------------------------------
+
+def test_dump_refuses_a_folder_of_other_files(tmp_path, capsys):
+    out = tmp_path / "photos"
+    out.mkdir()
+    (out / "holiday.png").write_bytes(b"not mine to delete")
+    (out / "passes").mkdir()
+    code, _, err = run(capsys, "dump", "-o", out, "--size", "32x18")
+    assert code == 2
+    assert one_line(err).startswith(f"error: -o: {out} is not empty and holds no dump")
+    assert snapshot(out) == {"holiday.png": b"not mine to delete"}
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["photos"]  # no lock, no staging
+
+
+def small_scene(name: str = "ball", color=(0.8, 0.3, 0.2)):
+    return scene_from_dict({
+        "size": [48, 32], "light_path": "volumes",
+        "camera": {"position": [0.0, 1.2, 3.0], "target": [0.0, 0.4, 0.0]},
+        "object": [{"name": name, "mesh": "builtin:sphere", "position": [0.0, 0.5, 0.0],
+                    "params": {"color": list(color)}}],
+        "light": [{"type": "ambient", "color": [0.2, 0.2, 0.25]},
+                  {"type": "point", "position": [1.0, 1.0, 1.0], "intensity": 3.0}]})
+
+
+@pytest.fixture
+def capture(gl):
+    made = []
+
+    def make(scene=None):
+        renderer = Renderer(scene or small_scene(), "deferred", gl=gl)
+        made.append(renderer)
+        return capture_frame(renderer)
+
+    yield make
+    for renderer in made:
+        renderer.release()
+
+
+def test_write_dump_refuses_a_folder_of_other_files(tmp_path, capture):
+    (tmp_path / "notes.txt").write_text("mine")
+    with pytest.raises(InputError, match="is not empty and holds no dump"):
+        write_dump(capture(), tmp_path)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["notes.txt"]
+
+
+def test_a_failed_dump_leaves_the_old_one(tmp_path, capture, monkeypatch):
+    out = tmp_path / "d"
+    frame = capture()
+    write_dump(frame, out)
+    (out / "notes.txt").write_text("mine")
+    before = snapshot(out)
+    calls = []
+    real = dump_module.write_image
+
+    def third_fails(path, *args, **kwargs):
+        calls.append(path)
+        if len(calls) == 3:
+            raise RenderError(f"cannot write {path}: No space left on device")
+        return real(path, *args, **kwargs)
+
+    monkeypatch.setattr(dump_module, "write_image", third_fails)
+    with pytest.raises(RenderError, match="No space left on device"):
+        write_dump(frame, out)
+    assert snapshot(out) == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["d"]
+
+
+def test_interrupted_between_the_renames_keeps_the_old_dump(tmp_path, capture, monkeypatch):
+    out = tmp_path / "d"
+    frame = capture()
+    write_dump(frame, out)
+    before = snapshot(out)
+    real = os.rename
+    renames = []
+
+    def interrupted(source, target):
+        renames.append(target)
+        if len(renames) == 2:  # old dump moved away, new one about to go in
+            raise KeyboardInterrupt
+        return real(source, target)
+
+    monkeypatch.setattr(dump_module.os, "rename", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        write_dump(frame, out)
+    monkeypatch.undo()
+    assert snapshot(out) == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["d"]
+
+
+def test_a_dump_killed_between_the_renames_is_recovered(tmp_path, capture):
+    """SIGKILL cannot be caught: the next dump into the folder puts the old one back before
+    it looks at it, and removes what the killed one left."""
+    out = tmp_path / "d"
+    frame = capture()
+    write_dump(frame, out)
+    os.rename(out, tmp_path / ".d.old-1234")
+    (tmp_path / ".d.dump-5678" / "passes").mkdir(parents=True)
+    write_dump(frame, out)
+    assert_whole_dump(out)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["d"]
+
+
+def test_a_300_character_object_name_dumps_and_compares(tmp_path, capture, capsys):
+    long_name = "fur_" + "x" * 296
+    first, second = tmp_path / "a", tmp_path / "b"
+    write_dump(capture(small_scene(long_name)), first)
+    manifest = write_dump(capture(small_scene(long_name, (0.1, 0.9, 0.1))), second)
+    assert_whole_dump(second)
+    files = [p["file"] for p in manifest["passes"] if long_name in p["name"]]
+    assert files and all(len(Path(f).name.encode()) < NAME_MAX - 20 for f in files)
+    code, _, err = run(capsys, "dump", "--compare", first, second, "-o", tmp_path / "diff")
+    assert code == 0, err
+    compared = json.loads((tmp_path / "diff" / "compare.json").read_text())
+    keys = {b["buffer"]: b for b in compared["buffers"]}
+    gbuffer = keys[f"passes/{long_name}.gbuffer"]  # keyed by the whole pass name
+    assert gbuffer["max"] > 0 and (tmp_path / "diff" / gbuffer["image"]).is_file()
+
+
+def test_long_names_stay_distinct_and_short():
+    a, b = "x" * 300 + "a", "x" * 300 + "b"
+    assert safe_name(a) != safe_name(b) and len(safe_name(a)) <= 100
+    assert safe_name("ball.gbuffer") == "ball.gbuffer"
+    assert len(temporary_path("/tmp/" + "y" * 250 + ".png").name.encode()) <= NAME_MAX
+
+
+def test_render_output_name_too_long_exits_2_before_rendering(tmp_path, capsys):
+    code, _, err = run(capsys, "render", "-o", tmp_path / ("z" * 260 + ".png"))
+    assert code == 2
+    assert "file name longer than 255 bytes" in one_line(err)
+
+
+# -- interrupted and concurrent dumps (subprocesses) --------------------------------------------
+
+# The child takes Ctrl-C as Python normally does even where the test runner was started with
+# SIGINT ignored (a background job), which the child would inherit.
+CHILD = ("import signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); "
+         "from deferred.cli import main; sys.exit(main(sys.argv[1:]))")
+
+
+def start_dump(out: Path, size: str) -> subprocess.Popen:
+    return subprocess.Popen([sys.executable, "-c", CHILD, "dump", "-o", str(out), "--size",
+                             size], cwd=out.parent, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.PIPE, text=True)
+
+
+@pytest.mark.parametrize("signum, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_interrupted_dump_leaves_a_whole_dump(tmp_path, signum, code):
+    out = tmp_path / "d"
+    assert main(["dump", "-o", str(out), "--size", "48x32"]) == 0
+    before = snapshot(out)
+    for attempt in range(3):  # the signal must land while files are written
+        child = start_dump(out, "640x360")
+        deadline = time.monotonic() + 60
+        while not any(p.name.startswith(".d.dump-") for p in tmp_path.iterdir()):
+            assert child.poll() is None, child.stderr.read()
+            assert time.monotonic() < deadline
+            time.sleep(0.005)
+        time.sleep(0.1 * attempt)
+        child.send_signal(signum)
+        err = child.communicate(timeout=60)[1]
+        assert sorted(p.name for p in tmp_path.iterdir()) == ["d"], err  # no staging, lock
+        assert leftovers(out) == []
+        manifest = assert_whole_dump(out)
+        if child.returncode == code:
+            assert err.strip().splitlines()[-1] == ("interrupted" if code == 130
+                                                    else "terminated")
+            assert snapshot(out) == before  # the old dump, untouched
+            return
+        assert child.returncode == 0, err  # finished before the signal: the new dump
+        assert manifest["size"] == [640, 360]
+        before = snapshot(out)
+    pytest.fail("the dump always finished before the signal")
+
+
+def test_two_dumps_into_one_folder_leave_one_whole_dump(tmp_path):
+    out = tmp_path / "d"
+    children = [start_dump(out, size) for size in ("96x54", "128x72")]
+    for child in children:
+        err = child.communicate(timeout=120)[1]
+        assert child.returncode == 0, err
+    manifest = assert_whole_dump(out)
+    assert manifest["size"] in ([96, 54], [128, 72])
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["d"]
+    assert leftovers(out) == []
