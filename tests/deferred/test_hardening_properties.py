@@ -1,0 +1,110 @@
+"""Issue #11, property tests: random scene documents are either a scene or one InputError (never
+another exception), quickly; what is accepted renders an image without NaN or inf."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from deferred.errors import InputError
+from deferred.renderer import Renderer
+from deferred.scene import scene_from_dict
+
+# Values of every kind a TOML document can hold, weighted to the troublesome ones.
+scalars = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.sampled_from([0.0, -0.0, 1.0, -1.0, 1e-30, 1e30, 1e300, float("nan"), float("inf")]),
+    st.integers(min_value=-2**63, max_value=2**63 - 1),
+    st.sampled_from([0, 1, -1, 2**31, 2**40]),
+    st.booleans(),
+    st.text(max_size=12),
+    st.sampled_from(["builtin:sphere", "builtin:torus", "standard", "revie_fur", "shell_fur",
+                     "point", "ambient", "ssao", "aces", "tiled"]),
+)
+values = st.recursive(
+    scalars,
+    lambda inner: st.one_of(st.lists(inner, max_size=4),
+                            st.dictionaries(st.text(max_size=8), inner, max_size=3)),
+    max_leaves=8)
+vec3 = st.one_of(st.lists(scalars, min_size=3, max_size=3), values)
+
+MATERIAL_KEYS = ["shells", "color", "specular_intensity", "specular_exponent", "fur_length",
+                 "density", "droplets", "wind", "curl_radius", "fins", "lod_error", "comb",
+                 "albedo_tip", "texture", "debug"]
+LIGHT_KEYS = ["color", "intensity", "position", "direction", "radius", "ground", "up",
+              "inner_angle", "outer_angle"]
+
+
+def object_tables():
+    return st.fixed_dictionaries(
+        {"mesh": st.one_of(st.sampled_from(["builtin:sphere", "builtin:plane",
+                                            "builtin:torus?segments=8&sides=6"]), values)},
+        optional={"material": st.sampled_from(["standard", "revie_fur", "shell_fur",
+                                               "stipple_glass", "nope"]),
+                  "position": vec3, "rotation": vec3, "scale": st.one_of(scalars, vec3),
+                  "name": st.one_of(st.text(max_size=300), scalars),
+                  "params": st.dictionaries(st.sampled_from(MATERIAL_KEYS), values,
+                                            max_size=3)})
+
+
+def light_tables():
+    return st.fixed_dictionaries(
+        {"type": st.one_of(st.sampled_from(["ambient", "directional", "point", "spot"]),
+                           scalars)},
+        optional={key: values for key in LIGHT_KEYS})
+
+
+scene_documents = st.fixed_dictionaries({}, optional={
+    "size": st.one_of(st.lists(st.integers(-2, 300), min_size=2, max_size=2), values),
+    "exposure": scalars, "background": vec3, "tonemap": scalars, "light_path": scalars,
+    "camera": st.fixed_dictionaries({}, optional={
+        "position": vec3, "target": vec3, "up": vec3, "fov": scalars, "near": scalars,
+        "far": scalars}),
+    "object": st.lists(object_tables(), max_size=2),
+    "light": st.lists(light_tables(), max_size=3),
+    "effect": st.lists(st.fixed_dictionaries(
+        {"type": st.sampled_from(["ssao", "fxaa", "edges", "bloom"])},
+        optional={"radius": scalars, "samples": scalars, "color": vec3}), max_size=2),
+    "event": st.lists(st.fixed_dictionaries(
+        {"time": scalars, "object": scalars, "params": st.dictionaries(
+            st.sampled_from(MATERIAL_KEYS), values, max_size=2)}), max_size=2),
+    "unknown": values,
+})
+
+
+@settings(max_examples=300, deadline=None,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@given(scene_documents)
+def test_a_random_scene_document_is_a_scene_or_one_input_error(document):
+    start = time.perf_counter()
+    try:
+        scene = scene_from_dict(document, "random.toml")
+    except InputError as exc:
+        message = str(exc)
+        assert message.startswith("random.toml") and "\n" not in message, message
+    else:
+        assert scene.size[0] >= 1 and scene.size[1] >= 1
+    assert time.perf_counter() - start < 10.0  # no hang (the unwrap and mesh checks bounded)
+
+
+@settings(max_examples=30, deadline=None,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@given(document=scene_documents)
+def test_an_accepted_random_scene_renders_a_finite_image(gl, document):
+    # What the loader accepts renders: no NaN or inf reaches a pixel (bounded values), or a
+    # limit the renderer checks is one InputError line.
+    try:
+        scene = scene_from_dict(document, "s.toml")
+    except InputError:
+        return
+    try:
+        with Renderer(scene, size=(24, 16), gl=gl) as renderer:
+            result = renderer.render(time=1.0)
+    except InputError as exc:
+        assert "\n" not in str(exc)
+        return
+    assert result.hdr.shape[:2] == (16, 24)
+    assert np.isfinite(result.hdr).all()
