@@ -7,6 +7,7 @@ naming the file/key and the problem; ``--debug`` shows the traceback instead.
 from __future__ import annotations
 
 import math
+import os
 import sys
 import time
 import traceback
@@ -349,7 +350,14 @@ def bench(scene: str | None, lights: str, shells: str, size: str | None, runs: i
     for line in benchmark.crossovers(report):
         stderr.print(line)
     if json_path == "-":
-        click.echo(report.to_json(), nl=False)
+        try:  # a full disk or a closed pipe shows here, not as a warning at exit
+            click.echo(report.to_json(), nl=False)
+            sys.stdout.flush()
+        except OSError as exc:
+            # what did not fit stays buffered: send it to nowhere, or the flush at exit fails
+            # again and prints a traceback
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+            raise RenderError(f"cannot write standard output: {exc.strerror or exc}") from exc
     for where, path in outputs.items():
         writers[where](report, path)
     if outputs:

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from .dump import safe_name
-from .errors import InputError
+from .errors import InputError, RenderError
 from .imageio import read_channels, write_image, write_text
 from .output_safety import same_file
 from .preview import heat_colors, to_uint8
@@ -88,7 +88,12 @@ def compare_dumps(first: str | Path, second: str | Path,
     a_files, b_files = dump_buffers(Path(first)), dump_buffers(Path(second))
     out = check_compare_output(first, second, output) if output is not None else None
     if out is not None:
-        out.mkdir(parents=True, exist_ok=True)
+        if out.exists() and not out.is_dir():
+            raise InputError("exists and is not a folder", str(out))
+        try:
+            out.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise RenderError(f"cannot write {out}: {exc.strerror or exc}") from exc
     results = []
     for key in list(a_files) + [k for k in b_files if k not in a_files]:
         if key not in b_files or key not in a_files:

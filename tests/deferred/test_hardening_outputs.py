@@ -493,3 +493,17 @@ def test_two_dumps_into_one_folder_leave_one_whole_dump(tmp_path):
     assert manifest["size"] in ([96, 54], [128, 72])
     assert sorted(p.name for p in tmp_path.iterdir()) == ["d"]
     assert leftovers(out) == []
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="no /dev/full")
+def test_bench_json_to_a_full_stdout_exits_1(tmp_path):
+    with open("/dev/full", "w") as full:
+        result = subprocess.run([sys.executable, "-m", "deferred.cli", "bench", "--size", "32x18",
+                                 "--lights", "1", "--shells", "0", "--runs", "1", "--warmup", "0",
+                                 "--pipelines", "deferred", "--light-paths", "volumes",
+                                 "--json", "-"], stdout=full, stderr=subprocess.PIPE, text=True,
+                                cwd=tmp_path)
+    assert result.returncode == 1
+    assert result.stderr.strip().splitlines()[-1] == \
+        "render failed: cannot write standard output: No space left on device"
+    assert "Traceback" not in result.stderr and "Exception ignored" not in result.stderr
