@@ -75,7 +75,8 @@ class Resources:
         from .imageio import read_image
 
         def create(ctx: moderngl.Context) -> moderngl.Texture:
-            pixels = read_image(path, srgb_to_linear=srgb)
+            pixels = read_image(path, srgb_to_linear=srgb,
+                                max_size=ctx.info["GL_MAX_TEXTURE_SIZE"])
             height, width, _ = pixels.shape
             texture = ctx.texture((width, height), 4, np.ascontiguousarray(
                 pixels[::-1]).astype(np.float16).tobytes(), dtype="f2")

@@ -8,7 +8,10 @@ from __future__ import annotations
 
 import os
 import secrets
-from collections.abc import Callable, Sequence
+import sys
+import tempfile
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -225,25 +228,36 @@ def _write_atomically(path: Path, write: Callable[[str], None]) -> None:
             pass  # the write's own error (or success) is what the caller needs to hear
 
 
+# -- reading ----------------------------------------------------------------------------------
+# Every read opens the header first and refuses, before decoding a pixel, an image larger than a
+# GL texture may be or one whose decoded pixels would take more than the memory budget: a
+# 16384 x 16384 texture is 4 GiB as float RGBA (more again on its way to the GPU) and would get
+# the process killed, not a one-line error.
+MAX_TEXTURE_SIZE = 16384  # GL_MAX_TEXTURE_SIZE of desktop GPUs and llvmpipe; the context's own
+#                           value where one is at hand (``max_size``)
+IMAGE_MEMORY_BUDGET = 1 << 30  # bytes an image may take once decoded (``bytes_per_pixel`` each)
+RGBA_FLOAT_BYTES = 16  # what read_image makes of every pixel: float32 RGBA
+
+
 def read_image(path: str | Path, srgb_to_linear: bool = False,
-               unassociated_alpha: bool = False) -> np.ndarray:
+               unassociated_alpha: bool = False, *, where: str | None = None,
+               max_size: int | None = MAX_TEXTURE_SIZE,
+               bytes_per_pixel: int = RGBA_FLOAT_BYTES) -> np.ndarray:
     """Read an image as float32 RGBA (H, W, 4), top row first. ``unassociated_alpha`` keeps the
     colour channels as stored where a format would associate them with alpha (PNG: data in
-    RGBA channels, such as a wetness mask, must not be premultiplied)."""
+    RGBA channels, such as a wetness mask, must not be premultiplied).
+
+    A missing, empty, truncated or corrupt file, or one over ``max_size`` pixels a side or over
+    ``IMAGE_MEMORY_BUDGET`` at ``bytes_per_pixel`` (what the caller makes of each pixel), is an
+    ``InputError`` naming the file, and ``where`` (a scene key) where given.
+    """
     import OpenImageIO as oiio
 
     path = Path(path)
     config = oiio.ImageSpec()
     if unassociated_alpha:
         config.attribute("oiio:UnassociatedAlpha", 1)
-    image = oiio.ImageInput.open(str(path), config)
-    if image is None:
-        raise InputError(f"cannot read image: {oiio.geterror() or 'unknown format'}", str(path))
-    try:
-        pixels = np.asarray(image.read_image(format=oiio.FLOAT), dtype=np.float32)
-        spec = image.spec()
-    finally:
-        image.close()
+    pixels, spec = _decode(path, where, config, max_size, lambda _: bytes_per_pixel)
     if pixels.ndim == 2:
         pixels = pixels[..., None]
     count = pixels.shape[2]
@@ -259,24 +273,17 @@ def read_image(path: str | Path, srgb_to_linear: bool = False,
     return pixels
 
 
-def read_channels(path: str | Path) -> tuple[np.ndarray, list[str], dict[str, object]]:
+def read_channels(path: str | Path, *, where: str | None = None, max_size: int | None = None
+                  ) -> tuple[np.ndarray, list[str], dict[str, object]]:
     """Read every channel of an image (EXR dumps): pixels (H, W, C), names, a few attributes.
 
     Channels come back in the order they were written when the file records it (EXR itself
     sorts them by name); ``z_channel`` and ``alpha_channel`` index into that order (-1: none).
+    Bad files are ``InputError`` as in :func:`read_image` (the budget counts float32 channels).
     """
-    import OpenImageIO as oiio
-
-    image = oiio.ImageInput.open(str(path))
-    if image is None:
-        raise InputError(f"cannot read image: {oiio.geterror()}", str(path))
-    try:
-        spec = image.spec()
-        pixels = np.asarray(image.read_image(format=oiio.FLOAT), dtype=np.float32)
-        names = list(spec.channelnames)
-        order = spec.getattribute(CHANNEL_ORDER_ATTRIBUTE)
-    finally:
-        image.close()
+    pixels, spec = _decode(Path(path), where, None, max_size, lambda count: 4 * count)
+    names = list(spec.channelnames)
+    order = spec.getattribute(CHANNEL_ORDER_ATTRIBUTE)
     if pixels.ndim == 2:
         pixels = pixels[..., None]
     if isinstance(order, str) and sorted(order.split(",")) == sorted(names):
@@ -286,3 +293,147 @@ def read_channels(path: str | Path) -> tuple[np.ndarray, list[str], dict[str, ob
     attributes = {"z_channel": names.index("Z") if "Z" in names else -1,
                   "alpha_channel": names.index("A") if "A" in names else -1}
     return pixels, names, attributes
+
+
+def check_image(path: str | Path, where: str | None = None, *,
+                max_size: int | None = MAX_TEXTURE_SIZE,
+                bytes_per_pixel: int = RGBA_FLOAT_BYTES) -> tuple[int, int, int]:
+    """``(width, height, channels)`` of an image that :func:`read_image` will read, checked as
+    it checks, without decoding it: for scene validation, before GL starts, of files read later.
+
+    The file must be complete too: a PNG ends in its IEND chunk; otherwise (a PNG with bytes
+    after it, another format) the last row is read, which for EXR is one chunk and finds the
+    chunks a truncated file lacks.
+    """
+    path = Path(path)
+    image, spec = _open(path, where, None, max_size, lambda _: bytes_per_pixel)
+    try:
+        if not _ends_in_png_iend(path):
+            with _quiet_stderr() as chatter:
+                row = image.read_scanlines(0, 0, spec.y + spec.height - 1, spec.y + spec.height,
+                                           0, 0, spec.nchannels, _oiio().FLOAT)
+            if row is None or image.has_error:
+                raise _unreadable(path, where, image.geterror(), chatter)
+            _echo(chatter)
+        return spec.width, spec.height, spec.nchannels
+    finally:
+        image.close()
+
+
+def _oiio():
+    import OpenImageIO as oiio
+
+    return oiio
+
+
+def _culprit(path: Path, where: str | None) -> str:
+    # under a scene key the file's name is enough; alone the message is all there is
+    return path.name if where else str(path)
+
+
+def _unreadable(path: Path, where: str | None, error: str, chatter: list[str]) -> InputError:
+    lines = [line.strip() for text in (error, *chatter) for line in (text or "").splitlines()
+             if line.strip()]
+    reason = lines[0] if lines else "not an image it can read"
+    return InputError(f"cannot read image {_culprit(path, where)}: {reason} (truncated or "
+                      f"corrupt?)", where)
+
+
+def _open(path: Path, where: str | None, config, max_size: int | None, bytes_per_pixel):
+    """An open ``ImageInput`` and its spec, the file's size checked; ``bytes_per_pixel`` maps a
+    channel count to the bytes the caller's pixels take."""
+    oiio = _oiio()
+    name = _culprit(path, where)
+    try:
+        size = path.stat().st_size
+    except OSError as exc:
+        reason = "not found" if isinstance(exc, FileNotFoundError) else exc.strerror or str(exc)
+        raise InputError(f"cannot read image {name}: {reason}", where) from None
+    if size == 0:
+        raise InputError(f"cannot read image {name}: the file is empty (0 bytes)", where)
+    with _quiet_stderr() as chatter:
+        image = oiio.ImageInput.open(str(path), config) if config is not None else \
+            oiio.ImageInput.open(str(path))
+    if image is None:
+        raise _unreadable(path, where, oiio.geterror(), chatter)
+    _echo(chatter)
+    spec = image.spec()
+    width, height, count = spec.width, spec.height, spec.nchannels
+    problem = None
+    if max_size is not None and max(width, height) > max_size:
+        problem = (f"is {width}x{height}, larger than the {max_size} pixels a side a GL "
+                   f"texture may have; scale it down")
+    elif width * height * bytes_per_pixel(count) > IMAGE_MEMORY_BUDGET:
+        need = width * height * bytes_per_pixel(count)
+        problem = (f"is {width}x{height}: it would take {_amount(need)} of memory here, more "
+                   f"than the {_amount(IMAGE_MEMORY_BUDGET)} allowed; scale it down")
+    if problem is not None:
+        image.close()
+        raise InputError(f"image {name} {problem}", where)
+    return image, spec
+
+
+def _decode(path: Path, where: str | None, config, max_size: int | None, bytes_per_pixel):
+    """The pixels (float32, as OIIO gives them) and spec of a checked image."""
+    oiio = _oiio()
+    image, spec = _open(path, where, config, max_size, bytes_per_pixel)
+    try:
+        with _quiet_stderr() as chatter:
+            pixels = image.read_image(format=oiio.FLOAT)
+        # OIIO answers a failed read with None (a truncated file), not an exception
+        if pixels is None or image.has_error:
+            raise _unreadable(path, where, image.geterror(), chatter)
+        _echo(chatter)
+    finally:
+        image.close()
+    return np.asarray(pixels, dtype=np.float32), spec
+
+
+def _amount(size: int) -> str:
+    for unit, scale in (("GiB", 1 << 30), ("MiB", 1 << 20), ("KiB", 1 << 10)):
+        if size >= scale:
+            return f"{size / scale:.1f} {unit}"
+    return f"{size} bytes"
+
+
+_PNG_IEND = b"\x00\x00\x00\x00IEND\xaeB`\x82"
+
+
+def _ends_in_png_iend(path: Path) -> bool:
+    """A PNG whose last bytes are its IEND chunk is complete (the cheap completeness check)."""
+    if path.suffix.lower() != ".png":
+        return False
+    with open(path, "rb") as file:
+        file.seek(max(0, path.stat().st_size - len(_PNG_IEND)))
+        return file.read() == _PNG_IEND
+
+
+@contextmanager
+def _quiet_stderr() -> Iterator[list[str]]:
+    """File descriptor 2 into a temporary file while OIIO reads: libpng prints its errors
+    itself (``libpng error: IDAT: ...``), which would break the command line's one-line errors.
+    The list yielded gets what was printed: after a successful read the caller prints it after
+    all (:func:`_echo`: warnings stay visible), after a failure its error says it.
+    Process-wide, like the descriptor: output of other threads in between is held back too."""
+    chatter: list[str] = []
+    try:
+        saved = os.dup(2)
+    except OSError:  # no descriptor 2 at all: nothing to keep quiet
+        yield chatter
+        return
+    with tempfile.TemporaryFile() as capture:
+        sys.stderr.flush()
+        os.dup2(capture.fileno(), 2)
+        try:
+            yield chatter
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            capture.seek(0)
+            chatter.append(capture.read().decode(errors="replace"))
+
+
+def _echo(chatter: list[str]) -> None:
+    text = "".join(chatter)
+    if text:
+        sys.stderr.write(text)

@@ -5,12 +5,30 @@ normal, UV, tangent, binormal and the RGBA *comb* colour of Revie section 2.4.1 
 direction in tangent space packed from [-1, 1] to [0, 1]; A: fur length scale). Files load through
 trimesh; missing normals are computed (area-weighted face normals), missing UVs come from an
 xatlas unwrap, tangent frames are built from the UVs.
+
+Every mesh is checked before any of that (:func:`check_geometry`): no triangles, non-finite or
+absurd coordinates, face indices outside the vertex list, only zero-area faces, or more than
+``MAX_TRIANGLES`` / ``MAX_VERTICES`` are an ``InputError`` naming the mesh. The coordinate limits
+come from float32, which the GPU and xatlas compute in: a coordinate beyond ``MAX_COORDINATE``
+(1e6) is a stray vertex or the wrong units (squares of large coordinates overflow float32:
+xatlas never finishes on a sphere scaled by 1e20), and a mesh spanning more than
+``MAX_SPAN_TO_EDGE`` (1e6) times its median edge length has edges of a few float32 steps of its
+size (one vertex at 1e6 on a unit sphere makes xatlas spend seconds, more further out). The
+unwrap itself runs in a child process with a time limit (``UNWRAP_TIMEOUT_S``, environment
+variable ``DEFERRED_UNWRAP_TIMEOUT``), so a mesh that still defeats it is an error after that
+time and Ctrl-C stops it (inside xatlas, the interpreter never sees the signal).
 """
 
 from __future__ import annotations
 
 import inspect
 import math
+import multiprocessing
+import os
+import signal
+import sys
+import time
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -22,6 +40,15 @@ from .errors import InputError
 BUILTIN_PREFIX = "builtin:"
 BUILTIN_MESHES = ("sphere", "torus", "plane", "cube")
 MESH_SUFFIXES = (".obj", ".ply", ".stl", ".off", ".glb", ".gltf")
+
+# Input limits (module doc; checked before trimesh parses a file or xatlas unwraps a mesh).
+MAX_MESH_FILE_BYTES = 1 << 30  # a 5M-triangle OBJ with normals and UVs is about 0.5 GB
+MAX_TRIANGLES = 5_000_000
+MAX_VERTICES = 10_000_000
+MAX_COORDINATE = 1e6
+MAX_SPAN_TO_EDGE = 1e6
+UNWRAP_TIMEOUT_S = 60.0
+UNWRAP_TIMEOUT_ENV = "DEFERRED_UNWRAP_TIMEOUT"
 
 # (name, components) in buffer order; the GLSL attribute is ``in_<name>``.
 VERTEX_ATTRIBUTES = (("position", 3), ("normal", 3), ("uv", 2), ("tangent", 3),
@@ -138,18 +165,16 @@ def build_mesh(name: str, positions: np.ndarray, indices: np.ndarray,
     """Complete a mesh to the framework's vertex format (normals, UVs, tangents, comb)."""
     positions = np.asarray(positions, dtype=np.float64)
     indices = np.asarray(indices, dtype=np.int64).reshape(-1, 3)
-    if len(positions) == 0 or len(indices) == 0:
-        raise InputError("mesh has no triangles", name)
-    if not np.isfinite(positions).all():
-        raise InputError("mesh has non-finite vertex positions", name)
-    if indices.min() < 0 or indices.max() >= len(positions):
-        raise InputError("mesh has face indices outside its vertex list", name)
+    check_geometry(name, positions, indices)
     if normals is None or len(normals) != len(positions) or not np.isfinite(normals).all():
         normals = _vertex_normals(positions, indices)
     normals = _normalize(np.asarray(normals, dtype=np.float64))
     generated = False
+    if uvs is not None and len(uvs) == len(positions) and not np.isfinite(uvs).all():
+        raise InputError("mesh has non-finite UVs (NaN or infinity)", name)
     if uvs is None or len(uvs) != len(positions):
-        positions, normals, colors, indices, uvs = _unwrap(positions, normals, colors, indices)
+        positions, normals, colors, indices, uvs = _unwrap(positions, normals, colors, indices,
+                                                           name)
         generated = True
     uvs = np.asarray(uvs, dtype=np.float64)
     tangents, binormals = tangent_frames(positions, normals, uvs, indices)
@@ -179,16 +204,157 @@ def _vertex_normals(positions: np.ndarray, indices: np.ndarray) -> np.ndarray:
     return _normalize(normals)
 
 
-def _unwrap(positions, normals, colors, indices):
-    """Generate UVs with an xatlas unwrap (vertices on seams are split)."""
-    import xatlas
+def check_geometry(name: str, positions: np.ndarray, indices: np.ndarray) -> None:
+    """``InputError`` (naming ``name``) for a mesh the framework cannot draw or unwrap: too
+    large, no triangles, non-finite or absurd coordinates, indices outside the vertex list, or
+    only zero-area faces (limits and why: module doc). Cheap next to the unwrap it guards."""
+    if len(indices) > MAX_TRIANGLES:
+        raise InputError(f"mesh has {len(indices):,} triangles, more than the "
+                         f"{MAX_TRIANGLES:,} the framework draws; simplify it", name)
+    if len(positions) > MAX_VERTICES:
+        raise InputError(f"mesh has {len(positions):,} vertices, more than the "
+                         f"{MAX_VERTICES:,} the framework draws; simplify it", name)
+    if len(positions) == 0 or len(indices) == 0:
+        raise InputError("mesh has no triangles", name)
+    finite = np.isfinite(positions).all(axis=1)
+    if not finite.all():
+        raise InputError(f"mesh has non-finite vertex positions (NaN or infinity; first: vertex "
+                         f"{int(np.argmin(finite))}, counting from 0)", name)
+    if indices.min() < 0 or indices.max() >= len(positions):
+        raise InputError(f"mesh has face indices outside its vertex list (0..{len(positions) - 1}"
+                         f"; found {int(indices.min())}..{int(indices.max())})", name)
+    largest = float(np.abs(positions).max())
+    if largest > MAX_COORDINATE:
+        vertex = int(np.argmax(np.abs(positions).max(axis=1)))
+        raise InputError(f"mesh has a coordinate of {largest:.3g} (vertex {vertex}, counting "
+                         f"from 0), beyond +-{MAX_COORDINATE:.0e}: a stray vertex or the wrong "
+                         f"units? (scale the object in the scene instead)", name)
+    used = positions[np.unique(indices)]
+    span = float((used.max(axis=0) - used.min(axis=0)).max())
+    # Doubled face areas; "zero" relative to the mesh's size, as float32 would see it.
+    areas = np.linalg.norm(np.cross(positions[indices[:, 1]] - positions[indices[:, 0]],
+                                    positions[indices[:, 2]] - positions[indices[:, 0]]), axis=1)
+    if span == 0.0 or not (areas > 1e-14 * span * span).any():
+        raise InputError(f"mesh is degenerate: none of its {len(indices):,} triangles has an "
+                         f"area (corners coincide or lie on a line)", name)
+    # The median edge, from a sample of the faces on large meshes (a median does not need all).
+    sample = indices[::max(1, len(indices) // 1_000_000)]
+    edges = np.concatenate([np.linalg.norm(positions[sample[:, (i + 1) % 3]]
+                                           - positions[sample[:, i]], axis=1) for i in range(3)])
+    edges = edges[edges > 0.0]
+    median = float(np.median(edges))
+    if span > MAX_SPAN_TO_EDGE * median:
+        raise InputError(f"mesh spans {span:.3g} units but its median edge is {median:.3g} "
+                         f"({span / median:.2g} times smaller, limit {MAX_SPAN_TO_EDGE:.0e}): a "
+                         f"stray vertex far from the rest?", name)
 
-    vmapping, new_indices, uvs = xatlas.parametrize(positions.astype(np.float32),
-                                                   indices.astype(np.uint32))
+
+def _unwrap(positions: np.ndarray, normals: np.ndarray, colors: np.ndarray | None,
+            indices: np.ndarray, name: str = "mesh"):
+    """Generate UVs with an xatlas unwrap (vertices on seams are split)."""
+    vmapping, new_indices, uvs = unwrap_uvs(positions, indices, name)
     vmapping = vmapping.astype(np.int64)
     colors = None if colors is None else np.asarray(colors)[vmapping]
     return (positions[vmapping], normals[vmapping], colors,
             new_indices.astype(np.int64), uvs.astype(np.float64))
+
+
+def unwrap_timeout() -> float:
+    """Seconds an unwrap may take: ``DEFERRED_UNWRAP_TIMEOUT`` or ``UNWRAP_TIMEOUT_S``."""
+    text = os.environ.get(UNWRAP_TIMEOUT_ENV)
+    if text is None or not text.strip():
+        return UNWRAP_TIMEOUT_S
+    try:
+        seconds = float(text)
+    except ValueError:
+        seconds = math.nan
+    if not (math.isfinite(seconds) and seconds > 0.0):
+        raise InputError(f"environment variable {UNWRAP_TIMEOUT_ENV} must be a number of "
+                         f"seconds greater than 0, got '{text}'")
+    return seconds
+
+
+def _xatlas_parametrize(positions: np.ndarray, indices: np.ndarray):
+    import xatlas
+
+    return xatlas.parametrize(positions, indices)
+
+
+def _unwrap_child(connection, positions: np.ndarray, indices: np.ndarray) -> None:
+    """The unwrap process: xatlas, then the arrays (or the error) back through the pipe."""
+    # Ctrl-C is the parent's to handle (it ends this process), and so is SIGTERM: a handler
+    # forked from the parent (deferred.output_safety's) would turn the parent's terminate()
+    # into an exception here. xatlas' ASSERT lines and a traceback from here would break the
+    # command line's one-line errors.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, 1)
+    os.dup2(devnull, 2)
+    sys.stdout = sys.stderr = open(os.devnull, "w")  # noqa: SIM115 - the process's whole life
+    try:
+        result = ("ok", _xatlas_parametrize(positions, indices))
+    except Exception as exc:  # noqa: BLE001 - reported by the parent, naming the mesh
+        result = ("error", f"{type(exc).__name__}: {exc}")
+    connection.send(result)
+    connection.close()
+
+
+def _process_context():
+    # fork: the child starts in about 10 ms with the arrays already in its memory (spawn: about
+    # 300 ms to import numpy and xatlas again); spawn where fork is missing or unsafe (macOS).
+    if sys.platform != "darwin" and "fork" in multiprocessing.get_all_start_methods():
+        return multiprocessing.get_context("fork")
+    return multiprocessing.get_context("spawn")
+
+
+def unwrap_uvs(positions: np.ndarray, indices: np.ndarray,
+               name: str = "mesh") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """xatlas' ``(vmapping, indices, uvs)`` for a mesh, computed in a child process.
+
+    xatlas can run for ever on a bad mesh and, inside C++, ignores Ctrl-C: the child is ended
+    after :func:`unwrap_timeout` seconds (an ``InputError`` naming ``name``) or when the wait
+    here is interrupted. A crash of the child is an ``InputError`` too.
+    """
+    limit = unwrap_timeout()
+    context = _process_context()
+    receiver, sender = context.Pipe(duplex=False)
+    child = context.Process(target=_unwrap_child, daemon=True, name=f"unwrap {name}",
+                            args=(sender, np.ascontiguousarray(positions, dtype=np.float32),
+                                  np.ascontiguousarray(indices, dtype=np.uint32)))
+    try:
+        with warnings.catch_warnings():
+            # Python 3.12+ warns that forking a threaded process (GL drivers, BLAS) may
+            # deadlock the child; ours runs numpy and xatlas only, and the time limit bounds it.
+            warnings.filterwarnings("ignore", message=".*fork.*", category=DeprecationWarning)
+            child.start()
+        sender.close()  # the child holds the only writing end: its exit ends the wait below
+        deadline = time.monotonic() + limit
+        # short polls: a pending Ctrl-C is raised here at the latest a quarter second later
+        while not receiver.poll(min(0.25, max(0.0, deadline - time.monotonic()))):
+            if time.monotonic() >= deadline:
+                raise InputError(f"UV unwrap did not finish in {limit:g} s; give the mesh UVs "
+                                 f"or simplify it", name)
+        try:
+            status, payload = receiver.recv()
+        except EOFError:
+            child.join(5.0)
+            code = child.exitcode
+            how = f"signal {-code}" if code is not None and code < 0 else f"exit code {code}"
+            raise InputError(f"UV unwrap failed: the unwrapping process died ({how}; out of "
+                             f"memory?); give the mesh UVs or simplify it", name) from None
+        child.join(2.0)  # it only has to exit now
+        if status != "ok":
+            raise InputError(f"UV unwrap failed: {payload}; give the mesh UVs", name)
+        return payload
+    finally:
+        receiver.close()
+        if child.is_alive():  # out of time, interrupted, or the wait itself failed
+            child.terminate()
+            child.join(1.0)
+            if child.is_alive():
+                child.kill()
+        child.join()
 
 
 # -- built-in shapes ---------------------------------------------------------------------------
@@ -344,12 +510,19 @@ def load_mesh(spec: str, base_dir: Path | None = None, where: str | None = None)
     if path.suffix.lower() not in MESH_SUFFIXES:
         raise InputError(f"unsupported mesh format '{path.suffix}' "
                          f"(use {', '.join(MESH_SUFFIXES)})", where)
+    size = path.stat().st_size
+    if size > MAX_MESH_FILE_BYTES:  # before trimesh spends minutes and gigabytes parsing it
+        raise InputError(f"mesh file {path.name} is {size:,} bytes, more than the "
+                         f"{MAX_MESH_FILE_BYTES:,} the framework reads; simplify it", where)
     import trimesh
 
     try:
         loaded = trimesh.load(str(path), force="mesh", process=False)
+    except ImportError:
+        raise  # a broken installation (exit 1), not a bad file
     except Exception as exc:  # noqa: BLE001 - trimesh raises many exception types
-        raise InputError(f"cannot read mesh {path.name}: {exc}", where) from None
+        reason = str(exc) or type(exc).__name__
+        raise InputError(f"cannot read mesh {path.name}: {reason}", where) from None
     if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:
         raise InputError(f"mesh {path.name} has no triangles", where)
     positions = np.asarray(loaded.vertices, dtype=np.float64)
@@ -365,7 +538,9 @@ def load_mesh(spec: str, base_dir: Path | None = None, where: str | None = None)
     try:
         return build_mesh(path.name, positions, indices, normals, uvs, colors)
     except InputError as exc:
-        raise InputError(exc.message, where) from None
+        # ``where`` is a scene key (``scene.toml: object[0].mesh``): say which file too
+        message = exc.message if where == spec else f"{path.name}: {exc.message}"
+        raise InputError(message, where) from None
 
 
 def _vertex_colours(loaded) -> np.ndarray | None:

@@ -8,6 +8,7 @@ import moderngl
 from pydantic import Field
 
 from deferred.errors import InputError
+from deferred.imageio import check_image
 from deferred.material import BlinnPhongParams, Material
 from deferred.registry import materials
 from deferred.validation import Albedo
@@ -28,9 +29,14 @@ class StandardMaterial(Material):
     surface_shader = "materials/standard/surface.glsl"
 
     def check_files(self, where: str | None) -> None:
-        if self.params.texture is not None and not self.resolve_path(self.params.texture).is_file():
-            raise InputError(f"texture file not found: {self.resolve_path(self.params.texture)}",
-                             f"{where}.texture" if where else "texture")
+        if self.params.texture is None:
+            return
+        path = self.resolve_path(self.params.texture)
+        key = f"{where}.texture" if where else "texture"
+        if not path.is_file():
+            raise InputError(f"texture file not found: {path}", key)
+        # the texture is read when GL draws it: a bad file fails now, not after GL starts
+        check_image(path, key)
 
     def defines(self, obj) -> dict[str, str]:
         defines = super().defines(obj)

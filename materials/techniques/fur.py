@@ -137,11 +137,7 @@ def check_heightfield(path: Path | None, where: str | None) -> None:
     key = f"{where}.heightfield" if where else "heightfield"
     if not path.is_file():
         raise InputError(f"heightfield image not found: {path}", key)
-    try:
-        load_heightfield(path)
-    except InputError as exc:
-        raise InputError(f"cannot read heightfield image {path.name}: {exc.message}",
-                         key) from None
+    load_heightfield(path, key)  # its errors name the file and the key
 
 
 def fur_volume_texture(frame: Frame, params: FurParams,
