@@ -187,9 +187,12 @@ def test_render_on_a_full_disk_exits_1_and_keeps_the_old_image(tmp_path):
     def small_files():
         resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
 
-    result = subprocess.run([sys.executable, "-m", "deferred.cli", "render", "-o", str(out),
-                             "--size", "160x90"], preexec_fn=small_files, capture_output=True,
-                            text=True, cwd=tmp_path)
+    # -B: Python would write stale modules' bytecode under the limit too, and its pyc writer
+    # does not notice a short write: a truncated .pyc in the source tree breaks every later run
+    result = subprocess.run([sys.executable, "-B", "-m", "deferred.cli", "render", "-o",
+                             str(out), "--size", "160x90"], preexec_fn=small_files,
+                            capture_output=True, text=True, cwd=tmp_path,
+                            env={**os.environ, "PYTHONDONTWRITEBYTECODE": "1"})
     assert result.returncode == 1, result.stderr
     line = one_line(result.stderr)
     assert line.startswith(f"render failed: cannot write {out}: ")
