@@ -281,6 +281,13 @@ def test_image_memory_budget(images, monkeypatch):
     assert read_image(images / "good.png").shape == (48, 48, 4)
 
 
+def test_gl_size_limit_is_the_callers(images):
+    """Where a context is at hand its GL_MAX_TEXTURE_SIZE replaces the 16384 default."""
+    with pytest.raises(InputError, match="48x48, larger than the 32 pixels a side"):
+        read_image(images / "good.png", max_size=32)
+    assert read_channels(images / "wide.png")[0].shape == (1, 20000, 4)  # dumps: no GL limit
+
+
 @pytest.mark.parametrize("name", list(BAD_IMAGES))
 def test_read_functions_name_the_file(images, capfd, name):
     for read in (read_image, check_image):
