@@ -7,6 +7,7 @@ detected and switched on only where the driver reports them; everything has a 3.
 from __future__ import annotations
 
 import os
+import threading
 from dataclasses import dataclass, field
 
 import moderngl
@@ -57,6 +58,7 @@ class GLContext:
         return int(self.ctx.info["GL_MAX_TEXTURE_SIZE"])
 
     _parking: moderngl.Framebuffer | None = None
+    pool_key: tuple | None = None  # set by acquire_context
 
     def make_current(self) -> None:
         """Make this context the thread's current one.
@@ -100,3 +102,40 @@ def create_context(backend: str | None = None, allow_gl43: bool | None = None) -
         raise RenderError("cannot create a GL 3.3 core context "
                           f"(backend {backend}): {exc}") from exc
     return GLContext(ctx, detect_features(ctx, allow_gl43))
+
+
+# Contexts given back by renderers that made their own, one per thread, backend and GL level:
+# creating and destroying an EGL context per renderer grows the process by about 100 KB each
+# time (Mesa keeps per-context allocations), so a program making a Renderer per frame reuses one.
+_idle: dict[tuple, GLContext] = {}
+_idle_lock = threading.Lock()
+
+
+def _pool_key(backend: str | None, allow_gl43: bool | None) -> tuple:
+    backend = backend or os.environ.get("DEFERRED_GL_BACKEND", "egl")
+    if allow_gl43 is None:
+        allow_gl43 = os.environ.get("DEFERRED_GL33", "") not in ("1", "true", "yes")
+    return threading.get_ident(), backend, allow_gl43
+
+
+def acquire_context(backend: str | None = None, allow_gl43: bool | None = None) -> GLContext:
+    """A context for a renderer to own: one given back on this thread (:func:`give_back_context`),
+    else a new one (:func:`create_context`)."""
+    key = _pool_key(backend, allow_gl43)
+    with _idle_lock:
+        gl = _idle.pop(key, None)
+    if gl is None:
+        gl = create_context(backend, allow_gl43)
+        gl.pool_key = key
+    return gl
+
+
+def give_back_context(gl: GLContext) -> None:
+    """Keep ``gl`` (every object of its user released) for the next :func:`acquire_context` of
+    this thread; a context already kept there, or one not from the pool, is released."""
+    key = getattr(gl, "pool_key", None)
+    with _idle_lock:
+        if key is None or key in _idle:
+            gl.release()
+        else:
+            _idle[key] = gl

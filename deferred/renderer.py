@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .context import Features, GLContext, create_context
+from .context import Features, GLContext, acquire_context, give_back_context
 from .errors import InputError
 from .frame import Frame, Resources
 from .generated import generated_glsl
@@ -91,7 +91,7 @@ class Renderer:
             *(type(obj.material) for obj in scene.objects), *light_types, *shading_models,
             *(type(effect) for effect in scene.effects)] if cls.shader_root is not None]
         self._owns_context = gl is None
-        self.gl = gl or create_context()
+        self.gl = gl or acquire_context()
         self.gl.make_current()
         ctx = self.gl.ctx
         features = self.gl.features
@@ -102,7 +102,7 @@ class Renderer:
                                features.storage_buffers, self.gl.max_texture_size)
         except InputError:
             if self._owns_context:
-                self.gl.release()
+                give_back_context(self.gl)
             raise
         self.pipeline = PIPELINES[pipeline](self.light_path)
         if self.light_path != provisional:
@@ -201,7 +201,7 @@ class Renderer:
         self.targets.release()
         self.shaders.release()
         if self._owns_context:
-            self.gl.release()
+            give_back_context(self.gl)
 
     def __enter__(self) -> Renderer:
         return self
