@@ -281,7 +281,23 @@ def _xatlas_parametrize(positions: np.ndarray, indices: np.ndarray):
     return xatlas.parametrize(positions, indices)
 
 
-def _unwrap_child(connection, positions: np.ndarray, indices: np.ndarray) -> None:
+def _die_with_parent(parent: int) -> None:
+    """Linux: the kernel kills this process when its parent dies, even by SIGKILL (the OOM
+    killer), which leaves no ``finally`` to end a hung unwrap."""
+    if not sys.platform.startswith("linux"):
+        return
+    try:
+        import ctypes
+
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        return
+    if os.getppid() != parent:  # the parent died before prctl: nobody waits for the result
+        os._exit(1)
+
+
+def _unwrap_child(connection, positions: np.ndarray, indices: np.ndarray,
+                  parent: int) -> None:
     """The unwrap process: xatlas, then the arrays (or the error) back through the pipe."""
     # Ctrl-C is the parent's to handle (it ends this process), and so is SIGTERM: a handler
     # forked from the parent (deferred.output_safety's) would turn the parent's terminate()
@@ -289,6 +305,7 @@ def _unwrap_child(connection, positions: np.ndarray, indices: np.ndarray) -> Non
     # command line's one-line errors.
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    _die_with_parent(parent)
     devnull = os.open(os.devnull, os.O_WRONLY)
     os.dup2(devnull, 1)
     os.dup2(devnull, 2)
@@ -322,7 +339,7 @@ def unwrap_uvs(positions: np.ndarray, indices: np.ndarray,
     receiver, sender = context.Pipe(duplex=False)
     child = context.Process(target=_unwrap_child, daemon=True, name=f"unwrap {name}",
                             args=(sender, np.ascontiguousarray(positions, dtype=np.float32),
-                                  np.ascontiguousarray(indices, dtype=np.uint32)))
+                                  np.ascontiguousarray(indices, dtype=np.uint32), os.getpid()))
     try:
         with warnings.catch_warnings():
             # Python 3.12+ warns that forking a threaded process (GL drivers, BLAS) may
