@@ -26,3 +26,14 @@ class ShaderError(DeferredError):
 
 class RenderError(DeferredError):
     """A failure while rendering (GL error, missing feature). Exit code 1."""
+
+
+def gl_error(stage: str, error: str, size: tuple[int, int] | None = None) -> RenderError:
+    """The error for GL error flag ``error`` raised during ``stage`` (a pass, an upload); out of
+    memory says what to shrink."""
+    message = f"{stage}: {error}"
+    if error == "GL_OUT_OF_MEMORY":
+        at = f" at {size[0]}x{size[1]}" if size else ""
+        message += (f" (the frame's render targets, textures and buffers{at} do not fit in GL "
+                    "memory: render smaller, or with fewer shells, lights or effects)")
+    return RenderError(message)

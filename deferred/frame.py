@@ -13,7 +13,7 @@ import numpy as np
 
 from .camera import gl_bytes
 from .context import GLContext
-from .errors import DeferredError, InputError, RenderError
+from .errors import DeferredError, InputError, RenderError, gl_error
 from .mesh import GpuMesh, MeshData
 from .shaderlib import ShaderLibrary
 from .targets import FrameTargets
@@ -182,7 +182,7 @@ class Frame:
             raise RenderError(f"pass {render_pass.name}: {type(exc).__name__}: {exc}") from exc
         error = self.ctx.error
         if error != "GL_NO_ERROR":
-            raise RenderError(f"pass {render_pass.name}: {error}")
+            raise gl_error(f"pass {render_pass.name}", error, (self.width, self.height))
 
     # -- uniforms ------------------------------------------------------------------------------
     def camera_uniforms(self) -> dict[str, Any]:

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .context import Features, GLContext, acquire_context, give_back_context
-from .errors import InputError
+from .errors import DeferredError, InputError, RenderError, gl_error
 from .frame import Frame, Resources
 from .generated import generated_glsl
 from .graph import PassGraph, PassGraphError, compile_graph
@@ -120,6 +120,10 @@ class Renderer:
         self.light_buffer = LightBuffer(ctx, features)
         self.light_lists = LightLists(ctx) if features.compute_shaders else None
         self.last_frame: Frame | None = None
+        error = ctx.error
+        if error != "GL_NO_ERROR":  # the targets did not fit: nothing is left behind
+            self.release()
+            raise gl_error("creating the render targets", error, self.size)
 
     @property
     def passes(self) -> list[RenderPass]:
@@ -159,17 +163,25 @@ class Renderer:
             raise InputError(f"frame time must be a finite number of seconds, got {time}", "time")
         self.scene.apply_timeline(time)
         self.gl.make_current()
+        ctx = self.gl.ctx
+        stale = ctx.error  # reading clears it: errors from here on are this frame's
+        if stale != "GL_NO_ERROR":
+            warnings.warn(f"GL error {stale} left by code outside the renderer", stacklevel=2)
         frame = Frame(self.gl, self.shaders, self.targets, self.resources, self.scene,
                       self.light_buffer, strict=self.strict, light_lists=self.light_lists,
                       time=time)
         self.light_buffer.upload(self.scene.lights, frame.view, frame.projection)
+        self._check_gl("uploading the lights")
         for render_pass in self.passes:
-            render_pass.prepare(frame)
-        ctx = self.gl.ctx
+            try:
+                render_pass.prepare(frame)
+            except DeferredError:
+                raise
+            except Exception as exc:  # noqa: BLE001 - a plugin's prepare: say which pass
+                raise RenderError(f"pass {render_pass.name}: preparing: "
+                                  f"{type(exc).__name__}: {exc}") from exc
+            self._check_gl(f"pass {render_pass.name}: preparing")
         self.gl.park()  # whatever framebuffer was bound may have been released since
-        stale = ctx.error  # reading clears it: errors below belong to our passes
-        if stale != "GL_NO_ERROR":
-            warnings.warn(f"GL error {stale} left by code outside the renderer", stacklevel=2)
         for render_pass in self.passes:
             if before_pass:
                 before_pass(render_pass, frame)
@@ -183,6 +195,11 @@ class Renderer:
         image, hdr = (self.read_final(), self.read_hdr()) if readback else (None, None)
         return RenderResult(image, hdr, frame.stats.draw_calls, dict(frame.stats.draws_by_pass),
                             frame.stats.gl_call_seconds)
+
+    def _check_gl(self, stage: str) -> None:
+        error = self.gl.ctx.error
+        if error != "GL_NO_ERROR":
+            raise gl_error(stage, error, self.size)
 
     def read_final(self) -> np.ndarray:
         data = np.frombuffer(self.targets[FINAL].read(alignment=1), dtype=np.uint8)

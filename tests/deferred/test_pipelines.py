@@ -200,3 +200,33 @@ def test_session_context_survives_another_context_released(gl):
         assert np.array_equal(renderer.render().image, before)
         albedo = renderer.targets.read("albedo_specular")
         assert albedo[..., :3].max() > 0.5
+
+
+def _raise_gl_error() -> None:
+    """Set GL_INVALID_ENUM on the current context, as a driver would (glEnable of no cap)."""
+    import ctypes
+
+    ctypes.CDLL("libOpenGL.so.0").glEnable(ctypes.c_uint(0xFFFF))
+
+
+def test_a_gl_error_while_preparing_a_pass_names_the_pass_not_outside_code(gl, monkeypatch):
+    import warnings
+
+    from deferred.errors import RenderError, gl_error
+    from deferred.scene import scene_from_dict
+
+    scene = scene_from_dict({"size": [32, 24], "object": [{"mesh": "builtin:sphere"}],
+                             "light": [{"type": "directional"}]})
+    with Renderer(scene, gl=gl) as renderer:
+        target = renderer.passes[1]
+        monkeypatch.setattr(type(target), "prepare", lambda self, frame: _raise_gl_error())
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")  # not "left by code outside the renderer"
+            with pytest.raises(RenderError, match=rf"^pass {target.name}: preparing: "
+                                                  "GL_INVALID_ENUM$"):
+                renderer.render()
+        monkeypatch.undo()
+        assert renderer.render().image.shape == (24, 32, 4)  # the renderer still works
+    message = str(gl_error("pass gbuffer", "GL_OUT_OF_MEMORY", (800, 600)))
+    assert message.startswith("pass gbuffer: GL_OUT_OF_MEMORY (the frame's render targets")
+    assert "at 800x600" in message and "render smaller" in message
