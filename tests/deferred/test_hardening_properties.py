@@ -108,3 +108,54 @@ def test_an_accepted_random_scene_renders_a_finite_image(gl, document):
         return
     assert result.hdr.shape[:2] == (16, 24)
     assert np.isfinite(result.hdr).all()
+
+
+finite_coordinates = st.floats(min_value=-10.0, max_value=10.0)
+coordinates = st.one_of(
+    finite_coordinates, finite_coordinates, finite_coordinates,
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.sampled_from([0.0, 1e-30, 1e7, -1e20, 1e300, float("nan"), float("inf")]))
+
+
+@st.composite
+def obj_documents(draw) -> str:
+    """An OBJ file from random arrays: vertices with any coordinates (repeated ones too), faces
+    with any indices (0, negative and past the end are wrong in OBJ's 1-based indexing)."""
+    count = draw(st.integers(0, 12))
+    coordinate = finite_coordinates if draw(st.integers(0, 2)) else coordinates
+    vertices = draw(st.lists(st.tuples(coordinate, coordinate, coordinate),
+                             min_size=count, max_size=count))
+    if vertices and draw(st.booleans()):
+        vertices += vertices[: draw(st.integers(1, len(vertices)))]  # coincident vertices
+    index = st.integers(1, max(len(vertices), 1))
+    faces = draw(st.lists(st.tuples(index, index, index), max_size=16))
+    if draw(st.integers(0, 3)) == 0:  # one face with a wrong index
+        wrong = st.sampled_from([0, -len(vertices) - 1, len(vertices) + 1])
+        faces.append(draw(st.tuples(index, index, wrong)))
+    lines = [f"v {x!r} {y!r} {z!r}" for x, y, z in vertices]
+    lines += [f"f {a} {b} {c}" for a, b, c in faces]
+    return "\n".join(lines) + "\n"
+
+
+@settings(max_examples=120, deadline=None,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large,
+                                 HealthCheck.function_scoped_fixture])
+@given(text=obj_documents())
+def test_a_random_mesh_file_is_a_mesh_or_one_input_error_in_bounded_time(
+        text, tmp_path, monkeypatch):
+    from deferred.mesh import load_mesh
+
+    monkeypatch.setenv("DEFERRED_UNWRAP_TIMEOUT", "5")
+    path = tmp_path / "random.obj"
+    path.write_text(text)
+    start = time.perf_counter()
+    try:
+        mesh = load_mesh(str(path), where="scene.toml: object[0].mesh")
+    except InputError as exc:
+        message = str(exc)
+        assert "\n" not in message and "object[0].mesh" in message, message
+    else:
+        assert len(mesh.indices) > 0 and np.isfinite(mesh.positions).all()
+        assert np.isfinite(mesh.uvs).all() and np.isfinite(mesh.normals).all()
+        assert mesh.indices.max() < len(mesh.positions)
+    assert time.perf_counter() - start < 8.0
