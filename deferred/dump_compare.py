@@ -6,6 +6,9 @@ difference images.
 from __future__ import annotations
 
 import json
+import os
+import secrets
+import shutil
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -15,8 +18,10 @@ import numpy as np
 from .dump import safe_name
 from .errors import InputError, RenderError
 from .imageio import read_channels, write_image, write_text
-from .output_safety import same_file
+from .output_safety import same_file, signals_deferred
 from .preview import heat_colors, to_uint8
+
+COMPARE_FILE = "compare.json"  # marks a folder as a comparison's output
 
 
 @dataclass
@@ -86,14 +91,39 @@ def compare_dumps(first: str | Path, second: str | Path,
     (turbo; black where equal). NaN equals NaN; NaN against a number counts as infinite.
     """
     a_files, b_files = dump_buffers(Path(first)), dump_buffers(Path(second))
-    out = check_compare_output(first, second, output) if output is not None else None
-    if out is not None:
-        if out.exists() and not out.is_dir():
-            raise InputError("exists and is not a folder", str(out))
-        try:
-            out.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise RenderError(f"cannot write {out}: {exc.strerror or exc}") from exc
+    if output is None:
+        return _compare_all(a_files, b_files, first, second, None)
+    out = check_compare_output(first, second, output).resolve()
+    if out.exists() and not out.is_dir():
+        raise InputError("exists and is not a folder", str(output))
+    if out.is_dir() and any(out.iterdir()) and not (out / COMPARE_FILE).is_file():
+        raise InputError("is a folder of other files, not an earlier comparison; choose an "
+                         "empty or new folder", str(output))
+    # Written as a whole: into a hidden folder next to the output, which then replaces it, so
+    # an unreadable buffer or an interruption leaves no folder or the earlier comparison.
+    staging = out.parent / f".{out.name[:200]}.compare-{secrets.token_hex(4)}"
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        staging.mkdir()
+        results = _compare_all(a_files, b_files, first, second, staging)
+        write_text(staging / COMPARE_FILE, json.dumps(
+            {"a": str(first), "b": str(second), "buffers": [r.describe() for r in results]},
+            indent=2) + "\n")
+        with signals_deferred():
+            old = out.parent / f".{out.name[:200]}.old-{secrets.token_hex(4)}"
+            if out.exists():
+                os.rename(out, old)
+            os.rename(staging, out)
+            shutil.rmtree(old, ignore_errors=True)
+    except OSError as exc:
+        raise RenderError(f"cannot write {output}: {exc.strerror or exc}") from exc
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+    return results
+
+
+def _compare_all(a_files: dict[str, Path], b_files: dict[str, Path], first: str | Path,
+                 second: str | Path, out: Path | None) -> list[BufferDiff]:
     results = []
     for key in list(a_files) + [k for k in b_files if k not in a_files]:
         if key not in b_files or key not in a_files:
@@ -101,10 +131,6 @@ def compare_dumps(first: str | Path, second: str | Path,
             results.append(BufferDiff(key, problem=f"missing in {side}"))
             continue
         results.append(_compare_buffer(key, a_files[key], b_files[key], out))
-    if out is not None:
-        write_text(out / "compare.json", json.dumps(
-            {"a": str(first), "b": str(second), "buffers": [r.describe() for r in results]},
-            indent=2) + "\n")
     return results
 
 

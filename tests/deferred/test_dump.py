@@ -437,6 +437,25 @@ def test_cli_compare(tmp_path, capsys):
     assert (tmp_path / "b-diff" / "compare.json").is_file()
 
 
+def test_cli_compare_output_is_whole_and_never_a_folder_of_other_files(tmp_path, capsys):
+    for name in ("a", "b"):
+        assert run(capsys, "dump", "-o", tmp_path / name, "--size", "64x36")[0] == 0
+    out = tmp_path / "diff"
+    out.mkdir()
+    (out / "stale.png").write_bytes(b"an earlier difference image")
+    (out / "compare.json").write_text("{}")  # an earlier comparison: replaced as a whole
+    code, _, err = run(capsys, "dump", "--compare", tmp_path / "a", tmp_path / "b", "-o", out)
+    assert code == 0, err
+    assert sorted(p.name for p in out.iterdir()) == ["compare.json"]  # equal dumps: no images
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a", "b", "diff"]  # no staging left
+    notes = tmp_path / "notes"
+    notes.mkdir()
+    (notes / "todo.txt").write_text("mine")
+    code, _, err = run(capsys, "dump", "--compare", tmp_path / "a", tmp_path / "b", "-o", notes)
+    assert code == 2 and "is a folder of other files" in err and str(notes) in err
+    assert sorted(p.name for p in notes.iterdir()) == ["todo.txt"]
+
+
 SCENE_TOML = """size = [64, 36]
 light_path = "volumes"
 [[object]]
