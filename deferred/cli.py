@@ -68,7 +68,7 @@ def cli(debug: bool) -> None:
 @click.option("--pipeline", type=click.Choice(sorted(PIPELINES)), default="deferred",
               show_default=True)
 @click.option("--size", help="WIDTHxHEIGHT, overrides the scene's size.")
-@click.option("--frames", type=click.IntRange(min=1), default=1, show_default=True,
+@click.option("--frames", type=click.IntRange(min=1, max=100_000), default=1, show_default=True,
               help="Render this many frames, frame i at --time + i / --fps seconds: all of "
                    "them go to a sequence or a video; an image gets the last (timing).")
 @click.option("--fps", type=FiniteFloat(min=0.0, min_open=True, max=1000.0), default=24.0,
@@ -131,6 +131,7 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
             loaded, view_name = debug_scene, None
     with Renderer(loaded, pipeline, size_override, strict=strict or None,
                   light_path=light_path) as renderer:
+        renderer.check_times(times)  # a simulation cannot reach the last frame: refuse now
         if kind != "image":
             written, frame_ms = _render_animation(renderer, out, times, fps)
         else:
@@ -244,12 +245,14 @@ def dump(scene: str | None, output: str | None, pipeline: str, size: str | None,
     loaded = _scene(scene)
     check_dump_inputs(out_dir, scene_inputs(loaded, scene))
     patterns = [p.strip() for p in passes.split(",") if p.strip()] if passes is not None else None
+    if patterns == []:
+        raise InputError("names no pass (give names or globs, or leave --passes out)", "--passes")
     with Renderer(loaded, pipeline, _size_option(size), strict=strict or None,
                   light_path=light_path) as renderer:
         chosen = select_passes(renderer.passes, patterns)  # bad input fails before any file
         where = parse_pixel(pixel, renderer.size) if pixel is not None else None
         with Progress(SpinnerColumn(), TextColumn("{task.description}"), console=stderr,
-                      transient=True) as progress:
+                      transient=True, disable=not stderr.is_terminal) as progress:
             task = progress.add_task("capturing")
             manifest, history = dump_scene(
                 renderer, out_dir, patterns, where,
@@ -294,9 +297,9 @@ def _compare(first: str, second: str, output: str | None) -> None:
 @click.option("--shells", default="0,16,64", show_default=True, metavar="N,...",
               help="Shell counts for every object whose material has 'shells'.")
 @click.option("--size", help="WIDTHxHEIGHT, overrides the scene's size.")
-@click.option("--runs", type=click.IntRange(min=1), default=10, show_default=True,
+@click.option("--runs", type=click.IntRange(min=1, max=10_000), default=10, show_default=True,
               help="Timed frames per point (and as many again for the per-pass times).")
-@click.option("--warmup", type=click.IntRange(min=0), default=2, show_default=True,
+@click.option("--warmup", type=click.IntRange(min=0, max=10_000), default=2, show_default=True,
               help="Untimed frames first (shader compilation, first uploads).")
 @click.option("--pipelines", default="deferred,forward", show_default=True, metavar="NAME,...")
 @click.option("--light-paths", default="all", show_default=True, metavar="PATH,...",
@@ -335,7 +338,7 @@ def bench(scene: str | None, lights: str, shells: str, size: str | None, runs: i
                      "skipped (shells 0)")
     total = len(shell_counts) * len(sweep.lights) * len(sweep.pipelines)
     with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-                  console=stderr, transient=True) as progress:
+                  console=stderr, transient=True, disable=not stderr.is_terminal) as progress:
         task = progress.add_task("benchmark", total=total)
         started = []
 

@@ -71,11 +71,14 @@ class Resources:
         """A cached texture (see :meth:`cached`)."""
         return self.cached(key, create)
 
-    def image_texture(self, path: Path, srgb: bool = True) -> moderngl.Texture:
+    def image_texture(self, path: Path, srgb: bool = True,
+                      where: str | None = None) -> moderngl.Texture:
+        """The image at ``path`` as a mipmapped texture (cached); ``where`` (the scene key)
+        names it in a read error."""
         from .imageio import read_image
 
         def create(ctx: moderngl.Context) -> moderngl.Texture:
-            pixels = read_image(path, srgb_to_linear=srgb,
+            pixels = read_image(path, srgb_to_linear=srgb, where=where,
                                 max_size=ctx.info["GL_MAX_TEXTURE_SIZE"])
             height, width, _ = pixels.shape
             texture = ctx.texture((width, height), 4, np.ascontiguousarray(

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import os
 import secrets
+import stat
 import sys
 import tempfile
 from collections.abc import Callable, Iterator, Sequence
@@ -41,8 +42,15 @@ def check_output_path(path: str | Path, where: str = "-o",
     not itself a folder. With ``patterns``, a name with a run of ``#`` is a numbered image
     sequence (:func:`deferred.animation.expand_pattern`), checked as its first file."""
     path = Path(path)
+    shown = str(path) if len(str(path)) <= 120 else f"{str(path)[:60]}...{str(path)[-40:]}"
     if path.suffix.lower() not in suffixes:
-        raise InputError(f"output must end in {_either(suffixes)}: {path}", where)
+        raise InputError(f"output must end in {_either(suffixes)}: {shown}", where)
+    if any(len(part.encode()) > NAME_MAX for part in path.parent.parts):
+        raise InputError(f"folder name longer than {NAME_MAX} bytes: {shown}", where)
+    if len(path.name.encode()) > NAME_MAX:
+        raise InputError(f"file name longer than {NAME_MAX} bytes: {path.name[:40]}...", where)
+    if len(str(path.absolute()).encode()) >= PATH_MAX:
+        raise InputError(f"path longer than {PATH_MAX} bytes: {shown}", where)
     if not path.parent.is_dir():
         raise InputError(f"output folder does not exist: {path.parent}", where)
     first = path
@@ -190,6 +198,7 @@ def write_text(path: str | Path, text: str) -> Path:
 
 # A file name may hold 255 bytes on the common file systems (ext4, XFS, btrfs, APFS, NTFS).
 NAME_MAX = 255
+PATH_MAX = 4096  # bytes of a whole path (Linux)
 # What temporary_path adds to a name: ".", ".", 12 hex digits, ".tmp".
 _TEMPORARY_EXTRA = 18
 
@@ -247,9 +256,10 @@ def read_image(path: str | Path, srgb_to_linear: bool = False,
     colour channels as stored where a format would associate them with alpha (PNG: data in
     RGBA channels, such as a wetness mask, must not be premultiplied).
 
-    A missing, empty, truncated or corrupt file, or one over ``max_size`` pixels a side or over
-    ``IMAGE_MEMORY_BUDGET`` at ``bytes_per_pixel`` (what the caller makes of each pixel), is an
-    ``InputError`` naming the file, and ``where`` (a scene key) where given.
+    A missing, empty, truncated or corrupt file, one over ``max_size`` pixels a side or over
+    ``IMAGE_MEMORY_BUDGET`` at ``bytes_per_pixel`` (what the caller makes of each pixel), or one
+    holding NaN, infinite or negative values, is an ``InputError`` naming the file, and
+    ``where`` (a scene key) where given.
     """
     import OpenImageIO as oiio
 
@@ -258,6 +268,16 @@ def read_image(path: str | Path, srgb_to_linear: bool = False,
     if unassociated_alpha:
         config.attribute("oiio:UnassociatedAlpha", 1)
     pixels, spec = _decode(path, where, config, max_size, lambda _: bytes_per_pixel)
+    # Every image a scene reads (colours, heights, wetness) holds values from 0 up: NaN or a
+    # negative value (float EXR) would shade black or spread NaN through the frame.
+    bad = ~np.isfinite(pixels) | (pixels < 0.0)
+    if bad.any():
+        y, x = np.argwhere(bad.reshape(pixels.shape[0], pixels.shape[1], -1).any(axis=-1))[0]
+        value = pixels.reshape(pixels.shape[0], pixels.shape[1], -1)[y, x]
+        raise InputError(f"image {_culprit(path, where)} has {int(bad.sum()):,} values that are "
+                         f"NaN, infinite or negative (the first at pixel {x}, {y}: "
+                         f"{np.array2string(value, precision=3)}); images hold values >= 0",
+                         where)
     if pixels.ndim == 2:
         pixels = pixels[..., None]
     count = pixels.shape[2]
@@ -349,6 +369,9 @@ def _open(path: Path, where: str | None, config, max_size: int | None, bytes_per
     except OSError as exc:
         reason = "not found" if isinstance(exc, FileNotFoundError) else exc.strerror or str(exc)
         raise InputError(f"cannot read image {name}: {reason}", where) from None
+    if not stat.S_ISREG(path.stat().st_mode):
+        kind = "a folder" if path.is_dir() else "not a regular file (a device or pipe)"
+        raise InputError(f"cannot read image {name}: it is {kind}", where)
     if size == 0:
         raise InputError(f"cannot read image {name}: the file is empty (0 bytes)", where)
     with _quiet_stderr() as chatter:

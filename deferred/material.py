@@ -139,6 +139,10 @@ class Material:
     def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
         return {}
 
+    def check_time(self, time: float, where: str) -> None:
+        """Refuse (``InputError`` naming ``where``) a frame time this material cannot reach in
+        bounded work, before any frame is rendered: a simulation stepping from 0 to it."""
+
     # -- passes per phase --------------------------------------------------------------------
     def geometry_passes(self, obj: SceneObject) -> list[RenderPass]:
         return [GBufferPass(f"{obj.label}.gbuffer", Phase.GEOMETRY, obj)]

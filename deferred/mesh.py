@@ -37,6 +37,7 @@ import moderngl
 import numpy as np
 
 from .errors import InputError
+from .validation import require_regular_file
 
 BUILTIN_PREFIX = "builtin:"
 BUILTIN_MESHES = ("sphere", "torus", "plane", "cube")
@@ -455,6 +456,13 @@ _BUILTINS = {"sphere": builtin_sphere, "torus": builtin_torus, "plane": builtin_
 # Bounds of the built-in shapes' integer arguments (subdivision counts); float arguments
 # (sizes, radii) must be finite and positive.
 BUILTIN_COUNT_RANGE = (3, 4096)
+BUILTIN_SIZE_MAX = 1e4
+# Triangles each shape makes from its arguments (with defaults): checked before it is built.
+_BUILTIN_TRIANGLES = {
+    "sphere": lambda a: 2 * a["segments"] * a["rings"],
+    "torus": lambda a: 2 * a["segments"] * a["sides"],
+    "plane": lambda a: 2 * a["divisions"] ** 2,
+}
 
 
 def builtin_arguments(spec: str, where: str | None = None) -> tuple[str, dict[str, int | float]]:
@@ -483,6 +491,13 @@ def builtin_arguments(spec: str, where: str | None = None) -> tuple[str, dict[st
         if key in arguments:
             raise InputError(f"builtin:{shape} parameter '{key}' is given twice", where)
         arguments[key] = _builtin_argument(shape, key, text, kinds[key], where)
+    if shape in _BUILTIN_TRIANGLES:
+        counted = {name: p.default for name, p in parameters.items()} | arguments
+        triangles = _BUILTIN_TRIANGLES[shape](counted)
+        if triangles > MAX_TRIANGLES:
+            raise InputError(f"builtin:{shape} with these arguments has {triangles:,} "
+                             f"triangles, more than the {MAX_TRIANGLES:,} a mesh may have",
+                             where)
     return shape, arguments
 
 
@@ -503,9 +518,9 @@ def _builtin_argument(shape: str, key: str, text: str, kind: type, where: str) -
     except ValueError:
         raise InputError(f"builtin:{shape} parameter '{key}' must be a number, got '{text}'",
                          where) from None
-    if not math.isfinite(number) or number <= 0.0:
-        raise InputError(f"builtin:{shape} parameter '{key}' must be finite and greater than "
-                         f"0, got {text}", where)
+    if not math.isfinite(number) or not 0.0 < number <= BUILTIN_SIZE_MAX:
+        raise InputError(f"builtin:{shape} parameter '{key}' must be greater than 0 and at "
+                         f"most {BUILTIN_SIZE_MAX:g}, got {text}", where)
     return number
 
 
@@ -523,8 +538,7 @@ def load_mesh(spec: str, base_dir: Path | None = None, where: str | None = None)
     path = Path(spec)
     if not path.is_absolute() and base_dir is not None:
         path = base_dir / path
-    if not path.is_file():
-        raise InputError(f"mesh file not found: {path}", where)
+    require_regular_file(path, "mesh file", where)
     if path.suffix.lower() not in MESH_SUFFIXES:
         raise InputError(f"unsupported mesh format '{path.suffix}' "
                          f"(use {', '.join(MESH_SUFFIXES)})", where)

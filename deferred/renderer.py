@@ -44,16 +44,32 @@ def strict_default() -> bool:
 
 # Render targets live in system memory on llvmpipe: a size whose targets pass this is refused
 # before the context allocates them (one that does not fit would be killed, without a message).
-TARGET_MEMORY_BUDGET = int(os.environ.get("DEFERRED_TARGET_MEMORY", str(4 << 30)))
+TARGET_MEMORY_BUDGET = 4 << 30  # bytes; DEFERRED_TARGET_MEMORY overrides it
+
+
+def target_memory_budget() -> int:
+    """:data:`TARGET_MEMORY_BUDGET`, or the environment's ``DEFERRED_TARGET_MEMORY`` (bytes)."""
+    text = os.environ.get("DEFERRED_TARGET_MEMORY")
+    if text is None:
+        return TARGET_MEMORY_BUDGET
+    try:
+        budget = int(text)
+    except ValueError:
+        budget = 0
+    if budget <= 0:
+        raise InputError(f"must be a whole number of bytes > 0, got {text[:40]!r}",
+                         "DEFERRED_TARGET_MEMORY")
+    return budget
 
 
 def check_target_memory(graph: PassGraph, size: tuple[int, int], where: str = "size") -> None:
-    """Refuse a frame size whose render targets need more than :data:`TARGET_MEMORY_BUDGET`."""
+    """Refuse a frame size whose render targets need more than the budget."""
     needed = targets_bytes(graph.targets.values(), *size)
-    if needed > TARGET_MEMORY_BUDGET:
+    budget = target_memory_budget()
+    if needed > budget:
         raise InputError(f"{size[0]}x{size[1]} needs {needed >> 20} MiB of render targets "
                          f"({len(graph.targets)} targets); the budget is "
-                         f"{TARGET_MEMORY_BUDGET >> 20} MiB (DEFERRED_TARGET_MEMORY)", where)
+                         f"{budget >> 20} MiB (DEFERRED_TARGET_MEMORY)", where)
 
 
 class Renderer:
@@ -195,6 +211,14 @@ class Renderer:
         image, hdr = (self.read_final(), self.read_hdr()) if readback else (None, None)
         return RenderResult(image, hdr, frame.stats.draw_calls, dict(frame.stats.draws_by_pass),
                             frame.stats.gl_call_seconds)
+
+    def check_times(self, times: list[float], where: str = "--time") -> None:
+        """Every material's :meth:`~deferred.material.Material.check_time` for the latest of
+        ``times``: an animation is refused before its first frame, not part way."""
+        if times:
+            latest = max(times)
+            for obj in self.scene.objects:
+                obj.material.check_time(latest, where)
 
     def _check_gl(self, stage: str) -> None:
         error = self.gl.ctx.error

@@ -22,7 +22,14 @@ from types import MappingProxyType
 from typing import Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
 
 from . import registry
 from .camera import Camera, model_matrix
@@ -32,8 +39,9 @@ from .light import Light
 from .material import Material, MaterialParams
 from .mesh import MeshData, load_mesh
 from .params import validate_params
+from .passes import Phase
 from .shading import GBufferLayout, ShadingModel, compose_layout
-from .validation import Radiance, StrictValues, format_validation_error
+from .validation import Radiance, StrictValues, format_validation_error, require_regular_file
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -42,6 +50,7 @@ else:  # pragma: no cover
 
 Vec3 = tuple[float, float, float]
 MAX_SIZE = 16384
+MAX_DEPTH_RANGE = 1e7  # far / near
 DEMO_SCENE = "demo.toml"
 
 
@@ -61,6 +70,11 @@ class CameraModel(_Strict):
     def _check(self) -> CameraModel:
         if self.far <= self.near:
             raise ValueError("far must be greater than near")
+        if self.far / self.near > MAX_DEPTH_RANGE:
+            # measured: at 1e8 the deferred pipeline's depth reconstruction loses the scene
+            raise ValueError(f"far / near is {self.far / self.near:.3g}; at most "
+                             f"{MAX_DEPTH_RANGE:g} (the depth buffer's precision): raise near "
+                             "or lower far")
         if np.allclose(self.position, self.target):
             raise ValueError("position and target are the same point")
         forward = np.subtract(self.target, self.position, dtype=float)
@@ -72,13 +86,23 @@ class CameraModel(_Strict):
 
 
 class ObjectModel(_Strict):
-    name: str | None = None
+    name: str | None = Field(None, max_length=1000,
+                             description="label: printable, no control characters")
     mesh: str
     material: str = "standard"
     position: Vec3 = (0.0, 0.0, 0.0)
     rotation: Vec3 = Field((0.0, 0.0, 0.0), description="degrees, applied X, then Y, then Z")
     scale: float | Vec3 = 1.0
     params: dict[str, Any] = Field(default_factory=dict)
+
+    @field_validator("name")
+    @classmethod
+    def _printable(cls, name: str | None) -> str | None:
+        # a label goes into file names, messages and contact sheets
+        if name is not None and (not name or any(ord(c) < 32 or ord(c) == 127 for c in name)):
+            raise ValueError("must be printable text: no control characters (newline, tab, "
+                             "NUL) and not empty")
+        return name
 
     @model_validator(mode="after")
     def _check_scale(self) -> ObjectModel:
@@ -192,8 +216,9 @@ class SceneObject:
                 raise InputError(f"{material_cls.name} reads {key} once, at t = 0: a timeline "
                                  "cannot change it", f"{params_where}.{key}")
         # Every key checked against the material's model over the base (files, too)
-        material_cls.from_dict({**self.base_params.model_dump(), **params},
-                               self.material.base_dir, params_where)
+        changed = material_cls.from_dict({**self.base_params.model_dump(), **params},
+                                         self.material.base_dir, params_where)
+        self._check_same_passes(changed, params, params_where)
         event = TimelineEvent(float(time), MappingProxyType(dict(params)), where)
         previous = self.events
         self.events = tuple(sorted((*previous, event), key=lambda e: e.time))
@@ -206,6 +231,25 @@ class SceneObject:
             self._states.clear()
             raise
         return event
+
+    def _check_same_passes(self, changed: Material, params: Mapping[str, Any],
+                           where: str) -> None:
+        """The pass graph is built once, from the parameters at t = 0: an event whose
+        parameters would add or remove passes (fins on, shells from 0) cannot take effect."""
+        def names(material: Material) -> list[str]:
+            return [p.name for phase in Phase for p in material.passes(phase, self)]
+
+        base = type(self.material)(self.base_params, self.material.base_dir)
+        before, after = names(base), names(changed)
+        if before != after:
+            keys = [k for k in params if params[k] != getattr(self.base_params, k, None)]
+            added = sorted(set(after) - set(before))
+            removed = sorted(set(before) - set(after))
+            change = ", ".join([*(f"+{n}" for n in added), *(f"-{n}" for n in removed)])
+            raise InputError(f"changing {', '.join(keys) or 'these parameters'} on a timeline "
+                             f"would change the object's passes ({change}), which are built "
+                             "once from t = 0; set it in the object's own params",
+                             f"{where}.{keys[0]}" if len(keys) == 1 else where)
 
     def with_material(self, material: Material,
                       overrides: Mapping[str, Any] | None = None) -> SceneObject:
@@ -245,8 +289,10 @@ class Scene:
         if isinstance(obj, str):
             found = [o for o in self.objects if o.label == obj]
             if not found:
-                names = ", ".join(o.label for o in self.objects) or "none"
-                raise InputError(f"no object named '{obj}' (objects: {names})",
+                names = ", ".join(o.label[:40] for o in self.objects[:10]) or "none"
+                if len(self.objects) > 10:
+                    names += f", ... ({len(self.objects)} in all)"
+                raise InputError(f"no object named '{obj[:80]}' (objects: {names})",
                                  f"{where}.object" if where else "object")
             obj = found[0]
         return obj.add_event(time, params, where)
@@ -325,7 +371,7 @@ def load_scene(path: str | Path | None = None) -> Scene:
         return scene_from_toml(text, name=f"builtin:{name}.toml", base_dir=None)
     path = Path(path)
     if not path.is_file():
-        raise InputError("scene file not found", str(path))
+        require_regular_file(path, "scene file", str(path))
     try:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
@@ -338,6 +384,8 @@ def scene_from_toml(text: str, name: str = "<string>", base_dir: Path | None = N
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise InputError(f"malformed TOML: {exc}", name) from None
+    except RecursionError:
+        raise InputError("malformed TOML: arrays or tables nested too deep", name) from None
     return scene_from_dict(data, name, base_dir)
 
 

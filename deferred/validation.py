@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import math
+import stat
 import types
 import typing
+from pathlib import Path
 from typing import Annotated, Any, Literal
 
 from pydantic import (
@@ -16,6 +18,8 @@ from pydantic import (
     ValidationInfo,
     field_validator,
 )
+
+from .errors import InputError
 
 # Floats beyond this are refused (world units, intensities, rates): float32 shading has lost
 # every digit by then and a product of two overflows to inf.
@@ -61,7 +65,8 @@ def _message(first: dict, count: int) -> str:
         message = message.removeprefix("Value error, ")
     if first["type"] not in ("extra_forbidden", "missing") and "input" in first and \
             not isinstance(first["input"], dict):
-        message += f" (got {first['input']!r})"
+        got = repr(first["input"])
+        message += f" (got {got if len(got) <= 80 else got[:60] + ' ... ' + got[-15:]})"
     if count > 1:
         message += f" (and {count - 1} more problem{'s' if count > 2 else ''})"
     return message
@@ -147,3 +152,20 @@ UnitFloat = Annotated[float, Field(ge=0.0, le=1.0)]
 NonNegativeFloat = Annotated[float, Field(ge=0.0)]
 Albedo = tuple[UnitFloat, UnitFloat, UnitFloat]
 Radiance = tuple[NonNegativeFloat, NonNegativeFloat, NonNegativeFloat]
+
+
+def require_regular_file(path: Path, what: str, where: str | None) -> None:
+    """``InputError`` unless ``path`` is a regular file: missing, a folder, or a device or pipe
+    (``/dev/zero``, a FIFO: reading one never ends or gives nonsense) are each said so. The
+    path is named unless ``where`` already does."""
+    named = "" if where is not None and str(path) in where else f": {path}"
+    try:
+        mode = path.stat().st_mode
+    except FileNotFoundError:
+        raise InputError(f"{what} not found{named}", where) from None
+    except OSError as exc:
+        raise InputError(f"cannot read {what}{named}: {exc.strerror or exc}", where) from None
+    if stat.S_ISDIR(mode):
+        raise InputError(f"{what} is a folder, not a file{named}", where)
+    if not stat.S_ISREG(mode):
+        raise InputError(f"{what} is not a regular file (a device or pipe){named}", where)

@@ -7,11 +7,10 @@ from typing import TYPE_CHECKING
 import moderngl
 from pydantic import Field
 
-from deferred.errors import InputError
 from deferred.imageio import check_image
 from deferred.material import BlinnPhongParams, Material
 from deferred.registry import materials
-from deferred.validation import Albedo
+from deferred.validation import Albedo, require_regular_file
 
 if TYPE_CHECKING:
     from deferred.frame import Frame
@@ -33,8 +32,8 @@ class StandardMaterial(Material):
             return
         path = self.resolve_path(self.params.texture)
         key = f"{where}.texture" if where else "texture"
-        if not path.is_file():
-            raise InputError(f"texture file not found: {path}", key)
+        self._texture_key = key
+        require_regular_file(path, "texture file", key)
         # the texture is read when GL draws it: a bad file fails now, not after GL starts
         check_image(path, key)
 
@@ -48,4 +47,4 @@ class StandardMaterial(Material):
         if self.params.texture is None:
             return {}
         return {"u_albedo_texture": frame.resources.image_texture(
-            self.resolve_path(self.params.texture))}
+            self.resolve_path(self.params.texture), where=getattr(self, "_texture_key", None))}
