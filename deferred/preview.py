@@ -8,6 +8,7 @@ colours (0, the background, is black).
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import lru_cache
@@ -156,7 +157,10 @@ def text_mask(text: str, pixels: int = 12) -> np.ndarray | None:
         font = _font()
         font.clear()
         font.set_size(pixels * 0.75, 96)  # points at 96 dpi
-        font.set_text(text, 0.0)
+        with warnings.catch_warnings():
+            # a glyph the font lacks (CJK in an object's name) is drawn as a box; no warning
+            warnings.simplefilter("ignore")
+            font.set_text(text, 0.0)
         font.draw_glyphs_to_bitmap(antialiased=True)
         return np.asarray(font.get_image(), dtype=np.float32) / 255.0
     except (ImportError, OSError, RuntimeError, ValueError):
