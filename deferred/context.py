@@ -132,10 +132,32 @@ def acquire_context(backend: str | None = None, allow_gl43: bool | None = None) 
 
 def give_back_context(gl: GLContext) -> None:
     """Keep ``gl`` (every object of its user released) for the next :func:`acquire_context` of
-    this thread; a context already kept there, or one not from the pool, is released."""
+    this thread; a context already kept there, one not from the pool, or one left with a GL
+    error (its user failed part way) is released. The fixed-function state a renderer may
+    change is put back to GL's defaults, so the next renderer's image does not depend on it."""
     key = getattr(gl, "pool_key", None)
+    clean = key is not None and _reset_state(gl.ctx)
     with _idle_lock:
-        if key is None or key in _idle:
+        if not clean or key in _idle:
             gl.release()
         else:
             _idle[key] = gl
+
+
+GL_DEPTH_CLAMP = 0x864F
+
+
+def _reset_state(ctx: moderngl.Context) -> bool:
+    """GL's default fixed-function state; False if the context holds a GL error."""
+    if ctx.error != "GL_NO_ERROR":
+        return False
+    ctx.enable_only(moderngl.NOTHING)
+    ctx.disable_direct(GL_DEPTH_CLAMP)
+    ctx.polygon_offset = (0.0, 0.0)
+    ctx.front_face = "ccw"
+    ctx.cull_face = "back"
+    ctx.wireframe = False
+    ctx.depth_func = "<"
+    ctx.blend_func = moderngl.DEFAULT_BLENDING
+    ctx.blend_equation = moderngl.FUNC_ADD
+    return ctx.error == "GL_NO_ERROR"

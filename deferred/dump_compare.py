@@ -79,6 +79,9 @@ def check_compare_output(first: str | Path, second: str | Path, output: str | Pa
         if out == inside or inside in out.parents or same_file(out, inside):
             raise InputError(f"{output} is inside the dump {folder} being compared; "
                              "difference images would overwrite its files", where)
+        if out in inside.parents:
+            raise InputError(f"{output} holds the dump {folder} being compared; the "
+                             "comparison replaces the folder as a whole", where)
     return Path(output)
 
 
@@ -111,10 +114,17 @@ def compare_dumps(first: str | Path, second: str | Path,
             indent=2) + "\n")
         with signals_deferred():
             old = out.parent / f".{out.name[:200]}.old-{secrets.token_hex(4)}"
-            if out.exists():
+            had_old = out.exists()
+            if had_old:
                 os.rename(out, old)
-            os.rename(staging, out)
-            shutil.rmtree(old, ignore_errors=True)
+            try:
+                os.rename(staging, out)
+            except BaseException:
+                if had_old:
+                    os.rename(old, out)  # the earlier comparison stays where it was
+                raise
+            if had_old:
+                shutil.rmtree(old, ignore_errors=True)
     except OSError as exc:
         raise RenderError(f"cannot write {output}: {exc.strerror or exc}") from exc
     finally:

@@ -199,6 +199,7 @@ def write_text(path: str | Path, text: str) -> Path:
 # A file name may hold 255 bytes on the common file systems (ext4, XFS, btrfs, APFS, NTFS).
 NAME_MAX = 255
 PATH_MAX = 4096  # bytes of a whole path (Linux)
+NEGATIVE_TOLERANCE = 1e-3  # image values this far below 0 read as 0 (HDR filter ringing)
 # What temporary_path adds to a name: ".", ".", 12 hex digits, ".tmp".
 _TEMPORARY_EXTRA = 18
 
@@ -268,16 +269,6 @@ def read_image(path: str | Path, srgb_to_linear: bool = False,
     if unassociated_alpha:
         config.attribute("oiio:UnassociatedAlpha", 1)
     pixels, spec = _decode(path, where, config, max_size, lambda _: bytes_per_pixel)
-    # Every image a scene reads (colours, heights, wetness) holds values from 0 up: NaN or a
-    # negative value (float EXR) would shade black or spread NaN through the frame.
-    bad = ~np.isfinite(pixels) | (pixels < 0.0)
-    if bad.any():
-        y, x = np.argwhere(bad.reshape(pixels.shape[0], pixels.shape[1], -1).any(axis=-1))[0]
-        value = pixels.reshape(pixels.shape[0], pixels.shape[1], -1)[y, x]
-        raise InputError(f"image {_culprit(path, where)} has {int(bad.sum()):,} values that are "
-                         f"NaN, infinite or negative (the first at pixel {x}, {y}: "
-                         f"{np.array2string(value, precision=3)}); images hold values >= 0",
-                         where)
     if pixels.ndim == 2:
         pixels = pixels[..., None]
     count = pixels.shape[2]
@@ -287,7 +278,18 @@ def read_image(path: str | Path, srgb_to_linear: bool = False,
                                  np.ones(pixels.shape[:2] + (1,), np.float32)], axis=2)
     elif count == 3:
         pixels = np.concatenate([pixels, np.ones(pixels.shape[:2] + (1,), np.float32)], axis=2)
-    pixels = pixels[..., :4]
+    pixels = pixels[..., :4]  # extra channels (a depth, an id) are not read: not checked
+    # Every image a scene reads (colours, heights, wetness) holds values from 0 up: NaN,
+    # infinity or a clearly negative value (a float EXR) would shade black or spread NaN
+    # through the frame. Slightly negative values (filter ringing in an HDR image) are 0.
+    bad = ~np.isfinite(pixels) | (pixels < -NEGATIVE_TOLERANCE)
+    if bad.any():
+        y, x = np.argwhere(bad.any(axis=-1))[0]
+        raise InputError(f"image {_culprit(path, where)} has {int(bad.sum()):,} values that are "
+                         f"NaN, infinite or negative (the first at pixel {x}, {y}: "
+                         f"{np.array2string(pixels[y, x], precision=3)}); images hold values "
+                         ">= 0", where)
+    np.maximum(pixels, 0.0, out=pixels)
     if srgb_to_linear and spec.format.basetype != oiio.FLOAT and spec.format.basetype != oiio.HALF:
         pixels[..., :3] = srgb_decode(pixels[..., :3])
     return pixels

@@ -13,7 +13,6 @@ cost follows the pixels a light touches.
 
 from __future__ import annotations
 
-import re
 from functools import lru_cache
 from importlib.resources.abc import Traversable
 from pathlib import Path
@@ -22,6 +21,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, Literal
 import numpy as np
 from pydantic import Field
 
+from .context import GL_DEPTH_CLAMP
 from .gbuffer import DEPTH, GBUFFER_COLOR_TARGETS
 from .mesh import MeshData, build_mesh
 from .params import Params, validate_params
@@ -77,8 +77,9 @@ def view_direction(view: np.ndarray, direction) -> np.ndarray:
 
 
 def light_range_uniform(light_type: type[Light]) -> str:
-    """The ``ivec2`` uniform holding (first record, count) of one light type this frame."""
-    return RANGE_UNIFORM_PREFIX + re.sub(r"\W", "_", light_type.name)
+    """The ``ivec2`` uniform holding (first record, count) of one light type this frame: named
+    by type id, since a plugin's type name need not be a GLSL identifier."""
+    return f"{RANGE_UNIFORM_PREFIX}{light_type.type_id}"
 
 
 def light_dispatch_glsl(light_types: list[type[Light]]) -> str:
@@ -174,12 +175,13 @@ class LightTypePass(RenderPass):
             frame.set_state(depth_test=True, depth_func="gequal", cull="front", blend="add")
             frame.bind(program, {**uniforms, "u_volume_scale": scale}, textures, offered=camera)
             frame.ctx.enable_direct(GL_DEPTH_CLAMP)
-            frame.draw_mesh(mesh, program, instances=count)
-            frame.ctx.disable_direct(GL_DEPTH_CLAMP)
+            try:
+                frame.draw_mesh(mesh, program, instances=count)
+            finally:
+                frame.ctx.disable_direct(GL_DEPTH_CLAMP)
         else:
             frame.set_state(blend="add")
             frame.bind(program, uniforms, textures, offered=camera)
             frame.draw_fullscreen(program, instances=count)
 
 
-GL_DEPTH_CLAMP = 0x864F

@@ -109,17 +109,21 @@ class Renderer:
         self._owns_context = gl is None
         self.gl = gl or acquire_context()
         self.gl.make_current()
+        try:
+            self._build(scene, pipeline, requested, provisional, roots, generated)
+        except BaseException:
+            # nothing made here outlives a failed constructor, and the context goes back
+            self._release_partial()
+            raise
+
+    def _build(self, scene: Scene, pipeline: str, requested: str | None, provisional: str,
+               roots: list, generated: dict[str, str]) -> None:
         ctx = self.gl.ctx
         features = self.gl.features
-        try:
-            self.light_path = resolve_light_path(pipeline, requested, features)
-            volume_lights = sum(1 for light in scene.lights if light.volume != "fullscreen")
-            check_light_limits(self.light_path, self.size, volume_lights, len(scene.lights),
-                               features.storage_buffers, self.gl.max_texture_size)
-        except InputError:
-            if self._owns_context:
-                give_back_context(self.gl)
-            raise
+        self.light_path = resolve_light_path(pipeline, requested, features)
+        volume_lights = sum(1 for light in scene.lights if light.volume != "fullscreen")
+        check_light_limits(self.light_path, self.size, volume_lights, len(scene.lights),
+                           features.storage_buffers, self.gl.max_texture_size)
         self.pipeline = PIPELINES[pipeline](self.light_path)
         if self.light_path != provisional:
             self.graph = compile_graph(self.pipeline.build(scene))
@@ -137,9 +141,19 @@ class Renderer:
         self.light_lists = LightLists(ctx) if features.compute_shaders else None
         self.last_frame: Frame | None = None
         error = ctx.error
-        if error != "GL_NO_ERROR":  # the targets did not fit: nothing is left behind
-            self.release()
+        if error != "GL_NO_ERROR":  # the targets did not fit
             raise gl_error("creating the render targets", error, self.size)
+
+    def _release_partial(self) -> None:
+        self.gl.make_current()
+        for name in ("light_buffer", "light_lists", "resources", "targets", "shaders"):
+            part = getattr(self, name, None)
+            if part is not None:
+                part.release()
+        if self._owns_context:
+            give_back_context(self.gl)  # released instead where it holds a GL error
+        else:
+            _ = self.gl.ctx.error  # reading clears it: the caller's next renderer starts clean
 
     @property
     def passes(self) -> list[RenderPass]:
@@ -177,6 +191,7 @@ class Renderer:
         time = float(time)
         if not math.isfinite(time):
             raise InputError(f"frame time must be a finite number of seconds, got {time}", "time")
+        self.check_times([time], "time")
         self.scene.apply_timeline(time)
         self.gl.make_current()
         ctx = self.gl.ctx

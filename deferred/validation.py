@@ -3,19 +3,24 @@
 from __future__ import annotations
 
 import math
+import numbers
 import stat
 import types
 import typing
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
+import numpy as np
 from pydantic import (
     AfterValidator,
     BaseModel,
+    BeforeValidator,
     ConfigDict,
     Field,
+    PlainValidator,
     ValidationError,
     ValidationInfo,
+    WrapValidator,
     field_validator,
 )
 
@@ -90,11 +95,14 @@ def lax_problem(value: Any, annotation: Any) -> str | None:
     if origin is Annotated:
         return lax_problem(value, typing.get_args(annotation)[0])
     if origin in (typing.Union, types.UnionType):
-        problems = [lax_problem(value, member) for member in typing.get_args(annotation)]
+        members = typing.get_args(annotation)
+        problems = [lax_problem(value, member) for member in members]
         if any(problem is None for problem in problems):
             return None
-        # the member of the value's shape says what is wrong with it, not "expected a list"
-        return min(problems, key=lambda problem: problem.startswith("expected"))
+        # the member of the value's shape (a list or a scalar) says what is wrong with it
+        shaped = [problem for member, problem in zip(members, problems, strict=True)
+                  if _is_sequence(value) == (typing.get_origin(_bare(member)) in (tuple, list))]
+        return (shaped or problems)[0]
     if annotation is type(None):
         return None if value is None else f"expected nothing, not {value!r}"
     if origin is Literal:
@@ -103,22 +111,23 @@ def lax_problem(value: Any, annotation: Any) -> str | None:
     if annotation is bool:
         return None if isinstance(value, bool) else "expected true or false"
     if annotation in (int, float):
-        if isinstance(value, bool):
+        # numbers.Real takes numpy scalars (float32, int64) from the Python API
+        if isinstance(value, bool | np.bool_):
             return "expected a number, not true or false"
         if isinstance(value, str):
             return "expected a number, not a string"
-        if not isinstance(value, int | float):
+        if not isinstance(value, numbers.Real):
             return f"expected a number, not {type(value).__name__}"
-        if isinstance(value, float) and not math.isfinite(value):
+        if not math.isfinite(float(value)):
             return "must be a finite number"
-        if isinstance(value, int | float) and annotation is int and abs(value) > INT_LIMIT:
-            return f"must be within +-{INT_LIMIT}"
-        if isinstance(value, int | float) and abs(value) > FLOAT_LIMIT:
+        if annotation is int and isinstance(value, numbers.Integral):
+            return f"must be within +-{INT_LIMIT}" if abs(int(value)) > INT_LIMIT else None
+        if abs(float(value)) > FLOAT_LIMIT:
             return f"must be within +-{FLOAT_LIMIT:g}"
         return None
     if annotation is str:
         return None if isinstance(value, str) else "expected a string"
-    if origin in (tuple, list) and not isinstance(value, list | tuple):
+    if origin in (tuple, list) and not _is_sequence(value):
         return f"expected a list, not {type(value).__name__}"
     if origin in (tuple, list):
         arguments = typing.get_args(annotation)
@@ -131,6 +140,21 @@ def lax_problem(value: Any, annotation: Any) -> str | None:
     return None
 
 
+def _bare(annotation: Any) -> Any:
+    return typing.get_args(annotation)[0] if typing.get_origin(annotation) is Annotated \
+        else annotation
+
+
+def _is_sequence(value: Any) -> bool:
+    """A list, a tuple or a 1-D numpy array (the Python API's vectors)."""
+    return isinstance(value, list | tuple) or (isinstance(value, np.ndarray) and value.ndim == 1)
+
+
+# A field whose own validators convert its input first (a plugin's BeforeValidator on a
+# parameter) is left to them.
+_OWN_CONVERSION = (BeforeValidator, PlainValidator, WrapValidator)
+
+
 class StrictValues(BaseModel):
     """Base of every model read from a scene: numbers are finite and bounded, booleans are
     true or false, nothing is converted from another type (``shells = true`` is not 1)."""
@@ -141,7 +165,9 @@ class StrictValues(BaseModel):
     @classmethod
     def _no_lax_conversion(cls, value: Any, info: ValidationInfo) -> Any:
         field = cls.model_fields.get(info.field_name) if info.field_name else None
-        problem = lax_problem(value, field.annotation) if field is not None else None
+        if field is None or any(isinstance(m, _OWN_CONVERSION) for m in field.metadata):
+            return value
+        problem = lax_problem(value, field.annotation)
         if problem is not None:
             raise ValueError(problem)
         return value

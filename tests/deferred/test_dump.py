@@ -537,3 +537,13 @@ def test_write_image_keeps_written_channel_order(tmp_path):
     assert read_names == list(names)
     np.testing.assert_array_equal(back, pixels)
     assert attributes == {"z_channel": 2, "alpha_channel": 3}
+
+
+def test_cli_compare_never_replaces_a_folder_holding_the_dumps(tmp_path, capsys):
+    out = tmp_path / "cmp"
+    for name in ("a", "b"):
+        assert run(capsys, "dump", "-o", out / name, "--size", "64x36")[0] == 0
+    (out / "compare.json").write_text("{}")  # looks like an earlier comparison
+    code, _, err = run(capsys, "dump", "--compare", out / "a", out / "b", "-o", out)
+    assert code == 2 and "holds the dump" in err, err
+    assert (out / "a" / "manifest.json").is_file() and (out / "b" / "manifest.json").is_file()

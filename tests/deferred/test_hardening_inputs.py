@@ -324,3 +324,16 @@ def test_compare_with_a_bad_dump_exr(tmp_path, capfd, images, name):
     # no difference image, compare.json or b-diff folder (the comparison is written whole)
     assert sorted(str(p.relative_to(tmp_path)) for p in tmp_path.rglob("*")) \
         == ["a", "a/final.exr", "b", "b/final.exr"]
+
+
+def test_channels_past_rgba_are_not_checked_and_ringing_reads_as_zero(tmp_path):
+    pixels = np.full((4, 5, 5), 0.5, np.float32)
+    pixels[..., 4] = np.inf  # a depth channel of background: not read as colour
+    pixels[0, 0, 0] = -1e-4  # filter ringing in an HDR image
+    write_image(tmp_path / "five.exr", pixels, channels=["R", "G", "B", "A", "Z"])
+    read = read_image(tmp_path / "five.exr")
+    assert read.shape == (4, 5, 4) and read.min() == 0.0 and np.isfinite(read).all()
+    pixels[0, 0, 0] = -0.5
+    write_image(tmp_path / "five.exr", pixels, channels=["R", "G", "B", "A", "Z"])
+    with pytest.raises(InputError, match="NaN, infinite or negative"):
+        read_image(tmp_path / "five.exr")

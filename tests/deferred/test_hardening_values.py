@@ -189,3 +189,32 @@ def test_the_good_scene_renders(tmp_path, capsys, monkeypatch):
     (tmp_path / "s.toml").write_text(toml_document(GOOD))
     code = main(["render", "s.toml", "-o", "out.png"])
     assert code == 0, capsys.readouterr().err
+
+
+def test_the_python_api_takes_numpy_values_and_a_fields_own_conversion():
+    from typing import Annotated
+
+    import numpy as np
+    from pydantic import BeforeValidator
+
+    from deferred import registry
+    from deferred.errors import InputError
+    from deferred.params import Params, validate_params
+    from deferred.scene import scene_from_dict
+
+    point = registry.lights.get("point").from_dict(
+        {"intensity": np.float32(2.0), "radius": np.int64(3), "position": np.array([0., 1., 2.])})
+    assert point.params.intensity == 2.0 and point.params.position == (0.0, 1.0, 2.0)
+    scene = scene_from_dict({"camera": {"position": np.array([0.0, 1.0, 4.0])},
+                             "object": [{"mesh": "builtin:sphere", "material": "revie_fur",
+                                         "params": {"seed": 2_000_000_000}}]})
+    assert scene.objects[0].material.params.seed == 2_000_000_000  # ints: int32, not 1e9
+
+    class Hex(Params):
+        n: Annotated[int, BeforeValidator(lambda v: int(v, 16) if isinstance(v, str) else v)] = 0
+
+    assert validate_params(Hex, {"n": "0x10"}, "p").n == 16  # the plugin's conversion runs
+    with pytest.raises(InputError, match=r"expected a number, not true or false"):
+        registry.lights.get("point").from_dict({"intensity": np.bool_(True)}, "l")
+    with pytest.raises(InputError, match=r"scale: expected a number, not true or false"):
+        scene_from_dict({"object": [{"mesh": "builtin:sphere", "scale": [1, 2, True]}]})

@@ -62,3 +62,27 @@ def test_a_thousand_frames_keep_gl_objects_and_memory_flat():
     assert len(set(counts)) == 1, counts
     settled = memory[1]  # after the first 200 frames: caches and allocator pools filled
     assert max(memory[1:]) <= settled * 1.05, [m >> 20 for m in memory]
+
+
+def test_a_pooled_context_carries_no_state_or_error_into_the_next_renderer():
+    scene = scene_from_dict({
+        "size": [48, 32],
+        "object": [{"mesh": "builtin:torus"}],
+        "light": [{"type": "directional"}, {"type": "point", "position": [1.0, 1.0, 2.0]}]})
+    with Renderer(scene) as renderer:
+        reference = renderer.render().image
+    renderer = Renderer(scene)
+    renderer.render()
+    ctx = renderer.gl.ctx
+    ctx.front_face = "cw"  # what a caller's own GL code, or a pass that raised, may leave
+    ctx.wireframe = True
+    ctx.enable_direct(0x864F)  # GL_DEPTH_CLAMP
+    ctx.enable_direct(0x7FFF)  # no such capability: a pending GL_INVALID_ENUM
+    renderer.release()
+    with Renderer(scene) as again:
+        np.testing.assert_array_equal(again.render().image, reference)
+    renderer = Renderer(scene)
+    renderer.gl.ctx.front_face = "cw"
+    renderer.release()  # state only, no error: the context is kept, and reset
+    with Renderer(scene) as again:
+        np.testing.assert_array_equal(again.render().image, reference)
