@@ -21,7 +21,7 @@ MIN_GL_VERSION = 330
 class Features:
     """Optional GL features in use, decided once per context."""
 
-    storage_buffers: bool = False  # GL 4.3: lights in an SSBO instead of a float texture
+    storage_buffers: bool = False  # GL 4.3 (GLSL 430): the light lists' storage buffer
     compute_shaders: bool = False  # GL 4.3
     depth_clamp: bool = True  # GL 3.2 core: light volumes are never cut by the far plane
 

@@ -97,18 +97,18 @@ def _too_many_for_lists(lights: int, grid: ListGrid, size: int) -> str:
 
 
 def check_light_limits(light_path: str, size: tuple[int, int], volume_lights: int,
-                       lights: int, storage_buffers: bool, max_texture_size: int) -> None:
+                       lights: int, max_texture_size: int) -> None:
     """Refuse, before any frame, a light count the light path cannot hold: the lists' storage
-    (tiled, clustered: a slot per volume light in every list) and, without storage buffers,
-    the float texture of the GL 3.3 light buffer (a row per light)."""
+    (tiled, clustered: a slot per volume light in every list) and the light buffer's texture
+    (a row per light)."""
     if light_path in ("tiled", "clustered"):
         grid = list_grid(*size, light_path == "clustered")
         needed = list_bytes(grid, volume_lights)
         if needed > MAX_LIST_BYTES:
             raise InputError(_too_many_for_lists(volume_lights, grid, needed), "light")
-    if not storage_buffers and lights > max_texture_size:
-        raise InputError(f"{lights} lights; this context keeps lights in a texture of at most "
-                         f"{max_texture_size} rows (GL 3.3, no storage buffers)", "light")
+    if lights > max_texture_size:
+        raise InputError(f"{lights} lights; lights are kept in a texture of at most "
+                         f"{max_texture_size} rows (GL_MAX_TEXTURE_SIZE)", "light")
 
 
 def list_grid(width: int, height: int, clustered: bool) -> ListGrid:
@@ -201,9 +201,10 @@ class LightCullPass(RenderPass):
             defines)
         uniforms = {**frame.light_lists.uniforms(), "u_light_count": lights.count,
                     "u_global_light_count": lights.global_count}
-        textures = {} if self.clustered else {"u_linear_depth": frame.target(LINEAR_DEPTH)}
+        textures = {"u_lights": lights.texture}
+        if not self.clustered:
+            textures["u_linear_depth"] = frame.target(LINEAR_DEPTH)
         frame.bind_compute(shader, uniforms, textures, offered=frame.camera_uniforms())
-        lights.bind_storage()
         if self.clustered:
             groups = (max(1, math.ceil(lights.local_count / 64)), 1, 1)
         else:

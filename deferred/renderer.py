@@ -123,12 +123,11 @@ class Renderer:
         self.light_path = resolve_light_path(pipeline, requested, features)
         volume_lights = sum(1 for light in scene.lights if light.volume != "fullscreen")
         check_light_limits(self.light_path, self.size, volume_lights, len(scene.lights),
-                           features.storage_buffers, self.gl.max_texture_size)
+                           self.gl.max_texture_size)
         self.pipeline = PIPELINES[pipeline](self.light_path)
         if self.light_path != provisional:
             self.graph = compile_graph(self.pipeline.build(scene))
-        defines = {"DEFERRED_STORAGE_BUFFERS": "1"} if features.storage_buffers else {}
-        defines.update(self.pipeline.shader_defines())
+        defines = dict(self.pipeline.shader_defines())
         self.shaders = ShaderLibrary(ctx, features.glsl_version(), defines)
         for root in roots:
             self.shaders.add_root(root)

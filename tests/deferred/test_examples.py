@@ -14,7 +14,7 @@ EXAMPLES = sorted((Path(__file__).parents[2] / "examples").glob("*.toml"))
 
 @pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.stem)
 def test_example_renders(gl, path):
-    """Both pipelines, both light-buffer paths (GL 4.3 storage buffer, GL 3.3 texture): every
+    """Both pipelines, both GLSL levels (a GL 4.3 context, one limited to GL 3.3): every
     program of every material compiles and links on this driver and draws something."""
     scene = load_scene(path)
     contexts = [gl, GLContext(gl.ctx, Features(storage_buffers=False))]
@@ -28,5 +28,5 @@ def test_example_renders(gl, path):
             assert np.isfinite(result.hdr).all()
             assert result.image[..., :3].std() > 2.0  # something is on screen
             images.append(result.image)
-    if gl.features.storage_buffers:  # the two light-buffer paths give the same frame
+    if gl.features.storage_buffers:  # GLSL 430 and 330 give the same frame
         assert np.array_equal(images[0], images[2]) and np.array_equal(images[1], images[3])

@@ -89,7 +89,7 @@ def test_tile_lists_hold_every_light_that_reaches_a_pixel(gl):
         lists = renderer.light_lists
         grid = lists.grid
         data = np.frombuffer(lists.buffer.read(), dtype=np.uint32)
-        records = np.frombuffer(renderer.light_buffer._buffer.read(), dtype=np.float32)
+        records = np.frombuffer(renderer.light_buffer.texture.read(), dtype=np.float32)
         records = records.reshape(-1, 4, 4)[:renderer.light_buffer.count]
         depth = renderer.targets.read("linear_depth")[..., 0]
         frame = renderer.last_frame
