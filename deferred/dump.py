@@ -240,7 +240,7 @@ def _carry(source: Path, target: Path) -> None:
         _link_or_copy(str(source), str(target))
 
 
-def _swap_in(staging: Path, directory: Path) -> None:
+def swap_in_folder(staging: Path, directory: Path) -> None:
     """Replace ``directory`` with ``staging``: two renames with signals held between them, so
     the folder is always the old dump or the new one; then the old one is removed."""
     old = _sibling(directory, f"old-{secrets.token_hex(4)}")
@@ -315,7 +315,7 @@ def write_dump(capture: FrameCapture, directory: str | Path,
             write_text(staging / "manifest.json", json.dumps(manifest, indent=2) + "\n")
             if directory.is_dir():
                 _carry_over(directory, staging)
-            _swap_in(staging, directory)
+            swap_in_folder(staging, directory)
     except OSError as exc:  # the lock, the folders, the renames; files report their own
         raise RenderError(f"cannot write {directory}: {_reason(exc)}") from exc
     return manifest

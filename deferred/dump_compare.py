@@ -6,7 +6,6 @@ difference images.
 from __future__ import annotations
 
 import json
-import os
 import secrets
 import shutil
 from dataclasses import dataclass, field
@@ -15,10 +14,10 @@ from typing import Any
 
 import numpy as np
 
-from .dump import safe_name
+from .dump import safe_name, swap_in_folder
 from .errors import InputError, RenderError
 from .imageio import read_channels, write_image, write_text
-from .output_safety import same_file, signals_deferred
+from .output_safety import same_file
 from .preview import heat_colors, to_uint8
 
 COMPARE_FILE = "compare.json"  # marks a folder as a comparison's output
@@ -112,19 +111,7 @@ def compare_dumps(first: str | Path, second: str | Path,
         write_text(staging / COMPARE_FILE, json.dumps(
             {"a": str(first), "b": str(second), "buffers": [r.describe() for r in results]},
             indent=2) + "\n")
-        with signals_deferred():
-            old = out.parent / f".{out.name[:200]}.old-{secrets.token_hex(4)}"
-            had_old = out.exists()
-            if had_old:
-                os.rename(out, old)
-            try:
-                os.rename(staging, out)
-            except BaseException:
-                if had_old:
-                    os.rename(old, out)  # the earlier comparison stays where it was
-                raise
-            if had_old:
-                shutil.rmtree(old, ignore_errors=True)
+        swap_in_folder(staging, out)  # the earlier comparison stays if the swap fails
     except OSError as exc:
         raise RenderError(f"cannot write {output}: {exc.strerror or exc}") from exc
     finally:
