@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import collections.abc
 import math
 import numbers
 import stat
@@ -127,16 +128,32 @@ def lax_problem(value: Any, annotation: Any) -> str | None:
         return None
     if annotation is str:
         return None if isinstance(value, str) else "expected a string"
-    if origin in (tuple, list) and not _is_sequence(value):
+    sequences = (tuple, list, collections.abc.Sequence)
+    if origin in sequences and not _is_sequence(value):
         return f"expected a list, not {type(value).__name__}"
-    if origin in (tuple, list):
+    if origin in sequences:
         arguments = typing.get_args(annotation)
-        if origin is list or (len(arguments) == 2 and arguments[1] is Ellipsis):
+        if origin is not tuple or (len(arguments) == 2 and arguments[1] is Ellipsis):
             arguments = (arguments[0],) * len(value) if arguments else ()
         for element, element_type in zip(value, arguments, strict=False):
             problem = lax_problem(element, element_type)
             if problem is not None:
                 return problem
+    if origin in (dict, collections.abc.Mapping) and isinstance(value, dict):
+        arguments = typing.get_args(annotation)
+        for element in value.values() if len(arguments) == 2 else ():
+            problem = lax_problem(element, arguments[1])
+            if problem is not None:
+                return problem
+    if isinstance(annotation, type) and issubclass(annotation, StrictValues):
+        return None  # a nested model checks its own fields
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel) and \
+            isinstance(value, dict):
+        for name, field in annotation.model_fields.items():
+            if name in value:
+                problem = lax_problem(value[name], field.annotation)
+                if problem is not None:
+                    return f"{name}: {problem}"
     return None
 
 

@@ -218,3 +218,31 @@ def test_the_python_api_takes_numpy_values_and_a_fields_own_conversion():
         registry.lights.get("point").from_dict({"intensity": np.bool_(True)}, "l")
     with pytest.raises(InputError, match=r"scale: expected a number, not true or false"):
         scene_from_dict({"object": [{"mesh": "builtin:sphere", "scale": [1, 2, True]}]})
+
+
+def test_a_plugins_nested_fields_are_held_to_the_same_rules():
+    from collections.abc import Sequence
+
+    from pydantic import BaseModel
+
+    from deferred.errors import InputError
+    from deferred.params import Params, validate_params
+
+    class Inner(BaseModel):  # a plain pydantic model inside a plugin's parameters
+        x: float = 0.0
+
+    class Plugin(Params):
+        weights: dict[str, float] = {}
+        samples: Sequence[float] = ()
+        inner: Inner = Inner()
+
+    cases = [({"weights": {"a": True}}, "weights: expected a number, not true or false"),
+             ({"weights": {"a": "2.5"}}, "weights: expected a number, not a string"),
+             ({"samples": [1.0, 1e300]}, "samples: must be within"),
+             ({"inner": {"x": float("nan")}}, "inner: x: must be a finite number")]
+    for values, message in cases:
+        with pytest.raises(InputError, match=message):
+            validate_params(Plugin, values, "p")
+    good = validate_params(Plugin, {"weights": {"a": 1.0}, "samples": [1, 2],
+                                    "inner": {"x": 2.0}}, "p")
+    assert good.weights == {"a": 1.0} and good.inner.x == 2.0
