@@ -144,14 +144,8 @@ class Renderer:
             raise gl_error("creating the render targets", error, self.size)
 
     def _release_partial(self) -> None:
-        self.gl.make_current()
-        for name in ("light_buffer", "light_lists", "resources", "targets", "shaders"):
-            part = getattr(self, name, None)
-            if part is not None:
-                part.release()
-        if self._owns_context:
-            give_back_context(self.gl)  # released instead where it holds a GL error
-        else:
+        self.release()  # an owned context is released instead where it holds a GL error
+        if not self._owns_context:
             _ = self.gl.ctx.error  # reading clears it: the caller's next renderer starts clean
 
     @property
@@ -249,12 +243,11 @@ class Renderer:
     def release(self) -> None:
         self.gl.make_current()
         self.gl.park()
-        self.light_buffer.release()
-        if self.light_lists is not None:
-            self.light_lists.release()
-        self.resources.release()
-        self.targets.release()
-        self.shaders.release()
+        # every part made so far (a constructor that failed part way made only some)
+        for name in ("light_buffer", "light_lists", "resources", "targets", "shaders"):
+            part = getattr(self, name, None)
+            if part is not None:
+                part.release()
         if self._owns_context:
             give_back_context(self.gl)
 

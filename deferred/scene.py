@@ -370,8 +370,7 @@ def load_scene(path: str | Path | None = None) -> Scene:
         text = resources.files("deferred").joinpath("scenes", f"{name}.toml").read_text("utf-8")
         return scene_from_toml(text, name=f"builtin:{name}.toml", base_dir=None)
     path = Path(path)
-    if not path.is_file():
-        require_regular_file(path, "scene file", str(path))
+    require_regular_file(path, "scene file", str(path))
     try:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
