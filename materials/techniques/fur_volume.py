@@ -12,7 +12,13 @@ coverage of it (anti-aliased disc edges) and the strand's brightness.
 The texture is a 2D array (a slice per layer) of RGBA8 holding brightness * coverage in R and
 coverage in A, with mipmaps: a mip texel's alpha is the fraction of the area strands cover and
 R / A their mean brightness, so distant fur averages to the right colour and density instead of
-going bald (thresholding) or noisy (no filtering). Shells interpolate between adjacent slices.
+going bald (thresholding) or noisy (no filtering).
+
+A shell at height h reads the volume between two slices, interpolated. The texture holds
+``SUBSLICES`` interpolated slices per interval between two generated ones, so a shell reads one
+(the nearest, ``techniques/fur.glsl``) instead of two: half the filtered lookups, for heights
+rounded to a quarter of the slice spacing (Silva's h = (1 + n)/N falls exactly on one for
+N = 16 and 64 and every power of two).
 """
 
 from __future__ import annotations
@@ -23,6 +29,7 @@ import moderngl
 import numpy as np
 
 VOLUME_LAYERS = 16  # slices through the fur layer
+SUBSLICES = 4  # texture slices per interval between two generated slices (linear in between)
 
 
 @dataclass(frozen=True)
@@ -125,14 +132,31 @@ def strand_volume(p: FurPattern) -> np.ndarray:
     return volume
 
 
+def subslice_bytes(rgba: np.ndarray, per_interval: int = SUBSLICES) -> np.ndarray:
+    """RGBA8 of ``(layers, ...)`` float slices in [0, 1] with ``per_interval - 1`` linearly
+    interpolated ones between each two: ``(per_interval * (layers - 1) + 1, ...)``, slice j at
+    generated slice j / per_interval (made a slice at a time: heightfield volumes are large)."""
+    count = per_interval * (len(rgba) - 1) + 1
+    data = np.empty((count, *rgba.shape[1:]), np.uint8)
+    for j in range(count):
+        below, t = divmod(j, per_interval)
+        t /= per_interval
+        mixed = rgba[below] if t == 0.0 else rgba[below] * np.float32(1.0 - t) + \
+            rgba[below + 1] * np.float32(t)
+        data[j] = np.clip(np.rint(mixed * 255.0), 0, 255)
+    return data
+
+
 def volume_texture(ctx: moderngl.Context, volume: np.ndarray) -> moderngl.TextureArray:
-    """The volume as a mip-mapped, repeating RGBA8 2D array texture (see the module doc)."""
-    layers, height, width, _ = volume.shape
+    """The volume as a mip-mapped, repeating RGBA8 2D array texture (see the module doc), with
+    ``SUBSLICES`` slices per interval between two of ``volume``'s."""
+    _, height, width, _ = volume.shape
     coverage, brightness = volume[..., 0], volume[..., 1]
-    rgba = np.zeros((layers, height, width, 4), np.float32)
+    rgba = np.zeros((*volume.shape[:3], 4), np.float32)
     rgba[..., 0] = brightness * coverage  # premultiplied: mips average it with the coverage
     rgba[..., 3] = coverage
-    data = np.clip(np.rint(rgba[:, ::-1] * 255.0), 0, 255).astype(np.uint8)  # GL rows bottom-up
+    data = subslice_bytes(rgba[:, ::-1])  # GL rows bottom-up
+    layers = len(data)
     texture = ctx.texture_array((width, height, layers), 4, np.ascontiguousarray(data).tobytes())
     texture.build_mipmaps()
     texture.repeat_x = texture.repeat_y = True

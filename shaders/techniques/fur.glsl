@@ -6,19 +6,20 @@
 // in the three axis planes, blended by the object-space normal. It has no UV seams and no poles,
 // and the density is the same on every part of every mesh whatever its unwrap.
 
+#define FUR_SUBSLICES 4.0  // fur_volume.py's SUBSLICES
 uniform sampler2DArray u_fur_volume;  // slices of the strand volume, mip-mapped (alpha = coverage)
 uniform float u_fur_tiles;            // volume tiles per world unit
 uniform float u_self_shadow;          // Silva's K_shadow >= 1: fur darkens toward the roots
 
-// Coverage (x) and brightness * coverage (y) of the slices around h, interpolated.
+// Coverage (x) and brightness * coverage (y) of the volume at height h: the generated slices
+// around h, interpolated. The texture holds SUBSLICES interpolated slices per interval between
+// two generated ones (fur_volume.py): one lookup, of the nearest, at h rounded to a quarter of
+// the slice spacing.
 vec2 fur_slices(vec2 coord, vec2 dx, vec2 dy, float h) {
-    float layers = float(textureSize(u_fur_volume, 0).z);
+    float slices = float(textureSize(u_fur_volume, 0).z);
+    float layers = (slices - 1.0) / FUR_SUBSLICES + 1.0;  // generated slices
     float x = clamp(h * layers - 0.5, 0.0, layers - 1.0);
-    float k0 = floor(x);
-    float k1 = min(k0 + 1.0, layers - 1.0);
-    vec4 a = textureGrad(u_fur_volume, vec3(coord, k0), dx, dy);
-    vec4 b = textureGrad(u_fur_volume, vec3(coord, k1), dx, dy);
-    vec4 s = mix(a, b, x - k0);
+    vec4 s = textureGrad(u_fur_volume, vec3(coord, x * FUR_SUBSLICES), dx, dy);  // layer rounds
     return vec2(s.a, s.r);
 }
 

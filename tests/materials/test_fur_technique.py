@@ -2,6 +2,9 @@
 supersampled render, level of detail without popping, the root shell and self-shadowing, fins,
 density without seams, and the stipple fixes (no dot grid, no teeth)."""
 
+from pathlib import Path
+
+import moderngl
 import numpy as np
 import pytest
 
@@ -9,14 +12,19 @@ from deferred.buffer_views import with_material_view
 from deferred.materials.techniques.fins import edge_adjacency
 from deferred.materials.techniques.fur import shell_layout
 from deferred.materials.techniques.fur_volume import (
+    SUBSLICES,
+    VOLUME_LAYERS,
     FurPattern,
     pattern,
     strand_volume,
+    subslice_bytes,
+    volume_texture,
 )
 from deferred.materials.techniques.heightfield import heightfield_volume
 from deferred.mesh import load_mesh
 from deferred.renderer import Renderer
 from deferred.scene import scene_from_dict
+from deferred.shaderlib import ShaderLibrary
 
 LIGHTS = [{"type": "ambient", "color": [0.2, 0.2, 0.25]},
           {"type": "directional", "direction": [-0.5, -0.7, -0.6], "intensity": 1.5}]
@@ -80,6 +88,73 @@ def test_patterns_differ_and_patchy_has_bald_patches():
         top = volume[8:, ..., 0].mean(axis=0)
         return top.reshape(8, top.shape[0] // 8, 8, top.shape[1] // 8).mean(axis=(1, 3))
     assert block_coverage(patchy).std() > 2.0 * block_coverage(fine).std()
+
+
+def test_subslices_interpolate_between_the_generated_slices():
+    rng = np.random.default_rng(2)
+    rgba = rng.uniform(0.0, 1.0, (5, 6, 7, 4)).astype(np.float32)
+    data = subslice_bytes(rgba, 4)
+    assert data.shape == (17, 6, 7, 4) and data.dtype == np.uint8
+    for j in range(17):
+        k, t = divmod(j, 4)
+        upper = rgba[min(k + 1, 4)]
+        expected = (1.0 - t / 4) * rgba[k] + t / 4 * upper
+        assert np.abs(data[j].astype(float) - expected * 255.0).max() <= 0.5 + 1e-3, j
+    np.testing.assert_array_equal(data[::4], np.rint(rgba * 255.0))  # the generated ones
+
+
+HARNESS = Path(__file__).parents[1] / "fixtures" / "fur_harness"
+
+
+def test_the_glsl_subslice_count_is_the_volumes():
+    source = (Path(__file__).parents[2] / "shaders" / "techniques" / "fur.glsl").read_text()
+    assert f"#define FUR_SUBSLICES {SUBSLICES:.1f}" in source
+
+
+@pytest.mark.parametrize("layers", [16, 64])
+def test_one_lookup_reads_the_slices_interpolated_at_silvas_heights(gl, layers):
+    """fur_slices reads one subslice where it read two slices and mixed them: at Silva's layer
+    heights h = (1 + n)/N the same value, up to the RGBA8 rounding of each."""
+    volume = strand_volume(FurPattern(strands=64, size=32))
+    texture = volume_texture(gl.ctx, volume)
+    lib = ShaderLibrary(gl.ctx, 330)
+    lib.add_root(HARNESS)
+    program = lib.program("fur_slices.vert", "fur_slices.frag")
+    rng = np.random.default_rng(1)
+    size = volume.shape[1]
+    texel = rng.integers(0, size, (200, 2))  # (row, column) of the volume, top row first
+    heights = (1.0 + np.arange(layers)) / layers
+    h = np.repeat(heights, len(texel))
+    texel = np.tile(texel, (layers, 1))
+    coord = np.column_stack([(texel[:, 1] + 0.5) / size, (size - 1 - texel[:, 0] + 0.5) / size])
+    buffer = gl.ctx.buffer(np.column_stack([coord, h]).astype(np.float32).tobytes())
+    target = gl.ctx.texture((len(h), 1), 4, dtype="f4")
+    fbo = gl.ctx.framebuffer([target])
+    vao = gl.ctx.vertex_array(program, [(buffer, "2f 1f", "in_coord", "in_h")])
+    program["u_width"].value = float(len(h))
+    texture.use(0)
+    fbo.use()
+    gl.ctx.viewport = (0, 0, len(h), 1)
+    gl.ctx.enable_only(moderngl.NOTHING)
+    vao.render(moderngl.POINTS, vertices=len(h))
+    got = np.frombuffer(target.read(), np.float32).reshape(-1, 4)[:, :2]
+    for thing in (vao, fbo, target, buffer, texture):
+        thing.release()
+    gl.park()
+    lib.release()
+    # the two-slice interpolation, from the generated volume (coverage, brightness * coverage)
+    x = np.clip(h * VOLUME_LAYERS - 0.5, 0.0, VOLUME_LAYERS - 1.0)
+    k0 = np.floor(x).astype(int)
+    k1 = np.minimum(k0 + 1, VOLUME_LAYERS - 1)
+    t = x - k0
+    rows, columns = texel[:, 0], texel[:, 1]
+    coverage = volume[..., 0]
+    premultiplied = volume[..., 0] * volume[..., 1]
+    expected = np.column_stack([
+        (1 - t) * coverage[k0, rows, columns] + t * coverage[k1, rows, columns],
+        (1 - t) * premultiplied[k0, rows, columns] + t * premultiplied[k1, rows, columns]])
+    assert expected[:, 0].std() > 0.1  # strands and gaps
+    assert np.abs(got - expected).max() <= 1.0 / 255.0
 
 
 def test_a_heightfield_image_becomes_a_volume():
