@@ -29,12 +29,11 @@ import numpy as np
 from pydantic import Field, model_validator
 
 from deferred.errors import InputError
-from deferred.gbuffer import ALBEDO_SPECULAR, LINEAR_DEPTH, NORMAL_EXPONENT_ID
 from deferred.imageio import read_image
 from deferred.material import BlinnPhongParams, ForwardLitPass, GBufferPass, Material
 from deferred.passes import Phase, RenderPass
 from deferred.registry import materials
-from deferred.targets import COMPOSITE, LIGHT_ACCUMULATION
+from deferred.targets import COMPOSITE
 from deferred.validation import Albedo
 
 from .techniques.fins import FinPass
@@ -49,6 +48,7 @@ from .techniques.fur import (
     shell_count,
     tiles_per_unit,
 )
+from .techniques.fur_light import fur_light_pass, fur_light_sampler
 from .techniques.fur_volume import VOLUME_LAYERS
 from .techniques.shells import ShellPass
 from .techniques.strands import (
@@ -77,6 +77,7 @@ Vec3 = tuple[float, float, float]
 FUR_VERTEX = "materials/shell_fur/fur.vert"
 SHELL_FRAGMENT = "materials/shell_fur/shell.frag"
 FORWARD_SHELL_FRAGMENT = "materials/shell_fur/forward_shell.frag"
+SHELL_FUR_LIGHT = "shell_fur_light"  # the fur's light per pixel (techniques/fur_light.py)
 TIPS_WIDTH = 1024  # texels per row of the per-vertex strand texture
 COLOR_MAP_SIZE = 256
 GUST_WAVELENGTH = 1.0  # world units between gust fronts along the wind
@@ -335,7 +336,10 @@ class ObjectStateInputs:
 
     def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
         state = self.obj.material.state(frame, self.obj)
-        return {**super().textures(frame), "u_wetness_mask": state.mask_texture,
+        textures = super().textures(frame)
+        if SHELL_FUR_LIGHT in self.extra_reads:
+            textures = fur_light_sampler(textures, SHELL_FUR_LIGHT)
+        return {**textures, "u_wetness_mask": state.mask_texture,
                 "u_strand_tips": state.tips_texture}
 
     def uniforms(self, frame: Frame) -> dict[str, Any]:
@@ -415,7 +419,6 @@ class ShellFurForwardBasePass(ObjectStateInputs, ForwardLitPass):
     vertex = FUR_VERTEX
 
 
-LIGHT_SAMPLES = (LIGHT_ACCUMULATION, ALBEDO_SPECULAR, NORMAL_EXPONENT_ID, LINEAR_DEPTH)
 CHORD = {"STRAND_CHORD": "1"}
 
 
@@ -477,21 +480,28 @@ class ShellFurMaterial(Material):
                    **debug_defines(self.params)}
         if self.params.fur_mapping == "uv":
             defines["FUR_UV_MAPPING"] = "1"
+        if self.has_color_map():
+            defines["FUR_COLOR_MAP"] = "1"
         return defines
+
+    def has_color_map(self) -> bool:
+        """Whether the colour varies over the UVs (a texture or a pattern), else the tint."""
+        return self.params.color_texture is not None or self.params.color_pattern != "none"
 
     def uniforms(self, frame: Frame) -> dict[str, Any]:
         return {**super().uniforms(frame), "u_fur_tiles": tiles_per_unit(self.params)}
 
     def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
         params = self.params
+        textures = {"u_fur_volume": fur_volume_texture(frame, params, self.heightfield_path())}
         if params.color_texture is not None:
-            color_map = frame.resources.image_texture(self.resolve_path(params.color_texture))
-        else:
-            color_map = frame.resources.texture(
+            textures["u_color_map"] = frame.resources.image_texture(
+                self.resolve_path(params.color_texture))
+        elif self.has_color_map():
+            textures["u_color_map"] = frame.resources.texture(
                 ("shell_fur_pattern", params.color_pattern, params.seed, params.color,
                  params.pattern_color), lambda ctx: pattern_texture(ctx, params))
-        return {"u_fur_volume": fur_volume_texture(frame, params, self.heightfield_path()),
-                "u_color_map": color_map}
+        return textures
 
     def state(self, frame: Frame, obj: SceneObject) -> ShellFurState:
         """The object's state, advanced to the frame's time."""
@@ -508,6 +518,15 @@ class ShellFurMaterial(Material):
         return constants
 
     # -- passes ------------------------------------------------------------------------------
+    @classmethod
+    def scene_passes(cls, objects: list[SceneObject], phase: Phase) -> list[RenderPass]:
+        """The fur's light per pixel, gathered once for every shell_fur object's layers and
+        fins (deferred only: forward layers light themselves)."""
+        if phase != Phase.MATERIAL or not any(obj.material.params.shells > 0 for obj in objects):
+            return []
+        return [fur_light_pass("material.shell_fur_light", SHELL_FUR_LIGHT,
+                               objects[0].material.surface_id(), cls.name)]
+
     def geometry_passes(self, obj: SceneObject) -> list[RenderPass]:
         return [ShellFurBasePass(f"{obj.label}.gbuffer", Phase.GEOMETRY, obj,
                                  constants=self.vertex_constants(obj, 0.0), extra_defines=CHORD)]
@@ -519,11 +538,11 @@ class ShellFurMaterial(Material):
         if self.params.fins:
             passes.append(ShellFurFinPass(f"{obj.label}.fins", Phase.MATERIAL, obj,
                                           fragment=SHELL_FRAGMENT, colors=(COMPOSITE,),
-                                          extra_reads=LIGHT_SAMPLES,
+                                          extra_reads=(SHELL_FUR_LIGHT,),
                                           constants=self.vertex_constants(obj)))
         passes.append(ShellFurLayerPass(f"{obj.label}.layers", Phase.MATERIAL, obj,
                                         fragment=SHELL_FRAGMENT, colors=(COMPOSITE,),
-                                        extra_reads=LIGHT_SAMPLES,
+                                        extra_reads=(SHELL_FUR_LIGHT,),
                                         constants=self.vertex_constants(obj)))
         return passes
 

@@ -725,3 +725,89 @@ def test_a_wetness_mask_needs_four_channels(tmp_path, capsys):
     code, output = cli(capsys, "render", str(scene), "-o", str(tmp_path / "out.png"))
     assert code == 2
     assert "wetness_mask: wetness mask rgb.png needs 4 channels" in output
+
+
+# -- the fur's light per pixel (techniques/fur_light.py) -----------------------------------------
+
+AROUND = [(1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (-1, 1), (1, -1), (-1, -1)]  # (x, y)
+
+
+def fur_light_reference(irradiance, depth, holds):
+    """Per pixel: (its irradiance, its depth) where it holds the fur, else (the first neighbour
+    holding it, in base_irradiance's order, minus its depth), else zeros."""
+    height, width = holds.shape
+    expected = np.zeros((height, width, 4))
+    done = holds.copy()
+    expected[holds, :3] = irradiance[holds]
+    expected[holds, 3] = depth[holds]
+    for dx, dy in AROUND:
+        for y in range(height):
+            for x in range(width):
+                qx, qy = x + dx, y + dy
+                if done[y, x] or not (0 <= qx < width and 0 <= qy < height) or \
+                        not holds[qy, qx]:
+                    continue
+                expected[y, x, :3] = irradiance[qy, qx]
+                expected[y, x, 3] = -depth[qy, qx]
+                done[y, x] = True
+    return expected
+
+
+def test_the_fur_light_is_each_pixels_own_or_its_first_neighbours(render):
+    """The once-per-frame gather the layers read instead of searching the G-buffer themselves,
+    against numpy on the frame's own G-buffer, with another surface in front of the fur; and the
+    layers beyond the skin's silhouette, lit only through a neighbour, are drawn."""
+    scene = scene_from_dict({
+        "size": [72, 56], "background": [0.0, 0.0, 0.0],
+        "camera": {"position": [0.0, 0.0, 3.2], "target": [0.0, 0.0, 0.0], "fov": 40.0},
+        "object": [{"name": "fur", "mesh": "builtin:sphere", "material": "shell_fur",
+                    "params": {"fur_length": 0.15, "shells": 8, "fins": False}},
+                   {"name": "ball", "mesh": "builtin:sphere", "material": "standard",
+                    "position": [0.55, -0.3, 1.0], "scale": 0.3}],
+        "light": [{"type": "directional", "direction": [-0.4, -1.0, -0.5], "intensity": 1.5},
+                  {"type": "ambient", "color": [0.3, 0.3, 0.35]}]}, "fur_light")
+    result, renderer = render(scene)
+    read = renderer.targets.read
+    surface = scene.objects[0].material.surface_id()
+    holds = np.abs(read("normal_exponent_id")[..., 3] - surface) < 0.5
+    albedo = np.maximum(read("albedo_specular")[..., :3], 1.0 / 255.0)
+    irradiance = read("light_accumulation")[..., :3] / albedo
+    expected = fur_light_reference(irradiance, read("linear_depth")[..., 0], holds)
+    got = read("shell_fur_light")
+    assert 0.1 < holds.mean() < 0.7
+    other = (read("linear_depth")[..., 0] > 0.0) & ~holds
+    assert other.sum() > 20  # the ball in front
+    ring = got[..., 3] < 0.0
+    assert ring.sum() > 50
+    np.testing.assert_allclose(got, expected, rtol=1e-4, atol=1e-5)
+    # the fur past the skin: lit pixels where the G-buffer holds nothing
+    image = result.image[::-1]  # top row first; the targets are bottom row first
+    beyond = (read("linear_depth")[..., 0] == 0.0) & (image[..., :3].max(-1) > 8)
+    assert beyond.sum() > 40
+
+
+def test_without_a_colour_map_the_fur_is_the_tint_as_over_a_white_texture(render, tmp_path):
+    """No texture and no pattern: the layers skip the colour lookup (FUR_COLOR_MAP undefined)
+    and draw what a white texture gives; a pattern still shows."""
+    write_image(tmp_path / "white.png", np.ones((16, 16, 3), np.float32))
+    base = {"size": [96, 72], "background": [0.0, 0.0, 0.0],
+            "camera": {"position": [0.0, 0.6, 2.8], "target": [0.0, 0.0, 0.0], "fov": 40.0},
+            "light": [{"type": "directional", "direction": [-0.4, -1.0, -0.5]},
+                      {"type": "ambient", "color": [0.3, 0.3, 0.35]}]}
+    from conftest import psnr
+
+    def image(**params):
+        scene = {**base, "object": [{"mesh": "builtin:sphere", "material": "shell_fur",
+                                     "params": {"fur_length": 0.12, "shells": 8,
+                                                "color": [0.6, 0.4, 0.2], **params}}]}
+        for pipeline in ("deferred", "forward"):
+            result, _ = render(scene_from_dict(scene, "colour"), pipeline)
+            yield result.image[..., :3] / 255.0
+
+    tint = list(image())
+    white = list(image(color_texture=str(tmp_path / "white.png")))
+    striped = list(image(color_pattern="stripes", pattern_color=[0.1, 0.1, 0.1]))
+    for a, b, c in zip(tint, white, striped, strict=True):
+        assert a.sum(-1).astype(bool).mean() > 0.3
+        assert psnr(a, b) > 45.0
+        assert psnr(a, c) < 30.0

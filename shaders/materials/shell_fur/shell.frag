@@ -3,11 +3,13 @@
 // (Algorithm 2, layer.glsl); its light from the light accumulation at the root under it (the
 // lights shaded the base surface with kajiya_kay along the strand's chord, the G-buffer's
 // strand_tangent), divided by the base albedo and multiplied by this layer's colour and the
-// shadow factor gamma(h) (Eq. 6). So the layers cost the same whatever the number of lights;
+// shadow factor gamma(h) (Eq. 6). The root's light is read from the fur_light target, gathered
+// once per pixel for the frame (techniques/fur_light.glsl). So the layers cost the same whatever the number of lights;
 // what they lose against the forward pipeline is the tangent of each layer (one per strand
 // here) and the light's variation between the root and the layer.
 #include "techniques/fur.glsl"
 #include "techniques/accumulated_light.glsl"
+#include "techniques/fur_light.glsl"
 #include "materials/shell_fur/layer.glsl"
 #include "materials/shell_fur/color.glsl"
 #include "materials/shell_fur/debug.glsl"
@@ -54,16 +56,16 @@ void main() {
     if (!layer.kept || alpha < 0.5 / 255.0) discard;
     float tolerance = 0.5 * v_fur_extent + 0.002 * v_base_depth;
     vec3 irradiance;
-    bool base_valid = base_irradiance(pixel_of(v_base_clip), v_base_depth, tolerance,
-                                      irradiance);
-    bool own_valid = !base_valid && own_pixel_holds_fur();
+    bool base_valid = fur_light_at(pixel_of(v_base_clip), v_base_depth, tolerance, irradiance);
+    vec3 own_irradiance;
+    bool own_valid = !base_valid && own_fur_light(own_irradiance);
 #ifdef FUR_DEBUG_SAMPLES
     out_color = vec4(own_valid || !base_valid ? 1.0 : 0.0, base_valid || own_valid ? 1.0 : 0.0,
                      0.0, 1.0);
     return;
 #endif
     if (!base_valid && !own_valid) discard;  // the strand's light is unknown
-    if (own_valid) irradiance = irradiance_at(ivec2(gl_FragCoord.xy));
+    if (own_valid) irradiance = own_irradiance;
     // strands' own brightness where they cover; the skin between them on the root layer
     float brightness = mix(1.0, strands.y / max(strands.x, 1e-4), min(strands.x, 1.0));
     out_color = vec4(irradiance * albedo * brightness, alpha);
