@@ -48,7 +48,7 @@ from .techniques.fur import (
     shell_count,
     tiles_per_unit,
 )
-from .techniques.fur_light import fur_light_pass, fur_light_sampler
+from .techniques.fur_light import FurLightReader, fur_light_pass
 from .techniques.fur_volume import VOLUME_LAYERS
 from .techniques.shells import ShellPass
 from .techniques.strands import (
@@ -336,10 +336,7 @@ class ObjectStateInputs:
 
     def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
         state = self.obj.material.state(frame, self.obj)
-        textures = super().textures(frame)
-        if SHELL_FUR_LIGHT in self.extra_reads:
-            textures = fur_light_sampler(textures, SHELL_FUR_LIGHT)
-        return {**textures, "u_wetness_mask": state.mask_texture,
+        return {**super().textures(frame), "u_wetness_mask": state.mask_texture,
                 "u_strand_tips": state.tips_texture}
 
     def uniforms(self, frame: Frame) -> dict[str, Any]:
@@ -374,7 +371,7 @@ def layer_layout(count: float, shell_range: tuple[float, float] = (0.0, 1.0),
     return [layer if k in shown else None for k, layer in enumerate(layers)]
 
 
-class ShellFurLayerPass(ObjectStateInputs, ShellPass):
+class ShellFurLayerPass(FurLightReader, ObjectStateInputs, ShellPass):
     """The skin and the N layers (Silva's spacing, :func:`layer_layout`)."""
 
     vertex = FUR_VERTEX
@@ -400,7 +397,7 @@ class ShellFurLayerPass(ObjectStateInputs, ShellPass):
                 "u_shell_count": self._count / max(params.shells, 1)}
 
 
-class ShellFurFinPass(ObjectStateInputs, FinPass):
+class ShellFurFinPass(FurLightReader, ObjectStateInputs, FinPass):
     vertex = FUR_VERTEX
     clumps = True
 
@@ -539,10 +536,12 @@ class ShellFurMaterial(Material):
             passes.append(ShellFurFinPass(f"{obj.label}.fins", Phase.MATERIAL, obj,
                                           fragment=SHELL_FRAGMENT, colors=(COMPOSITE,),
                                           extra_reads=(SHELL_FUR_LIGHT,),
+                                          fur_light=SHELL_FUR_LIGHT,
                                           constants=self.vertex_constants(obj)))
         passes.append(ShellFurLayerPass(f"{obj.label}.layers", Phase.MATERIAL, obj,
                                         fragment=SHELL_FRAGMENT, colors=(COMPOSITE,),
                                         extra_reads=(SHELL_FUR_LIGHT,),
+                                        fur_light=SHELL_FUR_LIGHT,
                                         constants=self.vertex_constants(obj)))
         return passes
 

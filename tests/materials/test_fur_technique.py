@@ -138,10 +138,11 @@ def test_one_lookup_reads_the_slices_interpolated_at_silvas_heights(gl, layers):
     gl.ctx.enable_only(moderngl.NOTHING)
     vao.render(moderngl.POINTS, vertices=len(h))
     got = np.frombuffer(target.read(), np.float32).reshape(-1, 4)[:, :2]
+    gl.park()  # off the framebuffer before it goes
     for thing in (vao, fbo, target, buffer, texture):
         thing.release()
-    gl.park()
     lib.release()
+    assert gl.ctx.error == "GL_NO_ERROR"
     # the two-slice interpolation, from the generated volume (coverage, brightness * coverage)
     x = np.clip(h * VOLUME_LAYERS - 0.5, 0.0, VOLUME_LAYERS - 1.0)
     k0 = np.floor(x).astype(int)
@@ -369,3 +370,4 @@ def test_pattern_size_fields_are_validated():
     with pytest.raises(ValueError, match="unknown fur pattern"):
         pattern("spiky")
     assert FurPattern().layers == 16
+
