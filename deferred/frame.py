@@ -274,7 +274,7 @@ class Frame:
             unit += 1
         self.light_buffer.bind(program, unit, members)
         if self.light_lists is not None:
-            self.light_lists.bind(program, members)
+            self.light_lists.bind(program, unit + 1, members)
 
     def set_uniforms(self, program: moderngl.Program, values: dict[str, Any],
                      members: frozenset[str] | None = None) -> None:

@@ -1,10 +1,12 @@
 // Per-tile or per-cluster light lists (deferred.light_lists): the tiled and clustered light
 // paths and Forward+. One storage buffer: a count per list, then each list's light indices
 // (capacity slots per list; indices into the light buffer, volume lights only - the full-screen
-// ones, [0, u_global_light_count), apply to every pixel).
+// ones, [0, u_global_light_count), apply to every pixel). The culling shaders write it; the
+// shading passes read its copy in u_light_list_texture, 4096 words a row (LIST_TEXTURE_WIDTH).
 layout(std430, binding = 1) buffer LightLists {
     uint light_list_data[];
 };
+uniform usampler2D u_light_list_texture;
 
 uniform int u_list_count;       // lists: tiles, or tiles x depth slices
 uniform int u_list_capacity;    // slots per list
@@ -27,12 +29,16 @@ int light_list_of(ivec2 pixel, float depth) {
 #endif
 }
 
+uint light_list_word(int i) {
+    return texelFetch(u_light_list_texture, ivec2(i & 4095, i >> 12), 0).r;
+}
+
 int light_list_length(int list) {
-    return min(int(light_list_data[list]), u_list_capacity);
+    return min(int(light_list_word(list)), u_list_capacity);
 }
 
 int light_list_light(int list, int k) {
-    return int(light_list_data[u_list_count + list * u_list_capacity + k]);
+    return int(light_list_word(u_list_count + list * u_list_capacity + k));
 }
 
 // Whether the volume light `index` reaches view-space point P: its record's position is the

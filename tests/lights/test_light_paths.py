@@ -203,3 +203,15 @@ def test_more_lights_than_the_gl33_light_texture_holds_is_refused(gl, monkeypatc
     monkeypatch.setattr(GLContext, "max_texture_size", property(lambda self: 8))
     with pytest.raises(InputError, match=r"^light: 16 lights; .* at most 8 rows"):
         Renderer(scene, gl=gl33)
+
+
+def test_the_rows_of_the_lists_texture_bound_the_lists_too():
+    """The shading passes read the lists from a texture LIST_TEXTURE_WIDTH words wide: at 4K
+    its rows, not MAX_LIST_BYTES, limit the lights."""
+    from deferred.light_lists import LIST_TEXTURE_WIDTH, MAX_LIST_BYTES, check_light_limits
+
+    rows = 4096  # 64 MiB of lists
+    check_light_limits("tiled", (3840, 2160), 400, 402, max_texture_size=rows)  # 51.8 MB
+    with pytest.raises(InputError, match=r"^light: 600 lights need 74 MiB .* limit is 64 MiB"):
+        check_light_limits("tiled", (3840, 2160), 600, 602, max_texture_size=rows)
+    assert rows * 4 * LIST_TEXTURE_WIDTH < MAX_LIST_BYTES
