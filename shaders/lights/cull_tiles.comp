@@ -94,14 +94,20 @@ void main() {
     }
     barrier();
     if (!s_empty) {
+        // The tile's bounds in registers: read in the loop, shared memory is read again for
+        // every light (the loop's atomics keep the compiler from hoisting the reads), and on
+        // llvmpipe each read is a gather over the SIMD lanes.
+        float near_depth = s_near_depth;
+        float far_depth = s_far_depth;
+        vec3 plane0 = s_planes[0], plane1 = s_planes[1], plane2 = s_planes[2], plane3 = s_planes[3];
         int local_count = u_light_count - u_global_light_count;
         for (int i = int(gl_LocalInvocationIndex); i < local_count; i += INVOCATIONS) {
             int index = u_global_light_count + i;
             vec4 sphere = fetch_light_sphere(index);
             float z = -sphere.z;
-            if (z + sphere.w < s_near_depth || z - sphere.w > s_far_depth) continue;
-            if (dot(s_planes[0], sphere.xyz) < -sphere.w || dot(s_planes[1], sphere.xyz) < -sphere.w ||
-                dot(s_planes[2], sphere.xyz) < -sphere.w || dot(s_planes[3], sphere.xyz) < -sphere.w)
+            if (z + sphere.w < near_depth || z - sphere.w > far_depth) continue;
+            if (dot(plane0, sphere.xyz) < -sphere.w || dot(plane1, sphere.xyz) < -sphere.w ||
+                dot(plane2, sphere.xyz) < -sphere.w || dot(plane3, sphere.xyz) < -sphere.w)
                 continue;
             uint slot = atomicAdd(s_count, 1u);
             if (int(slot) < u_list_capacity)
