@@ -48,7 +48,7 @@ from .techniques.fur import (
     shell_count,
     tiles_per_unit,
 )
-from .techniques.fur_light import FurLightReader, fur_light_pass
+from .techniques.fur_light import FurLightReader, fur_light_pass, fur_light_targets
 from .techniques.fur_volume import VOLUME_LAYERS
 from .techniques.shells import ShellPass
 from .techniques.strands import (
@@ -472,9 +472,9 @@ class ShellFurMaterial(Material):
         return None if params.wetness_mask is None else self.resolve_path(params.wetness_mask)
 
     def defines(self, obj: SceneObject) -> dict[str, str]:
-        # layers reject light samples the G-buffer shows occluded (Revie's Figure 2.8 fix)
-        defines = {**super().defines(obj), "FUR_OCCLUSION_TEST": "1",
-                   **debug_defines(self.params)}
+        # The layers reject light samples the G-buffer shows occluded (Revie's Figure 2.8 fix)
+        # by the depths of the fur_light gather (techniques/fur_light.glsl), always.
+        defines = {**super().defines(obj), **debug_defines(self.params)}
         if self.params.fur_mapping == "uv":
             defines["FUR_UV_MAPPING"] = "1"
         if self.has_color_map():
@@ -535,12 +535,12 @@ class ShellFurMaterial(Material):
         if self.params.fins:
             passes.append(ShellFurFinPass(f"{obj.label}.fins", Phase.MATERIAL, obj,
                                           fragment=SHELL_FRAGMENT, colors=(COMPOSITE,),
-                                          extra_reads=(SHELL_FUR_LIGHT,),
+                                          extra_reads=fur_light_targets(SHELL_FUR_LIGHT),
                                           fur_light=SHELL_FUR_LIGHT,
                                           constants=self.vertex_constants(obj)))
         passes.append(ShellFurLayerPass(f"{obj.label}.layers", Phase.MATERIAL, obj,
                                         fragment=SHELL_FRAGMENT, colors=(COMPOSITE,),
-                                        extra_reads=(SHELL_FUR_LIGHT,),
+                                        extra_reads=fur_light_targets(SHELL_FUR_LIGHT),
                                         fur_light=SHELL_FUR_LIGHT,
                                         constants=self.vertex_constants(obj)))
         return passes

@@ -1,22 +1,23 @@
 """The fur's light, gathered once per frame (Revie 2.4.4, Listing 2.2, done per pixel instead of
-per shell fragment).
+per layer fragment).
 
 A fur layer fragment takes the light of the base-mesh point under it from the light
-accumulation, divided by the G-buffer albedo; where the G-buffer shows another surface there,
-the first of the 8 neighbours that holds the fur (``techniques/accumulated_light.glsl``). Done
-by every fragment of every layer, that search is most of a layer's cost on a CPU rasteriser:
-up to 9 pixels of 4 G-buffer reads each, and a SIMD rasteriser runs both sides of every branch.
-This scene pass does it once per pixel: ``fur_light`` holds, per pixel, the irradiance of the
-fur there, or of the first neighbour holding it, with the linear depth of the pixel it came
-from (negated for a neighbour's; 0: none), so a layer fragment reads one texel and checks the
-depth itself (``techniques/fur_light.glsl``).
+accumulation, divided by the G-buffer albedo: the first of that pixel and its 8 neighbours that
+holds the fur at the expected depth (``techniques/accumulated_light.glsl``'s search). Done by
+every fragment of every layer, the search was half a layer's cost on a CPU rasteriser (up to 9
+pixels of 4 G-buffer reads each; a SIMD rasteriser runs every branch). This scene pass does
+the part that does not depend on the layer once per pixel, into two targets:
 
-The search checked each candidate's depth against the layer's expected depth and took the first
-that passed; the gather can only check the first holding the fur. Where the surface's depth
-changes fast from pixel to pixel (silhouettes) a fragment then falls back to its own pixel more
-often. On shell_fur's long fur that changes 30 of 480,000 pixels of Table 1's frame; on
-revie_fur's short stippled fur it left a dotted rim (1.2% of the pixels of Figure 2.5 off by
-more than 16/255), so revie_fur keeps the search.
+- ``<target>``: the irradiance of the fur at the pixel, else of the first neighbour holding it,
+  and where it came from (alpha 1: the pixel itself, -1: a neighbour, 0: none);
+- ``<target>_depths``: the least and greatest linear depth of the fur over the 3x3 pixels.
+
+A layer fragment (``techniques/fur_light.glsl``) reads both texels at its base pixel and takes
+the light where the expected depth lies within the depth range, widened by its tolerance. That
+accepts every fragment the search accepted; it also accepts one whose expected depth falls
+between two parts of the fur seen in the 3x3 pixels (along an edge where the fur occludes
+itself), with the first pixel's light, where the search took the light of the pixel at the right
+depth. revie_fur keeps the search: its stipple samples are skipped per candidate.
 """
 
 from __future__ import annotations
@@ -36,34 +37,47 @@ if TYPE_CHECKING:
 FUR_LIGHT_FRAGMENT = "techniques/fur_light.frag"
 
 
-def fur_light_spec(surface: str) -> TargetSpec:
-    return TargetSpec(4, "f4", f"{surface} fur: irradiance of the fur at each pixel or its "
-                               "nearest neighbour holding it, and that pixel's linear depth "
-                               "(< 0: a neighbour's; 0: none)", clear=None)
+def fur_light_targets(target: str) -> tuple[str, str]:
+    """The two targets of a fur_light gather named ``target`` (what its readers read)."""
+    return target, f"{target}_depths"
 
 
 class FurLightReader:
-    """Mixin for an ``ObjectPass`` whose shader reads a fur_light target through
-    ``techniques/fur_light.glsl``: give the target as ``fur_light`` and among ``extra_reads``
-    (the pass graph orders the passes by it); it is bound as ``u_fur_light``."""
+    """Mixin for an ``ObjectPass`` whose shader reads a fur_light gather through
+    ``techniques/fur_light.glsl``: give its name as ``fur_light`` and its targets
+    (:func:`fur_light_targets`) among ``extra_reads`` (the pass graph orders the passes by
+    them); they are bound as ``u_fur_light`` and ``u_fur_light_depths``."""
 
     fur_light: str | None = None
 
     def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
         textures = super().textures(frame)  # type: ignore[misc]
-        if self.fur_light is not None:
-            textures = dict(textures)
-            textures["u_fur_light"] = textures.pop(f"u_{self.fur_light}")
+        if self.fur_light is None:
+            return textures
+        light, depths = fur_light_targets(self.fur_light)
+        if f"u_{light}" not in textures or f"u_{depths}" not in textures:
+            raise TypeError(f"{self.name}: fur_light {self.fur_light!r} needs "  # type: ignore[attr-defined]
+                            f"extra_reads {light!r} and {depths!r}")
+        textures = dict(textures)
+        textures["u_fur_light"] = textures.pop(f"u_{light}")
+        textures["u_fur_light_depths"] = textures.pop(f"u_{depths}")
         return textures
 
 
-def fur_light_pass(name: str, target: str, surface_id: int, surface: str) -> FullscreenPass:
-    """The material-phase pass that fills ``target`` for the material of ``surface_id`` (its
-    G-buffer id). It runs before every object's passes (``Order.FIRST``): the layers read it."""
+def fur_light_pass(name: str, target: str, surface_id: int, material: str) -> FullscreenPass:
+    """The material-phase pass that fills ``target``'s two targets for the material named
+    ``material`` (G-buffer id ``surface_id``). It runs before every object's passes
+    (``Order.FIRST``): the layers read it."""
+    light, depths = fur_light_targets(target)
     return FullscreenPass(
         name, Phase.MATERIAL, FUR_LIGHT_FRAGMENT,
         {"u_light_accumulation": LIGHT_ACCUMULATION, "u_albedo_specular": ALBEDO_SPECULAR,
          "u_normal_exponent_id": NORMAL_EXPONENT_ID, "u_linear_depth": LINEAR_DEPTH},
-        (target,), defines={"FUR_OCCLUSION_TEST": "1"},
+        (light, depths),
         uniforms=lambda frame: {"u_surface_id": float(surface_id)},
-        creates={target: fur_light_spec(surface)}, order=Order.FIRST)
+        creates={light: TargetSpec(4, "f4", f"{material} fur: irradiance at each pixel, or "
+                                            "at its first neighbour holding the fur (alpha "
+                                            "1 / -1; 0: none)"),
+                 depths: TargetSpec(2, "f4", f"{material} fur: least and greatest linear "
+                                             "depth of the fur over the 3x3 pixels")},
+        order=Order.FIRST)

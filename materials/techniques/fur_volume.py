@@ -157,7 +157,7 @@ def volume_texture(ctx: moderngl.Context, volume: np.ndarray) -> moderngl.Textur
     rgba[..., 3] = coverage
     data = subslice_bytes(rgba[:, ::-1])  # GL rows bottom-up
     layers = len(data)
-    texture = ctx.texture_array((width, height, layers), 4, np.ascontiguousarray(data).tobytes())
+    texture = ctx.texture_array((width, height, layers), 4, data)
     texture.build_mipmaps()
     texture.repeat_x = texture.repeat_y = True
     texture.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)

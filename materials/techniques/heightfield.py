@@ -16,7 +16,8 @@ from .fur_volume import VOLUME_LAYERS
 # Memory a heightfield texel costs on its way to the GPU: heightfield_volume's float64 slices,
 # volume_texture's float RGBA copy and its RGBA8 subslices peak at about 870 bytes per texel with
 # 16 layers (measured with tracemalloc), against the 16 of a decoded image; read_image's budget
-# counts this.
+# counts this. On the GPU a texel then takes 61 RGBA8 subslices with their mipmaps, about 325
+# bytes.
 HEIGHTFIELD_BYTES_PER_TEXEL = VOLUME_LAYERS * 64
 
 

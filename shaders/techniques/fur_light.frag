@@ -1,11 +1,13 @@
 // The fur's light per pixel (materials/techniques/fur_light.py): the irradiance of the fur at
 // this pixel, else of the first neighbour holding it (the order of base_irradiance's search),
-// and the linear depth of the pixel it came from: > 0 this pixel's, < 0 a neighbour's, 0 none.
-// The search reads only surface ids, and the light and depth of the one pixel it chose: a CPU
-// rasteriser runs every branch, so reading them in the search would read them nine times.
+// with where it came from (1 this pixel, -1 a neighbour, 0 none); and the least and greatest
+// linear depth of the fur over the 3x3 pixels. The search reads only ids and depths, and the
+// light of the one pixel it chose: a CPU rasteriser runs every branch, so reading the light in
+// the search would read it nine times.
 #include "techniques/accumulated_light.glsl"
 
-out vec4 out_light;
+layout(location = 0) out vec4 out_light;
+layout(location = 1) out vec2 out_depths;
 
 bool holds_surface(ivec2 pixel) {
     return inside(pixel)
@@ -16,15 +18,22 @@ void main() {
     ivec2 pixel = ivec2(gl_FragCoord.xy);
     ivec2 neighbour = pixel;
     bool found = false;
+    vec2 depths = vec2(3.0e38, 0.0);
     for (int k = 7; k >= 0; --k) {  // backwards: the first in AROUND's order is kept
         ivec2 q = pixel + AROUND[k];
         if (holds_surface(q)) {
+            float depth = texelFetch(u_linear_depth, q, 0).r;
+            depths = vec2(min(depths.x, depth), max(depths.y, depth));
             neighbour = q;
             found = true;
         }
     }
     bool own = holds_surface(pixel);
+    if (own) {
+        float depth = texelFetch(u_linear_depth, pixel, 0).r;
+        depths = vec2(min(depths.x, depth), max(depths.y, depth));
+    }
     ivec2 chosen = own ? pixel : neighbour;
-    float depth = texelFetch(u_linear_depth, chosen, 0).r;
-    out_light = own || found ? vec4(irradiance_at(chosen), own ? depth : -depth) : vec4(0.0);
+    out_light = own || found ? vec4(irradiance_at(chosen), own ? 1.0 : -1.0) : vec4(0.0);
+    out_depths = own || found ? depths : vec2(0.0);
 }

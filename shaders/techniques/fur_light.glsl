@@ -1,15 +1,18 @@
-// A fur layer fragment's light from the fur_light target (materials/techniques/fur_light.py):
-// one texel instead of base_irradiance's search, the same answer where the pixel under the
-// base point, or the first neighbour holding the fur, lies within `tolerance` of the expected
-// depth. Include techniques/accumulated_light.glsl first (pixel_of, inside).
-uniform sampler2D u_fur_light;  // the material's fur_light target (fur_light.py)
+// A fur layer fragment's light from a fur_light gather (materials/techniques/fur_light.py): two
+// texels instead of base_irradiance's search. Include techniques/accumulated_light.glsl first
+// (pixel_of, inside).
+uniform sampler2D u_fur_light;         // irradiance; 1 this pixel's, -1 a neighbour's, 0 none
+uniform sampler2D u_fur_light_depths;  // least and greatest depth of the fur over 3x3 pixels
 
-// The base sample: the fur's light at `pixel` (or its first neighbour holding the fur), if that
-// sample's depth is within `tolerance` of `expected_depth`.
+// The base sample: the fur's light at `pixel` (or its first neighbour holding the fur), if the
+// fur there spans `expected_depth` within `tolerance`.
 bool fur_light_at(ivec2 pixel, float expected_depth, float tolerance, out vec3 irradiance) {
-    vec4 s = inside(pixel) ? texelFetch(u_fur_light, pixel, 0) : vec4(0.0);
+    bool on_screen = inside(pixel);
+    vec4 s = on_screen ? texelFetch(u_fur_light, pixel, 0) : vec4(0.0);
+    vec2 depths = on_screen ? texelFetch(u_fur_light_depths, pixel, 0).rg : vec2(0.0);
     irradiance = s.rgb;
-    return s.a != 0.0 && abs(abs(s.a) - expected_depth) <= tolerance;
+    return s.a != 0.0 && expected_depth >= depths.x - tolerance
+        && expected_depth <= depths.y + tolerance;
 }
 
 // The fragment's own pixel, if it holds the fur (the last resort of a hidden base).

@@ -370,4 +370,3 @@ def test_pattern_size_fields_are_validated():
     with pytest.raises(ValueError, match="unknown fur pattern"):
         pattern("spiky")
     assert FurPattern().layers == 16
-

@@ -733,24 +733,29 @@ AROUND = [(1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (-1, 1), (1, -1), (-1, -1)] 
 
 
 def fur_light_reference(irradiance, depth, holds):
-    """Per pixel: (its irradiance, its depth) where it holds the fur, else (the first neighbour
-    holding it, in base_irradiance's order, minus its depth), else zeros."""
+    """Per pixel: (its irradiance, 1) where it holds the fur, else (the first neighbour's
+    holding it, in base_irradiance's order, -1), else zeros; and the least and greatest depth of
+    the fur over the 3x3 pixels (zeros where none holds it)."""
     height, width = holds.shape
-    expected = np.zeros((height, width, 4))
-    done = holds.copy()
-    expected[holds, :3] = irradiance[holds]
-    expected[holds, 3] = depth[holds]
-    for dx, dy in AROUND:
-        for y in range(height):
-            for x in range(width):
+    light = np.zeros((height, width, 4))
+    depths = np.zeros((height, width, 2))
+    light[holds, :3] = irradiance[holds]
+    light[holds, 3] = 1.0
+    for y in range(height):
+        for x in range(width):
+            seen = [depth[y + dy, x + dx] for dx, dy in [(0, 0), *AROUND]
+                    if 0 <= x + dx < width and 0 <= y + dy < height and holds[y + dy, x + dx]]
+            if seen:
+                depths[y, x] = min(seen), max(seen)
+            if holds[y, x]:
+                continue
+            for dx, dy in AROUND:
                 qx, qy = x + dx, y + dy
-                if done[y, x] or not (0 <= qx < width and 0 <= qy < height) or \
-                        not holds[qy, qx]:
-                    continue
-                expected[y, x, :3] = irradiance[qy, qx]
-                expected[y, x, 3] = -depth[qy, qx]
-                done[y, x] = True
-    return expected
+                if 0 <= qx < width and 0 <= qy < height and holds[qy, qx]:
+                    light[y, x, :3] = irradiance[qy, qx]
+                    light[y, x, 3] = -1.0
+                    break
+    return light, depths
 
 
 def test_the_fur_light_is_each_pixels_own_or_its_first_neighbours(render):
@@ -772,14 +777,17 @@ def test_the_fur_light_is_each_pixels_own_or_its_first_neighbours(render):
     holds = np.abs(read("normal_exponent_id")[..., 3] - surface) < 0.5
     albedo = np.maximum(read("albedo_specular")[..., :3], 1.0 / 255.0)
     irradiance = read("light_accumulation")[..., :3] / albedo
-    expected = fur_light_reference(irradiance, read("linear_depth")[..., 0], holds)
+    light, depths = fur_light_reference(irradiance, read("linear_depth")[..., 0], holds)
     got = read("shell_fur_light")
     assert 0.1 < holds.mean() < 0.7
     other = (read("linear_depth")[..., 0] > 0.0) & ~holds
     assert other.sum() > 20  # the ball in front
     ring = got[..., 3] < 0.0
     assert ring.sum() > 50
-    np.testing.assert_allclose(got, expected, rtol=1e-4, atol=1e-5)
+    np.testing.assert_allclose(got, light, rtol=1e-4, atol=1e-5)
+    spread = depths[..., 1] - depths[..., 0]
+    assert (spread > 0.05).sum() > 20  # the silhouettes, and the fur's edge behind the ball
+    np.testing.assert_allclose(read("shell_fur_light_depths"), depths, rtol=1e-6)
     # the fur past the skin: lit pixels where the G-buffer holds nothing
     image = result.image[::-1]  # top row first; the targets are bottom row first
     beyond = (read("linear_depth")[..., 0] == 0.0) & (image[..., :3].max(-1) > 8)
@@ -804,6 +812,14 @@ def test_without_a_colour_map_the_fur_is_the_tint_as_over_a_white_texture(render
             result, _ = render(scene_from_dict(scene, "colour"), pipeline)
             yield result.image[..., :3] / 255.0
 
+    plain = scene_from_dict({**base, "object": [{"mesh": "builtin:sphere",
+                                                 "material": "shell_fur"}]}, "plain")
+    material = plain.objects[0].material
+    assert "FUR_COLOR_MAP" not in material.defines(plain.objects[0])
+    striped_scene = scene_from_dict({**base, "object": [{
+        "mesh": "builtin:sphere", "material": "shell_fur",
+        "params": {"color_pattern": "stripes"}}]}, "striped")
+    assert "FUR_COLOR_MAP" in striped_scene.objects[0].material.defines(striped_scene.objects[0])
     tint = list(image())
     white = list(image(color_texture=str(tmp_path / "white.png")))
     striped = list(image(color_pattern="stripes", pattern_color=[0.1, 0.1, 0.1]))
@@ -811,3 +827,24 @@ def test_without_a_colour_map_the_fur_is_the_tint_as_over_a_white_texture(render
         assert a.sum(-1).astype(bool).mean() > 0.3
         assert psnr(a, b) > 45.0
         assert psnr(a, c) < 30.0
+
+
+def test_short_fur_keeps_its_silhouette_in_the_deferred_pipeline(render):
+    """Fur beyond the skin's silhouette, lit from the skin by the gather, is drawn as much as
+    the forward pipeline (which lights each layer fragment itself) draws it: where the surface's
+    depth changes fast from pixel to pixel the first pixel holding the fur is at another depth,
+    and the light must still be found."""
+    scene = scene_from_dict({
+        "size": [160, 120], "background": [0.0, 0.0, 0.0],
+        "camera": {"position": [0.0, 0.0, 3.0], "target": [0.0, 0.0, 0.0], "fov": 40.0},
+        "object": [{"mesh": "builtin:sphere", "material": "shell_fur", "scale": 0.6,
+                    "params": {"fur_length": 0.12, "shells": 12, "fins": False}}],
+        "light": [{"type": "directional", "direction": [0.0, 0.0, -1.0], "intensity": 1.5},
+                  {"type": "ambient", "color": [0.3, 0.3, 0.35]}]}, "short")
+    deferred, renderer = render(scene)
+    forward, _ = render(scene, "forward")
+    beyond = renderer.targets.read("linear_depth")[::-1, :, 0] == 0.0  # top row first
+    drawn_deferred = (deferred.image[..., :3].max(-1) > 24) & beyond
+    drawn_forward = (forward.image[..., :3].max(-1) > 24) & beyond
+    assert drawn_forward.sum() > 150
+    assert drawn_deferred.sum() >= 0.95 * drawn_forward.sum()

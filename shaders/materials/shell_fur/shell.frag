@@ -3,10 +3,10 @@
 // (Algorithm 2, layer.glsl); its light from the light accumulation at the root under it (the
 // lights shaded the base surface with kajiya_kay along the strand's chord, the G-buffer's
 // strand_tangent), divided by the base albedo and multiplied by this layer's colour and the
-// shadow factor gamma(h) (Eq. 6). The root's light is read from the fur_light target, gathered
-// once per pixel for the frame (techniques/fur_light.glsl). So the layers cost the same whatever the number of lights;
-// what they lose against the forward pipeline is the tangent of each layer (one per strand
-// here) and the light's variation between the root and the layer.
+// shadow factor gamma(h) (Eq. 6); the root's light comes from the fur_light gather, made once
+// per pixel for the frame (techniques/fur_light.glsl). So the layers cost the same whatever the
+// number of lights; what they lose against the forward pipeline is the tangent of each layer
+// (one per strand here) and the light's variation between the root and the layer.
 #include "techniques/fur.glsl"
 #include "techniques/accumulated_light.glsl"
 #include "techniques/fur_light.glsl"
