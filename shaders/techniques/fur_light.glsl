@@ -6,10 +6,13 @@ uniform sampler2D u_fur_light_depths;  // least and greatest depth of the fur ov
 
 // The base sample: the fur's light at `pixel` (or its first neighbour holding the fur), if the
 // fur there spans `expected_depth` within `tolerance`.
+// A base pixel one off the screen reads the pixel inside: the search found its light among its
+// neighbours there.
 bool fur_light_at(ivec2 pixel, float expected_depth, float tolerance, out vec3 irradiance) {
-    bool on_screen = inside(pixel);
-    vec4 s = on_screen ? texelFetch(u_fur_light, pixel, 0) : vec4(0.0);
-    vec2 depths = on_screen ? texelFetch(u_fur_light_depths, pixel, 0).rg : vec2(0.0);
+    ivec2 clamped = clamp(pixel, ivec2(0), ivec2(u_resolution) - 1);
+    bool near = all(lessThanEqual(abs(pixel - clamped), ivec2(1)));
+    vec4 s = near ? texelFetch(u_fur_light, clamped, 0) : vec4(0.0);
+    vec2 depths = near ? texelFetch(u_fur_light_depths, clamped, 0).rg : vec2(0.0);
     irradiance = s.rgb;
     return s.a != 0.0 && expected_depth >= depths.x - tolerance
         && expected_depth <= depths.y + tolerance;

@@ -848,3 +848,19 @@ def test_short_fur_keeps_its_silhouette_in_the_deferred_pipeline(render):
     drawn_forward = (forward.image[..., :3].max(-1) > 24) & beyond
     assert drawn_forward.sum() > 150
     assert drawn_deferred.sum() >= 0.95 * drawn_forward.sum()
+
+
+def test_fur_over_the_screen_border_is_lit_as_inside(render):
+    """Fur whose root lies just off the screen takes the light of the pixels inside, as the
+    search did: the deferred image does not differ from the forward one more along the border
+    than inside (``fig12_word``: a furry square filling the frame)."""
+    from deferred.scene import load_scene
+
+    scene = load_scene(Path(__file__).parents[2] / "examples" / "shell_fur" / "fig12_word.toml")
+    deferred, _ = render(scene, size=(320, 240))  # roots 1 pixel off the screen
+    forward, _ = render(scene, "forward", size=(320, 240))
+    error = ((deferred.image[..., :3] / 255.0 - forward.image[..., :3] / 255.0) ** 2).sum(-1)
+    border = np.zeros(error.shape, bool)
+    border[:2], border[-2:], border[:, :2], border[:, -2:] = True, True, True, True
+    assert error[~border].mean() < 1e-3  # the pipelines agree on this short fur
+    assert error[border].mean() < 3.0 * error[~border].mean() + 1e-5
