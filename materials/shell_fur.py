@@ -77,7 +77,6 @@ Vec3 = tuple[float, float, float]
 FUR_VERTEX = "materials/shell_fur/fur.vert"
 SHELL_FRAGMENT = "materials/shell_fur/shell.frag"
 FORWARD_SHELL_FRAGMENT = "materials/shell_fur/forward_shell.frag"
-SHELL_FUR_LIGHT = "shell_fur_light"  # the fur's light per pixel (techniques/fur_light.py)
 TIPS_WIDTH = 1024  # texels per row of the per-vertex strand texture
 COLOR_MAP_SIZE = 256
 GUST_WAVELENGTH = 1.0  # world units between gust fronts along the wind
@@ -516,12 +515,18 @@ class ShellFurMaterial(Material):
 
     # -- passes ------------------------------------------------------------------------------
     @classmethod
+    def fur_light(cls) -> str:
+        """The fur light gather of this material's objects (``techniques/fur_light.py``): one
+        per material class, as its G-buffer id is."""
+        return f"{cls.name}_light"
+
+    @classmethod
     def scene_passes(cls, objects: list[SceneObject], phase: Phase) -> list[RenderPass]:
         """The fur's light per pixel, gathered once for every shell_fur object's layers and
         fins (deferred only: forward layers light themselves)."""
         if phase != Phase.MATERIAL or not any(obj.material.params.shells > 0 for obj in objects):
             return []
-        return [fur_light_pass("material.shell_fur_light", SHELL_FUR_LIGHT,
+        return [fur_light_pass(f"material.{cls.fur_light()}", cls.fur_light(),
                                objects[0].material.surface_id(), cls.name)]
 
     def geometry_passes(self, obj: SceneObject) -> list[RenderPass]:
@@ -535,13 +540,13 @@ class ShellFurMaterial(Material):
         if self.params.fins:
             passes.append(ShellFurFinPass(f"{obj.label}.fins", Phase.MATERIAL, obj,
                                           fragment=SHELL_FRAGMENT, colors=(COMPOSITE,),
-                                          extra_reads=fur_light_targets(SHELL_FUR_LIGHT),
-                                          fur_light=SHELL_FUR_LIGHT,
+                                          extra_reads=fur_light_targets(self.fur_light()),
+                                          fur_light=self.fur_light(),
                                           constants=self.vertex_constants(obj)))
         passes.append(ShellFurLayerPass(f"{obj.label}.layers", Phase.MATERIAL, obj,
                                         fragment=SHELL_FRAGMENT, colors=(COMPOSITE,),
-                                        extra_reads=fur_light_targets(SHELL_FUR_LIGHT),
-                                        fur_light=SHELL_FUR_LIGHT,
+                                        extra_reads=fur_light_targets(self.fur_light()),
+                                        fur_light=self.fur_light(),
                                         constants=self.vertex_constants(obj)))
         return passes
 
