@@ -23,7 +23,8 @@ The lists live in one storage buffer (``lights/light_lists.glsl``): a count per 
 ``capacity`` slots per list. Capacity is the frame's volume light count, so no list overflows.
 The culling shaders write the buffer; it is then copied into an R32UI texture, which the shading
 passes read: llvmpipe reads a texel several times as fast as a storage buffer's word, and the
-list loops read one per light (the tiled shading pass 15-23% faster at 256-1024 lights).
+list loops read one per light (the tiled shading pass 15-23% faster at 256-1024 lights). The
+lists are held twice, buffer and texture.
 """
 
 from __future__ import annotations
@@ -52,7 +53,8 @@ TILE = 16  # pixels per tile side (tiled, Forward+): the culling work group
 CLUSTER_TILE = 32  # pixels per cluster side
 CLUSTER_SLICES = 16  # exponential depth slices between the near and far planes
 MAX_LIST_BYTES = 512 * 1024 * 1024
-LIST_TEXTURE_WIDTH = 4096  # words per row of the lists' texture (light_lists.glsl's shifts)
+LIST_ROW_SHIFT = 14  # words per row of the lists' texture, as a power of two (u_list_row_shift)
+LIST_TEXTURE_WIDTH = 1 << LIST_ROW_SHIFT  # 16384: every GL 4.3 context (compute) allows it
 
 
 def resolve_light_path(pipeline: str, requested: str | None, features: Features,
@@ -152,12 +154,17 @@ class LightLists:
         limit = list_byte_limit(self.max_texture_size)
         if size > limit:  # checked before the first frame (check_light_limits)
             raise RenderError(_too_many_for_lists(capacity, grid, size, limit))
-        if self.buffer is None or self.buffer.size < size:
+        if self.buffer is None or self.texture is None or self.buffer.size < size:
             self.release()
-            self.buffer = self.ctx.buffer(reserve=size)
-            self.texture = self.ctx.texture((LIST_TEXTURE_WIDTH, size // (4 * LIST_TEXTURE_WIDTH)),
-                                            1, dtype="u4")
-            self.texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            buffer = self.ctx.buffer(reserve=size)
+            try:
+                texture = self.ctx.texture((LIST_TEXTURE_WIDTH, size // (4 * LIST_TEXTURE_WIDTH)),
+                                           1, dtype="u4")
+            except BaseException:
+                buffer.release()
+                raise
+            texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            self.buffer, self.texture = buffer, texture
         self.buffer.bind_to_storage_buffer(1)
 
     def publish(self) -> None:
@@ -174,6 +181,7 @@ class LightLists:
     def uniforms(self) -> dict[str, Any]:
         assert self.grid is not None
         return {"u_list_count": self.grid.count, "u_list_capacity": self.capacity,
+                "u_list_row_shift": LIST_ROW_SHIFT,
                 "u_list_grid": (self.grid.columns, self.grid.rows, self.grid.slices),
                 "u_list_tile": self.grid.tile, "u_list_depth": self.depth_scale}
 

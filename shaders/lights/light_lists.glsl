@@ -2,11 +2,12 @@
 // paths and Forward+. One storage buffer: a count per list, then each list's light indices
 // (capacity slots per list; indices into the light buffer, volume lights only - the full-screen
 // ones, [0, u_global_light_count), apply to every pixel). The culling shaders write it; the
-// shading passes read its copy in u_light_list_texture, 4096 words a row (LIST_TEXTURE_WIDTH).
+// shading passes read its copy in u_light_list_texture, 2^u_list_row_shift words a row.
 layout(std430, binding = 1) buffer LightLists {
     uint light_list_data[];
 };
 uniform usampler2D u_light_list_texture;
+uniform int u_list_row_shift;   // log2 of the texture's words per row
 
 uniform int u_list_count;       // lists: tiles, or tiles x depth slices
 uniform int u_list_capacity;    // slots per list
@@ -30,7 +31,8 @@ int light_list_of(ivec2 pixel, float depth) {
 }
 
 uint light_list_word(int i) {
-    return texelFetch(u_light_list_texture, ivec2(i & 4095, i >> 12), 0).r;
+    return texelFetch(u_light_list_texture,
+                      ivec2(i & ((1 << u_list_row_shift) - 1), i >> u_list_row_shift), 0).r;
 }
 
 int light_list_length(int list) {

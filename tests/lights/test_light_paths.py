@@ -206,12 +206,33 @@ def test_more_lights_than_the_gl33_light_texture_holds_is_refused(gl, monkeypatc
 
 
 def test_the_rows_of_the_lists_texture_bound_the_lists_too():
-    """The shading passes read the lists from a texture LIST_TEXTURE_WIDTH words wide: at 4K
-    its rows, not MAX_LIST_BYTES, limit the lights."""
+    """The shading passes read the lists from a texture LIST_TEXTURE_WIDTH words wide: where
+    the driver allows fewer rows than MAX_LIST_BYTES needs, its rows limit the lights."""
     from deferred.light_lists import LIST_TEXTURE_WIDTH, MAX_LIST_BYTES, check_light_limits
 
-    rows = 4096  # 64 MiB of lists
+    rows = 1024  # 64 MiB of lists
     check_light_limits("tiled", (3840, 2160), 400, 402, max_texture_size=rows)  # 51.8 MB
     with pytest.raises(InputError, match=r"^light: 600 lights need 74 MiB .* limit is 64 MiB"):
         check_light_limits("tiled", (3840, 2160), 600, 602, max_texture_size=rows)
     assert rows * 4 * LIST_TEXTURE_WIDTH < MAX_LIST_BYTES
+    # GL 4.3 (compute shaders) guarantees 16384 rows: there MAX_LIST_BYTES is the limit
+    assert 16384 * 4 * LIST_TEXTURE_WIDTH >= MAX_LIST_BYTES
+
+
+@pytest.mark.parametrize("pipeline, path", [("deferred", "tiled"), ("deferred", "clustered"),
+                                            ("forward", "tiled")])
+def test_a_renderer_reused_with_other_light_counts_draws_what_a_fresh_one_does(gl, pipeline,
+                                                                               path):
+    """The lists' buffer and texture are kept and grown across frames: fewer lights after more
+    (old entries past the new lists), then more again, then none."""
+    if not gl.features.compute_shaders:
+        pytest.skip("the driver has no compute shaders")
+    counts = (200, 16, 200, 0)
+    with Renderer(scene_with(counts[0]), pipeline, gl=gl, light_path=path) as renderer:
+        reused = []
+        for count in counts:
+            renderer.scene.lights = scene_with(count).lights
+            reused.append(renderer.render().hdr)
+    for count, image in zip(counts, reused, strict=True):
+        with Renderer(scene_with(count), pipeline, gl=gl, light_path=path) as renderer:
+            np.testing.assert_array_equal(image, renderer.render().hdr)
