@@ -6,9 +6,10 @@ Deferred:
 - ``volumes``: one instanced pass per light type, each light drawn as its bounding sphere (or a
   full-screen triangle), re-reading the G-buffer and blending into the light accumulation for
   every pixel it covers. Needs GL 3.3 only.
-- ``tiled``: a compute pass culls the volume lights per 16x16 tile against the tile's frustum and
-  depth bounds (``lights/cull_tiles.comp``); one full-screen pass then reads the G-buffer once
-  per pixel and loops the full-screen lights and its tile's list (``lights/list_shading.frag``).
+- ``tiled``: a compute pass culls the volume lights per 16x16 tile against the tile's frustum,
+  depth bounds and the view-space box of its points (``lights/cull_tiles.comp``); one
+  full-screen pass then reads the G-buffer once per pixel and loops the full-screen lights and
+  its tile's list (``lights/list_shading.frag``).
 - ``clustered``: the same shading, from lists of view-space clusters (32x32 tiles x 16
   exponential depth slices) filled light by light (``lights/cull_clusters.comp``).
 
@@ -244,6 +245,8 @@ class LightCullPass(RenderPass):
         textures = {"u_lights": lights.texture}
         if not self.clustered:
             textures["u_linear_depth"] = frame.target(LINEAR_DEPTH)
+            uniforms["u_pixel_to_view"] = pixel_to_view(frame.projection, frame.width,
+                                                        frame.height)
         frame.bind_compute(shader, uniforms, textures, offered=frame.camera_uniforms())
         if self.clustered:
             groups = (max(1, math.ceil(lights.local_count / 64)), 1, 1)
@@ -254,6 +257,16 @@ class LightCullPass(RenderPass):
         frame.ctx.memory_barrier()
         frame.light_lists.publish()
         frame.count_draw()
+
+
+def pixel_to_view(projection: np.ndarray, width: int, height: int) -> tuple[float, ...]:
+    """(scale.xy, offset.xy) with view-space xy / linear depth = pixel * scale + offset for a
+    perspective ``projection`` (math order, column vectors): the culling's view positions of
+    pixels, one multiply-add where the inverse projection takes a matrix product."""
+    p = projection
+    scale = (2.0 / (width * p[0, 0]), 2.0 / (height * p[1, 1]))
+    offset = ((p[0, 2] - 1.0) / p[0, 0], (p[1, 2] - 1.0) / p[1, 1])
+    return (*(float(v) for v in scale), *(float(v) for v in offset))
 
 
 def list_shading_pass(name: str, clustered: bool, gbuffer: tuple[str, ...],

@@ -116,6 +116,17 @@ def test_tile_lists_hold_every_light_that_reaches_a_pixel(gl):
     assert missing == 0
     # and the lists are far shorter than every light
     assert counts.mean() < 0.25 * (len(records) - global_count)
+    # and hold only lights whose sphere touches the view-space box of their tile's points
+    # (tighter than the tile's frustum between its depth bounds)
+    loose = 0
+    for list_index in np.unique(tile):
+        box = points[tile == list_index]
+        low, high = box.min(0) - 1e-4, box.max(0) + 1e-4
+        listed = data[grid.count + list_index * lists.capacity:][:counts[list_index]]
+        centres = records[listed.astype(int), 1, :3]
+        gap = centres - np.clip(centres, low, high)
+        loose += int((np.sum(gap * gap, -1) > records[listed.astype(int), 1, 3] ** 2).sum())
+    assert loose == 0
 
 
 def test_lights_outside_the_view_are_culled_on_the_cpu(gl):
