@@ -255,6 +255,13 @@ def _unwrap(positions: np.ndarray, normals: np.ndarray, colors: np.ndarray | Non
             indices: np.ndarray, name: str = "mesh"):
     """Generate UVs with an xatlas unwrap (vertices on seams are split)."""
     vmapping, new_indices, uvs = unwrap_uvs(positions, indices, name)
+    # xatlas leaves the corners of triangles too thin for it (relative to float32) without a
+    # chart: NaN. Such a triangle covers no texel; they take (0, 0). None charted: degenerate.
+    charted = np.isfinite(uvs).all(axis=1)
+    if not charted.any():
+        raise InputError(f"mesh is degenerate: the UV unwrap found no triangle with an area "
+                         f"among its {len(indices):,} (give the mesh UVs)", name)
+    uvs = np.where(charted[:, None], uvs, 0.0)
     vmapping = vmapping.astype(np.int64)
     colors = None if colors is None else np.asarray(colors)[vmapping]
     return (positions[vmapping], normals[vmapping], colors,

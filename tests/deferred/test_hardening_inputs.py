@@ -60,6 +60,8 @@ BAD_MESHES = {
     "flat.obj": ("v 0 0 0\nv 1 0 0\nv 2 0 0\nv 3 0 0\nf 1 2 3\nf 2 3 4\nf 1 1 2\n",
                  "degenerate"),
     "empty.obj": ("", "no triangles"),
+    # a triangle 1e-12 high: an area to the mesh checks, none to xatlas (its UVs came back NaN)
+    "thin.obj": ("v 0 0 0\nv 0 0 1e-12\nv 0 1 0\nf 2 3 1\n", "the UV unwrap found no triangle"),
 }
 
 
@@ -337,3 +339,15 @@ def test_channels_past_rgba_are_not_checked_and_ringing_reads_as_zero(tmp_path):
     write_image(tmp_path / "five.exr", pixels, channels=["R", "G", "B", "A", "Z"])
     with pytest.raises(InputError, match="NaN, infinite or negative"):
         read_image(tmp_path / "five.exr")
+
+
+def test_a_triangle_too_thin_to_unwrap_beside_good_ones_gets_finite_uvs(tmp_path):
+    """A triangle thinner than float32 resolves, alone, is a degenerate mesh to the unwrap (the
+    thin.obj case); beside a triangle it charts, the mesh loads with finite UVs everywhere."""
+    from deferred.mesh import load_mesh
+
+    path = tmp_path / "sliver.obj"
+    path.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1e-12\nf 1 2 3\nf 4 3 1\n")
+    mesh = load_mesh(str(path))
+    assert np.isfinite(mesh.uvs).all()
+    assert np.ptp(mesh.uvs, axis=0).min() > 0.1  # the good triangle is charted
