@@ -17,7 +17,9 @@ the light where the expected depth lies within the depth range, widened by its t
 accepts every fragment the search accepted; it also accepts one whose expected depth falls
 between two parts of the fur seen in the 3x3 pixels (along an edge where the fur occludes
 itself), with the first pixel's light, where the search took the light of the pixel at the right
-depth. revie_fur keeps the search: its stipple samples are skipped per candidate.
+depth. revie_fur keeps the search: its last resort reads a stipple sample's own light, which
+this gather does not hold, and a first version of it (the first pixel's depth only) left a
+dotted rim on its short fur.
 """
 
 from __future__ import annotations
