@@ -248,3 +248,22 @@ def test_a_renderer_reused_with_other_light_counts_draws_what_a_fresh_one_does(g
     for count, image in zip(counts, reused, strict=True):
         with Renderer(scene_with(count), pipeline, gl=gl, light_path=path) as renderer:
             np.testing.assert_array_equal(image, renderer.render().hdr)
+
+
+def test_pixel_to_view_is_the_inverse_projection_at_pixel_centres():
+    """The culling's view positions of pixels (one multiply-add) against the lighting's (the
+    inverse projection), for a wide and a tall frame."""
+    from deferred.camera import Camera
+    from deferred.light_lists import pixel_to_view
+
+    for width, height, fov in ((640, 360, 50.0), (200, 500, 90.0)):
+        projection = Camera(fov=fov, near=0.1, far=80.0).projection(width / height)
+        scale_x, scale_y, offset_x, offset_y = pixel_to_view(projection, width, height)
+        rng = np.random.default_rng(3)
+        pixels = rng.uniform(0.0, 1.0, (50, 2)) * (width, height)
+        ndc = np.column_stack([pixels / (width, height) * 2.0 - 1.0, np.ones((50, 2))])
+        rays = ndc @ np.linalg.inv(projection).T
+        rays = rays[:, :3] / rays[:, 3:]
+        expected = rays[:, :2] / -rays[:, 2:]
+        got = pixels * (scale_x, scale_y) + (offset_x, offset_y)
+        np.testing.assert_allclose(got, expected, rtol=1e-9, atol=1e-9)
