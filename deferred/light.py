@@ -66,9 +66,34 @@ class Light:
         """(4, 4) float32: color, position, direction, extra (view space). See lighting.glsl."""
         raise NotImplementedError
 
+    @classmethod
+    def records(cls, lights: list[Light], view: np.ndarray) -> np.ndarray:
+        """``(len(lights), 4, 4)`` float32: :meth:`record` of each light of this type. A type
+        with many lights a frame (point, spot) overrides it with numpy over all of them: one
+        ``record`` call per light cost 25 ms a frame at 1024 lights."""
+        return np.stack([np.asarray(light.record(view), dtype=np.float32).reshape(4, 4)
+                         for light in lights]) if lights else np.zeros((0, 4, 4), np.float32)
+
 
 def view_point(view: np.ndarray, point) -> np.ndarray:
     return (view @ np.append(np.asarray(point, dtype=np.float64), 1.0))[:3]
+
+
+def view_points(view: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """:func:`view_point` of ``(n, 3)`` points."""
+    return points @ view[:3, :3].T + view[:3, 3]
+
+
+def view_directions(view: np.ndarray, directions: np.ndarray) -> np.ndarray:
+    """:func:`view_direction` of ``(n, 3)`` directions."""
+    d = directions @ view[:3, :3].T
+    return d / np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-12)
+
+
+def radiances(lights: list[Light]) -> np.ndarray:
+    """:meth:`Light.radiance` of each light, ``(n, 3)``."""
+    return np.array([light.params.color for light in lights], np.float64) * \
+        np.array([light.params.intensity for light in lights], np.float64)[:, None]
 
 
 def view_direction(view: np.ndarray, direction) -> np.ndarray:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from pydantic import Field
 
-from deferred.light import Light, LightParams, view_point
+from deferred.light import Light, LightParams, radiances, view_point, view_points
 from deferred.registry import lights
 
 
@@ -34,3 +34,13 @@ class PointLight(Light):
         record[1, :3] = view_point(view, self.params.position)
         record[1, 3] = self.params.radius
         return record
+
+    @classmethod
+    def records(cls, lights: list[Light], view: np.ndarray) -> np.ndarray:
+        records = np.zeros((len(lights), 4, 4), dtype=np.float32)
+        if lights:
+            records[:, 0, :3] = radiances(lights)
+            records[:, 1, :3] = view_points(view, np.array([light.params.position
+                                                            for light in lights], np.float64))
+            records[:, 1, 3] = [light.params.radius for light in lights]
+        return records

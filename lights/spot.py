@@ -7,7 +7,14 @@ import math
 import numpy as np
 from pydantic import Field, model_validator
 
-from deferred.light import Light, view_direction, view_point
+from deferred.light import (
+    Light,
+    radiances,
+    view_direction,
+    view_directions,
+    view_point,
+    view_points,
+)
 from deferred.registry import lights
 from deferred.validation import NonZeroVec3
 
@@ -50,3 +57,17 @@ class SpotLight(Light):
         record[2, 3] = math.cos(math.radians(p.outer_angle))
         record[3, 0] = math.cos(math.radians(p.inner_angle))
         return record
+
+    @classmethod
+    def records(cls, lights: list[Light], view: np.ndarray) -> np.ndarray:
+        records = np.zeros((len(lights), 4, 4), dtype=np.float32)
+        if lights:
+            params = [light.params for light in lights]
+            records[:, 0, :3] = radiances(lights)
+            records[:, 1, :3] = view_points(view, np.array([p.position for p in params]))
+            records[:, 1, 3] = [p.radius for p in params]
+            records[:, 2, :3] = view_directions(view, np.array([p.direction for p in params],
+                                                               np.float64))
+            records[:, 2, 3] = np.cos(np.radians([p.outer_angle for p in params]))
+            records[:, 3, 0] = np.cos(np.radians([p.inner_angle for p in params]))
+        return records

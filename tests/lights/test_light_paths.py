@@ -267,3 +267,29 @@ def test_pixel_to_view_is_the_inverse_projection_at_pixel_centres():
         expected = rays[:, :2] / -rays[:, 2:]
         got = pixels * (scale_x, scale_y) + (offset_x, offset_y)
         np.testing.assert_allclose(got, expected, rtol=1e-9, atol=1e-9)
+
+
+@pytest.mark.parametrize("kind", ["point", "spot", "ambient", "directional"])
+def test_a_types_records_in_one_go_are_each_lights_record(kind):
+    """LightBuffer.pack asks each light type for all its lights' records at once (point and
+    spot in numpy); they are what each light's own record gives."""
+    from deferred.camera import Camera
+    from deferred.registry import lights as light_registry
+
+    rng = np.random.default_rng(7)
+    cls = light_registry.get(kind)
+    made = []
+    for _ in range(6):
+        values = {"color": rng.uniform(0.0, 1.0, 3).tolist(),
+                  "intensity": float(rng.uniform(0.5, 3.0))}
+        if kind in ("point", "spot"):
+            values |= {"position": rng.uniform(-3.0, 3.0, 3).tolist(),
+                       "radius": float(rng.uniform(0.5, 6.0))}
+        if kind in ("spot", "directional"):
+            values["direction"] = rng.uniform(-1.0, 1.0, 3).tolist()
+        made.append(cls.from_dict(values))
+    view = Camera(position=(1.0, 2.0, 4.0), target=(0.0, 0.5, 0.0)).view()
+    together = cls.records(made, view)
+    one_by_one = np.stack([np.asarray(light.record(view), np.float32) for light in made])
+    np.testing.assert_allclose(together, one_by_one, rtol=1e-6, atol=1e-6)
+    assert cls.records([], view).shape == (0, 4, 4)
