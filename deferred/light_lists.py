@@ -56,6 +56,7 @@ CLUSTER_SLICES = 16  # exponential depth slices between the near and far planes
 MAX_LIST_BYTES = 512 * 1024 * 1024
 LIST_ROW_SHIFT = 14  # words per row of the lists' texture, as a power of two (u_list_row_shift)
 LIST_TEXTURE_WIDTH = 1 << LIST_ROW_SHIFT  # 16384: every GL 4.3 context (compute) allows it
+LIST_ROW_BYTES = 4 * LIST_TEXTURE_WIDTH
 
 
 def resolve_light_path(pipeline: str, requested: str | None, features: Features,
@@ -95,13 +96,12 @@ class ListGrid:
 def list_bytes(grid: ListGrid, capacity: int) -> int:
     """Bytes of the lists' storage buffer: a count and ``capacity`` slots per list, in whole
     rows of the lists' texture."""
-    row = 4 * LIST_TEXTURE_WIDTH
-    return -(-4 * grid.count * (1 + max(capacity, 1)) // row) * row
+    return -(-4 * grid.count * (1 + max(capacity, 1)) // LIST_ROW_BYTES) * LIST_ROW_BYTES
 
 
 def list_byte_limit(max_texture_size: int) -> int:
     """The most bytes of lists: MAX_LIST_BYTES, and the rows the lists' texture may have."""
-    return min(MAX_LIST_BYTES, max_texture_size * 4 * LIST_TEXTURE_WIDTH)
+    return min(MAX_LIST_BYTES, max_texture_size * LIST_ROW_BYTES)
 
 
 def _too_many_for_lists(lights: int, grid: ListGrid, size: int, limit: int) -> str:
@@ -159,7 +159,7 @@ class LightLists:
             self.release()
             buffer = self.ctx.buffer(reserve=size)
             try:
-                texture = self.ctx.texture((LIST_TEXTURE_WIDTH, size // (4 * LIST_TEXTURE_WIDTH)),
+                texture = self.ctx.texture((LIST_TEXTURE_WIDTH, size // LIST_ROW_BYTES),
                                            1, dtype="u4")
             except BaseException:
                 buffer.release()
@@ -172,7 +172,7 @@ class LightLists:
         """Copy the lists the culling wrote into the texture the shading reads (after a memory
         barrier)."""
         assert self.buffer is not None and self.texture is not None and self.grid is not None
-        rows = list_bytes(self.grid, self.capacity) // (4 * LIST_TEXTURE_WIDTH)
+        rows = list_bytes(self.grid, self.capacity) // LIST_ROW_BYTES
         self.texture.write(self.buffer, viewport=(0, 0, LIST_TEXTURE_WIDTH, rows))
 
     def clear_counts(self) -> None:

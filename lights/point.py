@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from pydantic import Field
 
-from deferred.light import Light, LightParams, radiances, view_point, view_points
+from deferred.light import Light, LightParams, radiances, view_points
 from deferred.registry import lights
 
 
@@ -29,11 +29,7 @@ class PointLight(Light):
     volume = "sphere"
 
     def record(self, view: np.ndarray) -> np.ndarray:
-        record = np.zeros((4, 4), dtype=np.float32)
-        record[0, :3] = self.radiance()
-        record[1, :3] = view_point(view, self.params.position)
-        record[1, 3] = self.params.radius
-        return record
+        return self.records([self], view)[0]
 
     @classmethod
     def records(cls, lights: list[Light], view: np.ndarray) -> np.ndarray:

@@ -2,19 +2,10 @@
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from pydantic import Field, model_validator
 
-from deferred.light import (
-    Light,
-    radiances,
-    view_direction,
-    view_directions,
-    view_point,
-    view_points,
-)
+from deferred.light import Light, radiances, view_directions, view_points
 from deferred.registry import lights
 from deferred.validation import NonZeroVec3
 
@@ -48,15 +39,7 @@ class SpotLight(Light):
     volume = "sphere"
 
     def record(self, view: np.ndarray) -> np.ndarray:
-        p = self.params
-        record = np.zeros((4, 4), dtype=np.float32)
-        record[0, :3] = self.radiance()
-        record[1, :3] = view_point(view, p.position)
-        record[1, 3] = p.radius
-        record[2, :3] = view_direction(view, p.direction)
-        record[2, 3] = math.cos(math.radians(p.outer_angle))
-        record[3, 0] = math.cos(math.radians(p.inner_angle))
-        return record
+        return self.records([self], view)[0]
 
     @classmethod
     def records(cls, lights: list[Light], view: np.ndarray) -> np.ndarray:

@@ -23,11 +23,16 @@ bool inside(ivec2 pixel) {
     return all(greaterThanEqual(pixel, ivec2(0))) && all(lessThan(pixel, ivec2(u_resolution)));
 }
 
+// Whether the G-buffer at `pixel` (on the screen) holds this surface, at any depth.
+bool holds_surface(ivec2 pixel) {
+    return same_surface(texelFetch(u_normal_exponent_id, pixel, 0).w, u_surface_id);
+}
+
 // Whether `pixel` holds this fur within `tolerance` of `expected` linear depth.
 bool holds_fur(ivec2 pixel, float expected, float tolerance) {
     if (!inside(pixel)) return false;
 #ifdef FUR_OCCLUSION_TEST
-    if (!same_surface(texelFetch(u_normal_exponent_id, pixel, 0).w, u_surface_id)) return false;
+    if (!holds_surface(pixel)) return false;
     if (abs(texelFetch(u_linear_depth, pixel, 0).r - expected) > tolerance) return false;
 #endif
     return true;
@@ -35,8 +40,7 @@ bool holds_fur(ivec2 pixel, float expected, float tolerance) {
 
 // Whether the fragment's own pixel holds this surface (the last resort of a hidden base).
 bool own_pixel_holds_fur() {
-    return same_surface(texelFetch(u_normal_exponent_id, ivec2(gl_FragCoord.xy), 0).w,
-                        u_surface_id);
+    return holds_surface(ivec2(gl_FragCoord.xy));
 }
 
 vec3 irradiance_at(ivec2 pixel) {

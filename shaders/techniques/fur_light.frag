@@ -9,11 +9,6 @@
 layout(location = 0) out vec4 out_light;
 layout(location = 1) out vec2 out_depths;
 
-bool holds_surface(ivec2 pixel) {
-    return inside(pixel)
-        && same_surface(texelFetch(u_normal_exponent_id, pixel, 0).w, u_surface_id);
-}
-
 void main() {
     ivec2 pixel = ivec2(gl_FragCoord.xy);
     ivec2 neighbour = pixel;
@@ -21,14 +16,14 @@ void main() {
     vec2 depths = vec2(3.0e38, 0.0);
     for (int k = 7; k >= 0; --k) {  // backwards: the first in AROUND's order is kept
         ivec2 q = pixel + AROUND[k];
-        if (holds_surface(q)) {
+        if (inside(q) && holds_surface(q)) {
             float depth = texelFetch(u_linear_depth, q, 0).r;
             depths = vec2(min(depths.x, depth), max(depths.y, depth));
             neighbour = q;
             found = true;
         }
     }
-    bool own = holds_surface(pixel);
+    bool own = holds_surface(pixel);  // a fragment's own pixel is on the screen
     if (own) {
         float depth = texelFetch(u_linear_depth, pixel, 0).r;
         depths = vec2(min(depths.x, depth), max(depths.y, depth));

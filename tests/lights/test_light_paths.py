@@ -271,8 +271,11 @@ def test_pixel_to_view_is_the_inverse_projection_at_pixel_centres():
 
 @pytest.mark.parametrize("kind", ["point", "spot", "ambient", "directional"])
 def test_a_types_records_in_one_go_are_each_lights_record(kind):
-    """LightBuffer.pack asks each light type for all its lights' records at once (point and
-    spot in numpy); they are what each light's own record gives."""
+    """LightBuffer.pack asks each light type for all its lights' records at once: point and
+    spot compute them in numpy (against the record layout of common/lighting.glsl, computed
+    here light by light), the others through each light's own record."""
+    import math
+
     from deferred.camera import Camera
     from deferred.registry import lights as light_registry
 
@@ -290,6 +293,20 @@ def test_a_types_records_in_one_go_are_each_lights_record(kind):
         made.append(cls.from_dict(values))
     view = Camera(position=(1.0, 2.0, 4.0), target=(0.0, 0.5, 0.0)).view()
     together = cls.records(made, view)
-    one_by_one = np.stack([np.asarray(light.record(view), np.float32) for light in made])
-    np.testing.assert_allclose(together, one_by_one, rtol=1e-6, atol=1e-6)
+    if kind in ("point", "spot"):
+        expected = np.zeros((len(made), 4, 4))
+        for k, light in enumerate(made):
+            p = light.params
+            expected[k, 0, :3] = np.asarray(p.color) * p.intensity
+            expected[k, 1, :3] = (view @ np.append(p.position, 1.0))[:3]
+            expected[k, 1, 3] = p.radius
+            if kind == "spot":
+                axis = view[:3, :3] @ np.asarray(p.direction)
+                expected[k, 2, :3] = axis / np.linalg.norm(axis)
+                expected[k, 2, 3] = math.cos(math.radians(p.outer_angle))
+                expected[k, 3, 0] = math.cos(math.radians(p.inner_angle))
+    else:
+        expected = np.stack([np.asarray(light.record(view), np.float32) for light in made])
+    np.testing.assert_allclose(together, expected, rtol=1e-6, atol=1e-6)
+    np.testing.assert_allclose(made[0].record(view), together[0], rtol=1e-6, atol=1e-6)
     assert cls.records([], view).shape == (0, 4, 4)
