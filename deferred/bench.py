@@ -257,7 +257,7 @@ def time_cpu(renderer, runs: int) -> tuple[float, int]:
     for _ in range(runs):
         ctx.finish()
         start = time.thread_time()
-        result = renderer.render(readback=False)
+        result = renderer.render(readback=False, time_gl_calls=True)
         elapsed = time.thread_time() - start
         samples.append((elapsed - result.gl_call_seconds) * 1000.0)
         draws = result.draw_calls

@@ -11,12 +11,12 @@ from typing import TYPE_CHECKING, Any
 import moderngl
 import numpy as np
 
-from .camera import gl_bytes
 from .context import GLContext
 from .errors import DeferredError, InputError, RenderError, gl_error
 from .mesh import GpuMesh, MeshData
 from .shaderlib import ShaderLibrary
 from .targets import FrameTargets
+from .uniforms import gl_value
 
 if TYPE_CHECKING:
     from .light_lists import LightLists
@@ -48,6 +48,10 @@ class Resources:
         self._mesh_refs: list[MeshData] = []  # keep ids stable while cached
         self._cached: dict[Any, Any] = {}
         self._fullscreen_vaos: dict[int, moderngl.VertexArray] = {}
+        # (pass, colours, depth) framebuffer requests already checked against the pass's
+        # declarations: declarations are fixed once the graph is compiled and targets are only
+        # ever added, so a request that passed once passes for the renderer's life
+        self.checked_framebuffers: dict[tuple, Any] = {}
 
     def gpu_mesh(self, mesh: MeshData) -> GpuMesh:
         gpu = self._meshes.get(id(mesh))
@@ -145,7 +149,7 @@ class Frame:
     def __init__(self, gl: GLContext, shaders: ShaderLibrary, targets: FrameTargets,
                  resources: Resources, scene: Scene, light_buffer: LightBuffer,
                  strict: bool = False, light_lists: LightLists | None = None,
-                 time: float = 0.0):
+                 time: float = 0.0, time_gl_calls: bool = False):
         self.gl = gl
         self.time = float(time)  # seconds: the scene's timeline is applied at this time
         self.light_lists = light_lists
@@ -161,16 +165,24 @@ class Frame:
         self.view = scene.camera.view()
         self.projection = scene.camera.projection(self.width / self.height)
         self.inverse_projection = np.linalg.inv(self.projection)
+        # the camera's uniforms as GL takes them: one dict for every pass of the frame
+        self.camera_values = {name: gl_value(value)
+                              for name, value in self.camera_uniforms().items()}
         self.stats = FrameStats()
+        self.time_gl_calls = time_gl_calls  # FrameStats.gl_call_seconds
         self.current_pass: RenderPass | None = None
         self._materials: dict[int, MaterialInputs] = {}
         self._objects: dict[int, dict[str, Any]] = {}
         self._shading_textures: dict[str, moderngl.Texture] | None = None
+        # what this frame set last: a pass stating the same is not set again (set_state)
+        self._state: tuple | None = None
+        self._framebuffers: dict[tuple, moderngl.Framebuffer] = {}
 
     # -- passes --------------------------------------------------------------------------------
     def run_pass(self, render_pass: RenderPass) -> None:
         """Clear the targets ``render_pass`` creates, run it, and name it in any failure."""
         self.current_pass = render_pass
+        draws_before = self.stats.draw_calls
         try:
             for name in render_pass.creates:
                 self.gl_call(lambda name=name: self.targets.clear(name))
@@ -186,6 +198,10 @@ class Frame:
         error = self.ctx.error
         if error != "GL_NO_ERROR":
             raise gl_error(f"pass {render_pass.name}", error, (self.width, self.height))
+        draws = self.stats.draw_calls - draws_before
+        if draws:
+            by_pass = self.stats.draws_by_pass
+            by_pass[render_pass.name] = by_pass.get(render_pass.name, 0) + draws
 
     # -- uniforms ------------------------------------------------------------------------------
     def camera_uniforms(self) -> dict[str, Any]:
@@ -198,28 +214,32 @@ class Frame:
         }
 
     def object_uniforms(self, obj: SceneObject) -> dict[str, Any]:
-        """The object's transforms and id with the camera's (computed once per frame)."""
+        """The object's transforms and id (computed once per frame, for every object)."""
         if not self._objects:
             self._object_transforms()
         return self._objects[id(obj)]
 
     def _object_transforms(self) -> None:
         """Every object's transforms at once (one batched inverse, matrices as GL bytes)."""
-        camera = self.camera_uniforms()
-        camera = {name: gl_bytes(value) if isinstance(value, np.ndarray) else value
-                  for name, value in camera.items()}
         objects = self.scene.objects
         if not objects:
             return
         models = np.stack([obj.model for obj in objects])
         model_views = np.einsum("ij,njk->nik", self.view, models)
         normals = np.transpose(np.linalg.inv(model_views[:, :3, :3]), (0, 2, 1))
-        for obj, model, model_view, normal in zip(objects, models, model_views, normals,
-                                                   strict=True):
+
+        def column_major(matrices: np.ndarray) -> bytes:  # GLSL's order, all at once
+            return np.ascontiguousarray(np.transpose(matrices, (0, 2, 1)),
+                                        dtype=np.float32).tobytes()
+
+        model_bytes, view_bytes = column_major(models), column_major(model_views)
+        normal_bytes = column_major(normals)
+        for index, obj in enumerate(objects):
+            mat4, mat3 = slice(64 * index, 64 * index + 64), slice(36 * index, 36 * index + 36)
             self._objects[id(obj)] = {
-                "u_model": gl_bytes(model), "u_model_view": gl_bytes(model_view),
-                "u_normal_matrix": gl_bytes(normal),
-                "u_surface_id": float(obj.material.surface_id()), **camera}
+                "u_model": model_bytes[mat4], "u_model_view": view_bytes[mat4],
+                "u_normal_matrix": normal_bytes[mat3],
+                "u_surface_id": float(obj.material.surface_id())}
 
     def shading_textures(self) -> dict[str, moderngl.Texture]:
         """Samplers of the scene's shading models (ramps...), offered wherever lights run."""
@@ -244,8 +264,9 @@ class Frame:
         """Set uniforms and bind textures on ``program``.
 
         ``uniforms`` and ``textures`` are what the pass means to set: in strict mode each must
-        be declared by the program. ``offered`` values (camera, transforms) and the
-        ``material``'s are set where the program has them.
+        be declared by the program. The camera's values (:attr:`camera_values`), the lights',
+        ``offered`` values (an object's transforms) and the ``material``'s are set where the
+        program has them. A value the program holds already is not written again.
         """
         if self.strict:
             declared = self.shaders.declared_uniforms(program)
@@ -256,42 +277,30 @@ class Frame:
             if material is not None:
                 material.declared |= declared
                 material.programs.append(self.shaders.describe(program))
-        values = {**(offered or {})}
-        samplers: dict[str, moderngl.Texture] = dict(self.shading_textures())
+        program_uniforms = self.shaders.uniforms(program)
+        program_uniforms.set_shared("camera", self.camera_values)
         if material is not None:
-            values.update(material.uniforms)
-            samplers.update(material.textures)
-        values.update(uniforms or {})
-        samplers.update(textures or {})
-        members = self.shaders.members(program)
-        self.set_uniforms(program, values, members)
+            values = {**(offered or {}), **material.uniforms, **(uniforms or {})}
+            samplers = {**self.shading_textures(), **material.textures, **(textures or {})}
+        else:
+            values = {**(offered or {}), **(uniforms or {})}
+            samplers = {**self.shading_textures(), **(textures or {})}
+        program_uniforms.set(values)
         unit = 0
+        members = program_uniforms.members
         for name, texture in samplers.items():
-            if name not in members:
-                continue
-            texture.use(location=unit)
-            program[name].value = unit
-            unit += 1
-        self.light_buffer.bind(program, unit, members)
+            if name in members:
+                texture.use(location=unit)
+                program_uniforms.set_one(name, unit)
+                unit += 1
+        self.light_buffer.bind(program_uniforms, unit)
         if self.light_lists is not None:
-            self.light_lists.bind(program, unit + 1, members)
+            self.light_lists.bind(program_uniforms, unit + 1)
 
-    def set_uniforms(self, program: moderngl.Program, values: dict[str, Any],
-                     members: frozenset[str] | None = None) -> None:
-        """Set the values ``program`` has (no strict check: :meth:`bind` does that)."""
-        members = self.shaders.members(program) if members is None else members
-        for name, value in values.items():
-            if name not in members:
-                continue
-            member = program[name]
-            if isinstance(value, bytes):  # a matrix already in GL order
-                member.write(value)
-            elif isinstance(value, np.ndarray) and value.ndim == 2:
-                member.write(gl_bytes(value))
-            elif isinstance(value, np.ndarray):
-                member.value = tuple(float(v) for v in value)
-            else:
-                member.value = value
+    def set_uniforms(self, program: moderngl.Program, values: dict[str, Any]) -> None:
+        """Set the values ``program`` has (no strict check: :meth:`bind` does that); a value
+        the program holds already is not written again."""
+        self.shaders.uniforms(program).set(values)
 
     def bind_compute(self, shader: moderngl.ComputeShader, uniforms: dict[str, Any],
                      textures: dict[str, moderngl.Texture], *,
@@ -303,19 +312,13 @@ class Frame:
             if unknown:
                 raise RenderError(f"compute shader {self.shaders.describe(shader)} declares "
                                   f"no uniform {', '.join(repr(n) for n in unknown)}")
-        for name, value in {**(offered or {}), **uniforms}.items():
-            if name not in shader:
-                continue
-            if isinstance(value, np.ndarray) and value.ndim == 2:
-                shader[name].write(gl_bytes(value))
-            elif isinstance(value, np.ndarray):
-                shader[name].value = tuple(float(v) for v in value)
-            else:
-                shader[name].value = value
+        shader_uniforms = self.shaders.uniforms(shader)
+        shader_uniforms.set_shared("camera", self.camera_values)
+        shader_uniforms.set({**(offered or {}), **uniforms})
         for unit, (name, texture) in enumerate(textures.items()):
-            if name in shader:
+            if name in shader_uniforms.members:
                 texture.use(location=unit)
-                shader[name].value = unit
+                shader_uniforms.set_one(name, unit)
 
     def check_material_uniforms(self) -> None:
         """Strict mode, at the end of a frame: every uniform a material sets is declared by at
@@ -348,17 +351,18 @@ class Frame:
 
     def target_samplers(self, names) -> dict[str, moderngl.Texture]:
         """Targets by the sampler names shaders use for them: ``u_<target name>``."""
-        return {f"u_{name}": self.target(name) for name in names}
+        return {f"u_{name}": self.target(name) for name in names} if names else {}
 
     # -- drawing -------------------------------------------------------------------------------
     def count_draw(self) -> None:
         """Count a draw call of the running pass (passes drawing by other means call it)."""
         self.stats.draw_calls += 1
-        name = self.current_pass.name if self.current_pass is not None else ""
-        self.stats.draws_by_pass[name] = self.stats.draws_by_pass.get(name, 0) + 1
 
     def gl_call(self, call: Callable[[], Any]) -> Any:
-        """Run a drawing GL call, its time counted apart (``FrameStats.gl_call_seconds``)."""
+        """Run a drawing GL call, its time counted apart (``FrameStats.gl_call_seconds``)
+        when the frame measures it."""
+        if not self.time_gl_calls:
+            return call()
         start = time.thread_time()
         try:
             return call()
@@ -377,18 +381,34 @@ class Frame:
 
     def use_framebuffer(self, colors: tuple[str, ...] | list[str], depth: str | None = None,
                         depth_write: bool = True) -> moderngl.Framebuffer:
-        for name in (*colors, *((depth,) if depth else ())):
-            self.target(name)  # declared by the pass, and existing
-        fbo = self.targets.framebuffer(colors, depth)
-        fbo.use()
+        colors = tuple(colors)
+        request = (id(self.current_pass), colors, depth)
+        checked = self.resources.checked_framebuffers
+        if request not in checked:
+            for name in (*colors, *((depth,) if depth else ())):
+                self.target(name)  # declared by the pass, and existing
+            checked[request] = self.current_pass  # kept alive: its id stays its own
+        fbo = self._framebuffers.get(request[1:])
+        if fbo is None:  # once a frame: the targets' scissor is set on it then
+            fbo = self._framebuffers[request[1:]] = self.targets.framebuffer(colors, depth)
+        if self.ctx.fbo is not fbo:
+            fbo.use()
         fbo.depth_mask = depth_write
-        self.ctx.viewport = (0, 0, *fbo.size)
+        full = (0, 0, *fbo.size)
+        if fbo.viewport != full:
+            fbo.viewport = full
         return fbo
 
     def set_state(self, depth_test: bool = False, depth_func: str = "less",
                   cull: str | None = None, blend: str | None = None,
                   depth_offset: tuple[float, float] = (0.0, 0.0)) -> None:
-        """Set the fixed-function state a pass needs; every pass states all of it."""
+        """Set the fixed-function state a pass needs; every pass states all of it. The frame
+        sets GL state only here and in :meth:`set_depth_offset`, so a pass stating what the
+        last one did sets nothing (one program drawing many objects)."""
+        state = (depth_test, depth_func, cull, blend, depth_offset)
+        if state == self._state:
+            return
+        self._state = state
         self.ctx.polygon_offset = depth_offset
         flags = moderngl.NOTHING
         if depth_test:
@@ -402,3 +422,11 @@ class Frame:
             self.ctx.blend_func = BLEND_MODES[blend]
             self.ctx.blend_equation = moderngl.FUNC_ADD
         self.ctx.enable_only(flags)
+
+    def set_depth_offset(self, depth_offset: tuple[float, float]) -> None:
+        """Change only the depth offset (``glPolygonOffset``) of the state the pass set, for
+        draws of one pass that differ in it (the root shell)."""
+        if self._state is None or self._state[4] != depth_offset:
+            self.ctx.polygon_offset = depth_offset
+        if self._state is not None:
+            self._state = (*self._state[:4], depth_offset)

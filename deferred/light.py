@@ -192,13 +192,12 @@ class LightTypePass(RenderPass):
         if self.occlusion:
             textures["u_ssao"] = frame.target(self.occlusion)
         uniforms = {"u_light_offset": offset}
-        camera = frame.camera_uniforms()
         if sphere:
             # Back faces of the bounding sphere, kept where the surface lies in front of them:
             # works with the camera inside the volume; depth clamp stops the far plane cutting it.
             mesh, scale = light_volume_mesh()
             frame.set_state(depth_test=True, depth_func="gequal", cull="front", blend="add")
-            frame.bind(program, {**uniforms, "u_volume_scale": scale}, textures, offered=camera)
+            frame.bind(program, {**uniforms, "u_volume_scale": scale}, textures)
             frame.ctx.enable_direct(GL_DEPTH_CLAMP)
             try:
                 frame.draw_mesh(mesh, program, instances=count)
@@ -206,7 +205,7 @@ class LightTypePass(RenderPass):
                 frame.ctx.disable_direct(GL_DEPTH_CLAMP)
         else:
             frame.set_state(blend="add")
-            frame.bind(program, uniforms, textures, offered=camera)
+            frame.bind(program, uniforms, textures)
             frame.draw_fullscreen(program, instances=count)
 
 

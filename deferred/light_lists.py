@@ -44,6 +44,7 @@ from .passes import FullscreenPass, Order, Phase, RenderPass
 if TYPE_CHECKING:
     from .context import Features
     from .frame import Frame
+    from .uniforms import ProgramUniforms
 
 DEFERRED_PATHS = ("volumes", "tiled", "clustered")
 FORWARD_PATHS = ("naive", "tiled")
@@ -151,6 +152,10 @@ class LightLists:
         self.capacity = max(capacity, 1)
         self.clustered = grid.slices > 1
         self.depth_scale = (near, grid.slices / math.log(far / near))
+        self._uniforms = {"u_list_count": grid.count, "u_list_capacity": self.capacity,
+                          "u_list_row_shift": LIST_ROW_SHIFT,
+                          "u_list_grid": (grid.columns, grid.rows, grid.slices),
+                          "u_list_tile": grid.tile, "u_list_depth": self.depth_scale}
         size = list_bytes(grid, self.capacity)
         limit = list_byte_limit(self.max_texture_size)
         if size > limit:  # checked before the first frame (check_light_limits)
@@ -180,25 +185,21 @@ class LightLists:
         self.buffer.clear(size=4 * self.grid.count)
 
     def uniforms(self) -> dict[str, Any]:
+        """The lists' uniforms this frame (one dict per :meth:`prepare`: programs skip it while
+        they hold its values)."""
         assert self.grid is not None
-        return {"u_list_count": self.grid.count, "u_list_capacity": self.capacity,
-                "u_list_row_shift": LIST_ROW_SHIFT,
-                "u_list_grid": (self.grid.columns, self.grid.rows, self.grid.slices),
-                "u_list_tile": self.grid.tile, "u_list_depth": self.depth_scale}
+        return self._uniforms
 
-    def bind(self, program, texture_unit: int, members: frozenset[str] | None = None) -> None:
+    def bind(self, uniforms: ProgramUniforms, texture_unit: int) -> None:
         """Set the list uniforms, bind the buffer (culling) and the texture (shading, at
         ``texture_unit``) for a program using the lists."""
-        members = frozenset(program) if members is None else members
-        if self.buffer is None or "u_list_count" not in members:
+        if self.buffer is None or "u_list_count" not in uniforms.members:
             return
         self.buffer.bind_to_storage_buffer(1)
-        if "u_light_list_texture" in members:
+        if "u_light_list_texture" in uniforms.members:
             self.texture.use(location=texture_unit)
-            program["u_light_list_texture"].value = texture_unit
-        for name, value in self.uniforms().items():
-            if name in members:
-                program[name].value = value
+            uniforms.set_one("u_light_list_texture", texture_unit)
+        uniforms.set_shared("light_lists", self.uniforms())
 
     def counts(self) -> np.ndarray:
         """The list lengths of the last frame (host copy; tests and statistics)."""
@@ -247,7 +248,7 @@ class LightCullPass(RenderPass):
             textures["u_linear_depth"] = frame.target(LINEAR_DEPTH)
             uniforms["u_pixel_to_view"] = pixel_to_view(frame.projection, frame.width,
                                                         frame.height)
-        frame.bind_compute(shader, uniforms, textures, offered=frame.camera_uniforms())
+        frame.bind_compute(shader, uniforms, textures)
         if self.clustered:
             groups = (max(1, math.ceil(lights.local_count / 64)), 1, 1)
         else:

@@ -12,13 +12,17 @@ GL level: llvmpipe fetches texels about 3.4 times as fast as storage-buffer vec4
 from __future__ import annotations
 
 import itertools
+from typing import TYPE_CHECKING, Any
 
 import moderngl
 import numpy as np
 
 from .context import Features
 from .errors import InputError
-from .light import RANGE_UNIFORM_PREFIX, Light, light_range_uniform
+from .light import Light, light_range_uniform
+
+if TYPE_CHECKING:
+    from .uniforms import ProgramUniforms
 
 RECORD_VEC4S = 4
 
@@ -45,6 +49,7 @@ class LightBuffer:
         self.culled = 0  # volume lights dropped this frame: outside the view
         self.ranges: dict[type[Light], tuple[int, int]] = {}
         self._range_uniforms: dict[str, tuple[int, int]] = {}
+        self._uniforms: dict[str, Any] = {}  # what ``bind`` sets
         self._texture: moderngl.Texture | None = None
         self._capacity = 0
 
@@ -79,8 +84,15 @@ class LightBuffer:
                projection: np.ndarray | None = None) -> None:
         records, self.ranges, self.global_count = self.pack(lights, view, projection)
         self.count = sum(count for _, count in self.ranges.values())
-        self._range_uniforms = {light_range_uniform(light_type): span
-                                for light_type, span in self.ranges.items()}
+        # every type's range, (0, 0) for a type with no light this frame (all culled), and for
+        # a type of an earlier frame: a program keeps the value it was given last
+        self._range_uniforms = {**dict.fromkeys(self._range_uniforms, (0, 0)),
+                                **dict.fromkeys(map(light_range_uniform, map(type, lights)),
+                                                (0, 0)),
+                                **{light_range_uniform(light_type): span
+                                   for light_type, span in self.ranges.items()}}
+        self._uniforms = {"u_light_count": self.count, "u_global_light_count": self.global_count,
+                          **self._range_uniforms}
         self.culled = len(lights) - self.count
         rows = len(records)
         limit = int(self.ctx.info["GL_MAX_TEXTURE_SIZE"])
@@ -107,20 +119,13 @@ class LightBuffer:
         """The records' texture (``u_lights``), for compute shaders to sample."""
         return self._texture
 
-    def bind(self, program: moderngl.Program, texture_unit: int,
-             members: frozenset[str] | None = None) -> None:
-        members = frozenset(program) if members is None else members
-        if "u_light_count" in members:
-            program["u_light_count"].value = self.count
-        if "u_global_light_count" in members:
-            program["u_global_light_count"].value = self.global_count
-        for name in members:
-            # every type's range, (0, 0) for a type with no light this frame (all culled)
-            if name.startswith(RANGE_UNIFORM_PREFIX):
-                program[name].value = self._range_uniforms.get(name, (0, 0))
-        if "u_lights" in members:
+    def bind(self, uniforms: ProgramUniforms, texture_unit: int) -> None:
+        """Set the counts and ranges on a program, and bind the records at ``texture_unit``
+        where it reads them."""
+        uniforms.set_shared("lights", self._uniforms)  # a new dict each frame
+        if "u_lights" in uniforms.members:
             self._texture.use(location=texture_unit)
-            program["u_lights"].value = texture_unit
+            uniforms.set_one("u_lights", texture_unit)
 
     def _release_storage(self) -> None:
         if self._texture is not None:

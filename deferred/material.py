@@ -117,9 +117,15 @@ class Material:
 
     def defines(self, obj: SceneObject) -> dict[str, str]:
         """Preprocessor defines of this material's programs for ``obj``."""
-        names = [data.name for data in material_data(self)]
-        return {"SURFACE_FILE": f'"{self.surface_shader}"',
+        # every pass of every object asks, every frame: made once (the class, its shading
+        # model and so its data never change), copied for the caller to extend
+        base = self.__dict__.get("_base_defines")
+        if base is None:
+            names = [data.name for data in material_data(self)]
+            base = self.__dict__["_base_defines"] = {
+                "SURFACE_FILE": f'"{self.surface_shader}"',
                 "GBUFFER_DATA_WRITE": f'"{data_write_file(names)}"'}
+        return dict(base)
 
     def gbuffer_targets(self) -> tuple[str, ...]:
         """The targets this material's G-buffer passes write: the core G-buffer, then its data
@@ -128,13 +134,23 @@ class Material:
 
     def surface_id(self) -> int:
         """The G-buffer id of this material's pixels: its shading model and its type id."""
-        from . import registry
+        key = (self.type_id, self.shading_model)
+        cached = self.__dict__.get("_surface_id")  # asked for by every object, every frame
+        if cached is None or cached[0] != key:
+            from . import registry
 
-        return surface_id(self.type_id, registry.shading_models.get(self.shading_model).type_id)
+            model_id = registry.shading_models.get(self.shading_model).type_id
+            cached = self.__dict__["_surface_id"] = (key, surface_id(self.type_id, model_id))
+        return cached[1]
 
     def uniforms(self, frame: Frame) -> dict[str, Any]:
         """``u_<field>`` for every parameter that is a uniform (``uniform_overrides``)."""
-        return params_uniforms(self.params, self.uniform_overrides)
+        # params are frozen and replaced whole (a timeline event): made once per params
+        cached = self.__dict__.get("_params_uniforms")
+        if cached is None or cached[0] is not self.params:
+            cached = self.__dict__["_params_uniforms"] = (
+                self.params, params_uniforms(self.params, self.uniform_overrides))
+        return dict(cached[1])
 
     def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
         return {}

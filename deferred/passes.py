@@ -142,8 +142,7 @@ class FullscreenPass(RenderPass):
         frame.use_framebuffer(self.outputs, self.depth, depth_write=self.depth_write)
         frame.set_state(depth_test=self.depth_test, depth_func=self.depth_func, blend=self.blend)
         frame.bind(program, self.uniforms(frame) if self.uniforms else {},
-                   {u: frame.target(t) for u, t in self.inputs.items()},
-                   offered=frame.camera_uniforms())
+                   {u: frame.target(t) for u, t in self.inputs.items()})
         count = self.instances(frame) if self.instances else 1
         if count > 0:
             frame.draw_fullscreen(program, instances=count)
@@ -180,6 +179,7 @@ class ObjectPass(RenderPass):
     extra_reads: tuple[str, ...] = ()
     constants: dict[str, Any] | None = None  # uniforms fixed at construction
     extra_defines: dict[str, str] | None = None
+    _program_memo: tuple | None = None
 
     def __init__(self, name: str, phase: Phase, obj: SceneObject, **options: Any):
         self.name = name
@@ -220,8 +220,15 @@ class ObjectPass(RenderPass):
         frame.draw_mesh(self.obj.mesh, program)
 
     def program(self, frame: Frame) -> moderngl.Program:
-        return frame.shaders.program(self.vertex, self.fragment, self.geometry,
-                                     defines=self.defines(frame))
+        defines = self.defines(frame)
+        shaders = frame.shaders
+        memo = self._program_memo  # the last lookup: the same defines give the same program
+        if memo is not None and memo[0] is shaders and memo[1] == shaders.generation and \
+                memo[2] == defines:
+            return memo[3]
+        program = shaders.program(self.vertex, self.fragment, self.geometry, defines=defines)
+        self._program_memo = (shaders, shaders.generation, defines, program)
+        return program
 
     def execute(self, frame: Frame) -> None:
         program = self.program(frame)
@@ -241,7 +248,7 @@ class ObjectPass(RenderPass):
             if bound:  # everything else is set already: only what changes per draw
                 frame.set_uniforms(program, per_draw)
             else:
-                frame.bind(program, {**uniforms, **per_draw}, textures, offered=offered,
-                           material=material)
+                frame.bind(program, {**uniforms, **per_draw} if per_draw else uniforms,
+                           textures, offered=offered, material=material)
                 bound = True
             self.draw(frame, program)

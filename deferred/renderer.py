@@ -34,7 +34,7 @@ class RenderResult:
     hdr: np.ndarray | None  # (H, W, 4) float32, linear composite, top row first
     draw_calls: int
     draws_by_pass: dict[str, int]
-    gl_call_seconds: float = 0.0  # inside drawing GL calls (FrameStats)
+    gl_call_seconds: float = 0.0  # inside drawing GL calls (FrameStats; time_gl_calls only)
 
 
 def strict_default() -> bool:
@@ -176,11 +176,12 @@ class Renderer:
 
     def render(self, on_pass: PassCallback | None = None,
                before_pass: PassCallback | None = None, readback: bool = True,
-               time: float = 0.0) -> RenderResult:
+               time: float = 0.0, time_gl_calls: bool = False) -> RenderResult:
         """Run every pass once for the frame at ``time`` (seconds: the scene's timeline is
         applied first, and passes see it as ``frame.time``). ``on_pass``/``before_pass`` are
         called around each pass; ``readback=False`` skips reading the images back (timing
-        loops)."""
+        loops); ``time_gl_calls`` measures the CPU time of the drawing GL calls
+        (``RenderResult.gl_call_seconds``, for the bench: two clock reads per call)."""
         time = float(time)
         if not math.isfinite(time):
             raise InputError(f"frame time must be a finite number of seconds, got {time}", "time")
@@ -191,12 +192,15 @@ class Renderer:
         stale = ctx.error  # reading clears it: errors from here on are this frame's
         if stale != "GL_NO_ERROR":
             warnings.warn(f"GL error {stale} left by code outside the renderer", stacklevel=2)
+        self.shaders.forget_uniform_values()  # code between frames may have written them
         frame = Frame(self.gl, self.shaders, self.targets, self.resources, self.scene,
                       self.light_buffer, strict=self.strict, light_lists=self.light_lists,
-                      time=time)
+                      time=time, time_gl_calls=time_gl_calls)
         self.light_buffer.upload(self.scene.lights, frame.view, frame.projection)
         self._check_gl("uploading the lights")
         for render_pass in self.passes:
+            if type(render_pass).prepare is RenderPass.prepare:
+                continue  # nothing to prepare (most passes: skipping them saves a GL error read)
             try:
                 render_pass.prepare(frame)
             except DeferredError:

@@ -21,6 +21,7 @@ from pathlib import Path
 import moderngl
 
 from .errors import ShaderError
+from .uniforms import ProgramUniforms
 
 MAX_INCLUDE_DEPTH = 16
 
@@ -75,7 +76,12 @@ class ShaderLibrary:
         self._programs: dict[tuple, moderngl.Program] = {}
         self._declared: dict[int, frozenset[str]] = {}  # program glo -> declared uniform names
         self._labels: dict[int, str] = {}  # program glo -> its files, for messages
-        self._members: dict[int, frozenset[str]] = {}  # program glo -> active member names
+        # program glo -> its active uniforms and the values last written to them
+        self._uniforms: dict[int, ProgramUniforms] = {}
+        self._virtual_key: tuple[str, ...] = ()  # the virtual files' names, in program keys
+        # counts the times programs were released: a program looked up before is still valid
+        # while it is unchanged
+        self.generation = 0
 
     # -- files -------------------------------------------------------------------------------
     def add_root(self, root: Traversable | Path) -> None:
@@ -87,8 +93,12 @@ class ShaderLibrary:
         """Provide generated GLSL under ``name`` (e.g. the light dispatch of the registry)."""
         if self.virtual_files.get(name) != text:
             self.virtual_files[name] = text
+            self._virtual_key = tuple(sorted(self.virtual_files))
+            self.generation += 1
             for key in [k for k in self._programs if name in k[-1]]:
-                self._programs.pop(key).release()
+                program = self._programs.pop(key)
+                self._uniforms.pop(program.glo, None)
+                program.release()
 
     def read(self, name: str) -> str:
         if name in self.virtual_files:
@@ -142,9 +152,9 @@ class ShaderLibrary:
     def program(self, vertex: str, fragment: str | None = None, geometry: str | None = None,
                 defines: dict[str, str] | None = None) -> moderngl.Program:
         """Compile (or return the cached) program of these files with these defines."""
-        defines = dict(defines or {})
-        key = (vertex, fragment, geometry, tuple(sorted(defines.items())),
-               tuple(sorted(self.virtual_files)))
+        defines = defines or {}
+        # a frozenset of the defines: hashing it is cheaper than sorting them on every lookup
+        key = (vertex, fragment, geometry, frozenset(defines.items()), self._virtual_key)
         cached = self._programs.get(key)
         if cached is not None:
             return cached
@@ -160,7 +170,7 @@ class ShaderLibrary:
         self._declared[program.glo] = frozenset(
             name for source in sources.values() for name in declared_uniforms(source.text))
         self._labels[program.glo] = " + ".join(n for n in stages.values() if n is not None)
-        self._members[program.glo] = frozenset(program)
+        self._uniforms[program.glo] = ProgramUniforms(program)
         return program
 
     def declared_uniforms(self, program: moderngl.Program) -> frozenset[str]:
@@ -192,18 +202,28 @@ class ShaderLibrary:
 
     def members(self, program) -> frozenset[str]:
         """The program's active uniforms and blocks (``name in program`` walks them all)."""
-        members = self._members.get(program.glo)
-        if members is None:
-            members = self._members[program.glo] = frozenset(program)
-        return members
+        return self.uniforms(program).members
+
+    def uniforms(self, program) -> ProgramUniforms:
+        """The program's uniforms, written only when their values change."""
+        uniforms = self._uniforms.get(program.glo)
+        if uniforms is None:
+            uniforms = self._uniforms[program.glo] = ProgramUniforms(program)
+        return uniforms
+
+    def forget_uniform_values(self) -> None:
+        """Forget what each program holds (a frame starts: code between frames may have
+        written uniforms directly)."""
+        for uniforms in self._uniforms.values():
+            uniforms.forget()
 
     def describe(self, program: moderngl.Program) -> str:
         return self._labels.get(program.glo, "<program>")
 
     def compute(self, name: str, defines: dict[str, str] | None = None) -> moderngl.ComputeShader:
         """Compile (or return the cached) compute shader of this file with these defines."""
-        defines = dict(defines or {})
-        key = ("compute", name, tuple(sorted(defines.items())), tuple(sorted(self.virtual_files)))
+        defines = defines or {}
+        key = ("compute", name, frozenset(defines.items()), self._virtual_key)
         cached = self._programs.get(key)
         if cached is not None:
             return cached
@@ -216,8 +236,8 @@ class ShaderLibrary:
         self._programs[key] = shader
         self._declared[shader.glo] = frozenset(declared_uniforms(source.text))
         self._labels[shader.glo] = name
-        self._members[shader.glo] = frozenset(
-            name for name in declared_uniforms(source.text) if name in shader)
+        self._uniforms[shader.glo] = ProgramUniforms(shader, frozenset(
+            name for name in declared_uniforms(source.text) if name in shader))
         return shader
 
     @staticmethod
@@ -252,12 +272,13 @@ class ShaderLibrary:
         return f"{head}: {detail}" if not detail.startswith(head) else detail
 
     def release(self) -> None:
+        self.generation += 1
         for program in self._programs.values():
             program.release()
         self._programs.clear()
         self._declared.clear()
         self._labels.clear()
-        self._members.clear()
+        self._uniforms.clear()
 
 
 def _folder_entries(root: Traversable | Path, folder: str) -> list[Traversable]:

@@ -50,6 +50,6 @@ class ShellPass(ObjectPass):
         # The root shell lies on the base mesh: pulled toward the eye it wins the depth test
         # even where obliteration restored a neighbour's depth. Only it: an offset on the
         # outer shells would pull them through occluders at grazing angles.
-        frame.ctx.polygon_offset = ROOT_OFFSET if self._root else (0.0, 0.0)
+        frame.set_depth_offset(ROOT_OFFSET if self._root else (0.0, 0.0))
         super().draw(frame, program)
-        frame.ctx.polygon_offset = (0.0, 0.0)
+        frame.set_depth_offset((0.0, 0.0))

@@ -310,3 +310,19 @@ def test_a_types_records_in_one_go_are_each_lights_record(kind):
     np.testing.assert_allclose(together, expected, rtol=1e-6, atol=1e-6)
     np.testing.assert_allclose(made[0].record(view), together[0], rtol=1e-6, atol=1e-6)
     assert cls.records([], view).shape == (0, 4, 4)
+
+
+def test_a_light_type_gone_from_the_scene_adds_no_light(gl):
+    # Programs keep the range their light type was given last: a type removed from the scene
+    # between frames must get an empty range, as one culled does.
+    scene = scene_with(0)
+    with Renderer(scene, "forward", gl=gl, light_path="naive") as renderer:
+        lit = renderer.render().hdr
+        renderer.scene.lights = [light for light in scene.lights
+                                 if type(light).__name__ != "SpotLight"]
+        later = renderer.render().hdr
+    assert len(scene.lights) == len(ALL_TYPES) - 1
+    with Renderer(scene, "forward", gl=gl, light_path="naive") as renderer:
+        fresh = renderer.render().hdr
+    assert not np.array_equal(lit, fresh)  # the spot light did reach it
+    np.testing.assert_array_equal(later, fresh)

@@ -1,0 +1,102 @@
+"""Writing a program's uniforms, each only when its value changes.
+
+GL keeps uniform values per program. A pass drawing many objects with one program (every
+``standard`` object's G-buffer pass) used to write the camera, the light ranges and the material
+again for each object; now only what differs from the program's last values reaches GL, and a
+value is converted once (matrices to column-major bytes).
+
+The values a :class:`ProgramUniforms` remembers are right only while every write to the program
+goes through it: the frame writes uniforms only through here, and forgets the values when a frame
+starts (``ShaderLibrary.forget_uniform_values``), so code between frames may write a program
+directly.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import moderngl
+import numpy as np
+
+_UNSET = object()
+
+
+def gl_value(value: Any) -> Any:
+    """``value`` as moderngl takes it: a 2-D array becomes column-major float32 bytes (GLSL's
+    matrix order), a 1-D array a tuple of floats; bytes (a matrix already converted) and
+    numbers stay as they are."""
+    if isinstance(value, np.ndarray):
+        if value.ndim == 0:
+            return value.item()
+        if value.ndim == 2:
+            return np.ascontiguousarray(value.T, dtype=np.float32).tobytes()
+        return tuple(float(v) for v in value)
+    return value
+
+
+class ProgramUniforms:
+    """The active uniforms of one program and the values last written to them.
+
+    :meth:`set_shared` takes a dict many passes of a frame share (the camera, the light
+    counts): while the program still holds that very dict's values it is not even looked
+    through, which is most of the saving for a program drawing many objects.
+    """
+
+    __slots__ = ("members", "_program", "_handles", "_values", "_shared", "_owner")
+
+    def __init__(self, program: moderngl.Program | moderngl.ComputeShader,
+                 members: frozenset[str] | None = None):
+        self._program = program
+        # uniforms and blocks (``name in program`` walks every member each time)
+        self.members: frozenset[str] = frozenset(program) if members is None else members
+        self._handles: dict[str, Any] = {}
+        self._values: dict[str, Any] = {}
+        self._shared: dict[str, Mapping[str, Any]] = {}  # group -> the dict the program holds
+        self._owner: dict[str, str] = {}  # uniform name -> the group it was last set by
+
+    def set(self, values: Mapping[str, Any], _group: str | None = None) -> None:
+        """Write the values the program has and does not hold already; names it lacks are
+        skipped (:meth:`Frame.bind` checks them in strict mode)."""
+        held = self._values
+        for name in values.keys() & self.members:
+            value = values[name]
+            if isinstance(value, np.ndarray):
+                value = gl_value(value)
+            if held.get(name, _UNSET) != value:
+                self._write(name, value, _group)
+
+    def set_shared(self, group: str, values: Mapping[str, Any]) -> None:
+        """:meth:`set` for a dict shared by many passes, skipped while the program holds its
+        values (the dict must not change while it is in use: pass a new one instead)."""
+        if self._shared.get(group) is values:
+            return
+        self.set(values, group)
+        for name in values:
+            self._owner[name] = group
+        self._shared[group] = values
+
+    def set_one(self, name: str, value: Any) -> None:
+        """Write one value the program has (one it lacks is skipped)."""
+        if name in self.members:
+            value = gl_value(value)
+            if self._values.get(name, _UNSET) != value:
+                self._write(name, value, None)
+
+    def _write(self, name: str, value: Any, group: str | None) -> None:
+        handle = self._handles.get(name)
+        if handle is None:
+            handle = self._handles[name] = self._program[name]
+        if isinstance(value, bytes):
+            handle.write(value)
+        else:
+            handle.value = value
+        self._values[name] = value
+        owner = self._owner.get(name)
+        if owner is not None and owner != group:  # a shared dict's value overwritten
+            self._shared.pop(owner, None)
+
+    def forget(self) -> None:
+        """Drop the remembered values: the next write of each name reaches GL."""
+        self._values.clear()
+        self._shared.clear()

@@ -1,0 +1,109 @@
+"""Uniforms written only when they change (deferred.uniforms) and the frame's GL state memo: what
+the program and the context end up holding is what the last caller asked for."""
+
+import numpy as np
+import pytest
+
+from deferred.uniforms import ProgramUniforms, gl_value
+
+VERTEX = """#version 330
+uniform mat4 u_view;
+uniform vec3 u_color;
+uniform float u_x;
+void main() { gl_Position = u_view * vec4(u_color * u_x, 1.0); }
+"""
+FRAGMENT = """#version 330
+out vec4 colour;
+void main() { colour = vec4(1.0); }
+"""
+
+
+@pytest.fixture
+def program(gl):
+    made = gl.ctx.program(vertex_shader=VERTEX, fragment_shader=FRAGMENT)
+    yield made
+    made.release()
+
+
+class CountingUniforms(ProgramUniforms):
+    """Counts the writes that reach GL."""
+
+    __slots__ = ("writes",)
+
+    def __init__(self, program):
+        super().__init__(program)
+        self.writes = []
+
+    def _write(self, name, value, group):
+        self.writes.append(name)
+        super()._write(name, value, group)
+
+
+def test_a_value_the_program_holds_is_not_written_again(program):
+    uniforms = CountingUniforms(program)
+    view = np.arange(16, dtype=np.float64).reshape(4, 4)
+    uniforms.set({"u_view": view, "u_color": (1.0, 2.0, 3.0), "u_x": 0.5, "u_unknown": 1.0})
+    assert sorted(uniforms.writes) == ["u_color", "u_view", "u_x"]  # unknown names skipped
+    uniforms.set({"u_view": view.copy(), "u_color": (1.0, 2.0, 3.0), "u_x": 0.5})
+    assert len(uniforms.writes) == 3
+    uniforms.set({"u_view": view, "u_color": (1.0, 2.0, 3.0), "u_x": 0.25})
+    assert uniforms.writes[3:] == ["u_x"]
+    assert program["u_x"].value == pytest.approx(0.25)
+    # matrices reach GL column-major (GLSL's order), as gl_value converts them
+    stored = np.array(program["u_view"].value, dtype=np.float32)
+    np.testing.assert_array_equal(stored, view.T.reshape(-1))
+    assert gl_value(view) == np.ascontiguousarray(view.T, np.float32).tobytes()
+
+
+def test_a_shared_dict_is_set_again_after_a_pass_overwrote_one_of_its_values(program):
+    uniforms = CountingUniforms(program)
+    camera = {"u_x": 1.0, "u_color": (0.0, 1.0, 0.0)}
+    uniforms.set_shared("camera", camera)
+    uniforms.set_shared("camera", camera)
+    assert len(uniforms.writes) == 2  # the second time: skipped whole
+    uniforms.set({"u_x": 3.0})  # a pass's own value for a camera name
+    assert program["u_x"].value == pytest.approx(3.0)
+    uniforms.set_shared("camera", camera)
+    assert program["u_x"].value == pytest.approx(1.0)
+    assert uniforms.writes[2:] == ["u_x", "u_x"]  # only the overwritten value, twice
+
+
+def test_forgotten_values_are_written_again(program):
+    # between frames code may write a program directly; the frame forgets what it wrote
+    uniforms = ProgramUniforms(program)
+    uniforms.set({"u_x": 1.0})
+    program["u_x"].value = 7.0
+    uniforms.forget()
+    uniforms.set({"u_x": 1.0})
+    assert program["u_x"].value == pytest.approx(1.0)
+
+
+def test_the_state_memo_sets_what_a_pass_states(render):
+    # A pass stating the last pass's state sets nothing; one changing only the depth offset
+    # between draws (the root shell) must not leave the next pass with its offset.
+    from deferred.scene import load_scene
+
+    _, renderer = render(load_scene("builtin:demo"), size=(32, 18))
+    frame = renderer.last_frame
+    ctx = frame.ctx
+    frame.set_state(depth_test=True, cull="back", depth_offset=(1.0, 2.0))
+    assert ctx.polygon_offset == (1.0, 2.0)
+    frame.set_depth_offset((0.0, 0.0))
+    assert ctx.polygon_offset == (0.0, 0.0)
+    frame.set_state(depth_test=True, cull="back", depth_offset=(1.0, 2.0))
+    assert ctx.polygon_offset == (1.0, 2.0)
+    frame.set_state(blend="add")
+    assert ctx.polygon_offset == (0.0, 0.0)
+
+
+def test_gl_call_times_are_measured_only_when_asked(render):
+    from deferred.scene import load_scene
+
+    result, renderer = render(load_scene("builtin:overdraw"), size=(64, 36))
+    assert result.gl_call_seconds == 0.0
+    timed = renderer.render(time_gl_calls=True)
+    assert timed.gl_call_seconds > 0.0
+    np.testing.assert_array_equal(timed.hdr, result.hdr)
+    assert timed.draws_by_pass == result.draws_by_pass
+    assert sum(result.draws_by_pass.values()) == result.draw_calls
+
