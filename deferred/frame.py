@@ -149,7 +149,8 @@ class Frame:
     def __init__(self, gl: GLContext, shaders: ShaderLibrary, targets: FrameTargets,
                  resources: Resources, scene: Scene, light_buffer: LightBuffer,
                  strict: bool = False, light_lists: LightLists | None = None,
-                 time: float = 0.0, time_gl_calls: bool = False):
+                 time: float = 0.0, time_gl_calls: bool = False,
+                 shading_models: list | None = None):
         self.gl = gl
         self.time = float(time)  # seconds: the scene's timeline is applied at this time
         self.light_lists = light_lists
@@ -170,13 +171,15 @@ class Frame:
                               for name, value in self.camera_uniforms().items()}
         self.stats = FrameStats()
         self.time_gl_calls = time_gl_calls  # FrameStats.gl_call_seconds
+        # the scene's shading models (the renderer's, found once: a walk over every object)
+        self._shading_models = shading_models
         self.current_pass: RenderPass | None = None
         self._materials: dict[int, MaterialInputs] = {}
         self._objects: dict[int, dict[str, Any]] = {}
         self._shading_textures: dict[str, moderngl.Texture] | None = None
         # what this frame set last: a pass stating the same is not set again (set_state)
         self._state: tuple | None = None
-        self._framebuffers: dict[tuple, moderngl.Framebuffer] = {}
+        self._framebuffers: dict[tuple, tuple[moderngl.Framebuffer, tuple]] = {}
 
     # -- passes --------------------------------------------------------------------------------
     def run_pass(self, render_pass: RenderPass) -> None:
@@ -184,8 +187,9 @@ class Frame:
         self.current_pass = render_pass
         draws_before = self.stats.draw_calls
         try:
-            for name in render_pass.creates:
-                self.gl_call(lambda name=name: self.targets.clear(name))
+            if render_pass.creates:
+                for name in render_pass.creates:
+                    self.gl_call(lambda name=name: self.targets.clear(name))
             render_pass.execute(self)
         except InputError:
             raise
@@ -245,7 +249,8 @@ class Frame:
         """Samplers of the scene's shading models (ramps...), offered wherever lights run."""
         if self._shading_textures is None:
             self._shading_textures = {}
-            for model in self.scene.shading_models():
+            models = self._shading_models
+            for model in self.scene.shading_models() if models is None else models:
                 self._shading_textures.update(model.textures(self))
         return self._shading_textures
 
@@ -370,9 +375,12 @@ class Frame:
             self.stats.gl_call_seconds += time.thread_time() - start
 
     def draw_mesh(self, mesh: MeshData, program: moderngl.Program, instances: int = 1) -> None:
-        gpu = self.resources.gpu_mesh(mesh)
-        self.gl_call(lambda: gpu.render(program, instances=instances))
-        self.count_draw()
+        vertex_array = self.resources.gpu_mesh(mesh).vertex_array(program)
+        if self.time_gl_calls:
+            self.gl_call(lambda: vertex_array.render(moderngl.TRIANGLES, instances=instances))
+        else:
+            vertex_array.render(moderngl.TRIANGLES, instances=instances)
+        self.stats.draw_calls += 1
 
     def draw_fullscreen(self, program: moderngl.Program, instances: int = 1) -> None:
         vao = self.resources.fullscreen_vertex_array(program)
@@ -381,20 +389,21 @@ class Frame:
 
     def use_framebuffer(self, colors: tuple[str, ...] | list[str], depth: str | None = None,
                         depth_write: bool = True) -> moderngl.Framebuffer:
-        colors = tuple(colors)
-        request = (id(self.current_pass), colors, depth)
+        key = (tuple(colors), depth)
+        request = (id(self.current_pass), key)
         checked = self.resources.checked_framebuffers
         if request not in checked:
             for name in (*colors, *((depth,) if depth else ())):
                 self.target(name)  # declared by the pass, and existing
             checked[request] = self.current_pass  # kept alive: its id stays its own
-        fbo = self._framebuffers.get(request[1:])
-        if fbo is None:  # once a frame: the targets' scissor is set on it then
-            fbo = self._framebuffers[request[1:]] = self.targets.framebuffer(colors, depth)
-        if self.ctx.fbo is not fbo:
-            fbo.use()
+        known = self._framebuffers.get(key)
+        if known is None:  # once a frame: the targets' scissor is set on it then
+            fbo = self.targets.framebuffer(colors, depth)
+            known = self._framebuffers[key] = (fbo, (0, 0, *fbo.size))
+        fbo, full = known
+        if self.ctx.fbo is not fbo:  # binding a framebuffer ends llvmpipe's scene: GL work
+            self.gl_call(fbo.use)
         fbo.depth_mask = depth_write
-        full = (0, 0, *fbo.size)
         if fbo.viewport != full:
             fbo.viewport = full
         return fbo

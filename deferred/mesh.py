@@ -82,7 +82,14 @@ class MeshData:
         return np.ascontiguousarray(np.hstack(parts).astype(np.float32))
 
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        return self.positions.min(axis=0), self.positions.max(axis=0)
+        """(least, greatest) position per axis; made once per positions array (the GPU copy
+        assumes the arrays do not change either), as the fur's level of detail asks for it
+        every frame."""
+        cached = self.__dict__.get("_bounds")
+        if cached is None or cached[0] is not self.positions:
+            cached = self.__dict__["_bounds"] = (
+                self.positions, (self.positions.min(axis=0), self.positions.max(axis=0)))
+        return cached[1]
 
 
 # -- tangent frames and comb directions ------------------------------------------------------

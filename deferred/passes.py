@@ -199,7 +199,8 @@ class ObjectPass(RenderPass):
                                             else ())
 
     def defines(self, frame: Frame) -> dict[str, str]:
-        return {**self.obj.material.defines(self.obj), **(self.extra_defines or {})}
+        defines = self.obj.material.defines(self.obj)
+        return {**defines, **self.extra_defines} if self.extra_defines else defines
 
     def uniforms(self, frame: Frame) -> dict[str, Any]:
         return {}
@@ -236,7 +237,9 @@ class ObjectPass(RenderPass):
         frame.set_state(depth_test=self.depth_test, depth_func=self.depth_func, cull=self.cull,
                         blend=self.blend, depth_offset=self.depth_offset)
         material = frame.material_inputs(self.obj.material)
-        uniforms = {**(self.constants or {}), **self.uniforms(frame)}
+        uniforms = self.uniforms(frame)
+        if self.constants:
+            uniforms = {**self.constants, **uniforms}
         textures = self.textures(frame)
         offered = frame.object_uniforms(self.obj)
         count = self.draws(frame)

@@ -17,6 +17,7 @@ from .generated import generated_glsl
 from .graph import PassGraph, PassGraphError, compile_graph
 from .light_lists import LightLists, check_light_limits, resolve_light_path
 from .lightbuffer import LightBuffer
+from .material import Material
 from .passes import RenderPass
 from .pipeline import PIPELINES
 from .scene import Scene, check_size
@@ -100,7 +101,7 @@ class Renderer:
         self.graph: PassGraph = compile_graph(PIPELINES[pipeline](provisional).build(scene))
         check_target_memory(self.graph, self.size, "size" if size else f"{scene.source}: size")
         light_types = scene.light_types()
-        shading_models = scene.shading_models()
+        shading_models = self.shading_models = scene.shading_models()
         generated = generated_glsl(light_types, shading_models, scene.gbuffer_layout(),
                                    [obj.material for obj in scene.objects])
         roots = [cls.shader_root for cls in [
@@ -195,7 +196,8 @@ class Renderer:
         self.shaders.forget_uniform_values()  # code between frames may have written them
         frame = Frame(self.gl, self.shaders, self.targets, self.resources, self.scene,
                       self.light_buffer, strict=self.strict, light_lists=self.light_lists,
-                      time=time, time_gl_calls=time_gl_calls)
+                      time=time, time_gl_calls=time_gl_calls,
+                      shading_models=self.shading_models)
         self.light_buffer.upload(self.scene.lights, frame.view, frame.projection)
         self._check_gl("uploading the lights")
         for render_pass in self.passes:
@@ -230,7 +232,8 @@ class Renderer:
         if times:
             latest = max(times)
             for obj in self.scene.objects:
-                obj.material.check_time(latest, where)
+                if type(obj.material).check_time is not Material.check_time:  # most have none
+                    obj.material.check_time(latest, where)
 
     def _check_gl(self, stage: str) -> None:
         error = self.gl.ctx.error
