@@ -16,7 +16,7 @@ from .errors import DeferredError, InputError, RenderError, gl_error
 from .mesh import GpuMesh, MeshData
 from .shaderlib import ShaderLibrary
 from .targets import FrameTargets
-from .uniforms import gl_value
+from .uniforms import ProgramUniforms, gl_value
 
 if TYPE_CHECKING:
     from .light_lists import LightLists
@@ -124,7 +124,7 @@ class FrameStats:
     gl_call_seconds: float = 0.0
 
 
-@dataclass
+@dataclass(slots=True)
 class MaterialInputs:
     """A material's uniforms and textures for one frame, and which of them its programs
     declare (strict mode checks that each is declared by at least one)."""
@@ -163,9 +163,10 @@ class Frame:
         self.light_buffer = light_buffer
         self.width = targets.width
         self.height = targets.height
+        aspect = self.width / self.height
         self.view = scene.camera.view()
-        self.projection = scene.camera.projection(self.width / self.height)
-        self.inverse_projection = np.linalg.inv(self.projection)
+        self.projection = scene.camera.projection(aspect)
+        self.inverse_projection = scene.camera.inverse_projection(aspect)
         # the camera's uniforms as GL takes them: one dict for every pass of the frame
         self.camera_values = {name: gl_value(value)
                               for name, value in self.camera_uniforms().items()}
@@ -284,13 +285,31 @@ class Frame:
                 material.programs.append(self.shaders.describe(program))
         program_uniforms = self.shaders.uniforms(program)
         program_uniforms.set_shared("camera", self.camera_values)
-        if material is not None:
-            values = {**(offered or {}), **material.uniforms, **(uniforms or {})}
-            samplers = {**self.shading_textures(), **material.textures, **(textures or {})}
+        # in order, a later value of a name winning (no merged copies: a pass of many objects
+        # binds once a draw)
+        if offered:
+            program_uniforms.set(offered)
+        if material is not None and material.uniforms:
+            program_uniforms.set(material.uniforms)
+        if uniforms:
+            program_uniforms.set(uniforms)
+        shading = self.shading_textures()
+        if material is not None and material.textures or textures or shading:
+            if material is not None:
+                samplers = {**shading, **material.textures, **(textures or {})}
+            else:
+                samplers = {**shading, **(textures or {})}
+            unit = self._bind_samplers(program_uniforms, samplers)
         else:
-            values = {**(offered or {}), **(uniforms or {})}
-            samplers = {**self.shading_textures(), **(textures or {})}
-        program_uniforms.set(values)
+            unit = 0
+        self.light_buffer.bind(program_uniforms, unit)
+        if self.light_lists is not None:
+            self.light_lists.bind(program_uniforms, unit + 1)
+
+    @staticmethod
+    def _bind_samplers(program_uniforms: ProgramUniforms,
+                       samplers: dict[str, moderngl.Texture]) -> int:
+        """Bind the samplers the program has to units 0, 1, ...; the next free unit."""
         unit = 0
         members = program_uniforms.members
         for name, texture in samplers.items():
@@ -298,9 +317,7 @@ class Frame:
                 texture.use(location=unit)
                 program_uniforms.set_one(name, unit)
                 unit += 1
-        self.light_buffer.bind(program_uniforms, unit)
-        if self.light_lists is not None:
-            self.light_lists.bind(program_uniforms, unit + 1)
+        return unit
 
     def set_uniforms(self, program: moderngl.Program, values: dict[str, Any]) -> None:
         """Set the values ``program`` has (no strict check: :meth:`bind` does that); a value

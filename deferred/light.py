@@ -63,7 +63,9 @@ class Light:
         return np.asarray(self.params.color, dtype=np.float64) * self.params.intensity
 
     def record(self, view: np.ndarray) -> np.ndarray:
-        """(4, 4) float32: color, position, direction, extra (view space). See lighting.glsl."""
+        """(4, 4) float32: color, position, direction, extra (view space). See lighting.glsl.
+        A function of ``params`` and ``view`` alone: the light buffer packs the records again
+        only when one of them changes (``LightBuffer.upload``)."""
         raise NotImplementedError
 
     @classmethod

@@ -52,6 +52,7 @@ class LightBuffer:
         self._uniforms: dict[str, Any] = {}  # what ``bind`` sets
         self._texture: moderngl.Texture | None = None
         self._capacity = 0
+        self._packed: tuple | None = None  # what the texture holds the records of (upload)
 
     @staticmethod
     def pack(lights: list[Light], view: np.ndarray, projection: np.ndarray | None = None
@@ -82,6 +83,21 @@ class LightBuffer:
 
     def upload(self, lights: list[Light], view: np.ndarray,
                projection: np.ndarray | None = None) -> None:
+        """Pack the lights' records (culled by ``projection``'s frustum) into the texture. The
+        same lights with the same parameters (frozen: a change replaces them) seen from the
+        same camera give the same records, so they are packed and uploaded only when one of
+        these changes: packing costs milliseconds a frame at 1024 lights."""
+        key = (np.asarray(view).tobytes(),
+               None if projection is None else np.asarray(projection).tobytes(),
+               [(light, light.params) for light in lights])
+        if self._texture is not None and key == self._packed:
+            return
+        self._packed = None  # until this upload is done
+        self._upload(lights, view, projection)
+        self._packed = key
+
+    def _upload(self, lights: list[Light], view: np.ndarray,
+                projection: np.ndarray | None) -> None:
         records, self.ranges, self.global_count = self.pack(lights, view, projection)
         self.count = sum(count for _, count in self.ranges.values())
         # every type's range, (0, 0) for a type with no light this frame (all culled), and for
@@ -128,6 +144,7 @@ class LightBuffer:
             uniforms.set_one("u_lights", texture_unit)
 
     def _release_storage(self) -> None:
+        self._packed = None
         if self._texture is not None:
             self._texture.release()
             self._texture = None
