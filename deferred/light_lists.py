@@ -11,7 +11,7 @@ Deferred:
   full-screen pass then reads the G-buffer once per pixel and loops the full-screen lights and
   its tile's list (``lights/list_shading.frag``).
 - ``clustered``: the same shading, from lists of view-space clusters (32x32 tiles x 16
-  exponential depth slices) filled light by light (``lights/cull_clusters.comp``).
+  exponential depth slices) filled tile by tile (``lights/cull_clusters.comp``).
 
 Forward:
 
@@ -180,10 +180,6 @@ class LightLists:
         rows = list_bytes(self.grid, self.capacity) // LIST_ROW_BYTES
         self.texture.write(self.buffer, viewport=(0, 0, LIST_TEXTURE_WIDTH, rows))
 
-    def clear_counts(self) -> None:
-        assert self.buffer is not None and self.grid is not None
-        self.buffer.clear(size=4 * self.grid.count)
-
     def uniforms(self) -> dict[str, Any]:
         """The lists' uniforms this frame (one dict per :meth:`prepare`: programs skip it while
         they hold its values)."""
@@ -237,7 +233,6 @@ class LightCullPass(RenderPass):
         defines = {"CULL_FROM_NEAR": "1"} if self.from_near else {}
         if self.clustered:
             defines["LIGHT_LISTS_CLUSTERED"] = "1"
-            frame.light_lists.clear_counts()
         shader = frame.shaders.compute(
             "lights/cull_clusters.comp" if self.clustered else "lights/cull_tiles.comp",
             defines)
@@ -249,12 +244,8 @@ class LightCullPass(RenderPass):
             uniforms["u_pixel_to_view"] = pixel_to_view(frame.projection, frame.width,
                                                         frame.height)
         frame.bind_compute(shader, uniforms, textures)
-        if self.clustered:
-            groups = (max(1, math.ceil(lights.local_count / 64)), 1, 1)
-        else:
-            groups = (grid.columns, grid.rows, 1)
-        if lights.local_count > 0 or not self.clustered:
-            frame.gl_call(lambda: shader.run(*groups))
+        groups = math.ceil(grid.columns * grid.rows / 64)  # an invocation per tile
+        frame.gl_call(lambda: shader.run(groups, 1, 1))
         frame.ctx.memory_barrier()
         frame.light_lists.publish()
         frame.count_draw()

@@ -5,17 +5,11 @@
 #include "common/light_buffer.glsl"
 #include "generated/lights.glsl"
 #ifdef FORWARD_PLUS
-#include "lights/light_lists.glsl"
+#include "lights/listed_lights.glsl"
 
 vec3 forward_lighting(Surface s, vec3 P, vec3 V) {
-    vec3 color = evaluate_fullscreen_lights(s, P, V);
     int list = light_list_of(ivec2(gl_FragCoord.xy), -P.z);
-    int length = light_list_length(list);
-    for (int k = 0; k < length; ++k) {
-        int index = light_list_light(list, k);
-        if (light_reaches(index, P)) color += evaluate_volume_light(fetch_light(index), s, P, V);
-    }
-    return color;
+    return evaluate_fullscreen_lights(s, P, V) + evaluate_listed_lights(list, s, P, V);
 }
 #else
 vec3 forward_lighting(Surface s, vec3 P, vec3 V) {

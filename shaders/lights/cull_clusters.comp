@@ -1,48 +1,46 @@
 // Clustered light assignment (Olsson, Billeter and Assarsson 2012): view-space clusters of
-// screen tiles x exponential depth slices; a thread per volume light finds the clusters its
-// sphere's bounding box covers (tiles from the projected box, slices from its depth range) and
-// appends itself to each. The lists' counts are zero when this pass starts.
+// screen tiles x exponential depth slices. An invocation per tile tests every volume light, in
+// order, against the tile's side planes, and appends the ones that touch it to the list of
+// every slice their sphere's depth range covers. The invocation owns its tile's lists: no
+// atomics, and the lists come out in light order whatever the scheduling, so a frame shades
+// its lights in the same order every time (the same image, to the bit). A thread per light
+// appending with atomics, as before, gave the lists in the order the threads ran.
 layout(local_size_x = 64) in;
 
 #include "common/light_buffer.glsl"
 #include "lights/light_lists.glsl"
+#include "lights/tile_frustum.glsl"
 
-uniform mat4 u_projection;
-uniform vec2 u_resolution;
 uniform vec2 u_near_far;
 uniform int u_global_light_count;
 
 void main() {
-    int i = int(gl_GlobalInvocationID.x);
-    if (i >= u_light_count - u_global_light_count) return;
-    int index = u_global_light_count + i;
-    vec4 sphere = fetch_light(index).position;
-    float near_depth = -sphere.z - sphere.w;
-    float far_depth = -sphere.z + sphere.w;
-    if (far_depth < u_near_far.x || near_depth > u_near_far.y) return;
-    ivec2 low = ivec2(0);
-    ivec2 high = u_list_grid.xy - 1;
-    if (near_depth > u_near_far.x) {
-        // the projection of the sphere's view-space bounding box (all in front of the eye)
-        vec2 ndc_low = vec2(1.0);
-        vec2 ndc_high = vec2(-1.0);
-        for (int corner = 0; corner < 8; ++corner) {
-            vec3 offset = vec3(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1) * 2.0 - 1.0;
-            vec4 clip = u_projection * vec4(sphere.xyz + offset * sphere.w, 1.0);
-            vec2 ndc = clip.xy / clip.w;
-            ndc_low = min(ndc_low, ndc);
-            ndc_high = max(ndc_high, ndc);
+    int tiles = u_list_grid.x * u_list_grid.y;
+    int tile_index = int(gl_GlobalInvocationID.x);
+    if (tile_index >= tiles) return;
+    ivec2 tile = ivec2(tile_index % u_list_grid.x, tile_index / u_list_grid.x);
+    ivec2 origin = tile * u_list_tile;
+    vec3 planes[4];
+    tile_planes(origin, min(origin + u_list_tile, ivec2(u_resolution)), planes);
+    // the tile's list in slice s is tile_index + s * tiles; its count is kept in the buffer
+    for (int slice = 0; slice < u_list_grid.z; ++slice)
+        light_list_data[tile_index + slice * tiles] = 0u;
+    int local_count = u_light_count - u_global_light_count;
+    for (int i = 0; i < local_count; ++i) {
+        int index = u_global_light_count + i;
+        vec4 sphere = fetch_light_sphere(index);
+        float near_depth = -sphere.z - sphere.w;
+        float far_depth = -sphere.z + sphere.w;
+        if (far_depth < u_near_far.x || near_depth > u_near_far.y) continue;
+        if (!sphere_touches_planes(planes, sphere)) continue;
+        int last_slice = light_list_slice(far_depth);
+        for (int slice = light_list_slice(max(near_depth, u_near_far.x)); slice <= last_slice;
+             ++slice) {
+            int list = tile_index + slice * tiles;
+            uint count = light_list_data[list];
+            if (int(count) < u_list_capacity)
+                light_list_data[u_list_count + list * u_list_capacity + int(count)] = uint(index);
+            light_list_data[list] = count + 1u;
         }
-        if (any(lessThan(ndc_high, vec2(-1.0))) || any(greaterThan(ndc_low, vec2(1.0)))) return;
-        vec2 pixel_low = (clamp(ndc_low, -1.0, 1.0) * 0.5 + 0.5) * u_resolution;
-        vec2 pixel_high = (clamp(ndc_high, -1.0, 1.0) * 0.5 + 0.5) * u_resolution;
-        low = clamp(ivec2(floor(pixel_low)) / u_list_tile, ivec2(0), u_list_grid.xy - 1);
-        high = clamp(ivec2(floor(pixel_high)) / u_list_tile, ivec2(0), u_list_grid.xy - 1);
     }
-    int first_slice = light_list_slice(max(near_depth, u_near_far.x));
-    int last_slice = light_list_slice(far_depth);
-    for (int slice = first_slice; slice <= last_slice; ++slice)
-        for (int y = low.y; y <= high.y; ++y)
-            for (int x = low.x; x <= high.x; ++x)
-                light_list_append((slice * u_list_grid.y + y) * u_list_grid.x + x, index);
 }

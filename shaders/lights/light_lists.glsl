@@ -51,10 +51,3 @@ bool light_reaches(int index, vec3 P) {
     vec3 to_light = sphere.xyz - P;
     return dot(to_light, to_light) <= sphere.w * sphere.w;
 }
-
-// Append light `index` to `list` (culling shaders; counts start at 0 each frame).
-void light_list_append(int list, int index) {
-    uint slot = atomicAdd(light_list_data[list], 1u);
-    if (int(slot) < u_list_capacity)
-        light_list_data[u_list_count + list * u_list_capacity + int(slot)] = uint(index);
-}

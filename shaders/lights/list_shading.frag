@@ -4,7 +4,7 @@
 #include "gbuffer/fetch.glsl"
 #include "common/light_buffer.glsl"
 #include "generated/lights.glsl"
-#include "lights/light_lists.glsl"
+#include "lights/listed_lights.glsl"
 
 #ifdef HAS_SSAO
 uniform sampler2D u_ssao;
@@ -28,13 +28,7 @@ void main() {
     // brute force (benchmarks/brute_force.py): every volume light at every pixel, no lists
     total += evaluate_volume_lights(g.surface, P, V);
 #else
-    int list = light_list_of(pixel, g.linear_depth);
-    int length = light_list_length(list);
-    for (int k = 0; k < length; ++k) {
-        int index = light_list_light(list, k);
-        if (light_reaches(index, P))
-            total += evaluate_volume_light(fetch_light(index), g.surface, P, V);
-    }
+    total += evaluate_listed_lights(light_list_of(pixel, g.linear_depth), g.surface, P, V);
 #endif
     out_light = vec4(total, 0.0);
 }

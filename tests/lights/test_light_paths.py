@@ -130,6 +130,56 @@ def test_tile_lists_hold_every_light_that_reaches_a_pixel(gl):
     assert loose == 0
 
 
+@pytest.mark.parametrize("path", ["tiled", "clustered"])
+def test_lists_hold_their_lights_in_light_order_and_clusters_every_light_reaching_a_pixel(
+        gl, path):
+    """The culling appends each tile's lights in the order of the light buffer, so a frame
+    sums its lights in the same order whatever the scheduling (the same image every frame);
+    and a pixel's cluster holds every light whose sphere reaches the pixel's point."""
+    if not gl.features.compute_shaders:
+        pytest.skip("the driver has no compute shaders")
+    with Renderer(scene_with(150), "deferred", gl=gl, light_path=path) as renderer:
+        renderer.render()
+        lists = renderer.light_lists
+        grid = lists.grid
+        data = np.frombuffer(lists.buffer.read(), dtype=np.uint32)
+        records = np.frombuffer(renderer.light_buffer.texture.read(), dtype=np.float32)
+        records = records.reshape(-1, 4, 4)[:renderer.light_buffer.count]
+        depth = renderer.targets.read("linear_depth")[..., 0]
+        inverse = renderer.last_frame.inverse_projection
+        global_count = renderer.light_buffer.global_count
+        camera = renderer.scene.camera
+    counts = data[:grid.count]
+    assert counts.max() <= lists.capacity
+    entries = [data[grid.count + i * lists.capacity:][:counts[i]] for i in range(grid.count)]
+    assert sum(len(e) for e in entries) > 0
+    assert all(np.all(np.diff(e.astype(np.int64)) > 0) for e in entries)  # ascending, once each
+    if path == "tiled":
+        return  # test_tile_lists_hold_every_light_that_reaches_a_pixel checks the tiles'
+    height, width = depth.shape
+    ys, xs = np.nonzero(depth > 0.0)
+    ndc = np.stack([(xs + 0.5) / width * 2 - 1, (ys + 0.5) / height * 2 - 1,
+                    np.ones(len(xs)), np.ones(len(xs))], -1)
+    rays = ndc @ inverse.T
+    rays = rays[:, :3] / rays[:, 3:]
+    z = depth[ys, xs]
+    points = rays * (z / -rays[:, 2])[:, None]
+    spheres = records[global_count:, 1]
+    reach = np.linalg.norm(points[:, None, :] - spheres[None, :, :3], axis=-1) <= \
+        spheres[None, :, 3] * 0.999
+    assert reach.sum() > 1000
+    # the shader's light_list_slice and light_list_of, in numpy
+    near, far = camera.near, camera.far
+    slices = np.clip(np.floor(np.log(np.maximum(z, near) / near) * grid.slices /
+                              np.log(far / near)), 0, grid.slices - 1).astype(int)
+    cluster = (slices * grid.rows + ys // grid.tile) * grid.columns + xs // grid.tile
+    missing = 0
+    for pixel in np.nonzero(reach.any(axis=1))[0]:
+        needed = set((np.nonzero(reach[pixel])[0] + global_count).tolist())
+        missing += len(needed - set(entries[cluster[pixel]].tolist()))
+    assert missing == 0
+
+
 def test_lights_outside_the_view_are_culled_on_the_cpu(gl):
     from deferred.camera import Camera
 
