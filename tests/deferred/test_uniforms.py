@@ -107,3 +107,55 @@ def test_gl_call_times_are_measured_only_when_asked(render):
     assert timed.draws_by_pass == result.draws_by_pass
     assert sum(result.draws_by_pass.values()) == result.draw_calls
 
+
+
+WRITER_VERTEX = """#version 330
+uniform float u_float;
+uniform int u_int;
+uniform bool u_bool;
+uniform vec2 u_vec2;
+uniform vec3 u_vec3;
+uniform vec4 u_vec4;
+uniform ivec3 u_ivec3;
+uniform mat3 u_mat3;
+uniform mat4 u_mat4;
+uniform float u_array[3];
+uniform sampler2D u_sampler;
+void main() {
+    vec4 t = texture(u_sampler, u_vec2);
+    float b = u_bool ? 1.0 : 0.0;
+    gl_Position = u_mat4 * vec4(u_mat3 * u_vec3 * u_float + vec3(u_ivec3) * float(u_int), b)
+                  + u_vec4 + t + vec4(u_array[0] + u_array[1] + u_array[2]);
+}
+"""
+WRITER_VALUES = {
+    "u_float": 0.375, "u_int": -7, "u_bool": True, "u_vec2": (0.25, -1.5),
+    "u_vec3": (1.0, 2.0, 3.0), "u_vec4": (4.0, 5.0, 6.0, 7.0), "u_ivec3": (1, -2, 3),
+    "u_mat3": np.arange(9, dtype=np.float64).reshape(3, 3),
+    "u_mat4": np.arange(16, dtype=np.float64).reshape(4, 4) * 0.5,
+    "u_array": [0.5, 1.5, 2.5], "u_sampler": 3,
+}
+
+
+def test_the_uniform_writer_leaves_what_moderngls_own_setter_does(gl):
+    """uniform_writer packs and writes past moderngl's Python layers: every type of uniform
+    (arrays through the handle) holds the value moderngl's own setter gives it."""
+    from deferred.uniforms import uniform_writer
+
+    ours = gl.ctx.program(vertex_shader=WRITER_VERTEX, fragment_shader=FRAGMENT)
+    theirs = gl.ctx.program(vertex_shader=WRITER_VERTEX, fragment_shader=FRAGMENT)
+    try:
+        for name, value in WRITER_VALUES.items():
+            converted = gl_value(value)
+            uniform_writer(ours[name])(converted)
+            if isinstance(converted, bytes):
+                theirs[name].write(converted)
+            else:
+                theirs[name].value = converted
+        for name in WRITER_VALUES:
+            assert ours[name].read() == theirs[name].read(), name
+        assert ours["u_int"].value == -7 and ours["u_vec2"].value == (0.25, -1.5)
+        assert ours["u_array"].value == pytest.approx([0.5, 1.5, 2.5])
+    finally:
+        ours.release()
+        theirs.release()

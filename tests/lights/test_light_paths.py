@@ -376,3 +376,30 @@ def test_a_light_type_gone_from_the_scene_adds_no_light(gl):
         fresh = renderer.render().hdr
     assert not np.array_equal(lit, fresh)  # the spot light did reach it
     np.testing.assert_array_equal(later, fresh)
+
+
+@pytest.mark.parametrize("pipeline, path", [("deferred", "tiled"), ("forward", "naive")])
+def test_a_renderer_follows_a_light_and_the_camera_changed_between_frames(gl, pipeline, path):
+    """The light records are packed again only when the lights, their (frozen) parameters or
+    the camera change: a frame after each change draws what a fresh renderer does."""
+    from dataclasses import replace
+
+    if path == "tiled" and not gl.features.compute_shaders:
+        pytest.skip("the driver has no compute shaders")
+    scene = scene_with(40)
+    point = next(light for light in scene.lights if type(light).__name__ == "PointLight")
+    brighter = point.params.model_copy(update={"intensity": point.params.intensity * 3.0})
+    moved = replace(scene.camera, position=(0.6, 1.9, 4.0))
+    with Renderer(scene, pipeline, gl=gl, light_path=path) as renderer:
+        first = renderer.render().hdr
+        assert np.array_equal(renderer.render().hdr, first)  # nothing changed
+        point.params = brighter
+        after_light = renderer.render().hdr
+        renderer.scene.camera = moved
+        after_camera = renderer.render().hdr
+    assert not np.array_equal(after_light, first)
+    with Renderer(scene, pipeline, gl=gl, light_path=path) as renderer:
+        np.testing.assert_array_equal(renderer.render().hdr, after_camera)
+    scene.camera = replace(moved, position=(0.0, 1.6, 4.2))  # scene_with's camera
+    with Renderer(scene, pipeline, gl=gl, light_path=path) as renderer:
+        np.testing.assert_array_equal(renderer.render().hdr, after_light)
