@@ -136,6 +136,52 @@ class MaterialInputs:
     programs: list[str] = field(default_factory=list)
 
 
+class ObjectTransforms:
+    """Every object's transform uniforms (``u_model``, ``u_model_view``, ``u_normal_matrix`` as
+    GL bytes, ``u_surface_id``), made for all objects at once and kept while nothing they come
+    from changes: a scene whose objects and camera stand still reuses the last frame's (the
+    batched inverse and the conversions cost about 4 us an object a frame)."""
+
+    def __init__(self) -> None:
+        self._key: tuple | None = None
+        self._values: dict[int, dict[str, Any]] = {}
+
+    def of(self, objects: list[SceneObject], view: np.ndarray) -> dict[int, dict[str, Any]]:
+        """id(object) -> its uniforms, for ``objects`` seen with ``view``."""
+        if not objects:
+            return {}
+        surface_ids = [float(obj.material.surface_id()) for obj in objects]
+        # what the values are made of (contents, not identities: a model may be written in
+        # place), and which object each belongs to
+        key = (np.asarray(view).tobytes(), b"".join([obj.model.tobytes() for obj in objects]),
+               surface_ids, [id(obj) for obj in objects])
+        if key != self._key:
+            models = np.stack([obj.model for obj in objects])
+            self._values = self._make(objects, view, models, surface_ids)
+            self._key = key
+        return self._values
+
+    @staticmethod
+    def _make(objects: list[SceneObject], view: np.ndarray, models: np.ndarray,
+              surface_ids: list[float]) -> dict[int, dict[str, Any]]:
+        model_views = view @ models
+        normals = np.transpose(np.linalg.inv(model_views[:, :3, :3]), (0, 2, 1))
+
+        def column_major(matrices: np.ndarray) -> bytes:  # GLSL's order, all at once
+            return np.ascontiguousarray(np.transpose(matrices, (0, 2, 1)),
+                                        dtype=np.float32).tobytes()
+
+        model_bytes, view_bytes = column_major(models), column_major(model_views)
+        normal_bytes = column_major(normals)
+        values = {}
+        for index, (obj, surface_id) in enumerate(zip(objects, surface_ids, strict=True)):
+            mat4, mat3 = slice(64 * index, 64 * index + 64), slice(36 * index, 36 * index + 36)
+            values[id(obj)] = {
+                "u_model": model_bytes[mat4], "u_model_view": view_bytes[mat4],
+                "u_normal_matrix": normal_bytes[mat3], "u_surface_id": surface_id}
+        return values
+
+
 class Frame:
     """What a pass sees while it runs: GL, shaders, targets, scene, camera and lights, and the
     frame's ``time`` in seconds (animated materials read it in ``prepare``).
@@ -150,7 +196,8 @@ class Frame:
                  resources: Resources, scene: Scene, light_buffer: LightBuffer,
                  strict: bool = False, light_lists: LightLists | None = None,
                  time: float = 0.0, time_gl_calls: bool = False,
-                 shading_models: list | None = None):
+                 shading_models: list | None = None,
+                 object_transforms: ObjectTransforms | None = None):
         self.gl = gl
         self.time = float(time)  # seconds: the scene's timeline is applied at this time
         self.light_lists = light_lists
@@ -176,7 +223,9 @@ class Frame:
         self._shading_models = shading_models
         self.current_pass: RenderPass | None = None
         self._materials: dict[int, MaterialInputs] = {}
-        self._objects: dict[int, dict[str, Any]] = {}
+        # the objects' transforms, kept by the renderer across frames (ObjectTransforms)
+        self._object_transforms = object_transforms or ObjectTransforms()
+        self._objects: dict[int, dict[str, Any]] | None = None
         self._shading_textures: dict[str, moderngl.Texture] | None = None
         # what this frame set last: a pass stating the same is not set again (set_state)
         self._state: tuple | None = None
@@ -220,31 +269,9 @@ class Frame:
 
     def object_uniforms(self, obj: SceneObject) -> dict[str, Any]:
         """The object's transforms and id (computed once per frame, for every object)."""
-        if not self._objects:
-            self._object_transforms()
+        if self._objects is None:
+            self._objects = self._object_transforms.of(self.scene.objects, self.view)
         return self._objects[id(obj)]
-
-    def _object_transforms(self) -> None:
-        """Every object's transforms at once (one batched inverse, matrices as GL bytes)."""
-        objects = self.scene.objects
-        if not objects:
-            return
-        models = np.stack([obj.model for obj in objects])
-        model_views = np.einsum("ij,njk->nik", self.view, models)
-        normals = np.transpose(np.linalg.inv(model_views[:, :3, :3]), (0, 2, 1))
-
-        def column_major(matrices: np.ndarray) -> bytes:  # GLSL's order, all at once
-            return np.ascontiguousarray(np.transpose(matrices, (0, 2, 1)),
-                                        dtype=np.float32).tobytes()
-
-        model_bytes, view_bytes = column_major(models), column_major(model_views)
-        normal_bytes = column_major(normals)
-        for index, obj in enumerate(objects):
-            mat4, mat3 = slice(64 * index, 64 * index + 64), slice(36 * index, 36 * index + 36)
-            self._objects[id(obj)] = {
-                "u_model": model_bytes[mat4], "u_model_view": view_bytes[mat4],
-                "u_normal_matrix": normal_bytes[mat3],
-                "u_surface_id": float(obj.material.surface_id())}
 
     def shading_textures(self) -> dict[str, moderngl.Texture]:
         """Samplers of the scene's shading models (ramps...), offered wherever lights run."""
@@ -393,8 +420,10 @@ class Frame:
 
     def draw_mesh(self, mesh: MeshData, program: moderngl.Program, instances: int = 1) -> None:
         vertex_array = self.resources.gpu_mesh(mesh).vertex_array(program)
-        if self.time_gl_calls:
-            self.gl_call(lambda: vertex_array.render(moderngl.TRIANGLES, instances=instances))
+        if self.time_gl_calls:  # gl_call inlined: no closure a draw
+            start = time.thread_time()
+            vertex_array.render(moderngl.TRIANGLES, instances=instances)
+            self.stats.gl_call_seconds += time.thread_time() - start
         else:
             vertex_array.render(moderngl.TRIANGLES, instances=instances)
         self.stats.draw_calls += 1

@@ -12,7 +12,7 @@ import numpy as np
 
 from .context import Features, GLContext, acquire_context, give_back_context
 from .errors import DeferredError, InputError, RenderError, gl_error
-from .frame import Frame, Resources
+from .frame import Frame, ObjectTransforms, Resources
 from .generated import generated_glsl
 from .graph import PassGraph, PassGraphError, compile_graph
 from .light_lists import LightLists, check_light_limits, resolve_light_path
@@ -102,6 +102,7 @@ class Renderer:
         check_target_memory(self.graph, self.size, "size" if size else f"{scene.source}: size")
         light_types = scene.light_types()
         shading_models = self.shading_models = scene.shading_models()
+        self.object_transforms = ObjectTransforms()  # kept across frames
         generated = generated_glsl(light_types, shading_models, scene.gbuffer_layout(),
                                    [obj.material for obj in scene.objects])
         roots = [cls.shader_root for cls in [
@@ -197,7 +198,8 @@ class Renderer:
         frame = Frame(self.gl, self.shaders, self.targets, self.resources, self.scene,
                       self.light_buffer, strict=self.strict, light_lists=self.light_lists,
                       time=time, time_gl_calls=time_gl_calls,
-                      shading_models=self.shading_models)
+                      shading_models=self.shading_models,
+                      object_transforms=self.object_transforms)
         self.light_buffer.upload(self.scene.lights, frame.view, frame.projection)
         self._check_gl("uploading the lights")
         for render_pass in self.passes:

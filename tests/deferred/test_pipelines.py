@@ -230,3 +230,36 @@ def test_a_gl_error_while_preparing_a_pass_names_the_pass_not_outside_code(gl, m
     message = str(gl_error("pass gbuffer", "GL_OUT_OF_MEMORY", (800, 600)))
     assert message.startswith("pass gbuffer: GL_OUT_OF_MEMORY (the frame's render targets")
     assert "at 800x600" in message and "render smaller" in message
+
+
+@pytest.mark.parametrize("pipeline", ["deferred", "forward"])
+def test_an_object_moved_between_frames_is_drawn_where_it_is_now(gl, pipeline):
+    """The objects' transform uniforms are kept across frames while nothing they come from
+    changes (ObjectTransforms): a model written in place and a model replaced each reach the
+    next frame."""
+    def scene():
+        return scene_from_dict({
+            "size": [96, 64], "camera": {"position": [0.0, 1.0, 4.0]},
+            "object": [{"mesh": "builtin:plane", "scale": 4.0},
+                       {"mesh": "builtin:cube", "position": [-0.6, 0.5, 0.0], "scale": 0.5},
+                       {"mesh": "builtin:sphere", "position": [0.7, 0.5, 0.0], "scale": 0.5}],
+            "light": [{"type": "directional", "direction": [-0.3, -1.0, -0.5]},
+                      {"type": "ambient"}]})
+
+    def fresh(changed):
+        with Renderer(changed, pipeline, gl=gl) as renderer:
+            return renderer.render().hdr
+
+    kept = scene()
+    with Renderer(kept, pipeline, gl=gl) as renderer:
+        first = renderer.render().hdr
+        kept.objects[1].model[0, 3] += 0.4  # in place
+        in_place = renderer.render().hdr
+        kept.objects[2].model = kept.objects[2].model @ np.diag([1.0, 1.6, 1.0, 1.0])
+        replaced = renderer.render().hdr
+    assert not np.array_equal(first, in_place) and not np.array_equal(in_place, replaced)
+    expected = scene()
+    expected.objects[1].model[0, 3] += 0.4
+    np.testing.assert_array_equal(in_place, fresh(expected))
+    expected.objects[2].model = expected.objects[2].model @ np.diag([1.0, 1.6, 1.0, 1.0])
+    np.testing.assert_array_equal(replaced, fresh(expected))
