@@ -249,8 +249,9 @@ def time_cpu(renderer, runs: int) -> tuple[float, int]:
     """Median milliseconds per frame of the framework's own CPU work, and the draw calls of a
     frame: the rendering thread's CPU time (``time.thread_time``: waits for the driver and the
     rasteriser's worker threads are not in it) over ``render()``, less its CPU time inside the
-    drawing GL calls (draws, dispatches, clears; ``FrameStats.gl_call_seconds``), where llvmpipe
-    runs vertex work and binning on the calling thread."""
+    drawing GL calls (draws, dispatches, clears, framebuffer binds, the light lists' copy;
+    ``FrameStats.gl_call_seconds``), where llvmpipe runs vertex work and binning on the
+    calling thread."""
     ctx = renderer.gl.ctx
     samples = []
     draws = 0

@@ -119,8 +119,9 @@ class FrameStats:
     draw_calls: int = 0
     draws_by_pass: dict[str, int] = field(default_factory=dict)
     # CPU seconds of this thread inside the GL calls that do the drawing (draws, dispatches,
-    # clears; llvmpipe runs vertex work and binning there): the bench subtracts them from the
-    # frame's thread time to get the framework's own CPU time
+    # clears, framebuffer binds, copies; llvmpipe runs vertex work and binning there, and a
+    # framebuffer bind hands the last one's scene to the rasteriser): the bench subtracts them
+    # from the frame's thread time to get the framework's own CPU time
     gl_call_seconds: float = 0.0
 
 

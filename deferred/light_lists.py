@@ -247,7 +247,7 @@ class LightCullPass(RenderPass):
         groups = math.ceil(grid.columns * grid.rows / 64)  # an invocation per tile
         frame.gl_call(lambda: shader.run(groups, 1, 1))
         frame.ctx.memory_barrier()
-        frame.light_lists.publish()
+        frame.gl_call(frame.light_lists.publish)  # a copy of the lists: GL work
         frame.count_draw()
 
 
