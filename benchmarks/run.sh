@@ -26,3 +26,6 @@ deferred bench builtin:overdraw --size 640x360 --runs 2 --warmup 1 --lights 1,16
 deferred bench --size 640x360 --runs 3 --warmup 1 --light-paths volumes,naive \
     --lights 0,16,64 --shells 0,16,64 \
     --json $out/shells-640x360.json --csv $out/shells-640x360.csv --plot $out/shells-640x360.png
+
+# The framework's CPU time per draw call (scenes of 25, 100, 400 cubes; a minute).
+python benchmarks/draw_overhead.py
