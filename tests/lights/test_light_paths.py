@@ -2,6 +2,8 @@
 and naive paths; the light lists hold every light that reaches a pixel; lights off screen are
 culled on the CPU; a context without compute shaders runs volumes and naive."""
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
@@ -79,38 +81,50 @@ def test_forward_plus_lights_fur_shells_in_front_of_the_opaque_depth(gl):
     assert psnr(images[0], images[1], 255.0) >= 40.0
 
 
-def test_tile_lists_hold_every_light_that_reaches_a_pixel(gl):
+def listed_frame(gl, path: str, extra: int) -> SimpleNamespace:
+    """One frame of scene_with(extra) through a list path, read back: the lists (``entries``,
+    ``counts``), the light records, and each covered pixel's view-space point (``xs``, ``ys``,
+    ``z``, ``points``) with the volume lights whose sphere reaches it (``reach``)."""
     if not gl.features.compute_shaders:
         pytest.skip("the driver has no compute shaders")
-    scene = scene_with(120)
-    with Renderer(scene, "deferred", gl=gl, light_path="tiled") as renderer:
-        frame_result = renderer.render()
-        assert frame_result is not None
+    with Renderer(scene_with(extra), "deferred", gl=gl, light_path=path) as renderer:
+        renderer.render()
         lists = renderer.light_lists
         grid = lists.grid
         data = np.frombuffer(lists.buffer.read(), dtype=np.uint32)
         records = np.frombuffer(renderer.light_buffer.texture.read(), dtype=np.float32)
         records = records.reshape(-1, 4, 4)[:renderer.light_buffer.count]
         depth = renderer.targets.read("linear_depth")[..., 0]
-        frame = renderer.last_frame
-        inverse = frame.inverse_projection
+        inverse = renderer.last_frame.inverse_projection
         global_count = renderer.light_buffer.global_count
+        camera = renderer.scene.camera
     height, width = depth.shape
     ys, xs = np.nonzero(depth > 0.0)
     ndc = np.stack([(xs + 0.5) / width * 2 - 1, (ys + 0.5) / height * 2 - 1,
                     np.ones(len(xs)), np.ones(len(xs))], -1)
     rays = ndc @ inverse.T
     rays = rays[:, :3] / rays[:, 3:]
-    points = rays * (depth[ys, xs] / -rays[:, 2])[:, None]
+    z = depth[ys, xs]
+    points = rays * (z / -rays[:, 2])[:, None]
     spheres = records[global_count:, 1]
     reach = np.linalg.norm(points[:, None, :] - spheres[None, :, :3], axis=-1) <= \
         spheres[None, :, 3] * 0.999
-    assert reach.sum() > 1000  # the lights do light the scene
-    tile = (ys // grid.tile) * grid.columns + xs // grid.tile
     counts = data[:grid.count]
+    entries = [data[grid.count + i * lists.capacity:][:counts[i]] for i in range(grid.count)]
+    return SimpleNamespace(grid=grid, capacity=lists.capacity, counts=counts, entries=entries,
+                           records=records, global_count=global_count, camera=camera,
+                           xs=xs, ys=ys, z=z, points=points, reach=reach)
+
+
+def test_tile_lists_hold_every_light_that_reaches_a_pixel(gl):
+    frame = listed_frame(gl, "tiled", 120)
+    grid, reach, points, records = frame.grid, frame.reach, frame.points, frame.records
+    global_count, counts, entries = frame.global_count, frame.counts, frame.entries
+    assert reach.sum() > 1000  # the lights do light the scene
+    tile = (frame.ys // grid.tile) * grid.columns + frame.xs // grid.tile
     missing = 0
     for pixel in np.nonzero(reach.any(axis=1))[0]:
-        listed = data[grid.count + tile[pixel] * lists.capacity:][:counts[tile[pixel]]]
+        listed = entries[tile[pixel]]
         needed = np.nonzero(reach[pixel])[0] + global_count
         missing += len(set(needed.tolist()) - set(listed.tolist()))
     assert missing == 0
@@ -123,7 +137,7 @@ def test_tile_lists_hold_every_light_that_reaches_a_pixel(gl):
         box = points[tile == list_index]
         pad = 1e-4 * -box[:, 2].min() + 1e-5  # the shader's padding, and float32's bits
         low, high = box.min(0) - pad, box.max(0) + pad
-        listed = data[grid.count + list_index * lists.capacity:][:counts[list_index]]
+        listed = entries[list_index]
         centres = records[listed.astype(int), 1, :3]
         gap = centres - np.clip(centres, low, high)
         loose += int((np.sum(gap * gap, -1) > records[listed.astype(int), 1, 3] ** 2).sum())
@@ -136,46 +150,23 @@ def test_lists_hold_their_lights_in_light_order_and_clusters_every_light_reachin
     """The culling appends each tile's lights in the order of the light buffer, so a frame
     sums its lights in the same order whatever the scheduling (the same image every frame);
     and a pixel's cluster holds every light whose sphere reaches the pixel's point."""
-    if not gl.features.compute_shaders:
-        pytest.skip("the driver has no compute shaders")
-    with Renderer(scene_with(150), "deferred", gl=gl, light_path=path) as renderer:
-        renderer.render()
-        lists = renderer.light_lists
-        grid = lists.grid
-        data = np.frombuffer(lists.buffer.read(), dtype=np.uint32)
-        records = np.frombuffer(renderer.light_buffer.texture.read(), dtype=np.float32)
-        records = records.reshape(-1, 4, 4)[:renderer.light_buffer.count]
-        depth = renderer.targets.read("linear_depth")[..., 0]
-        inverse = renderer.last_frame.inverse_projection
-        global_count = renderer.light_buffer.global_count
-        camera = renderer.scene.camera
-    counts = data[:grid.count]
-    assert counts.max() <= lists.capacity
-    entries = [data[grid.count + i * lists.capacity:][:counts[i]] for i in range(grid.count)]
+    frame = listed_frame(gl, path, 150)
+    grid, entries = frame.grid, frame.entries
+    assert frame.counts.max() <= frame.capacity
     assert sum(len(e) for e in entries) > 0
     assert all(np.all(np.diff(e.astype(np.int64)) > 0) for e in entries)  # ascending, once each
     if path == "tiled":
         return  # test_tile_lists_hold_every_light_that_reaches_a_pixel checks the tiles'
-    height, width = depth.shape
-    ys, xs = np.nonzero(depth > 0.0)
-    ndc = np.stack([(xs + 0.5) / width * 2 - 1, (ys + 0.5) / height * 2 - 1,
-                    np.ones(len(xs)), np.ones(len(xs))], -1)
-    rays = ndc @ inverse.T
-    rays = rays[:, :3] / rays[:, 3:]
-    z = depth[ys, xs]
-    points = rays * (z / -rays[:, 2])[:, None]
-    spheres = records[global_count:, 1]
-    reach = np.linalg.norm(points[:, None, :] - spheres[None, :, :3], axis=-1) <= \
-        spheres[None, :, 3] * 0.999
+    reach, z, ys, xs = frame.reach, frame.z, frame.ys, frame.xs
     assert reach.sum() > 1000
     # the shader's light_list_slice and light_list_of, in numpy
-    near, far = camera.near, camera.far
+    near, far = frame.camera.near, frame.camera.far
     slices = np.clip(np.floor(np.log(np.maximum(z, near) / near) * grid.slices /
                               np.log(far / near)), 0, grid.slices - 1).astype(int)
     cluster = (slices * grid.rows + ys // grid.tile) * grid.columns + xs // grid.tile
     missing = 0
     for pixel in np.nonzero(reach.any(axis=1))[0]:
-        needed = set((np.nonzero(reach[pixel])[0] + global_count).tolist())
+        needed = set((np.nonzero(reach[pixel])[0] + frame.global_count).tolist())
         missing += len(needed - set(entries[cluster[pixel]].tolist()))
     assert missing == 0
 
