@@ -1,16 +1,15 @@
 // The volume lights of one light list at a surface point: the deferred tiled and clustered
 // shading and Forward+ (deferred.light_lists).
 //
-// A list holds the lights that touch its tile or cluster; most miss any one point of it, and
-// the sphere test is far cheaper than the light. Where a fragment shader runs as SIMD lanes
-// (llvmpipe) the light's arithmetic still runs for every entry; what a missed entry saves is
-// its four record fetches. Testing a chunk of entries first and then evaluating only the lights
-// that reach some lane (a bit mask per chunk) was tried: on llvmpipe it was slower at every
-// light count (lights.toml at 640x360: the tiled shading 46 -> 54 ms at 1024 lights, and a
-// Forward+ floor 9 -> 29 ms at 16), since a light reaching one pixel of a SIMD group reaches
-// most of them. Reading the list four entries a fetch (an RGBA32UI texture, the loop unrolled
-// by four with a test of each entry against the length) was slower too: the tiled shading
-// 42-49 -> 61-86 ms at 1024 lights, a Forward+ floor 71-73 -> 111-125 ms.
+// A list holds the lights that touch its tile or cluster; most miss any one point of it
+// (lights.toml at 1024 lights: 31.5 entries a pixel, 13.2 reaching it, 14.5 reaching some pixel
+// of its 8-pixel SIMD group). Where a fragment shader runs as SIMD lanes (llvmpipe) the light's
+// arithmetic still runs for every entry; a missed entry saves its record fetches. Two ways of
+// doing less were tried and were slower on llvmpipe at every light count, so an entry's cost is
+// mostly its fetches and the loop, not the light: testing 32 entries first and evaluating only
+// the set bits of the mask (the tiled shading 46 -> 54 ms at 1024 lights, a Forward+ floor
+// 9 -> 29 ms at 16), and reading the list four entries a fetch from an RGBA32UI texture with
+// the loop unrolled by four (42-49 -> 61-86 ms; a Forward+ floor 71-73 -> 111-125 ms).
 #include "common/light_buffer.glsl"
 #include "generated/lights.glsl"
 #include "lights/light_lists.glsl"
