@@ -3,8 +3,9 @@
 //
 // A list holds the lights that touch its tile or cluster; most miss any one point of it
 // (lights.toml at 1024 lights: 31.5 entries a pixel, 13.2 reaching it, 14.5 reaching some pixel
-// of its 4x2 block, the width of a 256-bit SIMD vector). Where a fragment shader runs as SIMD lanes (llvmpipe) the light's
-// arithmetic still runs for every entry; a missed entry saves its record fetches. Two ways of
+// of its 4x2 block, the width of a 256-bit SIMD vector). Where a fragment shader runs as SIMD
+// lanes (llvmpipe) the light's arithmetic still runs for every entry; a missed entry saves its
+// record fetches. Two ways of
 // doing less were tried and were slower on llvmpipe at every light count, so an entry's cost is
 // mostly its fetches and the loop, not the light: testing 32 entries first and evaluating only
 // the set bits of the mask (the tiled shading 46 -> 54 ms at 1024 lights, a Forward+ floor
