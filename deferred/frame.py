@@ -269,7 +269,8 @@ class Frame:
         }
 
     def object_uniforms(self, obj: SceneObject) -> dict[str, Any]:
-        """The object's transforms and id (computed once per frame, for every object)."""
+        """The object's transforms and id (for every object at once, kept across frames while
+        the camera and the objects hold: :class:`ObjectTransforms`)."""
         if self._objects is None:
             self._objects = self._object_transforms.of(self.scene.objects, self.view)
         return self._objects[id(obj)]

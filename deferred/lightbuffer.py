@@ -138,7 +138,7 @@ class LightBuffer:
     def bind(self, uniforms: ProgramUniforms, texture_unit: int) -> None:
         """Set the counts and ranges on a program, and bind the records at ``texture_unit``
         where it reads them."""
-        uniforms.set_shared("lights", self._uniforms)  # a new dict each frame
+        uniforms.set_shared("lights", self._uniforms)  # a new dict each upload
         if "u_lights" in uniforms.members:
             self._texture.use(location=texture_unit)
             uniforms.set_one("u_lights", texture_unit)

@@ -5,7 +5,7 @@
 // atomics, and the lists come out in light order whatever the scheduling, so a frame shades
 // its lights in the same order every time (the same image, to the bit). A thread per light
 // appending with atomics, as before, gave the lists in the order the threads ran.
-layout(local_size_x = 64) in;
+layout(local_size_x = CULL_GROUP_SIZE) in;  // deferred.light_lists
 
 #include "common/light_buffer.glsl"
 #include "lights/light_lists.glsl"
@@ -22,9 +22,9 @@ void main() {
     ivec2 origin = tile * u_list_tile;
     vec3 planes[4];
     tile_planes(origin, min(origin + u_list_tile, ivec2(u_resolution)), planes);
-    // the tile's list in slice s is tile_index + s * tiles; its count is kept in the buffer
-    for (int slice = 0; slice < u_list_grid.z; ++slice)
-        light_list_data[tile_index + slice * tiles] = 0u;
+    // the tile's list in slice s is tile_index + s * tiles
+    uint counts[LIST_SLICES];
+    for (int slice = 0; slice < LIST_SLICES; ++slice) counts[slice] = 0u;
     int local_count = u_light_count - u_global_light_count;
     for (int i = 0; i < local_count; ++i) {
         int index = u_global_light_count + i;
@@ -37,10 +37,12 @@ void main() {
         for (int slice = light_list_slice(max(near_depth, u_near_far.x)); slice <= last_slice;
              ++slice) {
             int list = tile_index + slice * tiles;
-            uint count = light_list_data[list];
+            uint count = counts[slice];
             if (int(count) < u_list_capacity)
                 light_list_data[u_list_count + list * u_list_capacity + int(count)] = uint(index);
-            light_list_data[list] = count + 1u;
+            counts[slice] = count + 1u;
         }
     }
+    for (int slice = 0; slice < LIST_SLICES; ++slice)
+        light_list_data[tile_index + slice * tiles] = counts[slice];
 }

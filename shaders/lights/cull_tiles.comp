@@ -13,7 +13,7 @@
 // bounds with shared atomics, then sharing out the lights), as before, cost 4-5x as much on
 // llvmpipe, where a work group's invocations are SIMD lanes looped over on one CPU thread and
 // each barrier and shared atomic is a pass over them.
-layout(local_size_x = 64) in;
+layout(local_size_x = CULL_GROUP_SIZE) in;  // deferred.light_lists
 
 #include "common/light_buffer.glsl"
 #include "lights/light_lists.glsl"

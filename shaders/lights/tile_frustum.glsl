@@ -25,7 +25,7 @@ void tile_planes(ivec2 origin, ivec2 end, out vec3 planes[4]) {
         if (dot(planes[k], centre) < 0.0) planes[k] = -planes[k];
 }
 
-// Whether the sphere (view-space centre, radius) is not wholly outside one of the planes.
+// Whether the sphere (view-space centre, radius) is not wholly outside any of the four planes.
 bool sphere_touches_planes(vec3 planes[4], vec4 sphere) {
     return dot(planes[0], sphere.xyz) >= -sphere.w && dot(planes[1], sphere.xyz) >= -sphere.w &&
            dot(planes[2], sphere.xyz) >= -sphere.w && dot(planes[3], sphere.xyz) >= -sphere.w;
