@@ -24,28 +24,44 @@ uniform vec2 u_near_far;
 uniform vec4 u_pixel_to_view;  // view xy / linear depth = pixel * .xy + .zw (pixel_to_view)
 uniform int u_global_light_count;
 
+// The tile's depth bounds and the box of its points, as main gathers them.
+float low_depth, high_depth;
+vec2 low_xy, high_xy;
+
+void take_pixel(float depth, ivec2 pixel, bool inside) {
+    if (inside && depth > 0.0) {
+        low_depth = min(low_depth, depth);
+        high_depth = max(high_depth, depth);
+        vec2 point = depth * ((vec2(pixel) + 0.5) * u_pixel_to_view.xy +
+                              u_pixel_to_view.zw);  // the lighting's view_position
+        low_xy = min(low_xy, point);
+        high_xy = max(high_xy, point);
+    }
+}
+
 void main() {
     int list = int(gl_GlobalInvocationID.x);
     if (list >= u_list_grid.x * u_list_grid.y) return;
     ivec2 tile = ivec2(list % u_list_grid.x, list / u_list_grid.x);
     ivec2 origin = tile * u_list_tile;
     ivec2 end = min(origin + u_list_tile, ivec2(u_resolution));
-    // the tile's depth bounds and the view-space box of its points
-    float low_depth = uintBitsToFloat(0x7f7fffffu);  // the largest float
-    float high_depth = 0.0;
-    vec2 low_xy = vec2(low_depth);
-    vec2 high_xy = -low_xy;
-    for (int y = origin.y; y < end.y; ++y) {
-        for (int x = origin.x; x < end.x; ++x) {
-            float depth = texelFetch(u_linear_depth, ivec2(x, y), 0).r;
-            if (depth > 0.0) {
-                low_depth = min(low_depth, depth);
-                high_depth = max(high_depth, depth);
-                vec2 point = depth * ((vec2(x, y) + 0.5) * u_pixel_to_view.xy +
-                                      u_pixel_to_view.zw);  // the lighting's view_position
-                low_xy = min(low_xy, point);
-                high_xy = max(high_xy, point);
-            }
+    // the tile's depth bounds and the view-space box of its points, a 2x2 block of pixels a
+    // fetch (textureGather: a quarter of the fetches of one texel each)
+    low_depth = uintBitsToFloat(0x7f7fffffu);  // the largest float
+    high_depth = 0.0;
+    low_xy = vec2(low_depth);
+    high_xy = -low_xy;
+    vec2 texel = 1.0 / u_resolution;
+    for (int y = origin.y; y < end.y; y += 2) {
+        for (int x = origin.x; x < end.x; x += 2) {
+            // the corner shared by pixels (x, y) .. (x + 1, y + 1): .w (x, y), .z (x + 1, y),
+            // .x (x, y + 1), .y (x + 1, y + 1)
+            vec4 depths = textureGather(u_linear_depth, vec2(x + 1, y + 1) * texel, 0);
+            bool right = x + 1 < end.x, up = y + 1 < end.y;  // a tile of odd width or height
+            take_pixel(depths.w, ivec2(x, y), true);
+            take_pixel(depths.z, ivec2(x + 1, y), right);
+            take_pixel(depths.x, ivec2(x, y + 1), up);
+            take_pixel(depths.y, ivec2(x + 1, y + 1), right && up);
         }
     }
     bool empty = high_depth <= 0.0;

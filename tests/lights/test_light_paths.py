@@ -81,13 +81,14 @@ def test_forward_plus_lights_fur_shells_in_front_of_the_opaque_depth(gl):
     assert psnr(images[0], images[1], 255.0) >= 40.0
 
 
-def listed_frame(gl, path: str, extra: int) -> SimpleNamespace:
+def listed_frame(gl, path: str, extra: int, size: tuple[int, int] | None = None
+                 ) -> SimpleNamespace:
     """One frame of scene_with(extra) through a list path, read back: the lists (``entries``,
     ``counts``), the light records, and each covered pixel's view-space point (``xs``, ``ys``,
     ``z``, ``points``) with the volume lights whose sphere reaches it (``reach``)."""
     if not gl.features.compute_shaders:
         pytest.skip("the driver has no compute shaders")
-    with Renderer(scene_with(extra), "deferred", gl=gl, light_path=path) as renderer:
+    with Renderer(scene_with(extra), "deferred", size, gl=gl, light_path=path) as renderer:
         renderer.render()
         lists = renderer.light_lists
         grid = lists.grid
@@ -116,8 +117,9 @@ def listed_frame(gl, path: str, extra: int) -> SimpleNamespace:
                            xs=xs, ys=ys, z=z, points=points, reach=reach)
 
 
-def test_tile_lists_hold_every_light_that_reaches_a_pixel(gl):
-    frame = listed_frame(gl, "tiled", 120)
+@pytest.mark.parametrize("size", [None, (157, 93)])  # 160x96; odd: tiles of odd width, height
+def test_tile_lists_hold_every_light_that_reaches_a_pixel(gl, size):
+    frame = listed_frame(gl, "tiled", 120, size)
     grid, reach, points, records = frame.grid, frame.reach, frame.points, frame.records
     global_count, counts, entries = frame.global_count, frame.counts, frame.entries
     assert reach.sum() > 1000  # the lights do light the scene
