@@ -271,7 +271,11 @@ def pixel_to_view(projection: np.ndarray, width: int, height: int) -> tuple[floa
 
 def list_shading_pass(name: str, clustered: bool, gbuffer: tuple[str, ...],
                       occlusion: str | None) -> FullscreenPass:
-    """The deferred lighting of every light from the lists: one full-screen pass."""
+    """The deferred lighting of every light from the lists: one full-screen pass, which creates
+    the light accumulation (the scene's background where the G-buffer holds no surface, alpha
+    0; the lights' sum on surfaces, alpha 1), so no pass has to lay the background down first."""
+    from .targets import LIGHT_ACCUMULATION, LIGHT_ACCUMULATION_SPEC
+
     inputs = {f"u_{target}": target for target in gbuffer}
     defines = {}
     if occlusion:
@@ -279,7 +283,8 @@ def list_shading_pass(name: str, clustered: bool, gbuffer: tuple[str, ...],
         defines["HAS_SSAO"] = "1"
     if clustered:
         defines["LIGHT_LISTS_CLUSTERED"] = "1"
-    from .targets import LIGHT_ACCUMULATION
-
     return FullscreenPass(name, Phase.LIGHTING, "lights/list_shading.frag", inputs,
-                          (LIGHT_ACCUMULATION,), blend="add", defines=defines)
+                          (LIGHT_ACCUMULATION,), defines=defines,
+                          creates={LIGHT_ACCUMULATION: LIGHT_ACCUMULATION_SPEC},
+                          uniforms=lambda frame: {"u_background": frame.scene.background},
+                          order=Order.FIRST)

@@ -136,21 +136,24 @@ class DeferredPipeline(Pipeline):
         passes += phase_passes(scene, Phase.STIPPLE, [], wide)
         occlusion = AMBIENT_OCCLUSION if any(AMBIENT_OCCLUSION in p.creates for p in passes) \
             else None
-        background = FullscreenPass(
-            "lighting.background", Phase.LIGHTING, "lights/background.frag",
-            {"u_normal_exponent_id": NORMAL_EXPONENT_ID}, (LIGHT_ACCUMULATION,),
-            creates={LIGHT_ACCUMULATION: LIGHT_ACCUMULATION_SPEC}, order=Order.FIRST,
-            uniforms=lambda frame: {"u_background": frame.scene.background})
         if self.light_path == "volumes":
-            lights = [LightTypePass(cls, occlusion, layout.color_targets)
-                      for cls in scene.light_types()]
+            # the light accumulation starts as 0 on surfaces and the background elsewhere;
+            # each light type's pass adds into it
+            background = FullscreenPass(
+                "lighting.background", Phase.LIGHTING, "lights/background.frag",
+                {"u_normal_exponent_id": NORMAL_EXPONENT_ID}, (LIGHT_ACCUMULATION,),
+                creates={LIGHT_ACCUMULATION: LIGHT_ACCUMULATION_SPEC}, order=Order.FIRST,
+                uniforms=lambda frame: {"u_background": frame.scene.background})
+            lights = [background, *(LightTypePass(cls, occlusion, layout.color_targets)
+                                    for cls in scene.light_types())]
         else:
+            # one pass shades every light and writes the background where there is no surface
             clustered = self.light_path == "clustered"
             lights = [LightCullPass(f"lighting.cull_{'clusters' if clustered else 'tiles'}",
                                     Phase.LIGHTING, clustered),
                       list_shading_pass(f"lighting.{self.light_path}", clustered,
                                         layout.color_targets, occlusion)]
-        passes += phase_passes(scene, Phase.LIGHTING, [background, *lights], wide)
+        passes += phase_passes(scene, Phase.LIGHTING, lights, wide)
         composite = copy_pass("material.composite_copy", Phase.MATERIAL, LIGHT_ACCUMULATION,
                               COMPOSITE, COMPOSITE_SPEC, order=Order.FIRST)
         passes += phase_passes(scene, Phase.MATERIAL, [composite], wide)

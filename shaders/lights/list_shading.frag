@@ -1,6 +1,7 @@
 // Deferred lighting from light lists (the tiled and clustered paths): each pixel reads the
 // G-buffer once and loops over the full-screen lights and the volume lights of its tile or
-// cluster, adding the sum into the light accumulation - one pass for every light.
+// cluster - one pass for every light, which writes the light accumulation whole (the
+// background where there is no surface).
 #include "gbuffer/fetch.glsl"
 #include "common/light_buffer.glsl"
 #include "generated/lights.glsl"
@@ -11,13 +12,17 @@ uniform sampler2D u_ssao;
 #endif
 uniform vec2 u_resolution;
 uniform mat4 u_inverse_projection;
+uniform vec3 u_background;  // where the G-buffer holds no surface (alpha 0: coverage)
 
 out vec4 out_light;
 
 void main() {
     ivec2 pixel = ivec2(gl_FragCoord.xy);
     GBufferSample g = gbuffer_fetch(pixel);
-    if (g.surface_id <= 0.0) discard;
+    if (g.surface_id <= 0.0) {  // the pass creates the light accumulation: every pixel
+        out_light = vec4(u_background, 0.0);
+        return;
+    }
 #ifdef HAS_SSAO
     g.surface.occlusion = texelFetch(u_ssao, pixel, 0).r;
 #endif
@@ -30,5 +35,5 @@ void main() {
 #else
     total += evaluate_listed_lights(light_list_of(pixel, g.linear_depth), g.surface, P, V);
 #endif
-    out_light = vec4(total, 0.0);
+    out_light = vec4(total, 1.0);
 }

@@ -123,9 +123,9 @@ def test_insert_pass_is_checked_and_placed(render):
     probe = FullscreenPass("test.depth_probe", Phase.LIGHTING, "post/copy.frag",
                            {"u_source": LINEAR_DEPTH}, ("probe",),
                            creates={"probe": TargetSpec(1, "f4", "probe", clear=(0.0,))})
-    renderer.insert_pass(probe, before="lighting.background")
+    renderer.insert_pass(probe, before="lighting.cull_tiles")
     names = [p.name for p in renderer.passes]
-    assert names.index("test.depth_probe") == names.index("lighting.background") - 1
+    assert names.index("test.depth_probe") == names.index("lighting.cull_tiles") - 1
     renderer.render()
     assert np.array_equal(renderer.targets.read("probe"), renderer.targets.read(LINEAR_DEPTH))
     late = FullscreenPass("test.too_early", Phase.GEOMETRY, "post/copy.frag",
