@@ -270,11 +270,13 @@ def pixel_to_view(projection: np.ndarray, width: int, height: int) -> tuple[floa
 
 
 def list_shading_pass(name: str, clustered: bool, gbuffer: tuple[str, ...],
-                      occlusion: str | None) -> FullscreenPass:
+                      occlusion: str | None, composite: bool = False) -> FullscreenPass:
     """The deferred lighting of every light from the lists: one full-screen pass, which creates
     the light accumulation (the scene's background where the G-buffer holds no surface, alpha
-    0; the lights' sum on surfaces, alpha 1), so no pass has to lay the background down first."""
-    from .targets import LIGHT_ACCUMULATION, LIGHT_ACCUMULATION_SPEC
+    0; the lights' sum on surfaces, alpha 1), so no pass has to lay the background down first.
+    With ``composite`` it creates the composition buffer too, the same values (a frame with
+    no material pass: the copy between them would be all the material phase did)."""
+    from .targets import COMPOSITE, COMPOSITE_SPEC, LIGHT_ACCUMULATION, LIGHT_ACCUMULATION_SPEC
 
     inputs = {f"u_{target}": target for target in gbuffer}
     defines = {}
@@ -283,8 +285,13 @@ def list_shading_pass(name: str, clustered: bool, gbuffer: tuple[str, ...],
         defines["HAS_SSAO"] = "1"
     if clustered:
         defines["LIGHT_LISTS_CLUSTERED"] = "1"
-    return FullscreenPass(name, Phase.LIGHTING, "lights/list_shading.frag", inputs,
-                          (LIGHT_ACCUMULATION,), defines=defines,
-                          creates={LIGHT_ACCUMULATION: LIGHT_ACCUMULATION_SPEC},
+    outputs = (LIGHT_ACCUMULATION,)
+    creates = {LIGHT_ACCUMULATION: LIGHT_ACCUMULATION_SPEC}
+    if composite:
+        outputs += (COMPOSITE,)
+        creates[COMPOSITE] = COMPOSITE_SPEC
+        defines["WRITE_COMPOSITE"] = "1"
+    return FullscreenPass(name, Phase.LIGHTING, "lights/list_shading.frag", inputs, outputs,
+                          defines=defines, creates=creates,
                           uniforms=lambda frame: {"u_background": frame.scene.background},
                           order=Order.FIRST)

@@ -136,6 +136,7 @@ class DeferredPipeline(Pipeline):
         passes += phase_passes(scene, Phase.STIPPLE, [], wide)
         occlusion = AMBIENT_OCCLUSION if any(AMBIENT_OCCLUSION in p.creates for p in passes) \
             else None
+        folded = False  # the composition made by the lighting pass (below)
         if self.light_path == "volumes":
             # the light accumulation starts as 0 on surfaces and the background elsewhere;
             # each light type's pass adds into it
@@ -147,16 +148,24 @@ class DeferredPipeline(Pipeline):
             lights = [background, *(LightTypePass(cls, occlusion, layout.color_targets)
                                     for cls in scene.light_types())]
         else:
-            # one pass shades every light and writes the background where there is no surface
+            # One pass shades every light and writes the background where there is no surface.
+            # Where no other pass writes the light accumulation and the material phase has no
+            # pass, the composition is the light accumulation: the same pass writes both, and
+            # there is nothing to copy.
             clustered = self.light_path == "clustered"
+            folded = not phase_passes(scene, Phase.MATERIAL, [], wide) and not any(
+                LIGHT_ACCUMULATION in p.writes
+                for p in phase_passes(scene, Phase.LIGHTING, [], wide))
             lights = [LightCullPass(f"lighting.cull_{'clusters' if clustered else 'tiles'}",
                                     Phase.LIGHTING, clustered),
                       list_shading_pass(f"lighting.{self.light_path}", clustered,
-                                        layout.color_targets, occlusion)]
+                                        layout.color_targets, occlusion, composite=folded)]
         passes += phase_passes(scene, Phase.LIGHTING, lights, wide)
-        composite = copy_pass("material.composite_copy", Phase.MATERIAL, LIGHT_ACCUMULATION,
-                              COMPOSITE, COMPOSITE_SPEC, order=Order.FIRST)
-        passes += phase_passes(scene, Phase.MATERIAL, [composite], wide)
+        if not folded:
+            composite = copy_pass("material.composite_copy", Phase.MATERIAL,
+                                  LIGHT_ACCUMULATION, COMPOSITE, COMPOSITE_SPEC,
+                                  order=Order.FIRST)
+            passes += phase_passes(scene, Phase.MATERIAL, [composite], wide)
         passes += phase_passes(scene, Phase.POST, [tonemap_pass()], wide)
         return passes
 

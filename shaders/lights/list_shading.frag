@@ -14,13 +14,24 @@ uniform vec2 u_resolution;
 uniform mat4 u_inverse_projection;
 uniform vec3 u_background;  // where the G-buffer holds no surface (alpha 0: coverage)
 
-out vec4 out_light;
+layout(location = 0) out vec4 out_light;
+#ifdef WRITE_COMPOSITE
+// the composition buffer, where the frame has no material pass (deferred.light_lists)
+layout(location = 1) out vec4 out_composite;
+#endif
+
+void write_light(vec4 light) {
+    out_light = light;
+#ifdef WRITE_COMPOSITE
+    out_composite = light;
+#endif
+}
 
 void main() {
     ivec2 pixel = ivec2(gl_FragCoord.xy);
     GBufferSample g = gbuffer_fetch(pixel);
     if (g.surface_id <= 0.0) {  // the pass creates the light accumulation: every pixel
-        out_light = vec4(u_background, 0.0);
+        write_light(vec4(u_background, 0.0));
         return;
     }
 #ifdef HAS_SSAO
@@ -35,5 +46,5 @@ void main() {
 #else
     total += evaluate_listed_lights(light_list_of(pixel, g.linear_depth), g.surface, P, V);
 #endif
-    out_light = vec4(total, 1.0);
+    write_light(vec4(total, 1.0));
 }

@@ -396,3 +396,22 @@ def test_a_renderer_follows_a_light_and_the_camera_changed_between_frames(gl, pi
     scene.camera = replace(moved, position=(0.0, 1.6, 4.2))  # scene_with's camera
     with Renderer(scene, pipeline, gl=gl, light_path=path) as renderer:
         np.testing.assert_array_equal(renderer.render().hdr, after_light)
+
+
+@pytest.mark.parametrize("path", ["tiled", "clustered"])
+def test_the_list_shading_makes_the_composition_where_the_material_phase_has_no_pass(gl, path):
+    """With no material pass the list shading writes the composition buffer too (there is no
+    copy); a material with passes of its own (Revie's fur) keeps the copy that starts them."""
+    if not gl.features.compute_shaders:
+        pytest.skip("the driver has no compute shaders")
+    with Renderer(scene_with(16), "deferred", gl=gl, light_path=path) as renderer:
+        names = [p.name for p in renderer.passes]
+        assert "material.composite_copy" not in names
+        assert renderer.graph.creators["composite"] == f"lighting.{path}"
+        renderer.render()
+        np.testing.assert_array_equal(renderer.targets.read("composite"),
+                                      renderer.targets.read("light_accumulation"))
+    with Renderer(load_scene(), "deferred", (96, 64), gl=gl, light_path=path) as renderer:
+        assert renderer.graph.creators["composite"] == "material.composite_copy"
+        shading = renderer.passes[renderer.graph.index(f"lighting.{path}")]
+        assert set(shading.creates) == {"light_accumulation"}
