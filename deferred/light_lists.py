@@ -7,9 +7,10 @@ Deferred:
   full-screen triangle), re-reading the G-buffer and blending into the light accumulation for
   every pixel it covers. Needs GL 3.3 only.
 - ``tiled``: a compute pass culls the volume lights per 16x16 tile against the tile's frustum,
-  depth bounds and the view-space box of its points (``lights/cull_tiles.comp``); one
-  full-screen pass then reads the G-buffer once per pixel and loops the full-screen lights and
-  its tile's list (``lights/list_shading.frag``).
+  depth bounds and the view-space box of its points (``lights/cull_tiles.comp``), in two
+  dispatches: coarse tiles of 4x4 tiles against every light, then each tile against its
+  coarse tile's lights; one full-screen pass then reads the G-buffer once per pixel and loops
+  the full-screen lights and its tile's list (``lights/list_shading.frag``).
 - ``clustered``: the same shading, from lists of view-space clusters (32x32 tiles x 16
   exponential depth slices) filled tile by tile (``lights/cull_clusters.comp``).
 
@@ -21,7 +22,8 @@ Forward:
   tile's list (``common/forward_lighting.glsl``).
 
 The lists live in one storage buffer (``lights/light_lists.glsl``): a count per list, then
-``capacity`` slots per list. Capacity is the frame's volume light count, so no list overflows.
+``capacity`` slots per list, then (tiled) the coarse tiles' lists in the same layout. Capacity
+is the frame's volume light count, so no list overflows.
 The culling shaders write the buffer; it is then copied into an R32UI texture, which the shading
 passes read: llvmpipe reads a texel several times as fast as a storage buffer's word, and the
 list loops read one per light (the tiled shading pass 15-23% faster at 256-1024 lights). The
@@ -59,6 +61,9 @@ CLUSTER_SLICES = 16  # exponential depth slices between the near and far planes
 # 29 groups; 240 cluster tiles, 8 groups); 16 cost more than 32 or 64 in the groups' own
 # overhead (the tiled culling 4.2-6.1 ms at 1024 lights with 64 or 32, 8.0-8.6 with 16).
 CULL_GROUP_SIZE = 32
+# The tiled culling runs twice: over coarse tiles of COARSE_RATIO x COARSE_RATIO tiles against
+# every light, then over the tiles against their coarse tile's lights only.
+COARSE_RATIO = 4
 MAX_LIST_BYTES = 512 * 1024 * 1024
 LIST_ROW_SHIFT = 14  # words per row of the lists' texture, as a power of two (u_list_row_shift)
 LIST_TEXTURE_WIDTH = 1 << LIST_ROW_SHIFT  # 16384: every GL 4.3 context (compute) allows it
@@ -105,9 +110,35 @@ def list_bytes(grid: ListGrid, capacity: int) -> int:
     return -(-4 * grid.count * (1 + max(capacity, 1)) // LIST_ROW_BYTES) * LIST_ROW_BYTES
 
 
+def coarse_grid(grid: ListGrid) -> ListGrid:
+    """The coarse tiles of the tiled culling's first dispatch (COARSE_RATIO tiles a side)."""
+    return ListGrid(math.ceil(grid.columns / COARSE_RATIO), math.ceil(grid.rows / COARSE_RATIO),
+                    1, grid.tile * COARSE_RATIO)
+
+
+def coarse_list_bytes(grid: ListGrid, capacity: int) -> int:
+    """Bytes of the coarse lists, kept in the storage buffer after the lists (tiled only)."""
+    if grid.slices > 1:
+        return 0
+    return 4 * coarse_grid(grid).count * (1 + max(capacity, 1))
+
+
 def list_byte_limit(max_texture_size: int) -> int:
     """The most bytes of lists: MAX_LIST_BYTES, and the rows the lists' texture may have."""
     return min(MAX_LIST_BYTES, max_texture_size * LIST_ROW_BYTES)
+
+
+def list_overflow(grid: ListGrid, capacity: int, max_texture_size: int
+                  ) -> tuple[int, int] | None:
+    """(bytes needed, limit) where the lists do not fit: the shading's lists in the texture's
+    rows (:func:`list_byte_limit`), and the storage buffer, which also holds the coarse lists,
+    in MAX_LIST_BYTES; None where they fit."""
+    lists = list_bytes(grid, capacity)
+    texture_limit = list_byte_limit(max_texture_size)
+    if lists > texture_limit:
+        return lists, texture_limit
+    total = lists + coarse_list_bytes(grid, capacity)
+    return (total, MAX_LIST_BYTES) if total > MAX_LIST_BYTES else None
 
 
 def _too_many_for_lists(lights: int, grid: ListGrid, size: int, limit: int) -> str:
@@ -123,10 +154,9 @@ def check_light_limits(light_path: str, size: tuple[int, int], volume_lights: in
     (a row per light)."""
     if light_path in ("tiled", "clustered"):
         grid = list_grid(*size, light_path == "clustered")
-        needed = list_bytes(grid, volume_lights)
-        limit = list_byte_limit(max_texture_size)
-        if needed > limit:
-            raise InputError(_too_many_for_lists(volume_lights, grid, needed, limit), "light")
+        overflow = list_overflow(grid, volume_lights, max_texture_size)
+        if overflow is not None:
+            raise InputError(_too_many_for_lists(volume_lights, grid, *overflow), "light")
     if lights > max_texture_size:
         raise InputError(f"{lights} lights; lights are kept in a texture of at most "
                          f"{max_texture_size} rows (GL_MAX_TEXTURE_SIZE)", "light")
@@ -149,6 +179,7 @@ class LightLists:
         self.max_texture_size = int(ctx.info["GL_MAX_TEXTURE_SIZE"])
         self.grid: ListGrid | None = None
         self.capacity = 1
+        self.coarse_base = 0
         self.clustered = False
         self.depth_scale = (1.0, 1.0)
 
@@ -158,19 +189,23 @@ class LightLists:
         self.clustered = grid.slices > 1
         self.depth_scale = (near, grid.slices / math.log(far / near))
         self._uniforms = {"u_list_count": grid.count, "u_list_capacity": self.capacity,
+                          "u_list_base": 0,
                           "u_list_row_shift": LIST_ROW_SHIFT,
                           "u_list_grid": (grid.columns, grid.rows, grid.slices),
                           "u_list_tile": grid.tile, "u_list_depth": self.depth_scale}
-        size = list_bytes(grid, self.capacity)
-        limit = list_byte_limit(self.max_texture_size)
-        if size > limit:  # checked before the first frame (check_light_limits)
-            raise RenderError(_too_many_for_lists(capacity, grid, size, limit))
-        if self.buffer is None or self.texture is None or self.buffer.size < size:
+        lists = list_bytes(grid, self.capacity)  # what the shading reads, in the texture
+        size = lists + coarse_list_bytes(grid, self.capacity)
+        self.coarse_base = lists // 4  # the word where the coarse lists begin
+        overflow = list_overflow(grid, self.capacity, self.max_texture_size)
+        if overflow is not None:  # checked before the first frame (check_light_limits)
+            raise RenderError(_too_many_for_lists(capacity, grid, *overflow))
+        rows = lists // LIST_ROW_BYTES
+        if self.buffer is None or self.texture is None or self.buffer.size < size or \
+                self.texture.height < rows:
             self.release()
             buffer = self.ctx.buffer(reserve=size)
             try:
-                texture = self.ctx.texture((LIST_TEXTURE_WIDTH, size // LIST_ROW_BYTES),
-                                           1, dtype="u4")
+                texture = self.ctx.texture((LIST_TEXTURE_WIDTH, rows), 1, dtype="u4")
             except BaseException:
                 buffer.release()
                 raise
@@ -190,6 +225,18 @@ class LightLists:
         they hold its values)."""
         assert self.grid is not None
         return self._uniforms
+
+    def coarse_uniforms(self) -> dict[str, Any]:
+        """The tiled culling's two dispatches: the first's lists (the coarse tiles') and the
+        second's candidates (the same lists, read)."""
+        assert self.grid is not None
+        coarse = coarse_grid(self.grid)
+        first = {**self._uniforms, "u_list_base": self.coarse_base, "u_list_count": coarse.count,
+                 "u_list_grid": (coarse.columns, coarse.rows, 1), "u_list_tile": coarse.tile}
+        second = {**self._uniforms, "u_candidate_base": self.coarse_base,
+                  "u_candidate_count": coarse.count, "u_candidate_columns": coarse.columns,
+                  "u_candidate_ratio": COARSE_RATIO}
+        return {"first": first, "second": second}
 
     def bind(self, uniforms: ProgramUniforms, texture_unit: int) -> None:
         """Set the list uniforms, bind the buffer (culling) and the texture (shading, at
@@ -241,19 +288,30 @@ class LightCullPass(RenderPass):
         if self.clustered:
             defines["LIGHT_LISTS_CLUSTERED"] = "1"
             defines["LIST_SLICES"] = str(grid.slices)
-        shader = frame.shaders.compute(
-            "lights/cull_clusters.comp" if self.clustered else "lights/cull_tiles.comp",
-            defines)
-        uniforms = {**frame.light_lists.uniforms(), "u_light_count": lights.count,
-                    "u_global_light_count": lights.global_count}
+            shader = frame.shaders.compute("lights/cull_clusters.comp", defines)
+        else:
+            shader = frame.shaders.compute("lights/cull_tiles.comp",
+                                           {**defines, "CULL_CANDIDATES": "1"})
+        counts = {"u_light_count": lights.count, "u_global_light_count": lights.global_count}
         textures = {"u_lights": lights.texture}
-        if not self.clustered:
+        if self.clustered:
+            dispatches = [(shader, {**frame.light_lists.uniforms(), **counts}, grid)]
+        else:
             textures["u_linear_depth"] = frame.target(LINEAR_DEPTH)
-            uniforms["u_pixel_to_view"] = pixel_to_view(frame.projection, frame.width,
-                                                        frame.height)
-        frame.bind_compute(shader, uniforms, textures)
-        groups = math.ceil(grid.columns * grid.rows / CULL_GROUP_SIZE)  # an invocation a tile
-        frame.gl_call(lambda: shader.run(groups, 1, 1))
+            counts["u_pixel_to_view"] = pixel_to_view(frame.projection, frame.width,
+                                                      frame.height)
+            # coarse tiles against every light, then the tiles against their coarse tile's
+            coarse = frame.light_lists.coarse_uniforms()
+            first = frame.shaders.compute("lights/cull_tiles.comp",
+                                          {**defines, "CULL_COARSE": "1"})
+            dispatches = [(first, {**coarse["first"], **counts}, coarse_grid(grid)),
+                          (shader, {**coarse["second"], **counts}, grid)]
+        for index, (program, uniforms, tiles) in enumerate(dispatches):
+            if index:
+                frame.ctx.memory_barrier()
+            frame.bind_compute(program, uniforms, textures)
+            groups = math.ceil(tiles.columns * tiles.rows / CULL_GROUP_SIZE)  # a tile each
+            frame.gl_call(lambda program=program, groups=groups: program.run(groups, 1, 1))
         frame.ctx.memory_barrier()
         frame.gl_call(frame.light_lists.publish)  # a copy of the lists: GL work
         frame.count_draw()

@@ -39,10 +39,11 @@ void main() {
             int list = tile_index + slice * tiles;
             uint count = counts[slice];
             if (int(count) < u_list_capacity)
-                light_list_data[u_list_count + list * u_list_capacity + int(count)] = uint(index);
+                light_list_data[u_list_base + u_list_count + list * u_list_capacity +
+                                int(count)] = uint(index);
             counts[slice] = count + 1u;
         }
     }
     for (int slice = 0; slice < LIST_SLICES; ++slice)
-        light_list_data[tile_index + slice * tiles] = counts[slice];
+        light_list_data[u_list_base + tile_index + slice * tiles] = counts[slice];
 }

@@ -7,6 +7,10 @@
 // CULL_FROM_NEAR (Forward+): the bounds run from the near plane to the farthest depth, or to the
 // far plane on tiles of background, since blended surfaces (fur shells) lie in front of it;
 // there is no box.
+// It runs twice (deferred.light_lists): over coarse tiles of 4x4 tiles (CULL_COARSE) against
+// every light, then over the tiles against their coarse tile's list only (CULL_CANDIDATES):
+// at 1024 lights and 1280x720, 3600 tiles each testing every light cost 15-22 ms, the two
+// dispatches 8.6-9.2 ms.
 // An invocation per tile, looping the tile's pixels and then every light in order: the lists
 // come out in light order whatever the scheduling (the same image every frame, on any driver),
 // and no invocation waits on another. A work group per tile (its invocations reducing the
@@ -23,6 +27,16 @@ uniform sampler2D u_linear_depth;
 uniform vec2 u_near_far;
 uniform vec4 u_pixel_to_view;  // view xy / linear depth = pixel * .xy + .zw (pixel_to_view)
 uniform int u_global_light_count;
+#ifdef CULL_CANDIDATES
+// The coarse lists (deferred.light_lists: a first dispatch over tiles of u_candidate_ratio x
+// u_candidate_ratio tiles): a tile tests only its coarse tile's lights, which hold every light
+// that can touch it, in light order (the coarse tile's frustum, depth bounds and box hold the
+// tile's), instead of every light.
+uniform int u_candidate_base;     // where the coarse lists begin
+uniform int u_candidate_count;    // coarse lists
+uniform int u_candidate_columns;  // coarse tiles across
+uniform int u_candidate_ratio;    // tiles per coarse tile side
+#endif
 
 // The tile's depth bounds and the box of its points, as main gathers them.
 float low_depth, high_depth;
@@ -69,7 +83,11 @@ void main() {
     float far_depth = high_depth;
 #ifdef CULL_FROM_NEAR
     near_depth = u_near_far.x;
+#ifdef CULL_COARSE
+    far_depth = u_near_far.y;  // its tiles of background reach the far plane
+#else
     far_depth = empty ? u_near_far.y : high_depth;
+#endif
     empty = false;
 #endif
     int count = 0;
@@ -85,10 +103,19 @@ void main() {
         vec3 box_low = vec3(low_xy, -far_depth) - pad;
         vec3 box_high = vec3(high_xy, -near_depth) + pad;
 #endif
-        int slots = u_list_count + list * u_list_capacity;
+        int slots = u_list_base + u_list_count + list * u_list_capacity;
+#ifdef CULL_CANDIDATES
+        int coarse = (tile.y / u_candidate_ratio) * u_candidate_columns +
+                     tile.x / u_candidate_ratio;
+        int candidates = min(int(light_list_data[u_candidate_base + coarse]), u_list_capacity);
+        int candidate_slots = u_candidate_base + u_candidate_count + coarse * u_list_capacity;
+        for (int i = 0; i < candidates; ++i) {
+            int index = int(light_list_data[candidate_slots + i]);
+#else
         int local_count = u_light_count - u_global_light_count;
         for (int i = 0; i < local_count; ++i) {
             int index = u_global_light_count + i;
+#endif
             vec4 sphere = fetch_light_sphere(index);
             float z = -sphere.z;
             if (z + sphere.w < near_depth || z - sphere.w > far_depth) continue;
@@ -101,5 +128,5 @@ void main() {
             ++count;
         }
     }
-    light_list_data[list] = uint(count);
+    light_list_data[u_list_base + list] = uint(count);
 }

@@ -9,6 +9,7 @@ layout(std430, binding = 1) buffer LightLists {
 uniform usampler2D u_light_list_texture;
 uniform int u_list_row_shift;   // log2 of the texture's words per row
 
+uniform int u_list_base;        // culling: the word where its lists begin (the shading's: 0)
 uniform int u_list_count;       // lists: tiles, or tiles x depth slices
 uniform int u_list_capacity;    // slots per list
 uniform ivec3 u_list_grid;      // tiles across, tiles down, depth slices (1 when tiled)
