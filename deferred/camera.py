@@ -50,18 +50,19 @@ class Camera:
         return cached
 
     def projection(self, aspect: float) -> np.ndarray:
-        cached = self.__dict__.setdefault("_projections", {})
-        matrix = cached.get(aspect)
-        if matrix is None:
-            matrix = cached[aspect] = _read_only(pyrr.matrix44.create_perspective_projection(
-                self.fov, aspect, self.near, self.far, dtype=np.float64).T)
-        return matrix
+        return self._per_aspect("_projections", aspect, lambda: (
+            pyrr.matrix44.create_perspective_projection(
+                self.fov, aspect, self.near, self.far, dtype=np.float64).T))
 
     def inverse_projection(self, aspect: float) -> np.ndarray:
-        cached = self.__dict__.setdefault("_inverse_projections", {})
+        return self._per_aspect("_inverse_projections", aspect,
+                                lambda: np.linalg.inv(self.projection(aspect)))
+
+    def _per_aspect(self, name: str, aspect: float, make) -> np.ndarray:
+        cached = self.__dict__.setdefault(name, {})
         matrix = cached.get(aspect)
         if matrix is None:
-            matrix = cached[aspect] = _read_only(np.linalg.inv(self.projection(aspect)))
+            matrix = cached[aspect] = _read_only(make())
         return matrix
 
 

@@ -238,9 +238,8 @@ class Frame:
         self.current_pass = render_pass
         draws_before = self.stats.draw_calls
         try:
-            if render_pass.creates:
-                for name in render_pass.creates:
-                    self.gl_call(lambda name=name: self.targets.clear(name))
+            for name in render_pass.creates:
+                self.gl_call(lambda name=name: self.targets.clear(name))
             render_pass.execute(self)
         except InputError:
             raise
@@ -323,12 +322,10 @@ class Frame:
         if uniforms:
             program_uniforms.set(uniforms)
         shading = self.shading_textures()
-        if material is not None and material.textures or textures or shading:
-            if material is not None:
-                samplers = {**shading, **material.textures, **(textures or {})}
-            else:
-                samplers = {**shading, **(textures or {})}
-            unit = self._bind_samplers(program_uniforms, samplers)
+        own = material.textures if material is not None else None
+        if shading or own or textures:  # most draws bind no sampler: no dict is made for them
+            unit = self._bind_samplers(program_uniforms,
+                                       {**shading, **(own or {}), **(textures or {})})
         else:
             unit = 0
         self.light_buffer.bind(program_uniforms, unit)

@@ -180,6 +180,7 @@ class LightLists:
         self.grid: ListGrid | None = None
         self.capacity = 1
         self.coarse_base = 0
+        self.rows = 0
         self.clustered = False
         self.depth_scale = (1.0, 1.0)
 
@@ -199,7 +200,7 @@ class LightLists:
         overflow = list_overflow(grid, self.capacity, self.max_texture_size)
         if overflow is not None:  # checked before the first frame (check_light_limits)
             raise RenderError(_too_many_for_lists(capacity, grid, *overflow))
-        rows = lists // LIST_ROW_BYTES
+        rows = self.rows = lists // LIST_ROW_BYTES  # of the texture the shading reads
         if self.buffer is None or self.texture is None or self.buffer.size < size or \
                 self.texture.height < rows:
             self.release()
@@ -217,8 +218,7 @@ class LightLists:
         """Copy the lists the culling wrote into the texture the shading reads (after a memory
         barrier)."""
         assert self.buffer is not None and self.texture is not None and self.grid is not None
-        rows = list_bytes(self.grid, self.capacity) // LIST_ROW_BYTES
-        self.texture.write(self.buffer, viewport=(0, 0, LIST_TEXTURE_WIDTH, rows))
+        self.texture.write(self.buffer, viewport=(0, 0, LIST_TEXTURE_WIDTH, self.rows))
 
     def uniforms(self) -> dict[str, Any]:
         """The lists' uniforms this frame (one dict per :meth:`prepare`: programs skip it while

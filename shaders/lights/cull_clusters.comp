@@ -39,8 +39,7 @@ void main() {
             int list = tile_index + slice * tiles;
             uint count = counts[slice];
             if (int(count) < u_list_capacity)
-                light_list_data[u_list_base + u_list_count + list * u_list_capacity +
-                                int(count)] = uint(index);
+                light_list_data[light_list_first_slot(list) + int(count)] = uint(index);
             counts[slice] = count + 1u;
         }
     }

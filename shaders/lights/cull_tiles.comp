@@ -103,7 +103,7 @@ void main() {
         vec3 box_low = vec3(low_xy, -far_depth) - pad;
         vec3 box_high = vec3(high_xy, -near_depth) + pad;
 #endif
-        int slots = u_list_base + u_list_count + list * u_list_capacity;
+        int slots = light_list_first_slot(list);
 #ifdef CULL_CANDIDATES
         int coarse = (tile.y / u_candidate_ratio) * u_candidate_columns +
                      tile.x / u_candidate_ratio;

@@ -40,8 +40,13 @@ int light_list_length(int list) {
     return min(int(light_list_word(list)), u_list_capacity);
 }
 
+// The word of a list's first slot (its counts at u_list_base + list, then every list's slots).
+int light_list_first_slot(int list) {
+    return u_list_base + u_list_count + list * u_list_capacity;
+}
+
 int light_list_light(int list, int k) {
-    return int(light_list_word(u_list_count + list * u_list_capacity + k));
+    return int(light_list_word(light_list_first_slot(list) + k));
 }
 
 // Whether the volume light `index` reaches view-space point P: its record's position is the
