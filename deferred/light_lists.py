@@ -41,6 +41,8 @@ import numpy as np
 
 from .errors import InputError, RenderError
 from .gbuffer import LINEAR_DEPTH
+from .light import FULLSCREEN_LIGHT_CAPACITY
+from .lightbuffer import fullscreen_overflow
 from .passes import FullscreenPass, Order, Phase, RenderPass
 
 if TYPE_CHECKING:
@@ -151,7 +153,9 @@ def check_light_limits(light_path: str, size: tuple[int, int], volume_lights: in
                        lights: int, max_texture_size: int) -> None:
     """Refuse, before any frame, a light count the light path cannot hold: the lists' storage
     (tiled, clustered: a slot per volume light in every list) and the light buffer's texture
-    (a row per light)."""
+    (a row per light) and the full-screen lights' uniform array (any path: forward reads it)."""
+    if lights - volume_lights > FULLSCREEN_LIGHT_CAPACITY:
+        raise InputError(fullscreen_overflow(lights - volume_lights), "light")
     if light_path in ("tiled", "clustered"):
         grid = list_grid(*size, light_path == "clustered")
         overflow = list_overflow(grid, volume_lights, max_texture_size)

@@ -6,7 +6,9 @@ lighting pass draws one contiguous range and the tiled paths loop ``[0, global_c
 lights every pixel gets. Volume lights whose sphere lies outside the view frustum are dropped on
 the CPU before anything is uploaded (:func:`visible_spheres`, vectorised). The records live in an
 RGBA32F texture, one row per light (``u_lights``, read by ``common/light_buffer.glsl``), on every
-GL level: llvmpipe fetches texels about 3.4 times as fast as storage-buffer vec4s.
+GL level: llvmpipe fetches texels about 3.4 times as fast as storage-buffer vec4s. The full-screen
+lights' records are also a uniform array (``u_fullscreen_lights``), which the light loops of the
+list and forward paths read at every pixel.
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ import numpy as np
 
 from .context import Features
 from .errors import InputError
-from .light import Light, light_range_uniform
+from .light import FULLSCREEN_LIGHT_CAPACITY, FULLSCREEN_UNIFORM, Light, light_range_uniform
 
 if TYPE_CHECKING:
     from .uniforms import ProgramUniforms
@@ -39,6 +41,11 @@ def visible_spheres(records: np.ndarray, projection: np.ndarray) -> np.ndarray:
     centres = np.c_[records[:, 1, :3].astype(np.float64), np.ones(len(records))]
     distance = centres @ planes.T  # (lights, planes), positive inside
     return np.all(distance >= -records[:, 1, 3:4].astype(np.float64), axis=1)
+
+
+def fullscreen_overflow(count: int) -> str:
+    return (f"{count} full-screen (ambient, directional) lights; a frame holds at most "
+            f"{FULLSCREEN_LIGHT_CAPACITY}")
 
 
 class LightBuffer:
@@ -107,8 +114,12 @@ class LightBuffer:
                                                 (0, 0)),
                                 **{light_range_uniform(light_type): span
                                    for light_type, span in self.ranges.items()}}
+        if self.global_count > FULLSCREEN_LIGHT_CAPACITY:  # added after the renderer's check
+            raise InputError(fullscreen_overflow(self.global_count), "light")
+        fullscreen = np.zeros((FULLSCREEN_LIGHT_CAPACITY, RECORD_VEC4S, 4), np.float32)
+        fullscreen[:self.global_count] = records[:self.global_count]
         self._uniforms = {"u_light_count": self.count, "u_global_light_count": self.global_count,
-                          **self._range_uniforms}
+                          FULLSCREEN_UNIFORM: fullscreen.tobytes(), **self._range_uniforms}
         self.culled = len(lights) - self.count
         rows = len(records)
         limit = int(self.ctx.info["GL_MAX_TEXTURE_SIZE"])

@@ -115,9 +115,12 @@ def uniform_writer(handle: Any) -> Callable[[Any], None]:
     write_uniform = getattr(getattr(handle, "ctx", None), "_write_uniform", None)
     fmt = getattr(handle, "fmt", None)
     if write_uniform is None or fmt is None or getattr(handle, "array_length", None) != 1:
+        size = getattr(handle, "array_length", 1) * getattr(handle, "element_size", 0)
+
         def write_by_handle(value: Any) -> None:
             if isinstance(value, bytes):
-                handle.write(value)
+                # an array whose tail the program does not use is shorter than declared
+                handle.write(value[:size] if size and len(value) > size else value)
             else:
                 handle.value = value
         return write_by_handle

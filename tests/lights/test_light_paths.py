@@ -415,3 +415,41 @@ def test_the_list_shading_makes_the_composition_where_the_material_phase_has_no_
         assert renderer.graph.creators["composite"] == "material.composite_copy"
         shading = renderer.passes[renderer.graph.index(f"lighting.{path}")]
         assert set(shading.creates) == {"light_accumulation"}
+
+
+def test_several_full_screen_lights_of_a_type_each_light_the_list_and_forward_paths(gl):
+    # Their records come from the uniform array (four vec4s a light, the types' ranges into
+    # it); the volumes path draws each from the light texture instead: every record must land.
+    fill = [{"type": "directional", "direction": d, "intensity": 0.5, "color": c}
+            for d, c in [([1.0, -0.4, 0.2], [1.0, 0.4, 0.3]), ([-0.2, -0.5, -1.0], [0.3, 1.0, 0.4]),
+                         ([0.0, -1.0, 0.6], [0.3, 0.5, 1.0])]]
+    scene = scene_with(8)
+    scene.lights = [*scene.lights[:2], *map(scene_light, fill), *scene.lights[2:]]
+    reference, _ = render(gl, scene, "deferred", "volumes")
+    peak = float(reference.hdr[..., :3].max())
+    fewer = scene_with(8)
+    assert psnr(render(gl, fewer, "deferred", "volumes")[0].hdr[..., :3],
+                reference.hdr[..., :3], peak) < 30.0  # the three lights show
+    for pipeline, path in [("deferred", "tiled"), ("forward", "tiled"), ("forward", "naive")]:
+        result, _ = render(gl, scene, pipeline, path)
+        assert psnr(result.hdr[..., :3], reference.hdr[..., :3], peak) >= 40.0, (pipeline, path)
+
+
+def scene_light(values: dict):
+    from deferred.registry import lights
+
+    return lights.get(values["type"]).from_dict({k: v for k, v in values.items() if k != "type"})
+
+
+def test_more_full_screen_lights_than_a_frame_holds_is_refused_before_a_frame(gl):
+    from deferred.light import FULLSCREEN_LIGHT_CAPACITY
+
+    scene = scene_with(0)
+    scene.lights = [*scene.lights, *(scene_light({"type": "directional", "intensity": 0.1})
+                                     for _ in range(FULLSCREEN_LIGHT_CAPACITY - 1))]
+    with pytest.raises(InputError, match=rf"^light: {FULLSCREEN_LIGHT_CAPACITY + 1} full-screen "
+                                         rf".* at most {FULLSCREEN_LIGHT_CAPACITY}$"):
+        Renderer(scene, gl=gl, light_path="volumes")
+    scene.lights = scene.lights[:-1]  # at the capacity: renders
+    with Renderer(scene, "forward", gl=gl, light_path="naive") as renderer:
+        assert renderer.render().hdr[..., :3].max() > 0.0
