@@ -84,9 +84,17 @@ class ShaderLibrary:
         self.generation = 0
 
     # -- files -------------------------------------------------------------------------------
-    def add_root(self, root: Traversable | Path) -> None:
-        """Search ``root`` for shader files too (plugins ship their GLSL this way)."""
-        if root not in self.roots:
+    def add_root(self, root: Traversable | Path, first: bool = False) -> None:
+        """Search ``root`` for shader files too (plugins ship their GLSL this way); ``first``:
+        before every other root, so that its files replace theirs (benchmarks/shader_ab.py)."""
+        if root in self.roots:
+            return
+        if first:
+            if self._programs:  # they (and what is cached by them) hold the files replaced
+                raise RuntimeError("a root replacing shader files is added before any "
+                                   "program is compiled")
+            self.roots.insert(0, root)
+        else:
             self.roots.append(root)
 
     def set_virtual_file(self, name: str, text: str) -> None:

@@ -136,3 +136,21 @@ def test_driver_error_formats_map_to_file_and_line(library, tmp_path, driver_lin
     mapped = ShaderLibrary._map_error(message, {"fragment_shader": source},
                                       {"fragment_shader": "main.frag"})
     assert mapped.startswith("inc.glsl:3: ") and "foo" in mapped
+
+
+def test_a_root_added_first_replaces_files_and_only_before_any_program(library, tmp_path):
+    write(tmp_path, "a.glsl", "float a() { return 1.0; }\n")
+    write(tmp_path, "main.frag", '#include "a.glsl"\nout vec4 c;\nvoid main() { c = vec4(a()); }\n')
+    variant = tmp_path / "variant"
+    write(variant, "a.glsl", "float a() { return 2.0; }\n")
+    library.add_root(variant, first=True)
+    assert "return 2.0" in library.assemble("main.frag").text  # the variant's file wins
+    assert "return 1.0" not in library.assemble("main.frag").text
+    later = tmp_path / "later"
+    write(later, "a.glsl", "float a() { return 3.0; }\n")
+    library.add_root(later)  # appended: searched after the others
+    assert "return 2.0" in library.assemble("main.frag").text
+    write(tmp_path, "main.vert", "void main() { gl_Position = vec4(0.0); }\n")
+    library.program("main.vert", "main.frag")
+    with pytest.raises(RuntimeError, match="before any program is compiled"):
+        library.add_root(tmp_path / "too_late", first=True)  # compiled from what it would hide
