@@ -21,13 +21,12 @@ Forward:
   blended surfaces in front of the opaque ones are covered), and the lit passes loop their
   tile's list (``common/forward_lighting.glsl``).
 
-The lists live in one storage buffer (``lights/light_lists.glsl``): a count per list, then
-``capacity`` slots per list, then (tiled) the coarse tiles' lists in the same layout. Capacity
-is the frame's volume light count, so no list overflows.
-The culling shaders write the buffer; it is then copied into an R32UI texture, which the shading
-passes read: llvmpipe reads a texel several times as fast as a storage buffer's word, and the
-list loops read one per light (the tiled shading pass 15-23% faster at 256-1024 lights). The
-lists are held twice, buffer and texture.
+The culling shaders write each list twice (``lights/light_lists.glsl``): light indices in a
+storage buffer (a count per list, then ``capacity`` slots per list, then (tiled) the coarse
+tiles' lists in the same layout), and for the shading an RGBA32F texture of two texels a slot,
+the light's sphere and colour: the list loops read one texel a listed light, plus one for each
+light reaching the pixel. Capacity is the most volume lights the side planes of any (coarse)
+tile can hold, counted on the CPU (:func:`list_capacity`), so no list overflows.
 """
 
 from __future__ import annotations
@@ -67,9 +66,13 @@ CULL_GROUP_SIZE = 32
 # every light, then over the tiles against their coarse tile's lights only.
 COARSE_RATIO = 4
 MAX_LIST_BYTES = 512 * 1024 * 1024
-LIST_ROW_SHIFT = 14  # words per row of the lists' texture, as a power of two (u_list_row_shift)
+LIST_ROW_SHIFT = 14  # texels per row of the shading's lists texture, a power of two
 LIST_TEXTURE_WIDTH = 1 << LIST_ROW_SHIFT  # 16384: every GL 4.3 context (compute) allows it
-LIST_ROW_BYTES = 4 * LIST_TEXTURE_WIDTH
+SLOT_TEXELS = 2  # RGBA32F texels a slot of the shading's lists: the sphere, the colour
+LIST_ROW_BYTES = 16 * LIST_TEXTURE_WIDTH
+LIST_IMAGE_UNIT = 2  # the culling writes the shading's lists texture through this image unit
+# A listed light's colour texel holds type id + 256 x index in w, exact in a float below 2^24.
+MAX_LISTED_LIGHTS = 1 << 16
 
 
 def resolve_light_path(pipeline: str, requested: str | None, features: Features,
@@ -107,9 +110,15 @@ class ListGrid:
 
 
 def list_bytes(grid: ListGrid, capacity: int) -> int:
-    """Bytes of the lists' storage buffer: a count and ``capacity`` slots per list, in whole
-    rows of the lists' texture."""
-    return -(-4 * grid.count * (1 + max(capacity, 1)) // LIST_ROW_BYTES) * LIST_ROW_BYTES
+    """Bytes of the lists' light indices in the storage buffer: a count and ``capacity`` slots
+    per list."""
+    return 4 * grid.count * (1 + max(capacity, 1))
+
+
+def texture_rows(grid: ListGrid, capacity: int) -> int:
+    """Rows of the shading's lists texture: SLOT_TEXELS texels for a list's count and for each
+    of its ``capacity`` slots."""
+    return -(-SLOT_TEXELS * grid.count * (1 + max(capacity, 1)) // LIST_TEXTURE_WIDTH)
 
 
 def coarse_grid(grid: ListGrid) -> ListGrid:
@@ -125,22 +134,20 @@ def coarse_list_bytes(grid: ListGrid, capacity: int) -> int:
     return 4 * coarse_grid(grid).count * (1 + max(capacity, 1))
 
 
-def list_byte_limit(max_texture_size: int) -> int:
-    """The most bytes of lists: MAX_LIST_BYTES, and the rows the lists' texture may have."""
-    return min(MAX_LIST_BYTES, max_texture_size * LIST_ROW_BYTES)
-
-
-def list_overflow(grid: ListGrid, capacity: int, max_texture_size: int
-                  ) -> tuple[int, int] | None:
-    """(bytes needed, limit) where the lists do not fit: the shading's lists in the texture's
-    rows (:func:`list_byte_limit`), and the storage buffer, which also holds the coarse lists,
-    in MAX_LIST_BYTES; None where they fit."""
-    lists = list_bytes(grid, capacity)
-    texture_limit = list_byte_limit(max_texture_size)
-    if lists > texture_limit:
-        return lists, texture_limit
-    total = lists + coarse_list_bytes(grid, capacity)
+def list_overflow(grid: ListGrid, capacity: int) -> tuple[int, int] | None:
+    """(bytes needed, limit) where the storage buffer (the lists and, tiled, the coarse lists)
+    exceeds MAX_LIST_BYTES at ``capacity`` slots a list; None where it fits."""
+    total = list_bytes(grid, capacity) + coarse_list_bytes(grid, capacity)
     return (total, MAX_LIST_BYTES) if total > MAX_LIST_BYTES else None
+
+
+def texture_overflow(grid: ListGrid, capacity: int, max_texture_size: int
+                     ) -> tuple[int, int] | None:
+    """(bytes needed, limit) where the shading's lists texture does not fit at ``capacity``
+    slots a list: in MAX_LIST_BYTES, and in the rows the driver allows; None where it fits."""
+    rows = texture_rows(grid, capacity)
+    limit = min(MAX_LIST_BYTES, max_texture_size * LIST_ROW_BYTES)
+    return (rows * LIST_ROW_BYTES, limit) if rows * LIST_ROW_BYTES > limit else None
 
 
 def _too_many_for_lists(lights: int, grid: ListGrid, size: int, limit: int) -> str:
@@ -152,15 +159,19 @@ def _too_many_for_lists(lights: int, grid: ListGrid, size: int, limit: int) -> s
 def check_light_limits(light_path: str, size: tuple[int, int], volume_lights: int,
                        lights: int, max_texture_size: int) -> None:
     """Refuse, before any frame, a light count the light path cannot hold: the lists' storage
-    (tiled, clustered: a slot per volume light in every list) and the light buffer's texture
+    buffer (tiled, clustered: a slot per volume light in every list; the shading's texture of
+    them is sized to the frame's lights, :meth:`LightLists.prepare`), the light buffer's texture
     (a row per light) and the full-screen lights' uniform array (any path: forward reads it)."""
     if lights - volume_lights > FULLSCREEN_LIGHT_CAPACITY:
         raise InputError(fullscreen_overflow(lights - volume_lights), "light")
     if light_path in ("tiled", "clustered"):
         grid = list_grid(*size, light_path == "clustered")
-        overflow = list_overflow(grid, volume_lights, max_texture_size)
+        overflow = list_overflow(grid, volume_lights)  # every light in one list: the most
         if overflow is not None:
             raise InputError(_too_many_for_lists(volume_lights, grid, *overflow), "light")
+        if volume_lights > MAX_LISTED_LIGHTS:
+            raise InputError(f"{volume_lights} volume lights; the light lists hold at most "
+                             f"{MAX_LISTED_LIGHTS}", "light")
     if lights > max_texture_size:
         raise InputError(f"{lights} lights; lights are kept in a texture of at most "
                          f"{max_texture_size} rows (GL_MAX_TEXTURE_SIZE)", "light")
@@ -184,11 +195,13 @@ class LightLists:
         self.grid: ListGrid | None = None
         self.capacity = 1
         self.coarse_base = 0
-        self.rows = 0
         self.clustered = False
         self.depth_scale = (1.0, 1.0)
+        self._capacity_key: tuple | None = None
+        self._capacity = 1
 
     def prepare(self, grid: ListGrid, capacity: int, near: float, far: float) -> None:
+        """Lay out this frame's lists: ``capacity`` slots each (:func:`list_capacity`)."""
         self.grid = grid
         self.capacity = max(capacity, 1)
         self.clustered = grid.slices > 1
@@ -198,31 +211,33 @@ class LightLists:
                           "u_list_row_shift": LIST_ROW_SHIFT,
                           "u_list_grid": (grid.columns, grid.rows, grid.slices),
                           "u_list_tile": grid.tile, "u_list_depth": self.depth_scale}
-        lists = list_bytes(grid, self.capacity)  # what the shading reads, in the texture
+        lists = list_bytes(grid, self.capacity)
         size = lists + coarse_list_bytes(grid, self.capacity)
         self.coarse_base = lists // 4  # the word where the coarse lists begin
-        overflow = list_overflow(grid, self.capacity, self.max_texture_size)
-        if overflow is not None:  # checked before the first frame (check_light_limits)
+        overflow = list_overflow(grid, self.capacity) or \
+            texture_overflow(grid, self.capacity, self.max_texture_size)
+        if overflow is not None:
             raise RenderError(_too_many_for_lists(capacity, grid, *overflow))
-        rows = self.rows = lists // LIST_ROW_BYTES  # of the texture the shading reads
-        if self.buffer is None or self.texture is None or self.buffer.size < size or \
-                self.texture.height < rows:
-            self.release()
-            buffer = self.ctx.buffer(reserve=size)
-            try:
-                texture = self.ctx.texture((LIST_TEXTURE_WIDTH, rows), 1, dtype="u4")
-            except BaseException:
-                buffer.release()
-                raise
-            texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
-            self.buffer, self.texture = buffer, texture
+        rows = texture_rows(grid, self.capacity)
+        if self.buffer is None or self.buffer.size < size:
+            self._release_buffer()
+            self.buffer = self.ctx.buffer(reserve=size)
+        if self.texture is None or self.texture.height < rows:
+            self._release_texture()
+            self.texture = self.ctx.texture((LIST_TEXTURE_WIDTH, rows), 4, dtype="f4")
+            self.texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
         self.buffer.bind_to_storage_buffer(1)
 
-    def publish(self) -> None:
-        """Copy the lists the culling wrote into the texture the shading reads (after a memory
-        barrier)."""
-        assert self.buffer is not None and self.texture is not None and self.grid is not None
-        self.texture.write(self.buffer, viewport=(0, 0, LIST_TEXTURE_WIDTH, self.rows))
+    def capacity_for(self, spheres: np.ndarray, inverse_projection: np.ndarray, width: int,
+                     height: int, tile: int) -> int:
+        """:func:`list_capacity`, computed again only when its inputs change (the light buffer
+        makes a new ``spheres`` array when it packs the lights again)."""
+        key = (id(spheres), np.asarray(inverse_projection).tobytes(), width, height, tile)
+        if self._capacity_key is None or self._capacity_key[0] is not spheres or \
+                self._capacity_key[1:] != key[1:]:
+            self._capacity = list_capacity(spheres, inverse_projection, width, height, tile)
+            self._capacity_key = (spheres, *key[1:])  # holds the array: its id stays its own
+        return self._capacity
 
     def uniforms(self) -> dict[str, Any]:
         """The lists' uniforms this frame (one dict per :meth:`prepare`: programs skip it while
@@ -243,15 +258,22 @@ class LightLists:
         return {"first": first, "second": second}
 
     def bind(self, uniforms: ProgramUniforms, texture_unit: int) -> None:
-        """Set the list uniforms, bind the buffer (culling) and the texture (shading, at
-        ``texture_unit``) for a program using the lists."""
+        """Set the list uniforms, bind the buffer and the texture as an image (culling), or the
+        texture at ``texture_unit`` (shading), for a program using the lists."""
         if self.buffer is None or "u_list_count" not in uniforms.members:
             return
         self.buffer.bind_to_storage_buffer(1)
+        self.bind_image(uniforms)
         if "u_light_list_texture" in uniforms.members:
             self.texture.use(location=texture_unit)
             uniforms.set_one("u_light_list_texture", texture_unit)
         uniforms.set_shared("light_lists", self.uniforms())
+
+    def bind_image(self, uniforms: ProgramUniforms) -> None:
+        """Bind the shading's lists texture as the image a culling shader writes."""
+        if "u_light_list_image" in uniforms.members:
+            self.texture.bind_to_image(LIST_IMAGE_UNIT, read=False, write=True)
+            uniforms.set_one("u_light_list_image", LIST_IMAGE_UNIT)
 
     def counts(self) -> np.ndarray:
         """The list lengths of the last frame (host copy; tests and statistics)."""
@@ -259,13 +281,72 @@ class LightLists:
         data = np.frombuffer(self.buffer.read(size=4 * self.grid.count), dtype=np.uint32)
         return np.minimum(data, self.capacity)
 
-    def release(self) -> None:
+    def shading_slots(self) -> np.ndarray:
+        """The shading's copy of the lists as read back: (slots, 2, 4) float32, a sphere and a
+        colour texel per slot (tests)."""
+        assert self.texture is not None and self.grid is not None
+        slots = self.grid.count * (1 + self.capacity)
+        texels = np.frombuffer(self.texture.read(), dtype=np.float32).reshape(-1, 4)
+        return texels[:SLOT_TEXELS * slots].reshape(slots, SLOT_TEXELS, 4)
+
+    def _release_buffer(self) -> None:
         if self.buffer is not None:
             self.buffer.release()
             self.buffer = None
+
+    def _release_texture(self) -> None:
         if self.texture is not None:
             self.texture.release()
             self.texture = None
+
+    def release(self) -> None:
+        self._release_buffer()
+        self._release_texture()
+
+
+def list_capacity(spheres: np.ndarray, inverse_projection: np.ndarray, width: int, height: int,
+                  tile: int) -> int:
+    """The most of ``spheres`` (view-space centre xyz, radius w; the frame's volume lights) that
+    touch the four side planes of any tile of ``tile`` pixels: the lists' capacity. Every list
+    holds only lights whose sphere touches its tile's side planes (the culling shaders test
+    them, ``lights/tile_frustum.glsl``), and a tiled list's lights are a subset of its coarse
+    tile's: counted over the coarse tiles there, no list overflows.
+
+    Planes through the eye along a column (row) edge of pixels are shared by the tiles above
+    and below, so each sphere's columns and rows come from its signed distances to the edges'
+    planes, all lights at once; the radius is padded for the GPU's float32 planes."""
+    if len(spheres) == 0:
+        return 1
+    inverse = np.asarray(inverse_projection, np.float64)
+
+    def rays(pixels: np.ndarray, axis: int, across: float) -> np.ndarray:
+        """View rays through pixel coordinate ``pixels`` on ``axis``, at NDC ``across`` on the
+        other axis (as ``view_ray`` in tile_frustum.glsl)."""
+        ndc = np.zeros((len(pixels), 4))
+        ndc[:, axis] = pixels / (width, height)[axis] * 2.0 - 1.0
+        ndc[:, 1 - axis] = across
+        ndc[:, 2:] = 1.0
+        ray = ndc @ inverse.T
+        return ray[:, :3] / ray[:, 3:]
+
+    centres = np.asarray(spheres[:, :3], np.float64)
+    radii = np.asarray(spheres[:, 3], np.float64)
+    padded = radii * (1.0 + 1e-3) + 1e-4 * np.linalg.norm(centres, axis=1)
+    touched = []
+    for axis, extent in ((0, width), (1, height)):
+        edges = np.minimum(np.arange(0, extent + tile, tile), extent).astype(np.float64)
+        edges = np.unique(edges)
+        normals = np.cross(rays(edges, axis, -1.0), rays(edges, axis, 1.0))
+        normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+        inward = rays(edges + 0.5, axis, 0.0)  # towards growing pixels
+        normals *= np.sign(np.sum(normals * inward, axis=1))[:, None]
+        distance = centres @ normals.T  # (lights, edges), positive past the edge
+        touched.append((distance[:, :-1] >= -padded[:, None]) &
+                       (distance[:, 1:] <= padded[:, None]))
+    columns, rows = touched
+    # (columns, rows): a float32 product (BLAS; exact, counts are far below 2^24)
+    per_tile = columns.T.astype(np.float32) @ rows.astype(np.float32)
+    return max(int(per_tile.max()), 1)
 
 
 class LightCullPass(RenderPass):
@@ -285,7 +366,12 @@ class LightCullPass(RenderPass):
         lights = frame.light_buffer
         grid = list_grid(frame.width, frame.height, self.clustered)
         camera = frame.scene.camera
-        frame.light_lists.prepare(grid, lights.local_count, camera.near, camera.far)
+        # every list is a subset of its (coarse, tiled) tile's side-plane set
+        bounds = grid if self.clustered else coarse_grid(grid)
+        capacity = frame.light_lists.capacity_for(lights.volume_spheres,
+                                                  frame.inverse_projection, frame.width,
+                                                  frame.height, bounds.tile)
+        frame.light_lists.prepare(grid, capacity, camera.near, camera.far)
         defines = {"CULL_GROUP_SIZE": str(CULL_GROUP_SIZE)}
         if self.from_near:
             defines["CULL_FROM_NEAR"] = "1"
@@ -314,10 +400,10 @@ class LightCullPass(RenderPass):
             if index:
                 frame.ctx.memory_barrier()
             frame.bind_compute(program, uniforms, textures)
+            frame.light_lists.bind_image(frame.shaders.uniforms(program))
             groups = math.ceil(tiles.columns * tiles.rows / CULL_GROUP_SIZE)  # a tile each
             frame.gl_call(lambda program=program, groups=groups: program.run(groups, 1, 1))
         frame.ctx.memory_barrier()
-        frame.gl_call(frame.light_lists.publish)  # a copy of the lists: GL work
         frame.count_draw()
 
 

@@ -56,6 +56,8 @@ class LightBuffer:
         self.culled = 0  # volume lights dropped this frame: outside the view
         self.ranges: dict[type[Light], tuple[int, int]] = {}
         self._range_uniforms: dict[str, tuple[int, int]] = {}
+        # the volume lights' spheres in view space (centre xyz, radius), after culling
+        self.volume_spheres = np.zeros((0, 4), np.float32)
         self._uniforms: dict[str, Any] = {}  # what ``bind`` sets
         self._texture: moderngl.Texture | None = None
         self._capacity = 0
@@ -107,6 +109,7 @@ class LightBuffer:
                 projection: np.ndarray | None) -> None:
         records, self.ranges, self.global_count = self.pack(lights, view, projection)
         self.count = sum(count for _, count in self.ranges.values())
+        self.volume_spheres = records[self.global_count:self.count, 1].copy()
         # every type's range, (0, 0) for a type with no light this frame (all culled), and for
         # a type of an earlier frame: a program keeps the value it was given last
         self._range_uniforms = {**dict.fromkeys(self._range_uniforms, (0, 0)),

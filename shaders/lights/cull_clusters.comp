@@ -10,6 +10,7 @@ layout(local_size_x = CULL_GROUP_SIZE) in;  // deferred.light_lists
 #include "common/light_buffer.glsl"
 #include "lights/light_lists.glsl"
 #include "lights/tile_frustum.glsl"
+#include "lights/light_list_writer.glsl"
 
 uniform vec2 u_near_far;
 uniform int u_global_light_count;
@@ -39,10 +40,10 @@ void main() {
             int list = tile_index + slice * tiles;
             uint count = counts[slice];
             if (int(count) < u_list_capacity)
-                light_list_data[light_list_first_slot(list) + int(count)] = uint(index);
+                light_list_write(light_list_first_slot(list) + int(count), index, sphere);
             counts[slice] = count + 1u;
         }
     }
     for (int slice = 0; slice < LIST_SLICES; ++slice)
-        light_list_data[u_list_base + tile_index + slice * tiles] = counts[slice];
+        light_list_write_count(tile_index + slice * tiles, int(counts[slice]));
 }

@@ -22,6 +22,7 @@ layout(local_size_x = CULL_GROUP_SIZE) in;  // deferred.light_lists
 #include "common/light_buffer.glsl"
 #include "lights/light_lists.glsl"
 #include "lights/tile_frustum.glsl"
+#include "lights/light_list_writer.glsl"
 
 uniform sampler2D u_linear_depth;
 uniform vec2 u_near_far;
@@ -124,9 +125,9 @@ void main() {
             vec3 outside = sphere.xyz - clamp(sphere.xyz, box_low, box_high);
             if (dot(outside, outside) > sphere.w * sphere.w) continue;
 #endif
-            if (count < u_list_capacity) light_list_data[slots + count] = uint(index);
+            if (count < u_list_capacity) light_list_write(slots + count, index, sphere);
             ++count;
         }
     }
-    light_list_data[u_list_base + list] = uint(count);
+    light_list_write_count(list, count);
 }

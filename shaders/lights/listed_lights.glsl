@@ -21,9 +21,13 @@
 vec3 evaluate_listed_lights(int list, Surface s, vec3 P, vec3 V) {
     vec3 total = vec3(0.0);
     int length = light_list_length(list);
+    int first = light_list_first_slot(list);
     for (int k = 0; k < length; ++k) {
-        int index = light_list_light(list, k);
-        if (light_reaches(index, P)) total += evaluate_volume_light(fetch_light(index), s, P, V);
+        // the sphere test is far cheaper than the light; most entries miss the point
+        vec4 sphere = listed_light_sphere(first + k);
+        vec3 to_light = sphere.xyz - P;
+        if (dot(to_light, to_light) <= sphere.w * sphere.w)
+            total += evaluate_volume_light(listed_light_record(first + k, sphere), s, P, V);
     }
     return total;
 }

@@ -154,3 +154,14 @@ def test_a_root_added_first_replaces_files_and_only_before_any_program(library, 
     library.program("main.vert", "main.frag")
     with pytest.raises(RuntimeError, match="before any program is compiled"):
         library.add_root(tmp_path / "too_late", first=True)  # compiled from what it would hide
+
+
+def test_declared_uniforms_read_through_layouts_and_qualifiers():
+    from deferred.shaderlib import declared_uniforms
+
+    text = ("layout(rgba32f) uniform writeonly image2D u_image;\n"
+            "uniform highp float u_a, u_b[4];\n"
+            "layout(binding = 1) uniform restrict readonly image2D u_source;\n"
+            "// uniform float u_commented;\n"
+            "uniform Block { vec4 inside; };\n")
+    assert declared_uniforms(text) == {"u_image", "u_a", "u_b", "u_source"}

@@ -95,6 +95,7 @@ def listed_frame(gl, path: str, extra: int, size: tuple[int, int] | None = None
         data = np.frombuffer(lists.buffer.read(), dtype=np.uint32)
         records = np.frombuffer(renderer.light_buffer.texture.read(), dtype=np.float32)
         records = records.reshape(-1, 4, 4)[:renderer.light_buffer.count]
+        slots = lists.shading_slots()
         depth = renderer.targets.read("linear_depth")[..., 0]
         inverse = renderer.last_frame.inverse_projection
         global_count = renderer.light_buffer.global_count
@@ -113,6 +114,7 @@ def listed_frame(gl, path: str, extra: int, size: tuple[int, int] | None = None
     counts = data[:grid.count]
     entries = [data[grid.count + i * lists.capacity:][:counts[i]] for i in range(grid.count)]
     return SimpleNamespace(grid=grid, capacity=lists.capacity, counts=counts, entries=entries,
+                           data=data, slots=slots,
                            records=records, global_count=global_count, camera=camera,
                            xs=xs, ys=ys, z=z, points=points, reach=reach)
 
@@ -260,18 +262,31 @@ def test_more_lights_than_the_gl33_light_texture_holds_is_refused(gl, monkeypatc
         Renderer(scene, gl=gl33)
 
 
-def test_the_rows_of_the_lists_texture_bound_the_lists_too():
-    """The shading passes read the lists from a texture LIST_TEXTURE_WIDTH words wide: where
-    the driver allows fewer rows than MAX_LIST_BYTES needs, its rows limit the lights."""
-    from deferred.light_lists import LIST_TEXTURE_WIDTH, MAX_LIST_BYTES, check_light_limits
+def test_the_shading_lists_texture_is_sized_to_the_frame_and_refused_past_the_rows(gl):
+    """The shading reads the lists from a texture of SLOT_TEXELS texels a slot, sized each frame
+    to the lists' capacity: past the rows the driver allows, the frame is refused in one line."""
+    from deferred.errors import RenderError
+    from deferred.light_lists import (
+        LIST_ROW_BYTES,
+        LIST_TEXTURE_WIDTH,
+        SLOT_TEXELS,
+        LightLists,
+        list_grid,
+    )
 
-    rows = 1024  # 64 MiB of lists
-    check_light_limits("tiled", (3840, 2160), 400, 402, max_texture_size=rows)  # 51.8 MB
-    with pytest.raises(InputError, match=r"^light: 600 lights need 74 MiB .* limit is 64 MiB"):
-        check_light_limits("tiled", (3840, 2160), 600, 602, max_texture_size=rows)
-    assert rows * 4 * LIST_TEXTURE_WIDTH < MAX_LIST_BYTES
-    # GL 4.3 (compute shaders) guarantees 16384 rows: there MAX_LIST_BYTES is the limit
-    assert 16384 * 4 * LIST_TEXTURE_WIDTH >= MAX_LIST_BYTES
+    grid = list_grid(3840, 2160, clustered=False)  # 32400 tiles
+    lists = LightLists(gl.ctx)
+    try:
+        lists.prepare(grid, 100, 0.1, 100.0)
+        slots = grid.count * 101
+        assert lists.texture.width == LIST_TEXTURE_WIDTH
+        assert lists.texture.height == -(-SLOT_TEXELS * slots // LIST_TEXTURE_WIDTH)  # 400 rows
+        lists.max_texture_size = 256
+        with pytest.raises(RenderError, match=rf"^400 lights need \d+ MiB of light lists .* "
+                                              rf"limit is {256 * LIST_ROW_BYTES >> 20} MiB"):
+            lists.prepare(grid, 400, 0.1, 100.0)
+    finally:
+        lists.release()
 
 
 @pytest.mark.parametrize("pipeline, path", [("deferred", "tiled"), ("deferred", "clustered"),
@@ -453,3 +468,73 @@ def test_more_full_screen_lights_than_a_frame_holds_is_refused_before_a_frame(gl
     scene.lights = scene.lights[:-1]  # at the capacity: renders
     with Renderer(scene, "forward", gl=gl, light_path="naive") as renderer:
         assert renderer.render().hdr[..., :3].max() > 0.0
+
+
+@pytest.mark.parametrize("path", ["tiled", "clustered"])
+def test_the_shading_copy_of_the_lists_holds_each_listed_lights_sphere_colour_and_index(
+        gl, path):
+    # Every light type: the colour texel's w carries the type id and the index, which the
+    # shading needs for a spot light's direction and cone
+    frame = listed_frame(gl, path, 60)
+    grid, capacity, slots, records = frame.grid, frame.capacity, frame.slots, frame.records
+    np.testing.assert_array_equal(slots[:grid.count, 0, 0], frame.counts)
+    types = set()
+    for list_index, listed in enumerate(frame.entries):
+        first = grid.count + list_index * capacity
+        held = slots[first:first + len(listed)]
+        index = listed.astype(np.int64)
+        np.testing.assert_array_equal(held[:, 0], records[index, 1])  # the sphere
+        np.testing.assert_array_equal(held[:, 1, :3], records[index, 0, :3])  # the colour
+        np.testing.assert_array_equal(held[:, 1, 3], records[index, 0, 3] + 256.0 * index)
+        types |= set(records[index, 0, 3].tolist())
+    assert types == {3.0, 4.0}  # point and spot lights were listed
+
+
+def side_plane_counts(spheres, inverse, width, height, tile):
+    """Lights touching each tile's side planes, tile by tile as tile_frustum.glsl builds them
+    (float64): the reference of list_capacity."""
+    def ray(x, y):
+        v = inverse @ np.array([x / width * 2 - 1, y / height * 2 - 1, 1.0, 1.0])
+        return v[:3] / v[3]
+    counts = []
+    for y0 in range(0, height, tile):
+        for x0 in range(0, width, tile):
+            x1, y1 = min(x0 + tile, width), min(y0 + tile, height)
+            r00, r10, r01, r11 = ray(x0, y0), ray(x1, y0), ray(x0, y1), ray(x1, y1)
+            centre = r00 + r10 + r01 + r11
+            inside = np.ones(len(spheres), bool)
+            for a, b in ((r01, r00), (r10, r11), (r00, r10), (r11, r01)):
+                n = np.cross(a, b)
+                n /= np.linalg.norm(n)
+                n = n if n @ centre >= 0 else -n
+                inside &= spheres[:, :3] @ n >= -spheres[:, 3]
+            counts.append(int(inside.sum()))
+    return np.array(counts)
+
+
+@pytest.mark.parametrize("path", ["tiled", "clustered"])
+@pytest.mark.parametrize("size", [(320, 192), (317, 189)])  # odd: partial tiles
+def test_the_lists_capacity_bounds_every_list_and_is_the_side_planes_count(gl, path, size):
+    from deferred.light_lists import coarse_grid, list_capacity
+
+    if not gl.features.compute_shaders:
+        pytest.skip("the driver has no compute shaders")
+    scene = scene_with(150)
+    with Renderer(scene, "deferred", size, gl=gl, light_path=path) as renderer:
+        renderer.render()
+        lists = renderer.light_lists
+        grid, capacity = lists.grid, lists.capacity
+        raw = np.frombuffer(lists.buffer.read(), dtype=np.uint32)
+        spheres = renderer.light_buffer.volume_spheres.astype(np.float64)
+        inverse = renderer.last_frame.inverse_projection
+        local = renderer.light_buffer.local_count
+    tile = grid.tile if path == "clustered" else coarse_grid(grid).tile
+    reference = side_plane_counts(spheres, inverse, *size, tile)
+    assert capacity == reference.max() == list_capacity(spheres, inverse, *size, tile)
+    assert capacity < 0.5 * local  # far fewer slots than lights: the memory it saves
+    assert raw[:grid.count].max() <= capacity  # no list overflowed
+    if path == "tiled":  # and the coarse lists, after the lists
+        coarse = coarse_grid(grid)
+        base = lists.coarse_base
+        assert raw[base:base + coarse.count].max() <= capacity
+        assert raw[base:base + coarse.count].max() > 0.8 * capacity  # the bound is near
