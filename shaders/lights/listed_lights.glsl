@@ -4,16 +4,15 @@
 // A list holds the lights that touch its tile or cluster; most miss any one point of it
 // (lights.toml at 1024 lights: 31.5 entries a pixel, 13.2 reaching it, 14.5 reaching some pixel
 // of its 4x2 block, the width of a 256-bit SIMD vector). Where a fragment shader runs as SIMD
-// lanes (llvmpipe) the light's arithmetic still runs for every entry; a missed entry saves its
-// record fetches. With parts of this loop cut out (1024 lights, 640x360, a pass of 64 ms): the
-// list words cost about 10 ms, the sphere tests 15-20, the evaluations 25-30. Two ways of
-// evaluating fewer lights were tried and were slower on llvmpipe at every light count, the
-// loops and gathers they add costing more than the evaluations saved: testing 32 entries
-// first and evaluating only the set bits of the mask, in a loop whose trip count differs
-// between lanes (the tiled shading 46 -> 54 ms at 1024 lights, and 54-68 -> 85-109 ms in a
-// second A/B run; a Forward+ floor 9 -> 29 ms at 16 lights); and reading the list four entries
-// a fetch from an RGBA32UI texture with the loop unrolled by four (42-49 -> 61-86 ms; a
-// Forward+ floor 71-73 -> 111-125 ms).
+// lanes (llvmpipe) a light's arithmetic runs for the whole block where any lane is reached, and
+// is skipped where none is. Each entry is its light's sphere, then its colour: one texel a
+// listed light, one more for each that reaches (lights/light_lists.glsl). Cut-outs of this
+// loop at 1024 lights, 640x360, frames interleaved in one process (benchmarks/shader_ab.py;
+// the pass 56-60 ms with index lists): the evaluations beyond their record fetches 18-20 ms,
+// another texel fetch an entry 4-11 ms; the G-buffer read and the full-screen lights 11-13 ms.
+// Tried and slower on llvmpipe (benchmarks/README.md): a bit mask of reached entries with a
+// loop over its set bits; four indices a fetch; the sphere in the list but the colour through
+// the index.
 #include "common/light_buffer.glsl"
 #include "generated/lights.glsl"
 #include "lights/light_lists.glsl"
