@@ -3,10 +3,10 @@ process: the way to see a 5% change on a machine whose speed moves by 30% in min
 
 Each VARIANT is a folder laid out like ``deferred/shaders`` holding only the files it changes
 (``lights/listed_lights.glsl``, say); ``-`` is the shaders as they are. One renderer is built
-per variant on one GL context, and every round renders one frame of each in turn (timed by wall
-clock around ``render()`` and ``finish()``), then one frame of each with every pass fenced
-(``deferred.bench.time_passes``). Printed: each variant's median and minimum frame time and
-its passes' medians. Run from the repository root:
+per variant on one GL context, and every round renders, for each variant in turn, one frame
+timed by wall clock around ``render()`` and ``finish()`` and one with every pass fenced
+(``deferred.bench.time_passes``); each round starts from the next variant. Printed: each
+variant's median and minimum frame time and its passes' medians. Run from the repository root:
 
     python benchmarks/shader_ab.py [--scene FILE] [--size WxH] [--lights N] [--rounds N]
                                    [--pipeline NAME] [--light-path PATH] VARIANT...
@@ -67,8 +67,11 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     frames: list[list[float]] = [[] for _ in renderers]
     passes: list[dict[str, list[float]]] = [{} for _ in renderers]
-    for _ in range(args.rounds):
-        for renderer, times, by_pass in zip(renderers, frames, passes, strict=True):
+    order = list(zip(renderers, frames, passes, strict=True))
+    for round_index in range(args.rounds):
+        # each round starts from the next variant: none is always first after the others
+        shift = round_index % len(order)
+        for renderer, times, by_pass in order[shift:] + order[:shift]:
             gl.ctx.finish()
             start = time.perf_counter()
             renderer.render(readback=False)

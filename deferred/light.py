@@ -43,6 +43,7 @@ RANGE_UNIFORM_PREFIX = "u_light_range_"
 # the Forward+ frame at 16 lights 30.8-31.0 -> 27.7-28.5 ms at 640x360.
 FULLSCREEN_LIGHT_CAPACITY = 16
 FULLSCREEN_UNIFORM = "u_fullscreen_lights"
+FULLSCREEN_LIGHTS_FILE = "common/fullscreen_lights.glsl"
 
 
 class LightParams(Params):
@@ -123,20 +124,14 @@ def light_dispatch_glsl(light_types: list[type[Light]]) -> str:
     - ``evaluate_volume_light``: the same over the volume types only (the lists' lights);
     - ``evaluate_fullscreen_lights``, ``evaluate_volume_lights``: every full-screen (or volume)
       light, one loop per type over its range of the light buffer (sorted by type,
-      :class:`~deferred.lightbuffer.LightBuffer`), each calling its function directly. A SIMD
-      rasteriser that runs both sides of a branch (llvmpipe) pays every type's function per
-      light in a switch; in a loop per type it pays each light's own. The full-screen lights
+      :class:`~deferred.lightbuffer.LightBuffer`), each calling its function directly, with
+      no test of the type per light. The full-screen lights
       come first in the buffer, and their loops read the same records from the uniform array
       ``u_fullscreen_lights`` (``fullscreen_light``).
     """
     lines = [f'#include "{SHADING_DISPATCH_FILE}"',
-             f"uniform vec4 {FULLSCREEN_UNIFORM}[{4 * FULLSCREEN_LIGHT_CAPACITY}];",
-             "LightRecord fullscreen_light(int index) {",
-             f"    return LightRecord({FULLSCREEN_UNIFORM}[4 * index], "
-             f"{FULLSCREEN_UNIFORM}[4 * index + 1],",
-             f"                       {FULLSCREEN_UNIFORM}[4 * index + 2], "
-             f"{FULLSCREEN_UNIFORM}[4 * index + 3]);",
-             "}"]
+             f"#define FULLSCREEN_LIGHT_CAPACITY {FULLSCREEN_LIGHT_CAPACITY}",
+             f'#include "{FULLSCREEN_LIGHTS_FILE}"']
     lines += [f'#include "{cls.glsl_file}"' for cls in light_types]
     lines += [f"uniform ivec2 {light_range_uniform(cls)};" for cls in light_types]
 

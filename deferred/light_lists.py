@@ -71,7 +71,8 @@ LIST_TEXTURE_WIDTH = 1 << LIST_ROW_SHIFT  # 16384: every GL 4.3 context (compute
 SLOT_TEXELS = 2  # RGBA32F texels a slot of the shading's lists: the sphere, the colour
 LIST_ROW_BYTES = 16 * LIST_TEXTURE_WIDTH
 LIST_IMAGE_UNIT = 2  # the culling writes the shading's lists texture through this image unit
-# A listed light's colour texel holds type id + 256 x index in w, exact in a float below 2^24.
+# A listed light's colour texel holds type id + 256 x index (in the light buffer, full-screen
+# lights first) in w, exact in a float below 2^24.
 MAX_LISTED_LIGHTS = 1 << 16
 
 
@@ -169,8 +170,8 @@ def check_light_limits(light_path: str, size: tuple[int, int], volume_lights: in
         overflow = list_overflow(grid, volume_lights)  # every light in one list: the most
         if overflow is not None:
             raise InputError(_too_many_for_lists(volume_lights, grid, *overflow), "light")
-        if volume_lights > MAX_LISTED_LIGHTS:
-            raise InputError(f"{volume_lights} volume lights; the light lists hold at most "
+        if lights > MAX_LISTED_LIGHTS:  # a listed light's index in the light buffer
+            raise InputError(f"{lights} lights; the light lists index at most "
                              f"{MAX_LISTED_LIGHTS}", "light")
     if lights > max_texture_size:
         raise InputError(f"{lights} lights; lights are kept in a texture of at most "
@@ -197,13 +198,25 @@ class LightLists:
         self.coarse_base = 0
         self.clustered = False
         self.depth_scale = (1.0, 1.0)
+        self._capacity_spheres: np.ndarray | None = None  # what the last capacity counted
         self._capacity_key: tuple | None = None
         self._capacity = 1
 
     def prepare(self, grid: ListGrid, capacity: int, near: float, far: float) -> None:
-        """Lay out this frame's lists: ``capacity`` slots each (:func:`list_capacity`)."""
+        """Lay out this frame's lists: ``capacity`` slots each (:func:`list_capacity`). The
+        storage buffer's worst case was checked before the first frame; the shading's texture
+        (8x as large a slot) is checked here, at this frame's capacity."""
+        capacity = max(capacity, 1)
+        overflow = list_overflow(grid, capacity) or \
+            texture_overflow(grid, capacity, self.max_texture_size)
+        if overflow is not None:
+            needed, limit = overflow
+            raise RenderError(f"a tile's frustum holds {capacity} lights: the light lists "
+                              f"need {needed >> 20} MiB at this size ({grid.count} lists); the "
+                              f"limit is {limit >> 20} MiB: use fewer lights or the volumes "
+                              "path")
         self.grid = grid
-        self.capacity = max(capacity, 1)
+        self.capacity = capacity
         self.clustered = grid.slices > 1
         self.depth_scale = (near, grid.slices / math.log(far / near))
         self._uniforms = {"u_list_count": grid.count, "u_list_capacity": self.capacity,
@@ -214,10 +227,6 @@ class LightLists:
         lists = list_bytes(grid, self.capacity)
         size = lists + coarse_list_bytes(grid, self.capacity)
         self.coarse_base = lists // 4  # the word where the coarse lists begin
-        overflow = list_overflow(grid, self.capacity) or \
-            texture_overflow(grid, self.capacity, self.max_texture_size)
-        if overflow is not None:
-            raise RenderError(_too_many_for_lists(capacity, grid, *overflow))
         rows = texture_rows(grid, self.capacity)
         if self.buffer is None or self.buffer.size < size:
             self._release_buffer()
@@ -232,11 +241,10 @@ class LightLists:
                      height: int, tile: int) -> int:
         """:func:`list_capacity`, computed again only when its inputs change (the light buffer
         makes a new ``spheres`` array when it packs the lights again)."""
-        key = (id(spheres), np.asarray(inverse_projection).tobytes(), width, height, tile)
-        if self._capacity_key is None or self._capacity_key[0] is not spheres or \
-                self._capacity_key[1:] != key[1:]:
+        key = (np.asarray(inverse_projection).tobytes(), width, height, tile)
+        if self._capacity_spheres is not spheres or self._capacity_key != key:
             self._capacity = list_capacity(spheres, inverse_projection, width, height, tile)
-            self._capacity_key = (spheres, *key[1:])  # holds the array: its id stays its own
+            self._capacity_spheres, self._capacity_key = spheres, key
         return self._capacity
 
     def uniforms(self) -> dict[str, Any]:
@@ -258,12 +266,12 @@ class LightLists:
         return {"first": first, "second": second}
 
     def bind(self, uniforms: ProgramUniforms, texture_unit: int) -> None:
-        """Set the list uniforms, bind the buffer and the texture as an image (culling), or the
-        texture at ``texture_unit`` (shading), for a program using the lists."""
+        """Set the list uniforms, bind the buffer and the texture (at ``texture_unit``) for a
+        shading program using the lists (the culling binds the texture as its image:
+        :meth:`bind_image`)."""
         if self.buffer is None or "u_list_count" not in uniforms.members:
             return
         self.buffer.bind_to_storage_buffer(1)
-        self.bind_image(uniforms)
         if "u_light_list_texture" in uniforms.members:
             self.texture.use(location=texture_unit)
             uniforms.set_one("u_light_list_texture", texture_unit)

@@ -107,7 +107,17 @@ class LightBuffer:
 
     def _upload(self, lights: list[Light], view: np.ndarray,
                 projection: np.ndarray | None) -> None:
-        records, self.ranges, self.global_count = self.pack(lights, view, projection)
+        records, ranges, global_count = self.pack(lights, view, projection)
+        # lights added after the renderer checked them (check_light_limits): refused before
+        # anything here changes
+        if global_count > FULLSCREEN_LIGHT_CAPACITY:
+            raise InputError(fullscreen_overflow(global_count), "light")
+        rows = len(records)
+        limit = int(self.ctx.info["GL_MAX_TEXTURE_SIZE"])
+        if rows > limit:
+            raise InputError(f"{rows} lights; lights are kept in a texture of at most {limit} "
+                             "rows", "light")
+        self.ranges, self.global_count = ranges, global_count
         self.count = sum(count for _, count in self.ranges.values())
         self.volume_spheres = records[self.global_count:self.count, 1].copy()
         # every type's range, (0, 0) for a type with no light this frame (all culled), and for
@@ -117,18 +127,11 @@ class LightBuffer:
                                                 (0, 0)),
                                 **{light_range_uniform(light_type): span
                                    for light_type, span in self.ranges.items()}}
-        if self.global_count > FULLSCREEN_LIGHT_CAPACITY:  # added after the renderer's check
-            raise InputError(fullscreen_overflow(self.global_count), "light")
         fullscreen = np.zeros((FULLSCREEN_LIGHT_CAPACITY, RECORD_VEC4S, 4), np.float32)
         fullscreen[:self.global_count] = records[:self.global_count]
         self._uniforms = {"u_light_count": self.count, "u_global_light_count": self.global_count,
                           FULLSCREEN_UNIFORM: fullscreen.tobytes(), **self._range_uniforms}
         self.culled = len(lights) - self.count
-        rows = len(records)
-        limit = int(self.ctx.info["GL_MAX_TEXTURE_SIZE"])
-        if rows > limit:  # lights added after the renderer checked them (check_light_limits)
-            raise InputError(f"{rows} lights; lights are kept in a texture of at most {limit} "
-                             "rows", "light")
         if rows > self._capacity:
             self._release_storage()
             self._capacity = min(max(rows, 16), limit)

@@ -26,9 +26,9 @@ from .uniforms import ProgramUniforms
 MAX_INCLUDE_DEPTH = 16
 
 # Uniform declarations of assembled GLSL (strict mode checks names against them; blocks excluded).
-_UNIFORM = re.compile(r"^\s*(?:layout\s*\([^)]*\)\s*)?uniform\s+"
-                      r"(?:(?:lowp|mediump|highp|coherent|volatile|restrict|readonly|writeonly)"
-                      r"\s+)*\w+\s+([^;{]+);", re.MULTILINE)
+_QUALIFIERS = r"(?:(?:lowp|mediump|highp|coherent|volatile|restrict|readonly|writeonly)\s+)*"
+_UNIFORM = re.compile(r"^\s*(?:layout\s*\([^)]*\)\s*)?" + _QUALIFIERS + r"uniform\s+" +
+                      _QUALIFIERS + r"\w+\s+([^;{]+);", re.MULTILINE)
 _INCLUDE = re.compile(r'^\s*#\s*include\s+(?:"([^"]+)"|<([^>]+)>|([A-Za-z_]\w*))\s*$')
 # Mesa "0:57(3):", NVIDIA "0(57) :" - the location and the colon after it.
 _ERROR_LOCATION = re.compile(r"\b(\d+)(?::(\d+)\((\d+)\)|\((\d+)\))\s*:?")

@@ -2,12 +2,7 @@
 // index in the storage buffer, and, for the lists the shading reads (all but CULL_COARSE's),
 // the light's sphere and colour in the shading's texture, bound as an image.
 #ifndef CULL_COARSE
-layout(rgba32f) uniform writeonly image2D u_light_list_image;
-
-ivec2 light_list_image_texel(int slot) {
-    int texel = 2 * slot;
-    return ivec2(texel & ((1 << u_list_row_shift) - 1), texel >> u_list_row_shift);
-}
+layout(rgba32f) uniform writeonly image2D u_light_list_image;  // at light_list_texel(slot)
 #endif
 
 // The light `index` into `slot`: its sphere (as the culling read it) and, in the shading's
@@ -15,7 +10,7 @@ ivec2 light_list_image_texel(int slot) {
 void light_list_write(int slot, int index, vec4 sphere) {
     light_list_data[slot] = uint(index);
 #ifndef CULL_COARSE
-    ivec2 texel = light_list_image_texel(slot);
+    ivec2 texel = light_list_texel(slot);
     vec4 color = texelFetch(u_lights, ivec2(0, index), 0);
     imageStore(u_light_list_image, texel, sphere);
     imageStore(u_light_list_image, texel + ivec2(1, 0),
@@ -26,7 +21,7 @@ void light_list_write(int slot, int index, vec4 sphere) {
 void light_list_write_count(int list, int count) {
     light_list_data[u_list_base + list] = uint(count);
 #ifndef CULL_COARSE
-    imageStore(u_light_list_image, light_list_image_texel(u_list_base + list),
+    imageStore(u_light_list_image, light_list_texel(u_list_base + list),
                vec4(float(count), 0.0, 0.0, 0.0));
 #endif
 }

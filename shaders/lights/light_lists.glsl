@@ -10,7 +10,7 @@
 //   buffer, exact in a float). The first texel of a list's count slot holds its count in x.
 //   The shading loop reads one texel a listed light, and one more for each that reaches the
 //   pixel, where a list of indices cost the index, the sphere and the colour (lights.toml at
-//   1024 lights, 640x360: the tiled shading 60 -> 51 ms, interleaved in one process).
+//   1024 lights, 640x360: the tiled shading 62-67 -> 51-58 ms, benchmarks/README.md).
 layout(std430, binding = 1) buffer LightLists {
     uint light_list_data[];
 };
@@ -39,7 +39,8 @@ int light_list_of(ivec2 pixel, float depth) {
 #endif
 }
 
-// The shading texture's first texel of a slot (the second is the next one).
+// The shading texture's first texel of a slot (the second is the next one: SLOT_TEXELS in
+// deferred.light_lists).
 ivec2 light_list_texel(int slot) {
     int texel = 2 * slot;
     return ivec2(texel & ((1 << u_list_row_shift) - 1), texel >> u_list_row_shift);

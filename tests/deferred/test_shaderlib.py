@@ -162,6 +162,7 @@ def test_declared_uniforms_read_through_layouts_and_qualifiers():
     text = ("layout(rgba32f) uniform writeonly image2D u_image;\n"
             "uniform highp float u_a, u_b[4];\n"
             "layout(binding = 1) uniform restrict readonly image2D u_source;\n"
+            "layout(r32f) coherent uniform image2D u_before;\n"
             "// uniform float u_commented;\n"
             "uniform Block { vec4 inside; };\n")
-    assert declared_uniforms(text) == {"u_image", "u_a", "u_b", "u_source"}
+    assert declared_uniforms(text) == {"u_image", "u_a", "u_b", "u_source", "u_before"}
