@@ -238,12 +238,14 @@ class LightLists:
         self.buffer.bind_to_storage_buffer(1)
 
     def capacity_for(self, spheres: np.ndarray, inverse_projection: np.ndarray, width: int,
-                     height: int, tile: int) -> int:
+                     height: int, tile: int, slices: tuple[float, float, int] | None = None
+                     ) -> int:
         """:func:`list_capacity`, computed again only when its inputs change (the light buffer
         makes a new ``spheres`` array when it packs the lights again)."""
-        key = (np.asarray(inverse_projection).tobytes(), width, height, tile)
+        key = (np.asarray(inverse_projection).tobytes(), width, height, tile, slices)
         if self._capacity_spheres is not spheres or self._capacity_key != key:
-            self._capacity = list_capacity(spheres, inverse_projection, width, height, tile)
+            self._capacity = list_capacity(spheres, inverse_projection, width, height, tile,
+                                           slices)
             self._capacity_spheres, self._capacity_key = spheres, key
         return self._capacity
 
@@ -313,16 +315,19 @@ class LightLists:
 
 
 def list_capacity(spheres: np.ndarray, inverse_projection: np.ndarray, width: int, height: int,
-                  tile: int) -> int:
+                  tile: int, slices: tuple[float, float, int] | None = None) -> int:
     """The most of ``spheres`` (view-space centre xyz, radius w; the frame's volume lights) that
     touch the four side planes of any tile of ``tile`` pixels: the lists' capacity. Every list
     holds only lights whose sphere touches its tile's side planes (the culling shaders test
     them, ``lights/tile_frustum.glsl``), and a tiled list's lights are a subset of its coarse
-    tile's: counted over the coarse tiles there, no list overflows.
+    tile's: counted over the coarse tiles there, no list overflows. With ``slices`` (near, far,
+    count: the clustered lists), the most in any tile and depth slice: a light goes to the
+    slices its sphere's depth range covers (``lights/cull_clusters.comp``).
 
     Planes through the eye along a column (row) edge of pixels are shared by the tiles above
     and below, so each sphere's columns and rows come from its signed distances to the edges'
-    planes, all lights at once; the radius is padded for the GPU's float32 planes."""
+    planes, all lights at once; the radius (and the depth range) is padded for the GPU's
+    float32."""
     if len(spheres) == 0:
         return 1
     inverse = np.asarray(inverse_projection, np.float64)
@@ -352,8 +357,27 @@ def list_capacity(spheres: np.ndarray, inverse_projection: np.ndarray, width: in
         touched.append((distance[:, :-1] >= -padded[:, None]) &
                        (distance[:, 1:] <= padded[:, None]))
     columns, rows = touched
-    # (columns, rows): a float32 product (BLAS; exact, counts are far below 2^24)
-    per_tile = columns.T.astype(np.float32) @ rows.astype(np.float32)
+    columns = columns.astype(np.float32)
+    rows = rows.astype(np.float32)
+    if slices is not None:
+        near, far, count = slices
+        depth = -centres[:, 2]
+        pad = 1e-4 * np.abs(depth) + 1e-6
+        low = np.maximum(depth - padded - pad, near)
+        high = depth + padded + pad
+        inside = (high >= near) & (depth - padded - pad <= far)
+        scale = count / math.log(far / near)  # light_list_slice in light_lists.glsl
+
+        def slice_of(d: np.ndarray) -> np.ndarray:
+            return np.clip(np.floor(np.log(np.maximum(d, near) / near) * scale), 0, count - 1)
+
+        first, last = slice_of(low), slice_of(high)
+        covered = (np.arange(count)[None, :] >= first[:, None]) & \
+            (np.arange(count)[None, :] <= last[:, None]) & inside[:, None]
+        # (columns, rows) a slice: float32 products (BLAS; exact, counts far below 2^24)
+        most = max((columns.T @ (rows * covered[:, k:k + 1])).max() for k in range(count))
+        return max(int(most), 1)
+    per_tile = columns.T @ rows  # (columns, rows)
     return max(int(per_tile.max()), 1)
 
 
@@ -374,11 +398,12 @@ class LightCullPass(RenderPass):
         lights = frame.light_buffer
         grid = list_grid(frame.width, frame.height, self.clustered)
         camera = frame.scene.camera
-        # every list is a subset of its (coarse, tiled) tile's side-plane set
+        # every list is a subset of its (coarse, tiled) tile's side-plane set (and slice)
         bounds = grid if self.clustered else coarse_grid(grid)
+        slices = (camera.near, camera.far, grid.slices) if self.clustered else None
         capacity = frame.light_lists.capacity_for(lights.volume_spheres,
                                                   frame.inverse_projection, frame.width,
-                                                  frame.height, bounds.tile)
+                                                  frame.height, bounds.tile, slices)
         frame.light_lists.prepare(grid, capacity, camera.near, camera.far)
         defines = {"CULL_GROUP_SIZE": str(CULL_GROUP_SIZE)}
         if self.from_near:

@@ -491,9 +491,13 @@ def test_the_shading_copy_of_the_lists_holds_each_listed_lights_sphere_colour_an
     assert types == {3.0, 4.0}  # point and spot lights were listed
 
 
-def side_plane_counts(spheres, inverse, width, height, tile):
+def side_plane_counts(spheres, inverse, width, height, tile, slices=None):
     """Lights touching each tile's side planes, tile by tile as tile_frustum.glsl builds them
-    (float64): the reference of list_capacity."""
+    (float64), and with ``slices`` (near, far, count) each of the tile's depth slices their
+    depth range covers as cull_clusters.comp assigns them: the reference of list_capacity."""
+    def slice_of(d, near, far, count):
+        return np.clip(np.floor(np.log(np.maximum(d, near) / near) * count / np.log(far / near)),
+                       0, count - 1)
     def ray(x, y):
         v = inverse @ np.array([x / width * 2 - 1, y / height * 2 - 1, 1.0, 1.0])
         return v[:3] / v[3]
@@ -509,7 +513,15 @@ def side_plane_counts(spheres, inverse, width, height, tile):
                 n /= np.linalg.norm(n)
                 n = n if n @ centre >= 0 else -n
                 inside &= spheres[:, :3] @ n >= -spheres[:, 3]
-            counts.append(int(inside.sum()))
+            if slices is None:
+                counts.append(int(inside.sum()))
+                continue
+            near, far, count = slices
+            low, high = -spheres[:, 2] - spheres[:, 3], -spheres[:, 2] + spheres[:, 3]
+            inside &= (high >= near) & (low <= far)
+            first = slice_of(np.maximum(low, near), near, far, count)
+            last = slice_of(high, near, far, count)
+            counts += [int((inside & (first <= k) & (k <= last)).sum()) for k in range(count)]
     return np.array(counts)
 
 
@@ -531,9 +543,11 @@ def test_the_lists_capacity_bounds_every_list_and_is_the_side_planes_count(gl, p
         spheres = renderer.light_buffer.volume_spheres.astype(np.float64)
         inverse = renderer.last_frame.inverse_projection
         local = renderer.light_buffer.local_count
+        camera = renderer.scene.camera
     tile = grid.tile if path == "clustered" else coarse_grid(grid).tile
-    reference = side_plane_counts(spheres, inverse, *size, tile)
-    assert capacity == list_capacity(spheres, inverse, *size, tile)
+    slices = (camera.near, camera.far, grid.slices) if path == "clustered" else None
+    reference = side_plane_counts(spheres, inverse, *size, tile, slices)
+    assert capacity == list_capacity(spheres, inverse, *size, tile, slices)
     # the count of the planes, padded a little for the GPU's float32 planes
     assert reference.max() <= capacity <= reference.max() + 2
     assert capacity < 0.5 * local  # far fewer slots than lights: the memory it saves
