@@ -23,7 +23,16 @@ from .errors import InputError
 from .gbuffer import GBUFFER_COLOR_TARGETS
 from .imageio import srgb_encode, write_image
 from .passes import RenderPass
-from .preview import depth_colors, grey, id_colors, normal_colors, target_views, to_uint8, tonemap
+from .preview import (
+    depth_colors,
+    grey,
+    heat_colors,
+    id_colors,
+    normal_colors,
+    target_views,
+    to_uint8,
+    tonemap,
+)
 from .scene import Scene
 from .targets import COMPOSITE, LIGHT_ACCUMULATION
 
@@ -37,7 +46,10 @@ NAMED_VIEWS: dict[str, tuple[tuple[str, ...], str]] = {
     "shading": (("shading.model",), "shading model id, 0 = background (G-buffer)"),
     "light": (("R", "G", "B"), "light accumulation, linear HDR"),
     "composite": (("R", "G", "B", "A"), "composition buffer, linear HDR before tone mapping"),
+    "light_lists": (("lights.listed",), "volume lights in the light list each pixel loops over "
+                                        "(tiled, clustered, Forward+; a heat map in PNG)"),
 }
+LIST_CULLING_PASSES = (".cull_tiles", ".cull_clusters")  # the passes that fill the light lists
 
 
 @dataclass
@@ -100,6 +112,11 @@ def resolve_view(name: str, passes: Sequence[RenderPass]) -> tuple[str | None, s
     """``(pass, target)`` a view name needs: (None, None) for a named view, (None, target) for
     a target's end-of-frame contents, (pass, target) for a target after a pass."""
     written = {t for p in passes for t in p.writes}
+    if name == "light_lists":
+        if not any(p.name.endswith(LIST_CULLING_PASSES) for p in passes):
+            raise InputError("view 'light_lists' shows the light lists, which only the tiled and "
+                             "clustered light paths have", "--view")
+        return None, None
     if name in NAMED_VIEWS:
         needs = {"light": (LIGHT_ACCUMULATION,), "composite": (COMPOSITE,)}.get(
             name, GBUFFER_COLOR_TARGETS)
@@ -148,6 +165,12 @@ def view(capture: FrameCapture, name: str) -> View:
 
 def _named_view(capture: FrameCapture, name: str) -> View:
     channels, _ = NAMED_VIEWS[name]
+    if name == "light_lists":
+        if capture.light_lists is None:
+            raise KeyError("the frame was captured without light lists")
+        counts = capture.light_lists
+        return View(name, counts[..., None], channels, bool(counts.max(initial=0.0) <= 2048.0),
+                    heat_colors(counts))
     if name in ("light", "composite"):
         source = LIGHT_ACCUMULATION if name == "light" else COMPOSITE
         pixels = capture.target(source)[..., : len(channels)]

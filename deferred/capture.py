@@ -94,6 +94,9 @@ class FrameCapture:
     exposure: float = 1.0
     layout: GBufferLayout = field(default_factory=lambda: GBufferLayout({}))
     _gbuffer: dict[str, np.ndarray] | None = field(default=None, repr=False, compare=False)
+    # the length of the light list each pixel's shading loops over (tiled, clustered, Forward+;
+    # None on the other paths), top row first
+    light_lists: np.ndarray | None = None
 
     def __getitem__(self, name: str) -> PassCapture:
         for capture in self.passes:
@@ -207,9 +210,15 @@ def capture_frame(renderer: Renderer, passes: Sequence[str] | None = None,
         capture.draw_calls = result.draws_by_pass.get(capture.name, 0)
         capture.specs = dict(targets.specs)
     scene = renderer.scene
+    light_lists = None
+    if renderer.light_path in ("tiled", "clustered") and renderer.light_lists is not None:
+        depth = None  # deferred: only surfaces read a list (Forward+: every fragment drawn)
+        if renderer.pipeline_name == "deferred":
+            depth = to_float(targets.read_raw(LINEAR_DEPTH))[..., 0]
+        light_lists = renderer.light_lists.pixel_counts(*renderer.size, depth)[::-1]
     return FrameCapture(
         scene=scene.source, pipeline=renderer.pipeline_name, size=renderer.size,
         gl_info=renderer.gl.info, specs=dict(targets.specs), passes=captures,
         targets={name: targets.read_raw(name)[::-1] for name in targets.specs},
         image=result.image, frame_ms=frame_ms, tonemap=scene.tonemap, exposure=scene.exposure,
-        layout=scene.gbuffer_layout())
+        layout=scene.gbuffer_layout(), light_lists=light_lists)

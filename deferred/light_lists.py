@@ -291,6 +291,30 @@ class LightLists:
         data = np.frombuffer(self.buffer.read(size=4 * self.grid.count), dtype=np.uint32)
         return np.minimum(data, self.capacity)
 
+    def pixel_counts(self, width: int, height: int, depth: np.ndarray | None = None
+                     ) -> np.ndarray:
+        """The length of the list each pixel's shading loops over, (height, width) float32, GL's
+        bottom row first (the numpy twin of ``light_list_of``). Clustered lists need the linear
+        ``depth`` (same layout); pixels with no surface there (depth 0) read no list. Tiled: the
+        tile's list, or 0 where ``depth`` shows no surface."""
+        assert self.grid is not None
+        grid = self.grid
+        counts = self.counts().astype(np.float32)
+        ys, xs = np.mgrid[0:height, 0:width]
+        column = np.minimum(xs // grid.tile, grid.columns - 1)
+        row = np.minimum(ys // grid.tile, grid.rows - 1)
+        lists = row * grid.columns + column
+        if self.clustered:
+            if depth is None:
+                raise ValueError("clustered lists need the linear depth")
+            near, scale = self.depth_scale
+            slice_ = np.clip(np.floor(np.log(np.maximum(depth, near) / near) * scale), 0,
+                             grid.slices - 1).astype(np.int64)
+            lists = (slice_ * grid.rows + row) * grid.columns + column
+        shown = counts[lists]
+        return np.where(depth > 0.0, shown, 0.0).astype(np.float32) if depth is not None \
+            else shown
+
     def shading_slots(self) -> np.ndarray:
         """The shading's copy of the lists as read back: (slots, 2, 4) float32, a sphere and a
         colour texel per slot (tests)."""

@@ -569,3 +569,50 @@ def test_more_lights_than_a_listed_lights_index_holds_is_refused(monkeypatch):
     with pytest.raises(InputError, match=r"^light: 42 lights; the light lists index at most 41$"):
         light_lists.check_light_limits("clustered", (160, 96), 40, 42, max_texture_size=16384)
     light_lists.check_light_limits("volumes", (160, 96), 40, 42, max_texture_size=16384)
+
+
+@pytest.mark.parametrize("pipeline, path", [("deferred", "tiled"), ("deferred", "clustered"),
+                                            ("forward", "tiled")])
+def test_the_light_lists_view_shows_the_length_of_each_pixels_list(gl, pipeline, path):
+    from deferred.buffer_views import view
+    from deferred.capture import capture_frame
+
+    if not gl.features.compute_shaders:
+        pytest.skip("the driver has no compute shaders")
+    with Renderer(scene_with(120), pipeline, (157, 93), gl=gl, light_path=path) as renderer:
+        capture = capture_frame(renderer)
+        lists = renderer.light_lists
+        grid = lists.grid
+        counts = np.minimum(np.frombuffer(lists.buffer.read(size=4 * grid.count), np.uint32),
+                            lists.capacity)
+        camera = renderer.scene.camera
+    shown = view(capture, "light_lists")
+    assert shown.channels == ("lights.listed",) and shown.pixels.shape == (93, 157, 1)
+    # each pixel's list as light_list_of finds it (top row first, as the capture keeps it)
+    ys, xs = np.mgrid[92:-1:-1, 0:157]
+    tile = np.minimum(ys // grid.tile, grid.rows - 1) * grid.columns + \
+        np.minimum(xs // grid.tile, grid.columns - 1)
+    if pipeline == "deferred":
+        depth = capture.target("linear_depth")[..., 0]
+        if path == "clustered":
+            near, far = camera.near, camera.far
+            slices = np.clip(np.floor(np.log(np.maximum(depth, near) / near) * grid.slices /
+                                      np.log(far / near)), 0, grid.slices - 1).astype(int)
+            tile = slices * grid.rows * grid.columns + tile
+        expected = np.where(depth > 0.0, counts[tile], 0)
+        assert (depth == 0.0).any() and (expected[depth > 0.0] > 0).all()
+    else:  # Forward+: every fragment drawn reads its tile's list
+        expected = counts[tile]
+    np.testing.assert_array_equal(shown.pixels[..., 0], expected)
+    assert len(np.unique(expected)) > 5  # the lists differ over the frame
+    lit = shown.pixels[..., 0] > 0
+    assert (shown.preview[~lit] == 0.0).all() and (shown.preview[lit].max(axis=-1) > 0.0).all()
+
+
+def test_the_light_lists_view_needs_a_path_with_lists(gl):
+    from deferred.buffer_views import resolve_view
+
+    with Renderer(scene_with(4), gl=gl, light_path="volumes") as renderer:
+        with pytest.raises(InputError, match=r"^--view: view 'light_lists' shows the light "
+                                             r"lists, which only the tiled and clustered"):
+            resolve_view("light_lists", renderer.passes)
