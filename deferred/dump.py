@@ -290,6 +290,8 @@ def write_dump(capture: FrameCapture, directory: str | Path,
                               the z_channel), then declared data as <name>.<channel>
         DIR/light.exr         light accumulation, R G B
         DIR/final.exr         composition buffer (linear HDR), R G B A; DIR/final.png the frame
+        DIR/light_lists.exr   tiled and clustered paths: the volume lights in each pixel's light
+                              list, lights.listed (``--view light_lists``)
         DIR/passes/NN_<pass>.exr   what pass NN wrote, channels "<target>.R", ... ("<target>.Z")
         DIR/contact.png       every buffer as a labelled thumbnail, in pass order
         DIR/manifest.json     passes (phase, inputs, outputs, formats, time), G-buffer layout, GL
@@ -357,6 +359,10 @@ def _write_files(capture: FrameCapture, directory: Path, files: dict[str, str],
             write("light.exr", capture.target(LIGHT_ACCUMULATION)[..., :3],
                   channels=("R", "G", "B"), half=True)
             files["light"] = "light.exr"
+        if capture.light_lists is not None:
+            lists = view(capture, "light_lists")
+            write("light_lists.exr", lists.pixels, channels=lists.channels, half=lists.half)
+            files["light_lists"] = "light_lists.exr"
         write("final.exr", capture.target(COMPOSITE), channels=("R", "G", "B", "A"), half=True)
         write("final.png", capture.image)
         files.update({"final": "final.exr", "final_png": "final.png", "contact": "contact.png"})
@@ -389,6 +395,7 @@ def contact_tiles(capture: FrameCapture, thumb_width: int = 240) -> list[Tile]:
     names = ["albedo", "normal", "depth", "specular", "material"] \
         if all(capture.written(t) for t in GBUFFER_COLOR_TARGETS) else []
     names += ["light"] if capture.written(LIGHT_ACCUMULATION) else []
+    names += ["light_lists"] if capture.light_lists is not None else []
     for name in names + ["composite"]:
         tiles.append(Tile("frame", name, view(capture, name).preview[::step, ::step]))
     tiles.append(Tile("frame", "final.png", capture.image[::step, ::step, :3] / 255.0))

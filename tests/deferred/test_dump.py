@@ -382,10 +382,11 @@ def test_cli_dump_writes_the_folder(tmp_path, capsys):
     code, stdout, err = run(capsys, "dump", "-o", out, "--size", "96x64")
     assert code == 0, err
     assert stdout == ""
+    manifest = json.loads((out / "manifest.json").read_text())
+    lists = {"light_lists.exr"} if "light_lists" in manifest["files"] else set()  # tiled paths
     assert {p.name for p in out.iterdir()} == {"gbuffer.exr", "light.exr", "final.exr",
                                                "final.png", "contact.png", "manifest.json",
-                                               "passes"}
-    manifest = json.loads((out / "manifest.json").read_text())
+                                               "passes", *lists}
     assert manifest["scene"] == "builtin:demo.toml" and manifest["size"] == [96, 64]
     # a file for every pass that writes a target (light culling fills a buffer, no target)
     assert len(list((out / "passes").glob("*.exr"))) == \
@@ -547,3 +548,25 @@ def test_cli_compare_never_replaces_a_folder_holding_the_dumps(tmp_path, capsys)
     code, _, err = run(capsys, "dump", "--compare", out / "a", out / "b", "-o", out)
     assert code == 2 and "holds the dump" in err, err
     assert (out / "a" / "manifest.json").is_file() and (out / "b" / "manifest.json").is_file()
+
+
+def test_a_dump_of_a_list_path_holds_the_light_lists(tmp_path, renderer, gl):
+    if not gl.features.compute_shaders:
+        pytest.skip("the driver has no compute shaders")
+    from dataclasses import replace
+
+    from deferred.bench import with_extra_lights
+
+    scene = with_extra_lights(replace(small_scene(), light_path="tiled"), 40, SIZE[0] / SIZE[1])
+    capture = capture_frame(renderer(scene))
+    manifest = write_dump(capture, tmp_path / "dump")
+    assert manifest["files"]["light_lists"] == "light_lists.exr"
+    pixels, channels, _ = read_channels(tmp_path / "dump" / "light_lists.exr")
+    assert channels == ["lights.listed"]
+    np.testing.assert_array_equal(pixels[..., 0], capture.light_lists)
+    assert pixels.max() > 0 and len(np.unique(pixels)) > 3
+    assert any(t.subtitle == "light_lists" for t in contact_tiles(capture))
+    # the volumes path has no lists: no file, and no tile
+    volumes = capture_frame(renderer(small_scene()))
+    assert volumes.light_lists is None
+    assert "light_lists" not in write_dump(volumes, tmp_path / "other")["files"]
