@@ -25,6 +25,20 @@ def program(gl):
     made.release()
 
 
+class CountingWriters(dict):
+    """A program's uniform writers, each counting the writes it makes (into ``log``)."""
+
+    def __init__(self, log):
+        super().__init__()
+        self.log = log
+
+    def __setitem__(self, name, writer):
+        def counted(value, name=name, writer=writer):
+            self.log.append(name)
+            writer(value)
+        super().__setitem__(name, counted)
+
+
 class CountingUniforms(ProgramUniforms):
     """Counts the writes that reach GL."""
 
@@ -33,10 +47,7 @@ class CountingUniforms(ProgramUniforms):
     def __init__(self, program):
         super().__init__(program)
         self.writes = []
-
-    def _write(self, name, value, group):
-        self.writes.append(name)
-        super()._write(name, value, group)
+        self._writers = CountingWriters(self.writes)
 
 
 def test_a_value_the_program_holds_is_not_written_again(program):
