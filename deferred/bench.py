@@ -594,3 +594,26 @@ def crossovers(report: BenchReport) -> list[str]:
                 lines.append(f"{shells} shells: deferred ({deferred.light_path}) beats "
                              f"{against} from {lights} extra lights on")
     return lines
+
+
+def speedups(report: BenchReport) -> list[str]:
+    """Per shell count, at the most extra lights swept: the fastest deferred path's median
+    against naive forward's and the fastest forward path's, as lines to print."""
+    lines = []
+    for shells in sorted({r.shells for r in report.results}):
+        rows = [r for r in report.results if r.shells == shells]
+        lights = max(r.lights for r in rows)
+        deferred = _fastest(rows, "deferred", lights)
+        naive = _fastest(rows, "forward", lights, ("naive",))
+        forward = _fastest(rows, "forward", lights)
+        if deferred is None or forward is None:
+            continue
+        parts = []
+        if naive is not None:
+            parts.append(f"{naive.median_ms / deferred.median_ms:.1f}x naive forward "
+                         f"({naive.median_ms:.1f} ms)")
+        parts.append(f"{forward.median_ms / deferred.median_ms:.2f}x the fastest forward path "
+                     f"({forward.light_path}, {forward.median_ms:.1f} ms)")
+        lines.append(f"{shells} shells, {lights} extra lights: deferred ({deferred.light_path}) "
+                     f"{deferred.median_ms:.1f} ms: {', '.join(parts)}")
+    return lines

@@ -350,7 +350,7 @@ def bench(scene: str | None, lights: str, shells: str, size: str | None, runs: i
     # Not squeezed to 80 columns when stderr is a pipe or a file.
     table_console = stderr if stderr.is_terminal else Console(stderr=True, width=160)
     table_console.print(benchmark.results_table(report))
-    for line in benchmark.crossovers(report):
+    for line in [*benchmark.crossovers(report), *benchmark.speedups(report)]:
         stderr.print(line)
     if json_path == "-":
         try:  # a full disk or a closed pipe shows here, not as a warning at exit

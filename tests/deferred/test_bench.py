@@ -236,3 +236,23 @@ def test_builtin_overdraw_scene_has_objects_at_several_depths(render):
     assert result.draws_by_pass["floor.forward"] == 1 and np.isfinite(result.hdr).all()
     with pytest.raises(InputError, match="no built-in scene 'nope'"):
         load_scene("builtin:nope")
+
+
+def test_speedups_compare_the_fastest_deferred_path_at_the_most_lights():
+    from deferred.bench import BenchReport, BenchResult, speedups
+
+    def row(pipeline, path, lights, ms, shells=0):
+        return BenchResult(pipeline, lights, shells, 64, 36, [ms], light_path=path)
+
+    report = BenchReport({}, [
+        row("deferred", "volumes", 16, 9.0), row("deferred", "tiled", 16, 5.0),
+        row("forward", "naive", 16, 20.0), row("forward", "tiled", 16, 4.0),
+        row("deferred", "volumes", 1024, 300.0), row("deferred", "tiled", 1024, 50.0),
+        row("deferred", "clustered", 1024, 80.0), row("forward", "naive", 1024, 2600.0),
+        row("forward", "tiled", 1024, 130.0),
+        row("deferred", "volumes", 4, 10.0, shells=16), row("forward", "naive", 4, 8.0, 16)])
+    assert speedups(report) == [
+        "0 shells, 1024 extra lights: deferred (tiled) 50.0 ms: 52.0x naive forward "
+        "(2600.0 ms), 2.60x the fastest forward path (tiled, 130.0 ms)",
+        "16 shells, 4 extra lights: deferred (volumes) 10.0 ms: 0.8x naive forward (8.0 ms), "
+        "0.80x the fastest forward path (naive, 8.0 ms)"]
