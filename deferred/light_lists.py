@@ -26,7 +26,8 @@ storage buffer (a count per list, then ``capacity`` slots per list, then (tiled)
 tiles' lists in the same layout), and for the shading an RGBA32F texture of two texels a slot,
 the light's sphere and colour: the list loops read one texel a listed light, plus one for each
 light reaching the pixel. Capacity is the most volume lights the side planes of any (coarse)
-tile can hold, counted on the CPU (:func:`list_capacity`), so no list overflows.
+tile can hold (clustered: of any tile and depth slice), counted on the CPU
+(:func:`list_capacity`), so no list overflows.
 """
 
 from __future__ import annotations
