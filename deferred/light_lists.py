@@ -201,7 +201,7 @@ class LightLists:
         self.depth_scale = (1.0, 1.0)
         self._capacity_spheres: np.ndarray | None = None  # what the last capacity counted
         self._capacity_key: tuple | None = None
-        self._capacity = 1
+        self._counted_capacity = 1
 
     def prepare(self, grid: ListGrid, capacity: int, near: float, far: float) -> None:
         """Lay out this frame's lists: ``capacity`` slots each (:func:`list_capacity`). The
@@ -245,10 +245,10 @@ class LightLists:
         makes a new ``spheres`` array when it packs the lights again)."""
         key = (np.asarray(inverse_projection).tobytes(), width, height, tile, slices)
         if self._capacity_spheres is not spheres or self._capacity_key != key:
-            self._capacity = list_capacity(spheres, inverse_projection, width, height, tile,
-                                           slices)
+            self._counted_capacity = list_capacity(spheres, inverse_projection, width, height,
+                                                   tile, slices)
             self._capacity_spheres, self._capacity_key = spheres, key
-        return self._capacity
+        return self._counted_capacity
 
     def uniforms(self) -> dict[str, Any]:
         """The lists' uniforms this frame (one dict per :meth:`prepare`: programs skip it while
