@@ -210,15 +210,15 @@ def capture_frame(renderer: Renderer, passes: Sequence[str] | None = None,
         capture.draw_calls = result.draws_by_pass.get(capture.name, 0)
         capture.specs = dict(targets.specs)
     scene = renderer.scene
+    ends = {name: targets.read_raw(name)[::-1] for name in targets.specs}  # top row first
     light_lists = None
     if renderer.light_path in ("tiled", "clustered") and renderer.light_lists is not None:
         depth = None  # deferred: only surfaces read a list (Forward+: every fragment drawn)
-        if renderer.pipeline_name == "deferred":
-            depth = to_float(targets.read_raw(LINEAR_DEPTH))[..., 0]
+        if renderer.pipeline_name == "deferred":  # GL's bottom row first, as the lists count
+            depth = to_float(ends[LINEAR_DEPTH])[::-1, :, 0]
         light_lists = renderer.light_lists.pixel_counts(*renderer.size, depth)[::-1]
     return FrameCapture(
         scene=scene.source, pipeline=renderer.pipeline_name, size=renderer.size,
-        gl_info=renderer.gl.info, specs=dict(targets.specs), passes=captures,
-        targets={name: targets.read_raw(name)[::-1] for name in targets.specs},
+        gl_info=renderer.gl.info, specs=dict(targets.specs), passes=captures, targets=ends,
         image=result.image, frame_ms=frame_ms, tonemap=scene.tonemap, exposure=scene.exposure,
         layout=scene.gbuffer_layout(), light_lists=light_lists)

@@ -309,8 +309,7 @@ class LightLists:
             if depth is None:
                 raise ValueError("clustered lists need the linear depth")
             near, scale = self.depth_scale
-            slice_ = np.clip(np.floor(np.log(np.maximum(depth, near) / near) * scale), 0,
-                             grid.slices - 1).astype(np.int64)
+            slice_ = depth_slice(depth, near, scale, grid.slices).astype(np.int64)
             lists = (slice_ * grid.rows + row) * grid.columns + column
         shown = counts[lists]
         return np.where(depth > 0.0, shown, 0.0).astype(np.float32) if depth is not None \
@@ -337,6 +336,13 @@ class LightLists:
     def release(self) -> None:
         self._release_buffer()
         self._release_texture()
+
+
+def depth_slice(depth: np.ndarray, near: float, scale: float, slices: int) -> np.ndarray:
+    """The clustered lists' depth slice of each linear ``depth`` (float, whole numbers): the
+    numpy twin of ``light_list_slice`` in lights/light_lists.glsl, ``scale`` being slices /
+    log(far / near)."""
+    return np.clip(np.floor(np.log(np.maximum(depth, near) / near) * scale), 0, slices - 1)
 
 
 def list_capacity(spheres: np.ndarray, inverse_projection: np.ndarray, width: int, height: int,
@@ -391,12 +397,9 @@ def list_capacity(spheres: np.ndarray, inverse_projection: np.ndarray, width: in
         low = np.maximum(depth - padded - pad, near)
         high = depth + padded + pad
         inside = (high >= near) & (depth - padded - pad <= far)
-        scale = count / math.log(far / near)  # light_list_slice in light_lists.glsl
-
-        def slice_of(d: np.ndarray) -> np.ndarray:
-            return np.clip(np.floor(np.log(np.maximum(d, near) / near) * scale), 0, count - 1)
-
-        first, last = slice_of(low), slice_of(high)
+        scale = count / math.log(far / near)
+        first = depth_slice(low, near, scale, count)
+        last = depth_slice(high, near, scale, count)
         covered = (np.arange(count)[None, :] >= first[:, None]) & \
             (np.arange(count)[None, :] <= last[:, None]) & inside[:, None]
         # (columns, rows) a slice: float32 products (BLAS; exact, counts far below 2^24)
