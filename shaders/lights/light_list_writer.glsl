@@ -11,7 +11,7 @@ void light_list_write(int slot, int index, vec4 sphere) {
     light_list_data[slot] = uint(index);
 #ifndef CULL_COARSE
     ivec2 texel = light_list_texel(slot);
-    vec4 color = texelFetch(u_lights, ivec2(0, index), 0);
+    vec4 color = fetch_light(index).color;
     imageStore(u_light_list_image, texel, sphere);
     imageStore(u_light_list_image, texel + ivec2(1, 0),
                vec4(color.rgb, color.w + 256.0 * float(index)));

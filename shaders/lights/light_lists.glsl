@@ -68,8 +68,7 @@ vec4 listed_light_sphere(int slot) {
 LightRecord listed_light_record(int slot, vec4 sphere) {
     vec4 color = texelFetch(u_light_list_texture, light_list_texel(slot) + ivec2(1, 0), 0);
     int code = int(color.w);
-    int index = code >> 8;
-    return LightRecord(vec4(color.rgb, float(code & 255)), sphere,
-                       texelFetch(u_lights, ivec2(2, index), 0),
-                       texelFetch(u_lights, ivec2(3, index), 0));
+    LightRecord record = fetch_light(code >> 8);  // only what the light's type reads is read
+    return LightRecord(vec4(color.rgb, float(code & 255)), sphere, record.direction,
+                       record.extra);
 }
