@@ -9,8 +9,9 @@ Deferred:
 - ``tiled``: a compute pass culls the volume lights per 16x16 tile against the tile's frustum,
   depth bounds and the view-space box of its points (``lights/cull_tiles.comp``), in two
   dispatches: coarse tiles of 4x4 tiles against every light, then each tile against its
-  coarse tile's lights; one full-screen pass then reads the G-buffer once per pixel and loops
-  the full-screen lights and its tile's list (``lights/list_shading.frag``).
+  coarse tile's lights, and the lights that touch the tile against each of its 8x8 quadrants,
+  which have the lists; one full-screen pass then reads the G-buffer once per pixel and loops
+  the full-screen lights and its quadrant's list (``lights/list_shading.frag``).
 - ``clustered``: the same shading, from lists of view-space clusters (32x32 tiles x 16
   exponential depth slices) filled tile by tile (``lights/cull_clusters.comp``).
 
@@ -19,15 +20,15 @@ Forward:
 - ``naive``: every fragment loops every light.
 - ``tiled`` (Forward+): a depth pre-pass, the tiled culling (depth bounds from the near plane, so
   blended surfaces in front of the opaque ones are covered), and the lit passes loop their
-  tile's list (``common/forward_lighting.glsl``).
+  quadrant's list (``common/forward_lighting.glsl``).
 
-The culling shaders write each list twice (``lights/light_lists.glsl``): light indices in a
-storage buffer (a count per list, then ``capacity`` slots per list, then (tiled) the coarse
-tiles' lists in the same layout), and for the shading an RGBA32F texture of two texels a slot,
-the light's sphere and colour: the list loops read one texel a listed light, plus one for each
-light reaching the pixel. Capacity is the most volume lights the side planes of any (coarse)
-tile can hold (clustered: of any tile and depth slice), counted on the CPU
-(:func:`list_capacity`), so no list overflows.
+The culling shaders write the lists for the shading in an RGBA32F texture of two texels a
+slot, the light's sphere and colour (and its index, :meth:`LightLists.entries`); the list
+loops read one texel a listed light, plus one for each light reaching the pixel
+(``lights/light_lists.glsl``). A storage buffer holds each list's count, then (tiled) the
+coarse tiles' lists of light indices, a count and ``capacity`` slots each. Capacity is the
+most volume lights the side planes of any (coarse) tile can hold (clustered: of any tile and
+depth slice), counted on the CPU (:func:`list_capacity`), so no list overflows.
 """
 
 from __future__ import annotations
@@ -55,7 +56,10 @@ FORWARD_PATHS = ("naive", "tiled")
 # A path named for one pipeline, in the other: forward has no volumes or clusters.
 FORWARD_EQUIVALENT = {"volumes": "naive", "clustered": "tiled"}
 DEFERRED_EQUIVALENT = {"naive": "volumes"}
-TILE = 16  # pixels per tile side (tiled, Forward+)
+TILE = 16  # pixels per culling tile side (tiled, Forward+): an invocation of the culling each
+# The tiled lists are those of LIST_SPLIT x LIST_SPLIT sub-tiles of a culling tile (8x8 pixels):
+# the culling tests a light against a sub-tile only where it touches the tile.
+LIST_SPLIT = 2
 CLUSTER_TILE = 32  # pixels per cluster side
 CLUSTER_SLICES = 16  # exponential depth slices between the near and far planes
 # Invocations per culling work group, an invocation per tile. llvmpipe gives each CPU thread
@@ -111,10 +115,10 @@ class ListGrid:
         return self.columns * self.rows * self.slices
 
 
-def list_bytes(grid: ListGrid, capacity: int) -> int:
-    """Bytes of the lists' light indices in the storage buffer: a count and ``capacity`` slots
-    per list."""
-    return 4 * grid.count * (1 + max(capacity, 1))
+def list_bytes(grid: ListGrid) -> int:
+    """Bytes of the lists' counts in the storage buffer (their lights are in the shading's
+    texture only)."""
+    return 4 * grid.count
 
 
 def texture_rows(grid: ListGrid, capacity: int) -> int:
@@ -125,8 +129,15 @@ def texture_rows(grid: ListGrid, capacity: int) -> int:
 
 def coarse_grid(grid: ListGrid) -> ListGrid:
     """The coarse tiles of the tiled culling's first dispatch (COARSE_RATIO tiles a side)."""
-    return ListGrid(math.ceil(grid.columns / COARSE_RATIO), math.ceil(grid.rows / COARSE_RATIO),
-                    1, grid.tile * COARSE_RATIO)
+    ratio = COARSE_RATIO * LIST_SPLIT  # list tiles a coarse tile side
+    return ListGrid(math.ceil(grid.columns / ratio), math.ceil(grid.rows / ratio), 1,
+                    grid.tile * ratio)
+
+
+def culling_tiles(grid: ListGrid) -> int:
+    """The tiled culling's second dispatch: an invocation per TILE x TILE tile, for its
+    LIST_SPLIT x LIST_SPLIT lists."""
+    return math.ceil(grid.columns / LIST_SPLIT) * math.ceil(grid.rows / LIST_SPLIT)
 
 
 def coarse_list_bytes(grid: ListGrid, capacity: int) -> int:
@@ -137,9 +148,9 @@ def coarse_list_bytes(grid: ListGrid, capacity: int) -> int:
 
 
 def list_overflow(grid: ListGrid, capacity: int) -> tuple[int, int] | None:
-    """(bytes needed, limit) where the storage buffer (the lists and, tiled, the coarse lists)
-    exceeds MAX_LIST_BYTES at ``capacity`` slots a list; None where it fits."""
-    total = list_bytes(grid, capacity) + coarse_list_bytes(grid, capacity)
+    """(bytes needed, limit) where the storage buffer (the lists' counts and, tiled, the coarse
+    lists) exceeds MAX_LIST_BYTES at ``capacity`` slots a list; None where it fits."""
+    total = list_bytes(grid) + coarse_list_bytes(grid, capacity)
     return (total, MAX_LIST_BYTES) if total > MAX_LIST_BYTES else None
 
 
@@ -161,9 +172,10 @@ def _too_many_for_lists(lights: int, grid: ListGrid, size: int, limit: int) -> s
 def check_light_limits(light_path: str, size: tuple[int, int], volume_lights: int,
                        lights: int, max_texture_size: int) -> None:
     """Refuse, before any frame, a light count the light path cannot hold: the lists' storage
-    buffer (tiled, clustered: a slot per volume light in every list; the shading's texture of
-    them is sized to the frame's lights, :meth:`LightLists.prepare`), the light buffer's texture
-    (a row per light) and the full-screen lights' uniform array (any path: forward reads it)."""
+    buffer (tiled: the coarse lists, a slot per volume light in each; the shading's texture of
+    the lists is sized to the frame's lights, :meth:`LightLists.prepare`), the light buffer's
+    texture (a row per light) and the full-screen lights' uniform array (any path: forward
+    reads it)."""
     if lights - volume_lights > FULLSCREEN_LIGHT_CAPACITY:
         raise InputError(fullscreen_overflow(lights - volume_lights), "light")
     if light_path in ("tiled", "clustered"):
@@ -180,7 +192,7 @@ def check_light_limits(light_path: str, size: tuple[int, int], volume_lights: in
 
 
 def list_grid(width: int, height: int, clustered: bool) -> ListGrid:
-    tile = CLUSTER_TILE if clustered else TILE
+    tile = CLUSTER_TILE if clustered else TILE // LIST_SPLIT
     return ListGrid(math.ceil(width / tile), math.ceil(height / tile),
                     CLUSTER_SLICES if clustered else 1, tile)
 
@@ -225,7 +237,7 @@ class LightLists:
                           "u_list_row_shift": LIST_ROW_SHIFT,
                           "u_list_grid": (grid.columns, grid.rows, grid.slices),
                           "u_list_tile": grid.tile, "u_list_depth": self.depth_scale}
-        lists = list_bytes(grid, self.capacity)
+        lists = list_bytes(grid)
         size = lists + coarse_list_bytes(grid, self.capacity)
         self.coarse_base = lists // 4  # the word where the coarse lists begin
         rows = texture_rows(grid, self.capacity)
@@ -314,6 +326,17 @@ class LightLists:
         shown = counts[lists]
         return np.where(depth > 0.0, shown, 0.0).astype(np.float32) if depth is not None \
             else shown
+
+    def entries(self) -> list[np.ndarray]:
+        """Each list's light indices (into the light buffer), in list order, as the shading's
+        copy holds them (tests and statistics)."""
+        assert self.grid is not None
+        slots = self.shading_slots()
+        counts = self.counts()
+        codes = slots[:, 1, 3].astype(np.int64)  # type id + 256 x index
+        first = self.grid.count  # the counts' slots, then capacity slots a list
+        return [codes[first + i * self.capacity:][:counts[i]] >> 8
+                for i in range(self.grid.count)]
 
     def shading_slots(self) -> np.ndarray:
         """The shading's copy of the lists as read back: (slots, 2, 4) float32, a sphere and a
@@ -442,11 +465,14 @@ class LightCullPass(RenderPass):
             shader = frame.shaders.compute("lights/cull_clusters.comp", defines)
         else:
             shader = frame.shaders.compute("lights/cull_tiles.comp",
-                                           {**defines, "CULL_CANDIDATES": "1"})
+                                           {**defines, "CULL_CANDIDATES": "1",
+                                            **({"LIST_QUADRANTS": "1"} if LIST_SPLIT == 2
+                                               else {})})
         counts = {"u_light_count": lights.count, "u_global_light_count": lights.global_count}
         textures = {"u_lights": lights.texture}
         if self.clustered:
-            dispatches = [(shader, {**frame.light_lists.uniforms(), **counts}, grid)]
+            dispatches = [(shader, {**frame.light_lists.uniforms(), **counts}, grid.count //
+                           grid.slices)]
         else:
             textures["u_linear_depth"] = frame.target(LINEAR_DEPTH)
             counts["u_pixel_to_view"] = pixel_to_view(frame.projection, frame.width,
@@ -455,14 +481,14 @@ class LightCullPass(RenderPass):
             coarse = frame.light_lists.coarse_uniforms()
             first = frame.shaders.compute("lights/cull_tiles.comp",
                                           {**defines, "CULL_COARSE": "1"})
-            dispatches = [(first, {**coarse["first"], **counts}, coarse_grid(grid)),
-                          (shader, {**coarse["second"], **counts}, grid)]
+            dispatches = [(first, {**coarse["first"], **counts}, coarse_grid(grid).count),
+                          (shader, {**coarse["second"], **counts}, culling_tiles(grid))]
         for index, (program, uniforms, tiles) in enumerate(dispatches):
             if index:
                 frame.ctx.memory_barrier()
             frame.bind_compute(program, uniforms, textures)
             frame.light_lists.bind_image(frame.shaders.uniforms(program))
-            groups = math.ceil(tiles.columns * tiles.rows / CULL_GROUP_SIZE)  # a tile each
+            groups = math.ceil(tiles / CULL_GROUP_SIZE)  # an invocation a tile
             frame.gl_call(lambda program=program, groups=groups: program.run(groups, 1, 1))
         frame.ctx.memory_barrier()
         frame.count_draw()

@@ -96,6 +96,7 @@ def listed_frame(gl, path: str, extra: int, size: tuple[int, int] | None = None
         records = np.frombuffer(renderer.light_buffer.texture.read(), dtype=np.float32)
         records = records.reshape(-1, 4, 4)[:renderer.light_buffer.count]
         slots = lists.shading_slots()
+        frame_entries = lists.entries()  # from the shading's copy
         depth = renderer.targets.read("linear_depth")[..., 0]
         inverse = renderer.last_frame.inverse_projection
         global_count = renderer.light_buffer.global_count
@@ -112,7 +113,7 @@ def listed_frame(gl, path: str, extra: int, size: tuple[int, int] | None = None
     reach = np.linalg.norm(points[:, None, :] - spheres[None, :, :3], axis=-1) <= \
         spheres[None, :, 3] * 0.999
     counts = data[:grid.count]
-    entries = [data[grid.count + i * lists.capacity:][:counts[i]] for i in range(grid.count)]
+    entries = frame_entries
     return SimpleNamespace(grid=grid, capacity=lists.capacity, counts=counts, entries=entries,
                            data=data, slots=slots,
                            records=records, global_count=global_count, camera=camera,
@@ -120,8 +121,13 @@ def listed_frame(gl, path: str, extra: int, size: tuple[int, int] | None = None
 
 
 @pytest.mark.parametrize("size", [None, (157, 93)])  # 160x96; odd: tiles of odd width, height
-def test_tile_lists_hold_every_light_that_reaches_a_pixel(gl, size):
+@pytest.mark.parametrize("split", [2, 1])  # lists of 8x8 quadrants (the default), or 16x16
+def test_tile_lists_hold_every_light_that_reaches_a_pixel(gl, size, split, monkeypatch):
+    import deferred.light_lists as light_lists
+
+    monkeypatch.setattr(light_lists, "LIST_SPLIT", split)
     frame = listed_frame(gl, "tiled", 120, size)
+    assert frame.grid.tile == 16 // split
     grid, reach, points, records = frame.grid, frame.reach, frame.points, frame.records
     global_count, counts, entries = frame.global_count, frame.counts, frame.entries
     assert reach.sum() > 1000  # the lights do light the scene
@@ -240,18 +246,34 @@ def test_unknown_light_path_is_bad_input(gl):
         scene_from_dict({"light_path": "fast"})
 
 
-@pytest.mark.parametrize("path", ["tiled", "clustered"])
-def test_more_lights_than_the_lists_hold_is_refused_before_a_frame(gl, path, monkeypatch):
+def test_more_lights_than_the_coarse_lists_hold_is_refused_before_a_frame(gl, monkeypatch):
+    # the storage buffer: the lists' counts (960 bytes at 160x96), then the tiled culling's
+    # coarse lists, every volume light in each at the most (6 coarse lists)
     if not gl.features.compute_shaders:
         pytest.skip("the driver has no compute shaders")
     import deferred.light_lists as light_lists
 
-    scene = scene_with(40)
+    scene = scene_with(200)
     monkeypatch.setattr(light_lists, "MAX_LIST_BYTES", 4096)
     with pytest.raises(InputError, match=r"^light: \d+ lights need .* light lists"):
-        Renderer(scene, gl=gl, light_path=path)
+        Renderer(scene, gl=gl, light_path="tiled")
+    Renderer(scene_with(40), gl=gl, light_path="tiled").release()  # 3 KB: accepted
     with Renderer(scene, gl=gl, light_path="volumes") as renderer:  # volumes has no lists
         assert renderer.render().hdr[..., :3].max() > 0.0
+
+
+def test_lists_past_the_limit_refuse_the_frame_in_one_line(gl, monkeypatch):
+    # the shading's texture, sized to the frame's capacity: checked each frame
+    if not gl.features.compute_shaders:
+        pytest.skip("the driver has no compute shaders")
+    import deferred.light_lists as light_lists
+    from deferred.errors import RenderError
+
+    monkeypatch.setattr(light_lists, "MAX_LIST_BYTES", 64 * 1024)
+    with Renderer(scene_with(200), gl=gl, light_path="clustered") as renderer:
+        with pytest.raises(RenderError, match=r"^pass lighting.cull_clusters: a tile's frustum "
+                                              r"holds \d+ lights: the light lists need"):
+            renderer.render()
 
 
 def test_more_lights_than_the_gl33_light_texture_holds_is_refused(gl, monkeypatch):
@@ -274,7 +296,7 @@ def test_the_shading_lists_texture_is_sized_to_the_frame_and_refused_past_the_ro
         list_grid,
     )
 
-    grid = list_grid(3840, 2160, clustered=False)  # 32400 tiles
+    grid = list_grid(1920, 1080, clustered=False)  # 32400 lists of 8x8 pixels
     lists = LightLists(gl.ctx)
     try:
         lists.prepare(grid, 100, 0.1, 100.0)
