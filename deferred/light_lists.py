@@ -26,9 +26,10 @@ The culling shaders write the lists for the shading in an RGBA32F texture of two
 slot, the light's sphere and colour (and its index, :meth:`LightLists.entries`); the list
 loops read one texel a listed light, plus one for each light reaching the pixel
 (``lights/light_lists.glsl``). A storage buffer holds each list's count, then (tiled) the
-coarse tiles' lists of light indices, a count and ``capacity`` slots each. Capacity is the
-most volume lights the side planes of any (coarse) tile can hold (clustered: of any tile and
-depth slice), counted on the CPU (:func:`list_capacity`), so no list overflows.
+coarse tiles' lists of light indices, a count and ``coarse_capacity`` slots each. A list's
+capacity is the most volume lights the side planes of any of its tiles can hold (the 8x8 list
+tiles, the coarse tiles; clustered: any tile and depth slice), counted on the CPU
+(:func:`list_capacity`), so no list overflows.
 """
 
 from __future__ import annotations
@@ -147,10 +148,11 @@ def coarse_list_bytes(grid: ListGrid, capacity: int) -> int:
     return 4 * coarse_grid(grid).count * (1 + max(capacity, 1))
 
 
-def list_overflow(grid: ListGrid, capacity: int) -> tuple[int, int] | None:
+def list_overflow(grid: ListGrid, coarse_capacity: int) -> tuple[int, int] | None:
     """(bytes needed, limit) where the storage buffer (the lists' counts and, tiled, the coarse
-    lists) exceeds MAX_LIST_BYTES at ``capacity`` slots a list; None where it fits."""
-    total = list_bytes(grid) + coarse_list_bytes(grid, capacity)
+    lists) exceeds MAX_LIST_BYTES at ``coarse_capacity`` slots a coarse list; None where it
+    fits."""
+    total = list_bytes(grid) + coarse_list_bytes(grid, coarse_capacity)
     return (total, MAX_LIST_BYTES) if total > MAX_LIST_BYTES else None
 
 
@@ -208,19 +210,21 @@ class LightLists:
         self.max_texture_size = int(ctx.info["GL_MAX_TEXTURE_SIZE"])
         self.grid: ListGrid | None = None
         self.capacity = 1
+        self.coarse_capacity = 1
         self.coarse_base = 0
         self.clustered = False
         self.depth_scale = (1.0, 1.0)
-        self._capacity_spheres: np.ndarray | None = None  # what the last capacity counted
-        self._capacity_key: tuple | None = None
-        self._counted_capacity = 1
+        # the last capacity counted for each tile size: (spheres, key, capacity)
+        self._capacities: dict[tuple, tuple[np.ndarray, tuple, int]] = {}
 
-    def prepare(self, grid: ListGrid, capacity: int, near: float, far: float) -> None:
-        """Lay out this frame's lists: ``capacity`` slots each (:func:`list_capacity`). The
-        storage buffer's worst case was checked before the first frame; the shading's texture
-        (8x as large a slot) is checked here, at this frame's capacity."""
+    def prepare(self, grid: ListGrid, capacity: int, near: float, far: float,
+                coarse_capacity: int = 1) -> None:
+        """Lay out this frame's lists: ``capacity`` slots each, and (tiled) the coarse lists'
+        ``coarse_capacity`` (:func:`list_capacity`). The storage buffer's worst case was
+        checked before the first frame; both are checked here, at this frame's capacities."""
         capacity = max(capacity, 1)
-        overflow = list_overflow(grid, capacity) or \
+        coarse_capacity = max(coarse_capacity, 1)
+        overflow = list_overflow(grid, coarse_capacity) or \
             texture_overflow(grid, capacity, self.max_texture_size)
         if overflow is not None:
             needed, limit = overflow
@@ -230,6 +234,7 @@ class LightLists:
                               "path")
         self.grid = grid
         self.capacity = capacity
+        self.coarse_capacity = coarse_capacity
         self.clustered = grid.slices > 1
         self.depth_scale = (near, grid.slices / math.log(far / near))
         self._uniforms = {"u_list_count": grid.count, "u_list_capacity": self.capacity,
@@ -238,7 +243,7 @@ class LightLists:
                           "u_list_grid": (grid.columns, grid.rows, grid.slices),
                           "u_list_tile": grid.tile, "u_list_depth": self.depth_scale}
         lists = list_bytes(grid)
-        size = lists + coarse_list_bytes(grid, self.capacity)
+        size = lists + coarse_list_bytes(grid, coarse_capacity)
         self.coarse_base = lists // 4  # the word where the coarse lists begin
         rows = texture_rows(grid, self.capacity)
         if self.buffer is None or self.buffer.size < size:
@@ -255,12 +260,13 @@ class LightLists:
                      ) -> int:
         """:func:`list_capacity`, computed again only when its inputs change (the light buffer
         makes a new ``spheres`` array when it packs the lights again)."""
-        key = (np.asarray(inverse_projection).tobytes(), width, height, tile, slices)
-        if self._capacity_spheres is not spheres or self._capacity_key != key:
-            self._counted_capacity = list_capacity(spheres, inverse_projection, width, height,
-                                                   tile, slices)
-            self._capacity_spheres, self._capacity_key = spheres, key
-        return self._counted_capacity
+        key = (np.asarray(inverse_projection).tobytes(), width, height)
+        counted = self._capacities.get((tile, slices))
+        if counted is None or counted[0] is not spheres or counted[1] != key:
+            counted = (spheres, key, list_capacity(spheres, inverse_projection, width, height,
+                                                   tile, slices))
+            self._capacities[(tile, slices)] = counted
+        return counted[2]
 
     def uniforms(self) -> dict[str, Any]:
         """The lists' uniforms this frame (one dict per :meth:`prepare`: programs skip it while
@@ -274,10 +280,12 @@ class LightLists:
         assert self.grid is not None
         coarse = coarse_grid(self.grid)
         first = {**self._uniforms, "u_list_base": self.coarse_base, "u_list_count": coarse.count,
+                 "u_list_capacity": self.coarse_capacity,
                  "u_list_grid": (coarse.columns, coarse.rows, 1), "u_list_tile": coarse.tile}
         second = {**self._uniforms, "u_candidate_base": self.coarse_base,
                   "u_candidate_count": coarse.count, "u_candidate_columns": coarse.columns,
-                  "u_candidate_ratio": COARSE_RATIO}
+                  "u_candidate_ratio": COARSE_RATIO,
+                  "u_candidate_capacity": self.coarse_capacity}
         return {"first": first, "second": second}
 
     def bind(self, uniforms: ProgramUniforms, texture_unit: int) -> None:
@@ -449,13 +457,18 @@ class LightCullPass(RenderPass):
         lights = frame.light_buffer
         grid = list_grid(frame.width, frame.height, self.clustered)
         camera = frame.scene.camera
-        # every list is a subset of its (coarse, tiled) tile's side-plane set (and slice)
-        bounds = grid if self.clustered else coarse_grid(grid)
+        # every list is a subset of its tile's side-plane set (and slice), every coarse list
+        # of its coarse tile's
         slices = (camera.near, camera.far, grid.slices) if self.clustered else None
-        capacity = frame.light_lists.capacity_for(lights.volume_spheres,
+
+        def capacity(tile: int, slices: tuple | None = None) -> int:
+            return frame.light_lists.capacity_for(lights.volume_spheres,
                                                   frame.inverse_projection, frame.width,
-                                                  frame.height, bounds.tile, slices)
-        frame.light_lists.prepare(grid, capacity, camera.near, camera.far)
+                                                  frame.height, tile, slices)
+
+        coarse = 1 if self.clustered else capacity(coarse_grid(grid).tile)
+        frame.light_lists.prepare(grid, capacity(grid.tile, slices), camera.near, camera.far,
+                                  coarse)
         defines = {"CULL_GROUP_SIZE": str(CULL_GROUP_SIZE)}
         if self.from_near:
             defines["CULL_FROM_NEAR"] = "1"

@@ -38,6 +38,7 @@ uniform int u_candidate_base;     // where the coarse lists begin
 uniform int u_candidate_count;    // coarse lists
 uniform int u_candidate_columns;  // coarse tiles across
 uniform int u_candidate_ratio;    // tiles per coarse tile side
+uniform int u_candidate_capacity; // slots per coarse list
 #endif
 
 // LIST_QUADRANTS (the second dispatch): a tile's lists are those of its four 8x8 quadrants
@@ -274,8 +275,10 @@ void main() {
 #ifdef CULL_CANDIDATES
         int coarse = (tile.y / u_candidate_ratio) * u_candidate_columns +
                      tile.x / u_candidate_ratio;
-        int candidates = min(int(light_list_data[u_candidate_base + coarse]), u_list_capacity);
-        int candidate_slots = u_candidate_base + u_candidate_count + coarse * u_list_capacity;
+        int candidates = min(int(light_list_data[u_candidate_base + coarse]),
+                             u_candidate_capacity);
+        int candidate_slots = u_candidate_base + u_candidate_count +
+                              coarse * u_candidate_capacity;
         for (int i = 0; i < candidates; ++i) {
             int index = int(light_list_data[candidate_slots + i]);
 #else

@@ -560,25 +560,28 @@ def test_the_lists_capacity_bounds_every_list_and_is_the_side_planes_count(gl, p
     with Renderer(scene, pipeline, size, gl=gl, light_path=path) as renderer:
         renderer.render()
         lists = renderer.light_lists
-        grid, capacity = lists.grid, lists.capacity
+        grid, capacity, coarse_capacity = lists.grid, lists.capacity, lists.coarse_capacity
         raw = np.frombuffer(lists.buffer.read(), dtype=np.uint32)
         spheres = renderer.light_buffer.volume_spheres.astype(np.float64)
         inverse = renderer.last_frame.inverse_projection
         local = renderer.light_buffer.local_count
         camera = renderer.scene.camera
-    tile = grid.tile if path == "clustered" else coarse_grid(grid).tile
     slices = (camera.near, camera.far, grid.slices) if path == "clustered" else None
-    reference = side_plane_counts(spheres, inverse, *size, tile, slices)
-    assert capacity == list_capacity(spheres, inverse, *size, tile, slices)
+    reference = side_plane_counts(spheres, inverse, *size, grid.tile, slices)
+    assert capacity == list_capacity(spheres, inverse, *size, grid.tile, slices)
     # the count of the planes, padded a little for the GPU's float32 planes
     assert reference.max() <= capacity <= reference.max() + 2
     assert capacity < 0.5 * local  # far fewer slots than lights: the memory it saves
     assert raw[:grid.count].max() <= capacity  # no list overflowed
-    if path == "tiled":  # and the coarse lists, after the lists
+    assert raw[:grid.count].max() > 0.5 * capacity  # the bound is near
+    if path == "tiled":  # and the coarse lists, after the lists, with their own capacity
         coarse = coarse_grid(grid)
+        coarse_reference = side_plane_counts(spheres, inverse, *size, coarse.tile)
+        assert coarse_reference.max() <= coarse_capacity <= coarse_reference.max() + 2
+        assert coarse_capacity > capacity  # a coarse tile's planes hold more
         base = lists.coarse_base
-        assert raw[base:base + coarse.count].max() <= capacity
-        assert raw[base:base + coarse.count].max() > 0.8 * capacity  # the bound is near
+        assert raw[base:base + coarse.count].max() <= coarse_capacity
+        assert raw[base:base + coarse.count].max() > 0.8 * coarse_capacity
 
 
 def test_more_lights_than_a_listed_lights_index_holds_is_refused(monkeypatch):
