@@ -233,8 +233,10 @@ class Frame:
         self._framebuffers: dict[tuple, tuple[moderngl.Framebuffer, tuple]] = {}
 
     # -- passes --------------------------------------------------------------------------------
-    def run_pass(self, render_pass: RenderPass) -> None:
-        """Clear the targets ``render_pass`` creates, run it, and name it in any failure."""
+    def run_pass(self, render_pass: RenderPass, check_errors: bool = True) -> None:
+        """Clear the targets ``render_pass`` creates, run it, and name it in any failure (a GL
+        error too, unless ``check_errors`` is off: :meth:`check_errors` then does it for a run
+        of passes)."""
         self.current_pass = render_pass
         draws_before = self.stats.draw_calls
         try:
@@ -249,13 +251,29 @@ class Frame:
             raise type(exc)(f"pass {render_pass.name}: {exc}") from exc
         except Exception as exc:  # noqa: BLE001 - whatever a plugin's pass raises, say which
             raise RenderError(f"pass {render_pass.name}: {type(exc).__name__}: {exc}") from exc
-        error = self.ctx.error
-        if error != "GL_NO_ERROR":
-            raise gl_error(f"pass {render_pass.name}", error, (self.width, self.height))
+        if check_errors:
+            error = self.ctx.error
+            if error != "GL_NO_ERROR":
+                raise gl_error(f"pass {render_pass.name}", error, (self.width, self.height))
         draws = self.stats.draw_calls - draws_before
         if draws:
             by_pass = self.stats.draws_by_pass
             by_pass[render_pass.name] = by_pass.get(render_pass.name, 0) + draws
+
+    def check_errors(self, passes: list[RenderPass]) -> None:
+        """Raise the GL error, if any, that ``passes`` (run in order without checks) left,
+        naming the pass: with more than one, they run again one by one, each checked, and the
+        first to raise it is named (or all of them, where none does again). Reading the error
+        flag after every pass cost 3 us of a 20 us draw (a scene of 400 objects)."""
+        error = self.ctx.error
+        if error == "GL_NO_ERROR":
+            return
+        if len(passes) > 1:
+            for render_pass in passes:
+                self.run_pass(render_pass)
+        names = passes[0].name if len(passes) == 1 else \
+            f"{passes[0].name} .. {passes[-1].name} ({len(passes)} passes)"
+        raise gl_error(f"pass {names}", error, (self.width, self.height))
 
     # -- uniforms ------------------------------------------------------------------------------
     def camera_uniforms(self) -> dict[str, Any]:
@@ -448,7 +466,8 @@ class Frame:
         fbo, full = known
         if self.ctx.fbo is not fbo:  # binding a framebuffer ends llvmpipe's scene: GL work
             self.gl_call(fbo.use)
-        fbo.depth_mask = depth_write
+        if fbo.depth_mask != depth_write:  # the framebuffer keeps it: no GL call a draw
+            fbo.depth_mask = depth_write
         if fbo.viewport != full:
             fbo.viewport = full
         return fbo

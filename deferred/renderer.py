@@ -214,10 +214,23 @@ class Renderer:
                                   f"{type(exc).__name__}: {exc}") from exc
             self._check_gl(f"pass {render_pass.name}: preparing")
         self.gl.park()  # whatever framebuffer was bound may have been released since
-        for render_pass in self.passes:
+        # The GL error flag is read once a run of passes of one kind and phase (the objects'
+        # G-buffer passes, say), not once a pass: Frame.check_errors names the pass. Hooks
+        # look at each pass, so with them each is checked.
+        unchecked: list[RenderPass] = []
+        passes = self.passes
+        for index, render_pass in enumerate(passes):
             if before_pass:
                 before_pass(render_pass, frame)
-            frame.run_pass(render_pass)
+            hooked = before_pass is not None or on_pass is not None
+            frame.run_pass(render_pass, check_errors=hooked)
+            if not hooked:
+                unchecked.append(render_pass)
+                following = passes[index + 1] if index + 1 < len(passes) else None
+                if following is None or type(following) is not type(render_pass) or \
+                        following.phase != render_pass.phase:
+                    frame.check_errors(unchecked)
+                    unchecked = []
             if on_pass:
                 on_pass(render_pass, frame)
         frame.current_pass = None

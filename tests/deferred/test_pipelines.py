@@ -232,6 +232,40 @@ def test_a_gl_error_while_preparing_a_pass_names_the_pass_not_outside_code(gl, m
     assert "at 800x600" in message and "render smaller" in message
 
 
+@pytest.mark.parametrize("culprit", [0, 2, 3, "once"])
+def test_a_gl_error_in_one_of_a_run_of_object_passes_names_that_pass(gl, monkeypatch, culprit):
+    # the error flag is read once a run of passes of one kind (Frame.check_errors): the
+    # passes of the run are then run again one by one to name the one that raises it
+    from deferred.errors import RenderError
+    from deferred.scene import scene_from_dict
+
+    scene = scene_from_dict({"size": [32, 24], "light": [{"type": "directional"}],
+                             "object": [{"name": f"ball{i}", "mesh": "builtin:sphere",
+                                         "position": [i - 1.5, 0.0, 0.0], "scale": 0.3}
+                                        for i in range(4)]})
+    with Renderer(scene, gl=gl) as renderer:
+        gbuffer = [p for p in renderer.passes if p.name.endswith(".gbuffer")]
+        assert len(gbuffer) == 4
+        target = gbuffer[1 if culprit == "once" else culprit]
+        execute = type(target).execute
+        raised = []
+
+        def failing(self, frame):
+            execute(self, frame)
+            if self is target and not (culprit == "once" and raised):
+                raised.append(self)
+                _raise_gl_error()
+
+        monkeypatch.setattr(type(target), "execute", failing)
+        # an error that does not come again is put on the whole run
+        name = r"ball0.gbuffer .. ball3.gbuffer \(4 passes\)" if culprit == "once" else \
+            f"ball{culprit}.gbuffer"
+        with pytest.raises(RenderError, match=rf"^pass {name}: GL_INVALID_ENUM$"):
+            renderer.render()
+        monkeypatch.undo()
+        assert renderer.render().image.shape == (24, 32, 4)  # the renderer still works
+
+
 @pytest.mark.parametrize("pipeline", ["deferred", "forward"])
 def test_an_object_moved_between_frames_is_drawn_where_it_is_now(gl, pipeline):
     """The objects' transform uniforms are kept across frames while nothing they come from
