@@ -22,11 +22,12 @@ Forward:
   blended surfaces in front of the opaque ones are covered), and the lit passes loop their
   quadrant's list (``common/forward_lighting.glsl``).
 
-The culling shaders write the lists for the shading in an RGBA32F texture of two texels a
-slot, the light's sphere and colour (and its index, :meth:`LightLists.entries`); the list
-loops read one texel a listed light, plus one for each light reaching the pixel
-(``lights/light_lists.glsl``). A storage buffer holds each list's count, then (tiled) the
-coarse tiles' lists of light indices, a count and ``coarse_capacity`` slots each. A list's
+The culling shaders write the lists for the shading in an RGBA32UI texture of a texel a slot,
+the light's sphere (its radius a half float) and index (:meth:`LightLists.entries`); the list
+loops read one texel a listed light, plus the colour of each light reaching the pixel from
+the light buffer (``lights/light_lists.glsl``). A storage buffer holds each list's count,
+then (tiled) the coarse tiles' lists of light indices, a count and ``coarse_capacity`` slots
+each. A list's
 capacity is the most volume lights the side planes of any of its tiles can hold (the 8x8 list
 tiles, the coarse tiles; clustered: any tile and depth slice), counted on the CPU
 (:func:`list_capacity`), so no list overflows.
@@ -74,11 +75,11 @@ COARSE_RATIO = 4
 MAX_LIST_BYTES = 512 * 1024 * 1024
 LIST_ROW_SHIFT = 14  # texels per row of the shading's lists texture, a power of two
 LIST_TEXTURE_WIDTH = 1 << LIST_ROW_SHIFT  # 16384: every GL 4.3 context (compute) allows it
-SLOT_TEXELS = 2  # RGBA32F texels a slot of the shading's lists: the sphere, the colour
+SLOT_TEXELS = 1  # RGBA32UI texels a slot of the shading's lists: the sphere and the index
 LIST_ROW_BYTES = 16 * LIST_TEXTURE_WIDTH
 LIST_IMAGE_UNIT = 2  # the culling writes the shading's lists texture through this image unit
-# A listed light's colour texel holds type id + 256 x index (in the light buffer, full-screen
-# lights first) in w, exact in a float below 2^24.
+# A listed light's texel holds its index (in the light buffer, full-screen lights first) in 16
+# bits, beside its radius as a half float.
 MAX_LISTED_LIGHTS = 1 << 16
 
 
@@ -193,6 +194,17 @@ def check_light_limits(light_path: str, size: tuple[int, int], volume_lights: in
                          f"{max_texture_size} rows (GL_MAX_TEXTURE_SIZE)", "light")
 
 
+MAX_LISTED_RADIUS = 65504.0  # the largest half float: a listed light's radius is one
+
+
+def check_list_radii(spheres: np.ndarray) -> None:
+    """Refuse a volume light whose radius the lists cannot hold (a half float, rounded up)."""
+    if len(spheres) and float(spheres[:, 3].max()) > MAX_LISTED_RADIUS:
+        raise InputError(f"a light's radius of {float(spheres[:, 3].max()):g} is more than the "
+                         f"light lists hold ({MAX_LISTED_RADIUS:g}, a half float): use the "
+                         "volumes path", "light")
+
+
 def list_grid(width: int, height: int, clustered: bool) -> ListGrid:
     tile = CLUSTER_TILE if clustered else TILE // LIST_SPLIT
     return ListGrid(math.ceil(width / tile), math.ceil(height / tile),
@@ -251,7 +263,7 @@ class LightLists:
             self.buffer = self.ctx.buffer(reserve=size)
         if self.texture is None or self.texture.height < rows:
             self._release_texture()
-            self.texture = self.ctx.texture((LIST_TEXTURE_WIDTH, rows), 4, dtype="f4")
+            self.texture = self.ctx.texture((LIST_TEXTURE_WIDTH, rows), 4, dtype="u4")
             self.texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
         self.buffer.bind_to_storage_buffer(1)
 
@@ -263,6 +275,7 @@ class LightLists:
         key = (np.asarray(inverse_projection).tobytes(), width, height)
         counted = self._capacities.get((tile, slices))
         if counted is None or counted[0] is not spheres or counted[1] != key:
+            check_list_radii(spheres)
             counted = (spheres, key, list_capacity(spheres, inverse_projection, width, height,
                                                    tile, slices))
             self._capacities[(tile, slices)] = counted
@@ -301,10 +314,10 @@ class LightLists:
         uniforms.set_shared("light_lists", self.uniforms())
 
     def bind_image(self, uniforms: ProgramUniforms) -> None:
-        """Bind the shading's lists texture as the image a culling shader writes."""
+        """Bind the shading's lists texture as the image a culling shader writes (at the unit
+        its declaration names: ``LIST_IMAGE_UNIT``)."""
         if "u_light_list_image" in uniforms.members:
             self.texture.bind_to_image(LIST_IMAGE_UNIT, read=False, write=True)
-            uniforms.set_one("u_light_list_image", LIST_IMAGE_UNIT)
 
     def counts(self) -> np.ndarray:
         """The list lengths of the last frame (host copy; tests and statistics)."""
@@ -339,20 +352,22 @@ class LightLists:
         """Each list's light indices (into the light buffer), in list order, as the shading's
         copy holds them (tests and statistics)."""
         assert self.grid is not None
-        slots = self.shading_slots()
+        indices = self.shading_slots()[1].astype(np.int64)
         counts = self.counts()
-        codes = slots[:, 1, 3].astype(np.int64)  # type id + 256 x index
         first = self.grid.count  # the counts' slots, then capacity slots a list
-        return [codes[first + i * self.capacity:][:counts[i]] >> 8
-                for i in range(self.grid.count)]
+        return [indices[first + i * self.capacity:][:counts[i]] for i in range(self.grid.count)]
 
-    def shading_slots(self) -> np.ndarray:
-        """The shading's copy of the lists as read back: (slots, 2, 4) float32, a sphere and a
-        colour texel per slot (tests)."""
+    def shading_slots(self) -> tuple[np.ndarray, np.ndarray]:
+        """The shading's copy of the lists as read back, decoded: each slot's sphere (slots, 4)
+        float32 (a count slot holds its count's bits in x) and light index (slots,) uint32
+        (tests)."""
         assert self.texture is not None and self.grid is not None
         slots = self.grid.count * (1 + self.capacity)
-        texels = np.frombuffer(self.texture.read(), dtype=np.float32).reshape(-1, 4)
-        return texels[:SLOT_TEXELS * slots].reshape(slots, SLOT_TEXELS, 4)
+        texels = np.frombuffer(self.texture.read(), dtype=np.uint32).reshape(-1, 4)[:slots]
+        spheres = np.empty((slots, 4), np.float32)
+        spheres[:, :3] = texels[:, :3].view(np.float32)
+        spheres[:, 3] = (texels[:, 3] & 0xFFFF).astype(np.uint16).view(np.float16)
+        return spheres, texels[:, 3] >> 16
 
     def _release_buffer(self) -> None:
         if self.buffer is not None:
@@ -469,7 +484,7 @@ class LightCullPass(RenderPass):
         coarse = 1 if self.clustered else capacity(coarse_grid(grid).tile)
         frame.light_lists.prepare(grid, capacity(grid.tile, slices), camera.near, camera.far,
                                   coarse)
-        defines = {"CULL_GROUP_SIZE": str(CULL_GROUP_SIZE)}
+        defines = {"CULL_GROUP_SIZE": str(CULL_GROUP_SIZE), "LIST_IMAGE_UNIT": str(LIST_IMAGE_UNIT)}
         if self.from_near:
             defines["CULL_FROM_NEAR"] = "1"
         if self.clustered:

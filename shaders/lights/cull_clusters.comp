@@ -35,14 +35,12 @@ void main() {
         if (far_depth < u_near_far.x || near_depth > u_near_far.y) continue;
         if (!sphere_touches_planes(planes, sphere)) continue;
         int last_slice = light_list_slice(far_depth);
-        vec4 color = listed_light_color(index);  // once, for all its slices
         for (int slice = light_list_slice(max(near_depth, u_near_far.x)); slice <= last_slice;
              ++slice) {
             int list = tile_index + slice * tiles;
             uint count = counts[slice];
             if (int(count) < u_list_capacity)
-                light_list_write(light_list_first_slot(list) + int(count), index, sphere,
-                                 color);
+                light_list_write(light_list_first_slot(list) + int(count), index, sphere);
             counts[slice] = count + 1u;
         }
     }

@@ -224,8 +224,8 @@ void add_quadrant(inout Quadrants q, inout ivec4 lists, inout TileBounds whole, 
 }
 #endif
 
-void append(int first_slot, inout int count, int index, vec4 sphere, vec4 color) {
-    if (count < u_list_capacity) light_list_write(first_slot + count, index, sphere, color);
+void append(int first_slot, inout int count, int index, vec4 sphere) {
+    if (count < u_list_capacity) light_list_write(first_slot + count, index, sphere);
     ++count;
 }
 
@@ -291,7 +291,6 @@ void main() {
 #ifdef LIST_QUADRANTS
             bvec4 touched = quadrants_touched(q, sphere);
             if (!any(touched)) continue;
-            vec4 color = listed_light_color(index);
             ivec4 at = slots + counts;  // each quadrant's next slot
             ivec4 held = counts;
             counts += ivec4(touched);
@@ -304,10 +303,10 @@ void main() {
             while (quadrants != 0u) {
                 int lane = findLSB(quadrants);
                 quadrants &= quadrants - 1u;
-                if (held[lane] < u_list_capacity) light_list_write(at[lane], index, sphere, color);
+                if (held[lane] < u_list_capacity) light_list_write(at[lane], index, sphere);
             }
 #else
-            append(slot, count, index, sphere, listed_light_color(index));
+            append(slot, count, index, sphere);
 #endif
         }
     }

@@ -1,41 +1,34 @@
 // The culling shaders' writes of a list (lights/light_lists.glsl has the layout). The lists the
-// shading reads (all but CULL_COARSE's) go to the shading's texture, bound as an image: each
-// light's sphere and colour, and the list's count (also in the storage buffer, for statistics).
-// The coarse lists, which only the tiled culling's second dispatch reads, are light indices in
-// the storage buffer. The fine lists' indices are not written there too: the quadrant lists
-// (lights/cull_tiles.comp) made 2.6x as many entries, and each write is a masked scatter over a
-// SIMD block on llvmpipe (the culling at 1024 lights, 640x360: 9.0 -> 7.4 ms without them).
+// shading reads (all but CULL_COARSE's) go to the shading's texture, bound as an image: one
+// texel a listed light (its sphere and index, light_list_slot), and the list's count (also in
+// the storage buffer, for statistics). The coarse lists, which only the tiled culling's second
+// dispatch reads, are light indices in the storage buffer. The fine lists' indices are not
+// written there too: the quadrant lists (lights/cull_tiles.comp) made 2.6x as many entries, and
+// each write is a masked scatter over a SIMD block on llvmpipe (the culling at 1024 lights,
+// 640x360: 9.0 -> 7.4 ms without them; one texel a slot instead of two, the sphere and the
+// colour: 22.6 -> 15.1 ms at 1280x720).
 #ifndef CULL_COARSE
-layout(rgba32f) uniform writeonly image2D u_light_list_image;  // at light_list_texel(slot)
+// bound to its unit in the layout: moderngl 5.13 writes no value to an unsigned image uniform
+layout(rgba32ui, binding = LIST_IMAGE_UNIT) uniform writeonly uimage2D u_light_list_image;
 #endif
 
-// The light `index` into `slot`: the coarse lists' index, or the shading copy's sphere (as the
-// culling read it) and colour texel (listed_light_color).
-void light_list_write(int slot, int index, vec4 sphere, vec4 listed_color) {
+// The light `index` into `slot`: the coarse lists' index, or the shading copy's texel of its
+// sphere (as the culling read it) and index.
+void light_list_write(int slot, int index, vec4 sphere) {
 #ifdef CULL_COARSE
     light_list_data[slot] = uint(index);
 #else
-    ivec2 texel = light_list_texel(slot);
-    imageStore(u_light_list_image, texel, sphere);
-    imageStore(u_light_list_image, texel + ivec2(1, 0), listed_color);
-#endif
-}
-
-// A light's colour texel in the shading's copy: rgb, w = type id + 256 x index (exact in a
-// float below 2^24). Fetched once a light, however many lists it joins.
-vec4 listed_light_color(int index) {
-#ifdef CULL_COARSE
-    return vec4(0.0);  // the coarse lists have no shading copy
-#else
-    vec4 color = fetch_light(index).color;
-    return vec4(color.rgb, color.w + 256.0 * float(index));
+    // the radius as a half float rounded up, so the shading's sphere test stays conservative
+    uint radius = packHalf2x16(vec2(sphere.w, 0.0));
+    if (unpackHalf2x16(radius).x < sphere.w) radius += 1u;  // the next half float
+    imageStore(u_light_list_image, light_list_texel(slot),
+               uvec4(floatBitsToUint(sphere.xyz), (uint(index) << 16) | radius));
 #endif
 }
 
 void light_list_write_count(int list, int count) {
     light_list_data[u_list_base + list] = uint(count);
 #ifndef CULL_COARSE
-    imageStore(u_light_list_image, light_list_texel(u_list_base + list),
-               vec4(float(count), 0.0, 0.0, 0.0));
+    imageStore(u_light_list_image, light_list_texel(u_list_base + list), uvec4(count, 0u, 0u, 0u));
 #endif
 }

@@ -1,20 +1,21 @@
 // Per-tile or per-cluster light lists (deferred.light_lists): the tiled and clustered light
 // paths and Forward+. A list holds the volume lights that can touch its tile or cluster (the
-// full-screen ones, [0, u_global_light_count), apply to every pixel). The culling shaders write
-// each list twice:
-// - in a storage buffer of light indices: a count per list, then capacity slots per list
-//   (the coarse tiles' lists, which the tiled culling's second dispatch reads, live there only);
-// - for the shading, in u_light_list_texture, an RGBA32F texture of two texels a slot, 2^
-//   u_list_row_shift texels a row (lights/light_list_writer.glsl): the light's sphere
-//   (position.xyz, radius) and its colour (rgb; w = type id + 256 x its index in the light
-//   buffer, exact in a float). The first texel of a list's count slot holds its count in x.
-//   The shading loop reads one texel a listed light, and one more for each that reaches the
-//   pixel, where a list of indices cost the index, the sphere and the colour (lights.toml at
-//   1024 lights, 640x360: the tiled shading 62-67 -> 51-58 ms, benchmarks/README.md).
+// full-screen ones, [0, u_global_light_count), apply to every pixel). The culling shaders
+// (lights/light_list_writer.glsl) write:
+// - in a storage buffer: a count per list, then (tiled) the coarse tiles' lists of light
+//   indices, which the tiled culling's second dispatch reads;
+// - for the shading, in u_light_list_texture, an RGBA32UI texture of one texel a slot, 2^
+//   u_list_row_shift texels a row: each list's count (in the x of its count slot), and each
+//   listed light's sphere, its position's three floats and, in w, its index in the light
+//   buffer (high 16 bits) and its radius as a half float rounded up (low 16 bits).
+//   The shading loop reads one texel a listed light, and the light's colour (and, for the
+//   types that read them, the rest of its record) from the light buffer for each that reaches
+//   the pixel, where a list of indices cost the index, the sphere and the colour (lights.toml
+//   at 1024 lights, 640x360: the tiled shading 62-67 -> 51-58 ms, benchmarks/README.md).
 layout(std430, binding = 1) buffer LightLists {
     uint light_list_data[];
 };
-uniform sampler2D u_light_list_texture;
+uniform usampler2D u_light_list_texture;
 uniform int u_list_row_shift;   // log2 of the texture's texels per row
 
 uniform int u_list_base;        // culling: the word where its lists begin (the shading's: 0)
@@ -39,11 +40,9 @@ int light_list_of(ivec2 pixel, float depth) {
 #endif
 }
 
-// The shading texture's first texel of a slot (the second is the next one: SLOT_TEXELS in
-// deferred.light_lists).
+// The shading texture's texel of a slot (SLOT_TEXELS in deferred.light_lists).
 ivec2 light_list_texel(int slot) {
-    int texel = 2 * slot;
-    return ivec2(texel & ((1 << u_list_row_shift) - 1), texel >> u_list_row_shift);
+    return ivec2(slot & ((1 << u_list_row_shift) - 1), slot >> u_list_row_shift);
 }
 
 int light_list_length(int list) {
@@ -57,18 +56,23 @@ int light_list_first_slot(int list) {
     return u_list_base + u_list_count + list * u_list_capacity;
 }
 
-// A listed light's bounding sphere: view-space centre, radius (deferred.light: volume "sphere").
-vec4 listed_light_sphere(int slot) {
-    return texelFetch(u_light_list_texture, light_list_texel(slot), 0);
+// A listed light's slot: its bounding sphere (view-space centre, radius: deferred.light volume
+// "sphere") and its index in the light buffer.
+struct ListedLight {
+    vec4 sphere;
+    int index;
+};
+
+ListedLight listed_light(int slot) {
+    uvec4 texel = texelFetch(u_light_list_texture, light_list_texel(slot), 0);
+    return ListedLight(vec4(uintBitsToFloat(texel.xyz), unpackHalf2x16(texel.w).x),
+                       int(texel.w >> 16));
 }
 
-// Its whole record: the colour and type from the list, the sphere (its position texel) as read,
-// the direction and extra texels from the light buffer (types that use them: a shader of
-// point lights only never reads them).
-LightRecord listed_light_record(int slot, vec4 sphere) {
-    vec4 color = texelFetch(u_light_list_texture, light_list_texel(slot) + ivec2(1, 0), 0);
-    int code = int(color.w);
-    LightRecord record = fetch_light(code >> 8);  // only what the light's type reads is read
-    return LightRecord(vec4(color.rgb, float(code & 255)), sphere, record.direction,
-                       record.extra);
+// Its whole record: the light buffer's (only what the light's type reads is read), with the
+// sphere as listed (the radius a half float, rounded up).
+LightRecord listed_light_record(ListedLight listed) {
+    LightRecord record = fetch_light(listed.index);
+    record.position = listed.sphere;
+    return record;
 }

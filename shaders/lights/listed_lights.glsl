@@ -23,10 +23,10 @@ vec3 evaluate_listed_lights(int list, Surface s, vec3 P, vec3 V) {
     int first = light_list_first_slot(list);
     for (int k = 0; k < length; ++k) {
         // the sphere test is far cheaper than the light; most entries miss the point
-        vec4 sphere = listed_light_sphere(first + k);
-        vec3 to_light = sphere.xyz - P;
-        if (dot(to_light, to_light) <= sphere.w * sphere.w)
-            total += evaluate_volume_light(listed_light_record(first + k, sphere), s, P, V);
+        ListedLight listed = listed_light(first + k);
+        vec3 to_light = listed.sphere.xyz - P;
+        if (dot(to_light, to_light) <= listed.sphere.w * listed.sphere.w)
+            total += evaluate_volume_light(listed_light_record(listed), s, P, V);
     }
     return total;
 }

@@ -494,23 +494,40 @@ def test_more_full_screen_lights_than_a_frame_holds_is_refused_before_a_frame(gl
 
 
 @pytest.mark.parametrize("path", ["tiled", "clustered"])
-def test_the_shading_copy_of_the_lists_holds_each_listed_lights_sphere_colour_and_index(
-        gl, path):
-    # Every light type: the colour texel's w carries the type id and the index, which the
-    # shading needs for a spot light's direction and cone
+def test_the_shading_copy_of_the_lists_holds_each_listed_lights_sphere_and_index(gl, path):
+    # Every light type: the shading reads a reached light's colour, type and (spot) cone from
+    # the light buffer at the listed index
     frame = listed_frame(gl, path, 60)
-    grid, capacity, slots, records = frame.grid, frame.capacity, frame.slots, frame.records
-    np.testing.assert_array_equal(slots[:grid.count, 0, 0], frame.counts)
+    grid, capacity, records = frame.grid, frame.capacity, frame.records
+    spheres, indices = frame.slots
+    np.testing.assert_array_equal(spheres[:grid.count, 0].view(np.uint32), frame.counts)
     types = set()
     for list_index, listed in enumerate(frame.entries):
         first = grid.count + list_index * capacity
-        held = slots[first:first + len(listed)]
         index = listed.astype(np.int64)
-        np.testing.assert_array_equal(held[:, 0], records[index, 1])  # the sphere
-        np.testing.assert_array_equal(held[:, 1, :3], records[index, 0, :3])  # the colour
-        np.testing.assert_array_equal(held[:, 1, 3], records[index, 0, 3] + 256.0 * index)
+        np.testing.assert_array_equal(indices[first:first + len(listed)], index)
+        held = spheres[first:first + len(listed)]
+        np.testing.assert_array_equal(held[:, :3], records[index, 1, :3])  # the centre
+        radius = records[index, 1, 3]  # a half float, rounded up: the test stays conservative
+        assert np.all(held[:, 3] >= radius) and np.all(held[:, 3] <= radius * (1 + 2.0 ** -10))
         types |= set(records[index, 0, 3].tolist())
     assert types == {3.0, 4.0}  # point and spot lights were listed
+
+
+def test_a_radius_past_a_half_float_is_refused_on_the_list_paths(gl):
+    from deferred.scene import scene_from_dict
+
+    if not gl.features.compute_shaders:
+        pytest.skip("the driver has no compute shaders")
+    huge = scene_from_dict({"size": [32, 24], "object": [{"mesh": "builtin:plane"}],
+                            "light": [{"type": "point", "position": [0.0, 1.0, 0.0],
+                                       "radius": 70000.0}]})
+    with Renderer(huge, gl=gl, light_path="tiled") as renderer:
+        with pytest.raises(InputError, match=r"^light: a light's radius of 70000 is more than "
+                                             r"the light lists hold \(65504, a half float\)"):
+            renderer.render()
+    with Renderer(huge, gl=gl, light_path="volumes") as renderer:
+        assert renderer.render().hdr[..., :3].max() > 0.0
 
 
 def side_plane_counts(spheres, inverse, width, height, tile, slices=None):
