@@ -46,9 +46,9 @@ uniform int u_candidate_capacity; // slots per coarse list
 // light is tested against the whole tile first, and only where it touches it against the
 // quadrants, all four at once in the lanes of a vec4. lights.toml at 1024 lights, 640x360: the
 // shading loops 21.6 entries a pixel instead of 31.5 (the tiled shading 53-55 -> 40-45 ms), for
-// 3.5 -> 7.4 ms of culling, most of it the 2.6x as many writes (benchmarks/README.md).
+// 3.5 -> 4.2-5.5 ms of culling, most of it the 2.6x as many writes (benchmarks/README.md).
 // Indexing the quadrants' data with a variable (an array of structs, a loop over the lanes)
-// cost twice that on llvmpipe.
+// cost the culling 3x on llvmpipe.
 
 // A tile's (or quadrant's) depth bounds and the view-space box of its points.
 struct TileBounds {

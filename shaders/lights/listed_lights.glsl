@@ -2,17 +2,18 @@
 // shading and Forward+ (deferred.light_lists).
 //
 // A list holds the lights that touch its tile or cluster; most miss any one point of it
-// (lights.toml at 1024 lights: 31.5 entries a pixel, 13.2 reaching it, 14.5 reaching some pixel
-// of its 4x2 block, the width of a 256-bit SIMD vector). Where a fragment shader runs as SIMD
-// lanes (llvmpipe) a light's arithmetic runs for the whole block where any lane is reached, and
-// is skipped where none is. Each entry is its light's sphere, then its colour: one texel a
-// listed light, one more for each that reaches (lights/light_lists.glsl). Cut-outs of this
-// loop at 1024 lights, 640x360, frames interleaved in one process (benchmarks/shader_ab.py;
-// the pass 56-60 ms with index lists): the evaluations beyond their record fetches 18-20 ms,
-// another texel fetch an entry 4-11 ms; the G-buffer read and the full-screen lights 11-13 ms.
-// Tried and slower on llvmpipe (benchmarks/README.md): a bit mask of reached entries with a
-// loop over its set bits; four indices a fetch; the sphere in the list but the colour through
-// the index.
+// (lights.toml at 1024 lights, 640x360: 21.6 entries a pixel in the 8x8 tiled lists, 31.5 in
+// 16x16 ones, 13.2 reaching the pixel, 14.5 some pixel of its 4x2 block, the width of a
+// 256-bit SIMD vector). Where a fragment shader runs as SIMD lanes (llvmpipe) a light's
+// arithmetic runs for the whole block where any lane is reached, and is skipped where none
+// is. Each entry is one texel, its light's sphere and index; a light that reaches the pixel
+// reads its colour (and what else its type needs) from the light buffer
+// (lights/light_lists.glsl). Cut-outs of this loop at 256 lights, 640x360
+// (benchmarks/shader_ab.py, the pass 22 ms): the loop's sphere fetches and tests 3.2 ms, the
+// evaluations 7.5 ms, of which Blinn-Phong's pow 3.4; at 1024 lights pow is 8.7 of 39 ms.
+// Tried and slower or no faster on llvmpipe (benchmarks/README.md): a bit mask of reached
+// entries with a loop over its set bits; four indices a fetch; the loop unrolled by two; an
+// `if` around pow for negligible highlights (the compiler makes it a select).
 #include "common/light_buffer.glsl"
 #include "generated/lights.glsl"
 #include "lights/light_lists.glsl"
