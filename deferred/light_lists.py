@@ -27,10 +27,9 @@ the light's sphere (its radius a half float) and index (:meth:`LightLists.entrie
 loops read one texel a listed light, plus the colour of each light reaching the pixel from
 the light buffer (``lights/light_lists.glsl``). A storage buffer holds each list's count,
 then (tiled) the coarse tiles' lists of light indices, a count and ``coarse_capacity`` slots
-each. A list's
-capacity is the most volume lights the side planes of any of its tiles can hold (the 8x8 list
-tiles, the coarse tiles; clustered: any tile and depth slice), counted on the CPU
-(:func:`list_capacity`), so no list overflows.
+each. A list's capacity is the most volume lights the side planes of any of its tiles can hold
+(the 8x8 list tiles, the coarse tiles; clustered: any tile and depth slice), counted on the
+CPU (:func:`list_capacity`), so no list overflows.
 """
 
 from __future__ import annotations
