@@ -231,6 +231,9 @@ class Frame:
         # what this frame set last: a pass stating the same is not set again (set_state)
         self._state: tuple | None = None
         self._framebuffers: dict[tuple, tuple[moderngl.Framebuffer, tuple]] = {}
+        # whether GL's depth mask is the bound framebuffer's: a clear through another
+        # framebuffer (moderngl's clear) sets GL's and binds this one back without it
+        self._depth_mask_known = False
 
     # -- passes --------------------------------------------------------------------------------
     def run_pass(self, render_pass: RenderPass, check_errors: bool = True) -> None:
@@ -242,6 +245,7 @@ class Frame:
         try:
             for name in render_pass.creates:
                 self.gl_call(lambda name=name: self.targets.clear(name))
+                self._depth_mask_known = False
             render_pass.execute(self)
         except InputError:
             raise
@@ -268,6 +272,9 @@ class Frame:
         error = self.ctx.error
         if error == "GL_NO_ERROR":
             return
+        for _ in range(8):  # a driver may keep more than one flag: clear them all first
+            if self.ctx.error == "GL_NO_ERROR":
+                break
         if len(passes) > 1:
             for render_pass in passes:
                 self.run_pass(render_pass)
@@ -465,9 +472,12 @@ class Frame:
             known = self._framebuffers[key] = (fbo, (0, 0, *fbo.size))
         fbo, full = known
         if self.ctx.fbo is not fbo:  # binding a framebuffer ends llvmpipe's scene: GL work
-            self.gl_call(fbo.use)
-        if fbo.depth_mask != depth_write:  # the framebuffer keeps it: no GL call a draw
+            self.gl_call(fbo.use)  # which sets GL's depth mask to the framebuffer's
+            self._depth_mask_known = True
+        # the framebuffer keeps its mask: set only when it changes, not a GL call a draw
+        if fbo.depth_mask != depth_write or not self._depth_mask_known:
             fbo.depth_mask = depth_write
+            self._depth_mask_known = True
         if fbo.viewport != full:
             fbo.viewport = full
         return fbo

@@ -235,11 +235,12 @@ class LightLists:
         checked before the first frame; both are checked here, at this frame's capacities."""
         capacity = max(capacity, 1)
         coarse_capacity = max(coarse_capacity, 1)
-        overflow = list_overflow(grid, coarse_capacity) or \
-            texture_overflow(grid, capacity, self.max_texture_size)
+        coarse_overflow = list_overflow(grid, coarse_capacity)
+        overflow = coarse_overflow or texture_overflow(grid, capacity, self.max_texture_size)
         if overflow is not None:
             needed, limit = overflow
-            raise RenderError(f"a tile's frustum holds {capacity} lights: the light lists "
+            most = coarse_capacity if coarse_overflow else capacity
+            raise RenderError(f"a tile's frustum holds {most} lights: the light lists "
                               f"need {needed >> 20} MiB at this size ({grid.count} lists); the "
                               f"limit is {limit >> 20} MiB: use fewer lights or the volumes "
                               "path")
@@ -395,8 +396,9 @@ def list_capacity(spheres: np.ndarray, inverse_projection: np.ndarray, width: in
     """The most of ``spheres`` (view-space centre xyz, radius w; the frame's volume lights) that
     touch the four side planes of any tile of ``tile`` pixels: the lists' capacity. Every list
     holds only lights whose sphere touches its tile's side planes (the culling shaders test
-    them, ``lights/tile_frustum.glsl``), and a tiled list's lights are a subset of its coarse
-    tile's: counted over the coarse tiles there, no list overflows. With ``slices`` (near, far,
+    them: ``lights/tile_frustum.glsl``, and each 8x8 quadrant's edge planes in
+    ``lights/cull_tiles.comp``), so counted over the lists' own tiles no list overflows; the
+    coarse lists are counted over the coarse tiles. With ``slices`` (near, far,
     count: the clustered lists), the most in any tile and depth slice: a light goes to the
     slices its sphere's depth range covers (``lights/cull_clusters.comp``).
 
@@ -468,6 +470,9 @@ class LightCullPass(RenderPass):
         self.samples = self.reads
 
     def execute(self, frame: Frame) -> None:
+        if LIST_SPLIT not in (1, 2):  # the culling writes 16x16 lists or their quadrants
+            raise RenderError(f"LIST_SPLIT is {LIST_SPLIT}; the tiled culling splits a tile "
+                              "into 1 or 2 lists a side")
         lights = frame.light_buffer
         grid = list_grid(frame.width, frame.height, self.clustered)
         camera = frame.scene.camera

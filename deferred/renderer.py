@@ -223,7 +223,12 @@ class Renderer:
             if before_pass:
                 before_pass(render_pass, frame)
             hooked = before_pass is not None or on_pass is not None
-            frame.run_pass(render_pass, check_errors=hooked)
+            try:
+                frame.run_pass(render_pass, check_errors=hooked)
+            except Exception:
+                if unchecked:  # the raised error is the one to report: drop the earlier flag
+                    _ = self.gl.ctx.error  # reading it clears it
+                raise
             if not hooked:
                 unchecked.append(render_pass)
                 following = passes[index + 1] if index + 1 < len(passes) else None

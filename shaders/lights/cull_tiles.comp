@@ -271,6 +271,11 @@ void main() {
     int count = 0;
 #endif
     TileVolume volume = tile_volume(origin, end, whole);
+#if defined(LIST_QUADRANTS) && defined(CULL_FROM_NEAR)
+    // a quadrant of background reaches the far plane (blended surfaces may lie anywhere in
+    // front of it): so does the tile the quadrants are tested within
+    volume.depth.y = max(max(q.far_depth.x, q.far_depth.y), max(q.far_depth.z, q.far_depth.w));
+#endif
     if (!volume.empty) {
 #ifdef CULL_CANDIDATES
         int coarse = (tile.y / u_candidate_ratio) * u_candidate_columns +

@@ -1,6 +1,6 @@
 // The culling shaders' writes of a list (lights/light_lists.glsl has the layout). The lists the
 // shading reads (all but CULL_COARSE's) go to the shading's texture, bound as an image: one
-// texel a listed light (its sphere and index, light_list_slot), and the list's count (also in
+// texel a listed light (its sphere and index, at light_list_texel(slot)), and the list's count (also in
 // the storage buffer, for statistics). The coarse lists, which only the tiled culling's second
 // dispatch reads, are light indices in the storage buffer. The fine lists' indices are not
 // written there too: the quadrant lists (lights/cull_tiles.comp) made 2.6x as many entries, and

@@ -70,7 +70,9 @@ ListedLight listed_light(int slot) {
 }
 
 // Its whole record: the light buffer's (only what the light's type reads is read), with the
-// sphere as listed (the radius a half float, rounded up).
+// sphere as listed. Its radius is a half float rounded up, so a light's window reaches 0 up
+// to 2^-10 of the radius further out than on the volumes and naive paths (PSNR 61 dB at 1024
+// lights, 1280x720): the exact radius would cost a fetch more for every light that reaches.
 LightRecord listed_light_record(ListedLight listed) {
     LightRecord record = fetch_light(listed.index);
     record.position = listed.sphere;

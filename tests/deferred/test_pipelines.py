@@ -266,6 +266,38 @@ def test_a_gl_error_in_one_of_a_run_of_object_passes_names_that_pass(gl, monkeyp
         assert renderer.render().image.shape == (24, 32, 4)  # the renderer still works
 
 
+def test_a_pass_failing_after_an_unchecked_gl_error_leaves_no_error_to_the_next_frame(
+        gl, monkeypatch):
+    # the run's flag is not read before the failure: the failure is what is reported, and the
+    # next frame does not find a flag "left by code outside the renderer"
+    import warnings
+
+    from deferred.errors import RenderError
+    from deferred.scene import scene_from_dict
+
+    scene = scene_from_dict({"size": [32, 24], "light": [{"type": "directional"}],
+                             "object": [{"name": f"ball{i}", "mesh": "builtin:sphere",
+                                         "position": [i - 0.5, 0.0, 0.0], "scale": 0.3}
+                                        for i in range(2)]})
+    with Renderer(scene, gl=gl) as renderer:
+        first, second = [p for p in renderer.passes if p.name.endswith(".gbuffer")]
+        execute = type(first).execute
+
+        def failing(self, frame):
+            if self is second:
+                raise RuntimeError("broken")
+            execute(self, frame)
+            _raise_gl_error()
+
+        monkeypatch.setattr(type(first), "execute", failing)
+        with pytest.raises(RenderError, match=r"^pass ball1.gbuffer: RuntimeError: broken$"):
+            renderer.render()
+        monkeypatch.undo()
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            assert renderer.render().image.shape == (24, 32, 4)
+
+
 @pytest.mark.parametrize("pipeline", ["deferred", "forward"])
 def test_an_object_moved_between_frames_is_drawn_where_it_is_now(gl, pipeline):
     """The objects' transform uniforms are kept across frames while nothing they come from

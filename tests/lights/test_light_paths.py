@@ -302,7 +302,7 @@ def test_the_shading_lists_texture_is_sized_to_the_frame_and_refused_past_the_ro
         lists.prepare(grid, 100, 0.1, 100.0)
         slots = grid.count * 101
         assert lists.texture.width == LIST_TEXTURE_WIDTH
-        assert lists.texture.height == -(-SLOT_TEXELS * slots // LIST_TEXTURE_WIDTH)  # 400 rows
+        assert lists.texture.height == -(-SLOT_TEXELS * slots // LIST_TEXTURE_WIDTH)  # 200 rows
         lists.max_texture_size = 256
         with pytest.raises(RenderError, match=rf"^a tile's frustum holds 400 lights: the light "
                                               rf"lists need \d+ MiB .* \(32400 lists\); the "
@@ -602,10 +602,10 @@ def test_the_lists_capacity_bounds_every_list_and_is_the_side_planes_count(gl, p
 
 
 def test_more_lights_than_a_listed_lights_index_holds_is_refused(monkeypatch):
-    # the colour texel's w holds type id + 256 x index, exact in a float below 2^24
+    # a listed light's texel holds its index in 16 bits beside its half-float radius
     import deferred.light_lists as light_lists
 
-    assert 255 + 256.0 * (light_lists.MAX_LISTED_LIGHTS - 1) < 2 ** 24
+    assert light_lists.MAX_LISTED_LIGHTS <= 1 << 16  # a listed light's index: 16 bits
     monkeypatch.setattr(light_lists, "MAX_LISTED_LIGHTS", 41)
     light_lists.check_light_limits("tiled", (160, 96), 39, 41, max_texture_size=16384)
     with pytest.raises(InputError, match=r"^light: 42 lights; the light lists index at most 41$"):
