@@ -298,6 +298,38 @@ def test_a_pass_failing_after_an_unchecked_gl_error_leaves_no_error_to_the_next_
             assert renderer.render().image.shape == (24, 32, 4)
 
 
+def test_a_pass_after_a_clear_through_another_framebuffer_gets_its_depth_mask(gl):
+    # moderngl's clear sets GL's depth mask to the cleared framebuffer's and binds the bound
+    # one back without its own: Frame sets the mask again after a pass's clears, though the
+    # bound framebuffer's remembered mask has not changed
+    import ctypes
+    from types import SimpleNamespace
+
+    from deferred.gbuffer import DEPTH, GBUFFER_COLOR_TARGETS
+
+    def gl_depth_mask() -> bool:
+        value = ctypes.c_ubyte(9)
+        ctypes.CDLL("libOpenGL.so.0").glGetBooleanv(ctypes.c_uint(0x0B72), ctypes.byref(value))
+        return bool(value.value)  # GL_DEPTH_WRITEMASK
+
+    with Renderer(standard_scene(size=(32, 24)), "deferred", gl=gl) as renderer:
+        renderer.render()
+        frame = renderer.last_frame
+        seen = []
+
+        def draw(frame):
+            frame.use_framebuffer(GBUFFER_COLOR_TARGETS, DEPTH, depth_write=False)
+            seen.append(gl_depth_mask())
+
+        names = (*GBUFFER_COLOR_TARGETS, DEPTH)
+        probe = SimpleNamespace(name="probe", creates=(), reads=names, writes=names,
+                                execute=draw)
+        frame.run_pass(probe)  # binds the G-buffer's framebuffer, mask off
+        probe.creates = (DEPTH,)  # cleared through the depth target's own framebuffer
+        frame.run_pass(probe)
+        assert seen == [False, False]
+
+
 @pytest.mark.parametrize("pipeline", ["deferred", "forward"])
 def test_an_object_moved_between_frames_is_drawn_where_it_is_now(gl, pipeline):
     """The objects' transform uniforms are kept across frames while nothing they come from
