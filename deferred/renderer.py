@@ -219,10 +219,10 @@ class Renderer:
         # look at each pass, so with them each is checked.
         unchecked: list[RenderPass] = []
         passes = self.passes
+        hooked = before_pass is not None or on_pass is not None
         for index, render_pass in enumerate(passes):
             if before_pass:
                 before_pass(render_pass, frame)
-            hooked = before_pass is not None or on_pass is not None
             try:
                 frame.run_pass(render_pass, check_errors=hooked)
             except Exception:
