@@ -1,10 +1,12 @@
 """Benchmarks: the same scene through each pipeline over a sweep of light and shell counts.
 
-DESIGN.md, "Benchmarks". Every (pipeline, lights, shells) combination gets its own renderer on one
-shared GL context: ``warmup`` untimed frames, ``runs`` timed frames (wall clock around
-``render()`` plus ``ctx.finish()``; GL timer queries read nothing on llvmpipe), then ``runs``
-more frames timing each pass the same way, kept apart so the per-pass ``finish()`` calls do not
-inflate the totals.
+DESIGN.md, "Benchmarks". Every (pipeline, light path, lights, shells) point of a sweep gets its
+own renderer on one shared GL context: ``warmup`` untimed frames (shaders compile there), then
+``runs`` rounds, each of one frame timed by wall clock around ``render()`` plus ``ctx.finish()``,
+one frame timing each pass the same way (kept apart so the per-pass ``finish()`` calls do not
+inflate the totals) and one frame of CPU time. The points of one shell count are timed together,
+their rounds interleaved (:func:`run_bench`), so that ratios between them survive the machine's
+drift.
 
 The light sweep adds ``L`` point lights to the scene's own, placed by a seeded generator inside
 the objects' world bounds where the camera sees them, each with a radius covering a fixed share
@@ -230,44 +232,48 @@ def with_shells(scene: Scene, shells: int, where: str = "--shells") -> Scene:
 
 # -- timing --------------------------------------------------------------------------------------
 
+def time_frame(renderer) -> float:
+    """Milliseconds of one frame: the wall clock around ``render()`` and ``ctx.finish()``, the
+    GL queue drained before it starts."""
+    ctx = renderer.gl.ctx
+    ctx.finish()
+    start = time.perf_counter()
+    renderer.render(readback=False)
+    ctx.finish()
+    return (time.perf_counter() - start) * 1000.0
+
+
 def time_frames(renderer, runs: int, warmup: int) -> list[float]:
     """Milliseconds of ``runs`` frames after ``warmup`` untimed ones (shaders compile there)."""
-    ctx = renderer.gl.ctx
     for _ in range(warmup):
         renderer.render(readback=False)
-    ctx.finish()
-    times = []
-    for _ in range(runs):
-        start = time.perf_counter()
-        renderer.render(readback=False)
-        ctx.finish()
-        times.append((time.perf_counter() - start) * 1000.0)
-    return times
+    return [time_frame(renderer) for _ in range(runs)]
 
 
-def time_cpu(renderer, runs: int) -> tuple[float, int]:
-    """Median milliseconds per frame of the framework's own CPU work, and the draw calls of a
-    frame: the rendering thread's CPU time (``time.thread_time``: waits for the driver and the
+def cpu_frame(renderer) -> tuple[float, int]:
+    """Milliseconds of the framework's own CPU work in one frame, and the frame's draw calls:
+    the rendering thread's CPU time (``time.thread_time``: waits for the driver and the
     rasteriser's worker threads are not in it) over ``render()``, less its CPU time inside the
     drawing GL calls (draws, dispatches, clears, framebuffer binds, the light lists' copy;
     ``FrameStats.gl_call_seconds``), where llvmpipe runs vertex work and binning on the
     calling thread."""
-    ctx = renderer.gl.ctx
-    samples = []
-    draws = 0
-    for _ in range(runs):
-        ctx.finish()
-        start = time.thread_time()
-        result = renderer.render(readback=False, time_gl_calls=True)
-        elapsed = time.thread_time() - start
-        samples.append((elapsed - result.gl_call_seconds) * 1000.0)
-        draws = result.draw_calls
-    ctx.finish()
-    return statistics.median(samples), draws
+    renderer.gl.ctx.finish()
+    start = time.thread_time()
+    result = renderer.render(readback=False, time_gl_calls=True)
+    elapsed = time.thread_time() - start
+    renderer.gl.ctx.finish()
+    return (elapsed - result.gl_call_seconds) * 1000.0, result.draw_calls
+
+
+def time_cpu(renderer, runs: int) -> tuple[float, int]:
+    """Median milliseconds per frame of the framework's own CPU work over ``runs`` frames
+    (:func:`cpu_frame`), and the draw calls of a frame."""
+    samples = [cpu_frame(renderer) for _ in range(runs)]
+    return statistics.median(ms for ms, _ in samples), samples[-1][1]
 
 
 def timer_queries_work(gl: GLContext) -> bool:
-    """Whether the driver answers GL timer queries (llvmpipe reads 0)."""
+    """Whether the driver answers GL timer queries (Mesa 22.3's llvmpipe does)."""
     ctx = gl.ctx
     query = ctx.query(time=True)
     fbo = ctx.simple_framebuffer((64, 64))
@@ -300,8 +306,8 @@ def time_passes_gpu(renderer, runs: int) -> dict[str, float]:
     return {name: statistics.median(values) for name, values in samples.items()}
 
 
-def time_passes(renderer, runs: int) -> dict[str, float]:
-    """Median milliseconds of each pass, in pass order, over ``runs`` frames.
+def pass_frame(renderer) -> dict[str, list[float]]:
+    """Milliseconds of each pass of one frame, in pass order.
 
     ``finish()`` before and after every pass: llvmpipe answers no timer queries, and without the
     fence a pass's work would be billed to whichever later pass waited for it.
@@ -318,9 +324,22 @@ def time_passes(renderer, runs: int) -> dict[str, float]:
         ctx.finish()
         samples[render_pass.name].append((time.perf_counter() - started[render_pass.name]) * 1e3)
 
+    renderer.render(before_pass=before, on_pass=after, readback=False)
+    return samples
+
+
+def time_passes(renderer, runs: int) -> dict[str, float]:
+    """Median milliseconds of each pass, in pass order, over ``runs`` frames
+    (:func:`pass_frame`)."""
+    samples: dict[str, list[float]] = {p.name: [] for p in renderer.passes}
     for _ in range(runs):
-        renderer.render(before_pass=before, on_pass=after, readback=False)
-    return {name: statistics.median(values) for name, values in samples.items()}
+        for name, values in pass_frame(renderer).items():
+            samples[name] += values
+    return medians(samples)
+
+
+def medians(samples: dict[str, list[float]]) -> dict[str, float]:
+    return {name: statistics.median(values) for name, values in samples.items() if values}
 
 
 # -- results -------------------------------------------------------------------------------------
@@ -411,6 +430,7 @@ class Sweep:
     size: tuple[int, int] | None = None  # None: the scene's size
     runs: int = 10
     warmup: int = 2
+    interleave: bool = True  # the points of a shell count timed together (run_bench)
 
 
 def sweep_shells(scene: Scene, shells: Sequence[int]) -> list[int]:
@@ -418,12 +438,60 @@ def sweep_shells(scene: Scene, shells: Sequence[int]) -> list[int]:
     return list(shells) if shell_objects(scene) else [0]
 
 
+@dataclass
+class _TimedPoint:
+    """A sweep point being timed: its renderer and the samples gathered so far."""
+
+    lights: int
+    pipeline: str
+    light_path: str
+    renderer: Any
+    times_ms: list[float] = field(default_factory=list)
+    passes_ms: dict[str, list[float]] = field(default_factory=dict)
+    cpu_ms: list[float] = field(default_factory=list)
+    draw_calls: int = 0
+
+    def time_round(self) -> None:
+        """One timed frame, one with every pass fenced, one of CPU time."""
+        self.times_ms.append(time_frame(self.renderer))
+        for name, values in pass_frame(self.renderer).items():
+            self.passes_ms.setdefault(name, []).extend(values)
+        cpu, self.draw_calls = cpu_frame(self.renderer)
+        self.cpu_ms.append(cpu)
+
+    def result(self, shells: int, gpu: dict[str, float] | None) -> BenchResult:
+        return BenchResult(self.pipeline, self.lights, shells, *self.renderer.size,
+                           self.times_ms, medians(self.passes_ms), self.light_path,
+                           statistics.median(self.cpu_ms), self.draw_calls, gpu)
+
+
+def sweep_points(sweep: Sweep) -> list[tuple[int, str, str]]:
+    """The (lights, pipeline, light path) points of one shell count, in the report's order."""
+    return [(lights, pipeline, path) for lights in sweep.lights for pipeline in sweep.pipelines
+            for path in pipeline_paths(pipeline, sweep.light_paths)]
+
+
+def sweep_steps(scene: Scene, sweep: Sweep) -> int:
+    """How many times :func:`run_bench` calls ``progress``: a warm-up per point, a round of
+    frames per group of points timed together."""
+    points = len(sweep_points(sweep))
+    groups = 1 if sweep.interleave else points
+    return len(sweep_shells(scene, sweep.shells)) * (points + groups * sweep.runs)
+
+
 def run_bench(scene: Scene, sweep: Sweep, gl: GLContext | None = None,
               progress: Callable[[str], None] | None = None) -> BenchReport:
-    """Render every (pipeline, lights, shells) of ``sweep`` and time it.
+    """Render every (pipeline, light path, lights, shells) point of ``sweep`` and time it.
 
-    Pipelines alternate innermost so that drift in the machine's speed (other load, clocks)
-    falls on both alike. ``progress(description)`` is called before each combination.
+    With ``sweep.interleave`` (the default) the points of one shell count are timed together:
+    every point's renderer is built and warmed up, then each of ``runs`` rounds gives every
+    point one frame of each kind (timed, passes fenced, CPU time), each round starting from the
+    next point. A drift in the machine's speed (other load, clocks, llvmpipe's threads) then
+    falls on every point alike, and ratios between points (a light count against another, a
+    path against another) hold where timing one point after another moved them by 40%
+    (benchmarks/README.md). The cost: all those renderers are alive at once (about 50-90 MB
+    each at 1280x720 on lights.toml). Without it, one point is built, timed and released after
+    another. ``progress(description)`` is called before each warm-up and each round.
     """
     from .renderer import Renderer
 
@@ -434,38 +502,46 @@ def run_bench(scene: Scene, sweep: Sweep, gl: GLContext | None = None,
     if max(sweep.lights, default=0) + len(scene.lights) > MAX_LIGHTS:
         raise InputError(f"at most {MAX_LIGHTS} lights in all, the scene has "
                          f"{len(scene.lights)}", "--lights")
-    size = sweep.size or scene.size
-    aspect = size[0] / size[1]
-    shell_counts = sweep_shells(scene, sweep.shells)
-    variants = [with_shells(scene, s) if shell_objects(scene) else scene for s in shell_counts]
-    owns = gl is None
-    gl = gl or create_context()
-    runs = [(pipeline, path) for pipeline in sweep.pipelines
-            for path in pipeline_paths(pipeline, sweep.light_paths)]
-    if not runs:
+    points = sweep_points(sweep)
+    if not points:
         raise InputError("no light path of the pipelines chosen is in --light-paths",
                          "--light-paths")
+    size = sweep.size or scene.size
+    aspect = size[0] / size[1]
+    report = progress or (lambda description: None)
+    owns = gl is None
+    gl = gl or create_context()
     results = []
     try:
         timers = timer_queries_work(gl)
-        for shells, shelled in zip(shell_counts, variants, strict=True):
-            for lights in sweep.lights:
-                variant = with_extra_lights(shelled, lights, aspect)
-                for pipeline, path in runs:
-                    if progress:
-                        progress(f"{pipeline} ({path}), {lights} lights, {shells} shells")
-                    renderer = Renderer(variant, pipeline, size, gl=gl, light_path=path)
-                    try:
-                        times = time_frames(renderer, sweep.runs, sweep.warmup)
-                        passes = time_passes(renderer, sweep.runs)
-                        cpu, draws = time_cpu(renderer, sweep.runs)
-                        gpu = time_passes_gpu(renderer, sweep.runs) if timers else None
-                    finally:
-                        renderer.release()
-                    results.append(BenchResult(pipeline, lights, shells, *renderer.size,
-                                               times, passes, renderer.light_path, cpu, draws,
-                                               gpu))
-        info = {**renderer_info(gl, scene), "gl_timer_queries": timers}
+        for shells in sweep_shells(scene, sweep.shells):
+            shelled = with_shells(scene, shells) if shell_objects(scene) else scene
+            lit = {lights: with_extra_lights(shelled, lights, aspect) for lights in sweep.lights}
+            groups = [points] if sweep.interleave else [[point] for point in points]
+            for group in groups:
+                timed: list[_TimedPoint] = []
+                try:
+                    for lights, pipeline, path in group:
+                        report(f"warm-up: {pipeline} ({path}), {lights} lights, {shells} shells")
+                        renderer = Renderer(lit[lights], pipeline, size, gl=gl, light_path=path)
+                        timed.append(_TimedPoint(lights, pipeline, path, renderer))
+                        for _ in range(sweep.warmup):
+                            renderer.render(readback=False)
+                    for round_index in range(sweep.runs):
+                        what = (f"{len(timed)} points" if len(timed) > 1 else
+                                f"{timed[0].pipeline} ({timed[0].light_path}), "
+                                f"{timed[0].lights} lights")
+                        report(f"round {round_index + 1} of {sweep.runs}: {what}, "
+                               f"{shells} shells")
+                        for k in range(len(timed)):
+                            timed[(round_index + k) % len(timed)].time_round()
+                    results += [point.result(shells, time_passes_gpu(point.renderer, sweep.runs)
+                                             if timers else None) for point in timed]
+                finally:
+                    for point in timed:
+                        point.renderer.release()
+        info = {**renderer_info(gl, scene), "gl_timer_queries": timers,
+                "interleaved": sweep.interleave}
     finally:
         if owns:
             gl.release()
@@ -616,4 +692,25 @@ def speedups(report: BenchReport) -> list[str]:
                      f"({forward.light_path}, {forward.median_ms:.1f} ms)")
         lines.append(f"{shells} shells, {lights} extra lights: deferred ({deferred.light_path}) "
                      f"{deferred.median_ms:.1f} ms: {', '.join(parts)}")
+    return lines
+
+
+def growth(report: BenchReport) -> list[str]:
+    """Per shell count, for the deferred path fastest at the most extra lights swept: its median
+    at each light count against its own at the fewest, as lines to print (interleaved, the
+    frames of a line's counts were timed in the same rounds)."""
+    lines = []
+    for shells in sorted({r.shells for r in report.results}):
+        rows = [r for r in report.results if r.shells == shells]
+        best = _fastest(rows, "deferred", max(r.lights for r in rows))
+        if best is None:
+            continue
+        own = sorted((r for r in rows if r.pipeline == "deferred" and
+                      r.light_path == best.light_path), key=lambda r: r.lights)
+        if len(own) < 2:
+            continue
+        first = own[0]
+        ratios = ", ".join(f"{r.lights}: {r.median_ms / first.median_ms:.2f}x" for r in own[1:])
+        lines.append(f"{shells} shells, deferred ({best.light_path}) against its frame at "
+                     f"{first.lights} extra lights ({first.median_ms:.1f} ms): {ratios}")
     return lines

@@ -298,19 +298,23 @@ def _compare(first: str, second: str, output: str | None) -> None:
               help="Shell counts for every object whose material has 'shells'.")
 @click.option("--size", help="WIDTHxHEIGHT, overrides the scene's size.")
 @click.option("--runs", type=click.IntRange(min=1, max=10_000), default=10, show_default=True,
-              help="Timed frames per point (and as many again for the per-pass times).")
+              help="Timed frames per point (and as many again for the per-pass times and the "
+                   "CPU times).")
 @click.option("--warmup", type=click.IntRange(min=0, max=10_000), default=2, show_default=True,
               help="Untimed frames first (shader compilation, first uploads).")
 @click.option("--pipelines", default="deferred,forward", show_default=True, metavar="NAME,...")
 @click.option("--light-paths", default="all", show_default=True, metavar="PATH,...",
               help="Light paths to time: all (every path of each pipeline), or names: "
                    "volumes, tiled, clustered (deferred), naive, tiled (forward).")
+@click.option("--interleave/--no-interleave", default=True, show_default=True,
+              help="Time the points of a shell count together, their frames alternating (all "
+                   "their renderers alive at once), or one after another (less memory).")
 @click.option("--json", "json_path", metavar="FILE.json", help="Results as JSON ('-': stdout).")
 @click.option("--csv", "csv_path", metavar="FILE.csv", help="Results as CSV.")
 @click.option("--plot", "plot_path", metavar="FILE.png", help="ms against light count.")
 def bench(scene: str | None, lights: str, shells: str, size: str | None, runs: int, warmup: int,
-          pipelines: str, light_paths: str, json_path: str | None, csv_path: str | None,
-          plot_path: str | None) -> None:
+          pipelines: str, light_paths: str, interleave: bool, json_path: str | None,
+          csv_path: str | None, plot_path: str | None) -> None:
     """Time SCENE (the built-in demo when omitted) in each pipeline over a sweep of light and
     shell counts (DESIGN.md, "Benchmarks")."""
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
@@ -322,7 +326,8 @@ def bench(scene: str | None, lights: str, shells: str, size: str | None, runs: i
                             shells=benchmark.parse_counts(shells, "--shells"),
                             pipelines=benchmark.parse_pipelines(pipelines),
                             light_paths=benchmark.parse_light_paths(light_paths),
-                            size=_size_option(size), runs=runs, warmup=warmup)
+                            size=_size_option(size), runs=runs, warmup=warmup,
+                            interleave=interleave)
     writers = {"--json": benchmark.write_json, "--csv": benchmark.write_csv,
                "--plot": benchmark.write_plot}
     outputs = {}
@@ -332,11 +337,10 @@ def bench(scene: str | None, lights: str, shells: str, size: str | None, runs: i
     loaded = _scene(scene)
     for where, path in outputs.items():
         _check_not_inputs([path], loaded, scene, where)
-    shell_counts = benchmark.sweep_shells(loaded, sweep.shells)
     if not benchmark.shell_objects(loaded):
         stderr.print(f"{loaded.source}: no object has a 'shells' parameter; shell sweep "
                      "skipped (shells 0)")
-    total = len(shell_counts) * len(sweep.lights) * len(sweep.pipelines)
+    total = benchmark.sweep_steps(loaded, sweep)
     with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
                   console=stderr, transient=True, disable=not stderr.is_terminal) as progress:
         task = progress.add_task("benchmark", total=total)
@@ -350,7 +354,8 @@ def bench(scene: str | None, lights: str, shells: str, size: str | None, runs: i
     # Not squeezed to 80 columns when stderr is a pipe or a file.
     table_console = stderr if stderr.is_terminal else Console(stderr=True, width=160)
     table_console.print(benchmark.results_table(report))
-    for line in [*benchmark.crossovers(report), *benchmark.speedups(report)]:
+    for line in [*benchmark.crossovers(report), *benchmark.speedups(report),
+                 *benchmark.growth(report)]:
         stderr.print(line)
     if json_path == "-":
         try:  # a full disk or a closed pipe shows here, not as a warning at exit

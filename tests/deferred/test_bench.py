@@ -256,3 +256,82 @@ def test_speedups_compare_the_fastest_deferred_path_at_the_most_lights():
         "(2600.0 ms), 2.60x the fastest forward path (tiled, 130.0 ms)",
         "16 shells, 4 extra lights: deferred (volumes) 10.0 ms: 0.8x naive forward (8.0 ms), "
         "0.80x the fastest forward path (naive, 8.0 ms)"]
+
+
+def test_growth_compares_the_best_deferred_path_with_its_own_frame_at_the_fewest_lights():
+    from deferred.bench import BenchReport, BenchResult, growth
+
+    def row(pipeline, path, lights, ms, shells=0):
+        return BenchResult(pipeline, lights, shells, 64, 36, [ms], light_path=path)
+
+    report = BenchReport({}, [
+        row("deferred", "volumes", 1, 8.0), row("deferred", "tiled", 1, 10.0),
+        row("forward", "tiled", 1, 6.0),
+        row("deferred", "volumes", 256, 40.0), row("deferred", "tiled", 256, 12.5),
+        row("forward", "tiled", 256, 30.0),
+        row("deferred", "volumes", 1024, 160.0), row("deferred", "tiled", 1024, 20.0),
+        row("deferred", "volumes", 4, 10.0, shells=16)])
+    # the tiled path is the fastest at 1024; its 1-light frame, not volumes' faster one, is 1x
+    assert growth(report) == [
+        "0 shells, deferred (tiled) against its frame at 1 extra lights (10.0 ms): "
+        "256: 1.25x, 1024: 2.00x"]
+
+
+def _record_frames(monkeypatch):
+    """Log which renderer each frame and each release belongs to, in order."""
+    from deferred.renderer import Renderer
+
+    events = []
+    render, release = Renderer.render, Renderer.release
+
+    def logged_render(self, *args, **kwargs):
+        events.append(("frame", (self.pipeline_name, self.light_path, len(self.scene.lights))))
+        return render(self, *args, **kwargs)
+
+    def logged_release(self):
+        events.append(("release", (self.pipeline_name, self.light_path,
+                                   len(self.scene.lights))))
+        return release(self)
+
+    monkeypatch.setattr(Renderer, "render", logged_render)
+    monkeypatch.setattr(Renderer, "release", logged_release)
+    return events
+
+
+@pytest.mark.parametrize("interleave", [True, False])
+def test_interleaved_points_alternate_their_frames_round_by_round(gl, monkeypatch, interleave):
+    scene = standard_scene()
+    events = _record_frames(monkeypatch)
+    steps = []
+    sweep = Sweep(lights=[0, 3], runs=3, warmup=1, light_paths=["tiled"],
+                  interleave=interleave)
+    report = run_bench(scene, sweep, gl=gl, progress=steps.append)
+    from deferred.bench import sweep_steps
+
+    assert len(steps) == sweep_steps(scene, sweep)
+    assert report.renderer["interleaved"] is interleave
+    own = len(scene.lights)
+    points = [("deferred", "tiled", own), ("forward", "tiled", own),
+              ("deferred", "tiled", own + 3), ("forward", "tiled", own + 3)]
+    assert [(r.pipeline, r.light_path, r.lights) for r in report.results] == [
+        (p, path, n - own) for p, path, n in points]
+    assert all(r.runs == 3 and r.draw_calls > 0 and r.passes_ms for r in report.results)
+    frames = [point for kind, point in events if kind == "frame"]
+    releases = [i for i, (kind, _) in enumerate(events) if kind == "release"]
+    # a warm-up, 3 rounds of 3 kinds, then 3 with timer queries where the driver answers them
+    gpu = 3 if report.renderer["gl_timer_queries"] else 0
+    assert Counter(frames) == {point: 1 + 3 * 3 + gpu for point in points}
+    if interleave:
+        # every renderer is warmed up first, then each round is 3 frames of each point, the
+        # round starting one point further on; all released at the end
+        assert frames[:4] == points
+        for k in range(3):
+            round_frames = frames[4 + 12 * k:4 + 12 * (k + 1)]
+            assert round_frames == [p for p in points[k:] + points[:k] for _ in range(3)]
+        assert frames[40:] == [p for p in points for _ in range(gpu)]
+        assert releases == list(range(len(events) - 4, len(events)))
+    else:
+        # one point's frames, then its release, then the next point's
+        per_point = 10 + gpu
+        assert frames == [p for p in points for _ in range(per_point)]
+        assert releases == [(per_point + 1) * (i + 1) - 1 for i in range(4)]
