@@ -143,11 +143,19 @@ def light_dispatch_glsl(light_types: list[type[Light]]) -> str:
         return [*body, "    return vec3(0.0);", "}"]
 
     def loops(name: str, types: list[type[Light]], fetch: str) -> list[str]:
+        # do-while: the test at the end of the body. Where a shader runs as SIMD lanes with
+        # masks (llvmpipe), a for loop runs its body once more than it has lights, all lanes
+        # masked, to find that every lane is done; the `if` saves nothing there (its body runs
+        # masked), but keeps other GPUs from reading a record where a type has none.
         body = [f"vec3 {name}(Surface s, vec3 P, vec3 V) {{", "    vec3 total = vec3(0.0);"]
         for cls in types:
             r = light_range_uniform(cls)
-            body += [f"    for (int k = {r}.x; k < {r}.x + {r}.y; ++k)",
-                     f"        total += {cls.glsl_function}({fetch}(k), s, P, V);"]
+            body += [f"    if ({r}.y > 0) {{",
+                     f"        int k = {r}.x;",
+                     "        do {",
+                     f"            total += {cls.glsl_function}({fetch}(k), s, P, V);",
+                     f"        }} while (++k < {r}.x + {r}.y);",
+                     "    }"]
         return [*body, "    return total;", "}"]
 
     fullscreen = [cls for cls in light_types if cls.volume == "fullscreen"]

@@ -1,19 +1,24 @@
 // The volume lights of one light list at a surface point: the deferred tiled and clustered
 // shading and Forward+ (deferred.light_lists).
 //
-// A list holds the lights that touch its tile or cluster; most miss any one point of it
+// A list holds the lights that touch its tile or cluster; many miss any one point of it
 // (lights.toml at 1024 lights, 640x360: 21.6 entries a pixel in the 8x8 tiled lists, 31.5 in
-// 16x16 ones, 13.2 reaching the pixel, 14.5 some pixel of its 4x2 block, the width of a
-// 256-bit SIMD vector). Where a fragment shader runs as SIMD lanes (llvmpipe) a light's
-// arithmetic runs for the whole block where any lane is reached, and is skipped where none
-// is. Each entry is one texel, its light's sphere and index; a light that reaches the pixel
-// reads its colour (and what else its type needs) from the light buffer
-// (lights/light_lists.glsl). Cut-outs of this loop at 256 lights, 640x360
-// (benchmarks/shader_ab.py, the pass 22 ms): the loop's sphere fetches and tests 3.2 ms, the
-// evaluations 7.5 ms, of which Blinn-Phong's pow 3.4; at 1024 lights pow is 8.7 of 39 ms.
+// 16x16 ones, 13.2 reaching the pixel). Each entry is one texel, its light's sphere and index;
+// a light that reaches the pixel reads its colour (and what else its type needs) from the
+// light buffer (lights/light_lists.glsl).
+//
+// Where a fragment shader runs as SIMD lanes under masks (llvmpipe: Mesa 22.3's gallivm), an
+// `if` skips nothing: its body runs for every block of lanes, masked. So every entry costs its
+// light's whole evaluation whether it reaches the pixel or not (an `if` that never holds costs
+// as much as this one, benchmarks/README.md), and only a loop's trip count saves work: the
+// cost is entries x (fetch + sphere test + evaluation). The loop is a do-while, since a for
+// loop runs its body once more than its trips, masked, to find every lane done (1.2-2.2 ms of
+// the tiled shading's 22-36 ms at 256-1024 lights, 640x360). The sphere test stays: it costs
+// nothing measurable there and spares the evaluation on GPUs that branch.
 // Tried and slower or no faster on llvmpipe (benchmarks/README.md): a bit mask of reached
-// entries with a loop over its set bits; four indices a fetch; the loop unrolled by two; an
-// `if` around pow for negligible highlights (the compiler makes it a select).
+// entries with a loop over its set bits; a loop that skips to the next entry some lane (or,
+// with GL_ARB_shader_group_vote, any lane) reaches, evaluating only those; four indices a
+// fetch; the loop unrolled by two; an `if` around pow for negligible highlights.
 #include "common/light_buffer.glsl"
 #include "generated/lights.glsl"
 #include "lights/light_lists.glsl"
@@ -22,12 +27,14 @@ vec3 evaluate_listed_lights(int list, Surface s, vec3 P, vec3 V) {
     vec3 total = vec3(0.0);
     int length = light_list_length(list);
     int first = light_list_first_slot(list);
-    for (int k = 0; k < length; ++k) {
-        // the sphere test is far cheaper than the light; most entries miss the point
-        ListedLight listed = listed_light(first + k);
-        vec3 to_light = listed.sphere.xyz - P;
-        if (dot(to_light, to_light) <= listed.sphere.w * listed.sphere.w)
-            total += evaluate_volume_light(listed_light_record(listed), s, P, V);
+    if (length > 0) {  // masked on llvmpipe, as above; a real branch elsewhere
+        int k = 0;
+        do {
+            ListedLight listed = listed_light(first + k);
+            vec3 to_light = listed.sphere.xyz - P;
+            if (dot(to_light, to_light) <= listed.sphere.w * listed.sphere.w)
+                total += evaluate_volume_light(listed_light_record(listed), s, P, V);
+        } while (++k < length);
     }
     return total;
 }
