@@ -207,6 +207,8 @@ class LightTypePass(RenderPass):
         sphere = self.light_type.volume == "sphere"
         vertex = "lights/volume.vert" if sphere else "lights/fullscreen.vert"
         defines = {"HAS_SSAO": "1"} if self.occlusion else {}
+        if not sphere:
+            defines["FULLSCREEN_AT_FAR"] = "1"
         program = frame.shaders.program(vertex, "lights/accumulate.frag", defines=defines)
         frame.use_framebuffer((LIGHT_ACCUMULATION,), DEPTH, depth_write=False)
         textures = frame.target_samplers(self.gbuffer)
@@ -225,7 +227,9 @@ class LightTypePass(RenderPass):
             finally:
                 frame.ctx.disable_direct(GL_DEPTH_CLAMP)
         else:
-            frame.set_state(blend="add")
+            # On the far plane, drawn where the depth is nearer: the background's pixels are
+            # skipped, which an `if` in the shader cannot do on llvmpipe (light_lists.py).
+            frame.set_state(depth_test=True, depth_func="greater", blend="add")
             frame.bind(program, uniforms, textures)
             frame.draw_fullscreen(program, instances=count)
 

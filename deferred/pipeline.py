@@ -140,11 +140,16 @@ class DeferredPipeline(Pipeline):
         if self.light_path == "volumes":
             # the light accumulation starts as 0 on surfaces and the background elsewhere;
             # each light type's pass adds into it
+            # (cleared to the background, then drawn on the surfaces only: the depth test of
+            # light_lists.list_shading_pass)
+            accumulation = replace(LIGHT_ACCUMULATION_SPEC, clear=(*scene.background, 0.0))
             background = FullscreenPass(
                 "lighting.background", Phase.LIGHTING, "lights/background.frag",
                 {"u_normal_exponent_id": NORMAL_EXPONENT_ID}, (LIGHT_ACCUMULATION,),
-                creates={LIGHT_ACCUMULATION: LIGHT_ACCUMULATION_SPEC}, order=Order.FIRST,
-                uniforms=lambda frame: {"u_background": frame.scene.background})
+                creates={LIGHT_ACCUMULATION: accumulation}, order=Order.FIRST,
+                uniforms=lambda frame: {"u_background": frame.scene.background},
+                defines={"FULLSCREEN_AT_FAR": "1"}, depth=DEPTH, depth_test=True,
+                depth_func="greater")
             lights = [background, *(LightTypePass(cls, occlusion, layout.color_targets)
                                     for cls in scene.light_types())]
         else:
@@ -159,7 +164,8 @@ class DeferredPipeline(Pipeline):
             lights = [LightCullPass(f"lighting.cull_{'clusters' if clustered else 'tiles'}",
                                     Phase.LIGHTING, clustered),
                       list_shading_pass(f"lighting.{self.light_path}", clustered,
-                                        layout.color_targets, occlusion, composite=folded)]
+                                        layout.color_targets, occlusion, scene.background,
+                                        composite=folded)]
         passes += phase_passes(scene, Phase.LIGHTING, lights, wide)
         if not folded:
             composite = copy_pass("material.composite_copy", Phase.MATERIAL,

@@ -28,6 +28,7 @@ class PixelEvent:
     fragments: int | None
     before: dict[str, list[float]]
     after: dict[str, list[float]]
+    cleared: bool = False  # the pass cleared a target it creates: every pixel of it
 
     @property
     def changed(self) -> bool:
@@ -35,11 +36,12 @@ class PixelEvent:
 
     @property
     def wrote(self) -> bool:
-        return self.fragments is None or self.fragments > 0 or self.changed
+        return self.fragments is None or self.fragments > 0 or self.changed or self.cleared
 
     def describe(self) -> dict[str, Any]:
         return {"index": self.index, "pass": self.name, "phase": self.phase,
-                "fragments": self.fragments, "before": self.before, "after": self.after}
+                "fragments": self.fragments, "cleared": self.cleared, "before": self.before,
+                "after": self.after}
 
 
 def parse_pixel(text: str, size: tuple[int, int]) -> tuple[int, int]:
@@ -98,10 +100,13 @@ def pixel_history(renderer: Renderer, x: int, y: int) -> list[PixelEvent]:
 
     def after(render_pass: RenderPass, frame) -> None:
         values, fragments = pending.pop()
+        # a pass whose creates are cleared wrote the pixel even where no fragment reached it
+        # and the value is the one the last frame left (the background of a list shading pass)
+        cleared = any(spec.clear is not None for spec in render_pass.creates.values())
         events.append(PixelEvent(
             len(events), render_pass.name, render_pass.phase.value, fragments,
             {t: _floats(v) for t, v in values.items()},
-            {t: _floats(read(t)) for t in dict.fromkeys(render_pass.writes)}))
+            {t: _floats(read(t)) for t in dict.fromkeys(render_pass.writes)}, cleared))
 
     renderer.render(on_pass=after, before_pass=before)
     return events
@@ -120,6 +125,8 @@ def format_history(events: Sequence[PixelEvent], x: int, y: int,
     for event in wrote:
         what = "clear" if event.fragments is None else \
             f"{event.fragments} fragment{'s' if event.fragments != 1 else ''}"
+        if event.cleared and event.fragments is not None:
+            what = f"cleared, {what}"
         lines.append(f"{event.index:02d} {event.name} ({event.phase}): {what}")
         for target, value in event.after.items():
             was = event.before.get(target)

@@ -327,6 +327,34 @@ def test_pixel_history_lists_the_passes_that_wrote_a_pixel(renderer):
                                                 "material.composite_copy", "post.tonemap"]
 
 
+@pytest.mark.parametrize("light_path, passes", [
+    ("volumes", ("lighting.background", "lighting.ambient", "lighting.directional")),
+    ("tiled", ("lighting.tiled",)), ("clustered", ("lighting.clustered",))])
+def test_full_screen_lighting_runs_on_surfaces_only(gl, light_path, passes):
+    """The full-screen lighting passes draw on the far plane with the depth test "greater":
+    no fragment on the background (llvmpipe skips such blocks; an `if` would not), one on a
+    surface, and the background pixel still holds the scene's background (its pass clears the
+    light accumulation to it)."""
+    scene = small_scene()
+    scene.background = (0.25, 0.5, 0.75)
+    r = Renderer(scene, "deferred", gl=gl, light_path=light_path)
+    try:
+        capture = capture_frame(r)
+        depth = capture.target("depth")[..., 0]
+        sky_y, sky_x = (int(v[0]) for v in np.nonzero(depth >= 1.0))
+        floor_y, floor_x = (int(v[-1]) for v in np.nonzero(depth < 1.0))
+        sky = {e.name: e for e in pixel_history(r, sky_x, sky_y)}
+        floor = {e.name: e for e in pixel_history(r, floor_x, floor_y)}
+        for name in passes:
+            assert sky[name].fragments == 0 and floor[name].fragments == 1, name
+        assert sky[passes[0]].cleared and sky[passes[0]].wrote
+        background = np.array(capture.target("light_accumulation")[sky_y, sky_x], np.float32)
+        np.testing.assert_allclose(background, [0.25, 0.5, 0.75, 0.0], atol=1e-3)
+        assert capture.target("light_accumulation")[floor_y, floor_x][3] == 1.0  # coverage
+    finally:
+        r.release()
+
+
 def test_contact_sheet_has_every_buffer_in_pass_order(tmp_path, renderer):
     r = renderer(small_scene())
     capture = capture_frame(r)
