@@ -42,12 +42,14 @@ TONEMAPS = {"none": 0, "reinhard": 1, "aces": 2}
 PIPELINE_PASS, SCENE_PASS, OBJECT_PASS = 0, 1, 2  # groups within one Order rank
 
 
-def tonemap_pass() -> RenderPass:
+def tonemap_pass(scene: Scene) -> RenderPass:
+    """Exposure, the scene's tone mapping operator (fixed when the passes are built, as the
+    background is) and sRGB encoding."""
     return FullscreenPass(
         "post.tonemap", Phase.POST, "post/tonemap.frag", {"u_source": COMPOSITE}, (FINAL,),
         creates={FINAL: FINAL_SPEC}, order=Order.FIRST,
-        uniforms=lambda frame: {"u_exposure": frame.scene.exposure,
-                                "u_tonemap": TONEMAPS[frame.scene.tonemap]})
+        defines={"TONEMAP": str(TONEMAPS[scene.tonemap])},
+        uniforms=lambda frame: {"u_exposure": frame.scene.exposure})
 
 
 def scene_passes(scene: Scene, pipeline: str) -> list[RenderPass]:
@@ -172,7 +174,7 @@ class DeferredPipeline(Pipeline):
                                   LIGHT_ACCUMULATION, COMPOSITE, COMPOSITE_SPEC,
                                   order=Order.FIRST)
             passes += phase_passes(scene, Phase.MATERIAL, [composite], wide)
-        passes += phase_passes(scene, Phase.POST, [tonemap_pass()], wide)
+        passes += phase_passes(scene, Phase.POST, [tonemap_pass(scene)], wide)
         return passes
 
 
@@ -194,7 +196,7 @@ class ForwardPipeline(Pipeline):
                                        from_near=True))
         clear = ClearPass("forward.clear", Phase.FORWARD, creates)
         passes = phase_passes(scene, Phase.FORWARD, [clear, *fixed], wide)
-        passes += phase_passes(scene, Phase.POST, [tonemap_pass()], wide)
+        passes += phase_passes(scene, Phase.POST, [tonemap_pass(scene)], wide)
         return passes
 
     def shader_defines(self) -> dict[str, str]:

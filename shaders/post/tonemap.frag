@@ -3,7 +3,11 @@
 
 uniform sampler2D u_source;
 uniform float u_exposure;
-uniform int u_tonemap;  // 0 none (clamp), 1 Reinhard, 2 ACES (Narkowicz 2015 fit)
+// TONEMAP (deferred.pipeline.TONEMAPS): 0 none (clamp), 1 Reinhard, 2 ACES (Narkowicz 2015
+// fit). A define, not a uniform: on llvmpipe an `if` runs both operators (8% of the pass).
+#ifndef TONEMAP
+#define TONEMAP 2  // the scenes' default
+#endif
 
 out vec4 out_color;
 
@@ -13,7 +17,10 @@ vec3 aces_fit(vec3 x) {
 
 void main() {
     vec3 color = max(texelFetch(u_source, ivec2(gl_FragCoord.xy), 0).rgb, 0.0) * u_exposure;
-    if (u_tonemap == 1) color = color / (1.0 + color);
-    else if (u_tonemap == 2) color = aces_fit(color);
+#if TONEMAP == 1
+    color = color / (1.0 + color);
+#elif TONEMAP == 2
+    color = aces_fit(color);
+#endif
     out_color = vec4(srgb_encode(color), 1.0);
 }

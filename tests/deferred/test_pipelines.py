@@ -361,3 +361,30 @@ def test_an_object_moved_between_frames_is_drawn_where_it_is_now(gl, pipeline):
     np.testing.assert_array_equal(in_place, fresh(expected))
     expected.objects[2].model = expected.objects[2].model @ np.diag([1.0, 1.6, 1.0, 1.0])
     np.testing.assert_array_equal(replaced, fresh(expected))
+
+
+@pytest.mark.parametrize("tonemap", ["none", "reinhard", "aces"])
+def test_tonemap_operator_matches_a_numpy_reference(gl, tonemap):
+    """The final image is the composition times the exposure, through the scene's operator
+    (a define of the pass), sRGB encoded: checked against numpy for each operator."""
+    from deferred.capture import capture_frame
+    from deferred.scene import load_scene
+
+    scene = load_scene(None)
+    scene.tonemap = tonemap
+    scene.exposure = 1.7
+    renderer = Renderer(scene, "deferred", (96, 54), gl=gl)
+    try:
+        capture = capture_frame(renderer)
+    finally:
+        renderer.release()
+    x = np.maximum(capture.target("composite")[..., :3].astype(np.float64), 0.0) * 1.7
+    if tonemap == "reinhard":
+        x = x / (1.0 + x)
+    elif tonemap == "aces":
+        x = np.clip(x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0)
+    x = np.clip(x, 0.0, 1.0)
+    encoded = np.where(x < 0.0031308, 12.92 * x, 1.055 * x ** (1 / 2.4) - 0.055)
+    final = capture.target("final")[..., :3].astype(np.float64)
+    assert np.abs(final - encoded).max() <= 1.5 / 255
+    assert np.abs(final - encoded).mean() < 0.3 / 255
