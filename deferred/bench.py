@@ -35,6 +35,7 @@ import io
 import json
 import math
 import os
+import random
 import statistics
 import time
 from collections.abc import Callable, Sequence
@@ -57,6 +58,7 @@ DEFAULT_LIGHTS = (1, 16, 64, 256, 1024)
 DEFAULT_SHELLS = (0, 16, 64)
 MAX_LIGHTS = 16384  # the GL 3.3 path keeps one light per row of a texture
 LIGHT_SEED = 0
+ROUND_ORDER_SEED = 0  # run_bench: the order of the points in each round
 # A light's radius is this share of the half-height of the view at its depth: on screen each
 # sphere spans about 15% of the image height, in any scene at any scale.
 LIGHT_VIEW_SHARE = 0.3
@@ -485,13 +487,16 @@ def run_bench(scene: Scene, sweep: Sweep, gl: GLContext | None = None,
 
     With ``sweep.interleave`` (the default) the points of one shell count are timed together:
     every point's renderer is built and warmed up, then each of ``runs`` rounds gives every
-    point one frame of each kind (timed, passes fenced, CPU time), each round starting from the
-    next point. A drift in the machine's speed (other load, clocks, llvmpipe's threads) then
-    falls on every point alike, and ratios between points (a light count against another, a
-    path against another) hold where timing one point after another moved them by 40%
-    (benchmarks/README.md). The cost: all those renderers are alive at once (about 50-90 MB
-    each at 1280x720 on lights.toml). Without it, one point is built, timed and released after
-    another. ``progress(description)`` is called before each warm-up and each round.
+    point one frame of each kind (timed, passes fenced, CPU time), the points in a shuffled
+    order (seeded: the same orders each sweep). A drift in the machine's speed (other load,
+    clocks, llvmpipe's threads) then falls on every point alike, and so does whatever one point's
+    frames do to the next one's: in a fixed order each point followed the same one every round,
+    and a frame after a heavy one ran up to 40% slower (benchmarks/README.md). Ratios between
+    points (a light count against another, a path against another) hold where timing one
+    point after another moved them by 40%. The cost: all those renderers are alive at once
+    (about 50-90 MB each at 1280x720 on lights.toml). Without it, one point is built, timed and
+    released after another. ``progress(description)`` is called before each warm-up and each
+    round.
     """
     from .renderer import Renderer
 
@@ -519,6 +524,7 @@ def run_bench(scene: Scene, sweep: Sweep, gl: GLContext | None = None,
             lit = {lights: with_extra_lights(shelled, lights, aspect) for lights in sweep.lights}
             groups = [points] if sweep.interleave else [[point] for point in points]
             for group in groups:
+                order = random.Random(ROUND_ORDER_SEED)  # the same orders in every sweep
                 timed: list[_TimedPoint] = []
                 try:
                     for lights, pipeline, path in group:
@@ -533,8 +539,8 @@ def run_bench(scene: Scene, sweep: Sweep, gl: GLContext | None = None,
                                 f"{timed[0].lights} lights")
                         report(f"round {round_index + 1} of {sweep.runs}: {what}, "
                                f"{shells} shells")
-                        for k in range(len(timed)):
-                            timed[(round_index + k) % len(timed)].time_round()
+                        for k in order.sample(range(len(timed)), len(timed)):
+                            timed[k].time_round()
                     results += [point.result(shells, time_passes_gpu(point.renderer, sweep.runs)
                                              if timers else None) for point in timed]
                 finally:

@@ -323,13 +323,21 @@ def test_interleaved_points_alternate_their_frames_round_by_round(gl, monkeypatc
     assert Counter(frames) == {point: 1 + 3 * 3 + gpu for point in points}
     if interleave:
         # every renderer is warmed up first, then each round is 3 frames of each point, the
-        # round starting one point further on; all released at the end
+        # points in a shuffled order (seeded: the same each sweep); all released at the end
         assert frames[:4] == points
+        orders = []
         for k in range(3):
             round_frames = frames[4 + 12 * k:4 + 12 * (k + 1)]
-            assert round_frames == [p for p in points[k:] + points[:k] for _ in range(3)]
+            order = round_frames[::3]
+            assert sorted(order) == sorted(points)
+            assert round_frames == [p for p in order for _ in range(3)]
+            orders.append(order)
+        assert len({tuple(order) for order in orders}) > 1  # not one fixed order
         assert frames[40:] == [p for p in points for _ in range(gpu)]
         assert releases == list(range(len(events) - 4, len(events)))
+        again = _record_frames(monkeypatch)
+        run_bench(scene, sweep, gl=gl)
+        assert [p for kind, p in again if kind == "frame"][4:40] == frames[4:40]
     else:
         # one point's frames, then its release, then the next point's
         per_point = 10 + gpu
