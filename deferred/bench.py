@@ -491,7 +491,8 @@ def run_bench(scene: Scene, sweep: Sweep, gl: GLContext | None = None,
     order (seeded: the same orders each sweep). A drift in the machine's speed (other load,
     clocks, llvmpipe's threads) then falls on every point alike, and so does whatever one point's
     frames do to the next one's: in a fixed order each point followed the same one every round,
-    and a frame after a heavy one ran up to 40% slower (benchmarks/README.md). Ratios between
+    and one point's G-buffer passes, the same work as another's, ran 40% slower
+    (benchmarks/README.md). Ratios between
     points (a light count against another, a path against another) hold where timing one
     point after another moved them by 40%. The cost: all those renderers are alive at once
     (about 50-90 MB each at 1280x720 on lights.toml). Without it, one point is built, timed and
