@@ -165,10 +165,11 @@ def texture_overflow(grid: ListGrid, capacity: int, max_texture_size: int
     return (rows * LIST_ROW_BYTES, limit) if rows * LIST_ROW_BYTES > limit else None
 
 
-def _too_many_for_lists(lights: int, grid: ListGrid, size: int, limit: int) -> str:
-    return (f"{lights} lights need {size >> 20} MiB of light lists at this size "
-            f"({grid.count} lists); the limit is {limit >> 20} MiB: use fewer lights "
-            "or the volumes path")
+def _lists_too_big(what: str, grid: ListGrid, size: int, limit: int) -> str:
+    """The refusal of lists past a limit (before the first frame, or in one), ``what`` saying
+    which lights asked for them."""
+    return (f"{what}: the light lists need {size >> 20} MiB at this size ({grid.count} "
+            f"lists); the limit is {limit >> 20} MiB: use fewer lights or the volumes path")
 
 
 def check_light_limits(light_path: str, size: tuple[int, int], volume_lights: int,
@@ -184,7 +185,8 @@ def check_light_limits(light_path: str, size: tuple[int, int], volume_lights: in
         grid = list_grid(*size, light_path == "clustered")
         overflow = list_overflow(grid, volume_lights)  # every light in one list: the most
         if overflow is not None:
-            raise InputError(_too_many_for_lists(volume_lights, grid, *overflow), "light")
+            raise InputError(_lists_too_big(f"{volume_lights} lights", grid, *overflow),
+                             "light")
         if lights > MAX_LISTED_LIGHTS:  # a listed light's index in the light buffer
             raise InputError(f"{lights} lights; the light lists index at most "
                              f"{MAX_LISTED_LIGHTS}", "light")
@@ -238,12 +240,9 @@ class LightLists:
         coarse_overflow = list_overflow(grid, coarse_capacity)
         overflow = coarse_overflow or texture_overflow(grid, capacity, self.max_texture_size)
         if overflow is not None:
-            needed, limit = overflow
             most = coarse_capacity if coarse_overflow else capacity
-            raise RenderError(f"a tile's frustum holds {most} lights: the light lists "
-                              f"need {needed >> 20} MiB at this size ({grid.count} lists); the "
-                              f"limit is {limit >> 20} MiB: use fewer lights or the volumes "
-                              "path")
+            raise RenderError(_lists_too_big(f"a tile's frustum holds {most} lights", grid,
+                                             *overflow))
         self.grid = grid
         self.capacity = capacity
         self.coarse_capacity = coarse_capacity

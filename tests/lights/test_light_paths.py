@@ -255,7 +255,7 @@ def test_more_lights_than_the_coarse_lists_hold_is_refused_before_a_frame(gl, mo
 
     scene = scene_with(200)
     monkeypatch.setattr(light_lists, "MAX_LIST_BYTES", 4096)
-    with pytest.raises(InputError, match=r"^light: \d+ lights need .* light lists"):
+    with pytest.raises(InputError, match=r"^light: \d+ lights: the light lists need \d+ MiB"):
         Renderer(scene, gl=gl, light_path="tiled")
     Renderer(scene_with(40), gl=gl, light_path="tiled").release()  # 3 KB: accepted
     with Renderer(scene, gl=gl, light_path="volumes") as renderer:  # volumes has no lists
