@@ -1,6 +1,7 @@
 #!/bin/sh
-# Re-run the sweeps whose results benchmarks/README.md reports (about 45 minutes on two cores:
-# naive forward with 1024 lights takes 14 s a frame at 640x360 and 51 s at 1280x720).
+# Re-run the sweeps whose results benchmarks/README.md reports (about 30 minutes on two cores:
+# naive forward with 1024 lights takes 3.5 s a frame at 640x360 and 11 s at 1280x720, and each
+# point renders its warm-up, three frames a run, and a frame a run for the timer queries).
 # Run from the repository root with the package installed (`pip install -e .`).
 set -e
 out=benchmarks/results
@@ -14,11 +15,11 @@ deferred bench benchmarks/lights.toml --size 1280x720 --runs 3 --light-paths vol
     --json $out/lights-1280x720.json --csv $out/lights-1280x720.csv --plot $out/lights-1280x720.png
 
 # Light paths: every path of both pipelines, on lights.toml and on the overdraw scene.
-deferred bench benchmarks/lights.toml --size 640x360 --runs 2 --warmup 1 --lights 1,16,256,1024 \
+deferred bench benchmarks/lights.toml --size 640x360 --runs 7 --warmup 1 --lights 1,16,256,1024 \
     --json $out/paths-640x360.json --csv $out/paths-640x360.csv --plot $out/paths-640x360.png
-deferred bench benchmarks/lights.toml --size 1280x720 --runs 2 --warmup 1 --lights 1,16,256,1024 \
+deferred bench benchmarks/lights.toml --size 1280x720 --runs 3 --warmup 1 --lights 1,16,256,1024 \
     --json $out/paths-1280x720.json --csv $out/paths-1280x720.csv --plot $out/paths-1280x720.png
-deferred bench builtin:overdraw --size 640x360 --runs 2 --warmup 1 --lights 1,16,256 \
+deferred bench builtin:overdraw --size 640x360 --runs 3 --warmup 1 --lights 1,16,256 \
     --json $out/overdraw-640x360.json --csv $out/overdraw-640x360.csv \
     --plot $out/overdraw-640x360.png
 
