@@ -4,9 +4,9 @@ DESIGN.md, "Benchmarks". Every (pipeline, light path, lights, shells) point of a
 own renderer on one shared GL context: ``warmup`` untimed frames (shaders compile there), then
 ``runs`` rounds, each of one frame timed by wall clock around ``render()`` plus ``ctx.finish()``,
 one frame timing each pass the same way (kept apart so the per-pass ``finish()`` calls do not
-inflate the totals) and one frame of CPU time. The points of one shell count are timed together,
-their rounds interleaved (:func:`run_bench`), so that ratios between them survive the machine's
-drift.
+inflate the totals), one frame of CPU time, and one with GL timer queries where the driver
+answers them. The points of one shell count are timed together, their rounds interleaved
+(:func:`run_bench`), so that ratios between them survive the machine's drift.
 
 The light sweep adds ``L`` point lights to the scene's own, placed by a seeded generator inside
 the objects' world bounds where the camera sees them, each with a radius covering a fixed share
@@ -245,13 +245,6 @@ def time_frame(renderer) -> float:
     return (time.perf_counter() - start) * 1000.0
 
 
-def time_frames(renderer, runs: int, warmup: int) -> list[float]:
-    """Milliseconds of ``runs`` frames after ``warmup`` untimed ones (shaders compile there)."""
-    for _ in range(warmup):
-        renderer.render(readback=False)
-    return [time_frame(renderer) for _ in range(runs)]
-
-
 def cpu_frame(renderer) -> tuple[float, int]:
     """Milliseconds of the framework's own CPU work in one frame, and the frame's draw calls:
     the rendering thread's CPU time (``time.thread_time``: waits for the driver and the
@@ -288,11 +281,14 @@ def timer_queries_work(gl: GLContext) -> bool:
     return elapsed > 0
 
 
-def time_passes_gpu(renderer, runs: int) -> dict[str, float]:
-    """Median GL timer-query milliseconds of each pass (drivers that answer them)."""
-    ctx = renderer.gl.ctx
-    samples: dict[str, list[float]] = {p.name: [] for p in renderer.passes}
-    queries = {p.name: ctx.query(time=True) for p in renderer.passes}
+def timer_queries(renderer) -> dict[str, Any]:
+    """A GL time query per pass of ``renderer``, made once for all its frames (moderngl 5
+    cannot release a query)."""
+    return {p.name: renderer.gl.ctx.query(time=True) for p in renderer.passes}
+
+
+def gpu_frame(renderer, queries: dict[str, Any]) -> dict[str, float]:
+    """GL timer-query milliseconds of each pass of one frame (drivers that answer them)."""
 
     def before(render_pass, frame) -> None:
         queries[render_pass.name].__enter__()
@@ -300,19 +296,17 @@ def time_passes_gpu(renderer, runs: int) -> dict[str, float]:
     def after(render_pass, frame) -> None:
         queries[render_pass.name].__exit__(None, None, None)
 
-    for _ in range(runs):
-        renderer.render(before_pass=before, on_pass=after, readback=False)
-        ctx.finish()
-        for name, query in queries.items():
-            samples[name].append(query.elapsed / 1e6)
-    return {name: statistics.median(values) for name, values in samples.items()}
+    renderer.render(before_pass=before, on_pass=after, readback=False)
+    renderer.gl.ctx.finish()
+    return {name: query.elapsed / 1e6 for name, query in queries.items()}
 
 
 def pass_frame(renderer) -> dict[str, list[float]]:
-    """Milliseconds of each pass of one frame, in pass order.
+    """Milliseconds of each pass of one frame, in pass order, by wall clock.
 
-    ``finish()`` before and after every pass: llvmpipe answers no timer queries, and without the
-    fence a pass's work would be billed to whichever later pass waited for it.
+    ``finish()`` before and after every pass: without the fence a pass's work would be billed to
+    whichever later pass waited for it. (Timer queries, where a driver answers them, are
+    :func:`gpu_frame`'s.)
     """
     ctx = renderer.gl.ctx
     samples: dict[str, list[float]] = {p.name: [] for p in renderer.passes}
@@ -448,23 +442,30 @@ class _TimedPoint:
     pipeline: str
     light_path: str
     renderer: Any
+    queries: dict[str, Any] | None = None  # timer queries, where the driver answers them
     times_ms: list[float] = field(default_factory=list)
     passes_ms: dict[str, list[float]] = field(default_factory=dict)
     cpu_ms: list[float] = field(default_factory=list)
+    gpu_ms: dict[str, list[float]] = field(default_factory=dict)
     draw_calls: int = 0
 
     def time_round(self) -> None:
-        """One timed frame, one with every pass fenced, one of CPU time."""
+        """One timed frame, one with every pass fenced, one of CPU time, and one with timer
+        queries where the driver answers them."""
         self.times_ms.append(time_frame(self.renderer))
         for name, values in pass_frame(self.renderer).items():
             self.passes_ms.setdefault(name, []).extend(values)
         cpu, self.draw_calls = cpu_frame(self.renderer)
         self.cpu_ms.append(cpu)
+        if self.queries is not None:
+            for name, ms in gpu_frame(self.renderer, self.queries).items():
+                self.gpu_ms.setdefault(name, []).append(ms)
 
-    def result(self, shells: int, gpu: dict[str, float] | None) -> BenchResult:
+    def result(self, shells: int) -> BenchResult:
         return BenchResult(self.pipeline, self.lights, shells, *self.renderer.size,
                            self.times_ms, medians(self.passes_ms), self.light_path,
-                           statistics.median(self.cpu_ms), self.draw_calls, gpu)
+                           statistics.median(self.cpu_ms), self.draw_calls,
+                           medians(self.gpu_ms) if self.queries is not None else None)
 
 
 def sweep_points(sweep: Sweep) -> list[tuple[int, str, str]]:
@@ -487,7 +488,8 @@ def run_bench(scene: Scene, sweep: Sweep, gl: GLContext | None = None,
 
     With ``sweep.interleave`` (the default) the points of one shell count are timed together:
     every point's renderer is built and warmed up, then each of ``runs`` rounds gives every
-    point one frame of each kind (timed, passes fenced, CPU time), the points in a shuffled
+    point one frame of each kind (timed, passes fenced, CPU time, timer queries where the
+    driver answers them), the points in a shuffled
     order (seeded: the same orders each sweep). A drift in the machine's speed (other load,
     clocks, llvmpipe's threads) then falls on every point alike, and so does whatever one point's
     frames do to the next one's: in a fixed order each point followed the same one every round,
@@ -531,7 +533,8 @@ def run_bench(scene: Scene, sweep: Sweep, gl: GLContext | None = None,
                     for lights, pipeline, path in group:
                         report(f"warm-up: {pipeline} ({path}), {lights} lights, {shells} shells")
                         renderer = Renderer(lit[lights], pipeline, size, gl=gl, light_path=path)
-                        timed.append(_TimedPoint(lights, pipeline, path, renderer))
+                        timed.append(_TimedPoint(lights, pipeline, path, renderer,
+                                                 timer_queries(renderer) if timers else None))
                         for _ in range(sweep.warmup):
                             renderer.render(readback=False)
                     for round_index in range(sweep.runs):
@@ -542,8 +545,7 @@ def run_bench(scene: Scene, sweep: Sweep, gl: GLContext | None = None,
                                f"{shells} shells")
                         for k in order.sample(range(len(timed)), len(timed)):
                             timed[k].time_round()
-                    results += [point.result(shells, time_passes_gpu(point.renderer, sweep.runs)
-                                             if timers else None) for point in timed]
+                    results += [point.result(shells) for point in timed]
                 finally:
                     for point in timed:
                         point.renderer.release()

@@ -1,6 +1,6 @@
 """Frame capture: :func:`capture_frame` renders one frame and keeps, for each selected pass, the
 targets it wrote as they stood after it (top row first, in the stored type) and its wall-clock
-time (``ctx.finish()`` on both sides: GL timer queries read nothing on llvmpipe);
+time (``ctx.finish()`` on both sides, on any driver: timer queries are not on every one);
 :class:`FrameCapture` holds them with the end-of-frame targets and decodes the G-buffer.
 """
 

@@ -9,7 +9,11 @@ and refuses, naming the pass and the target:
 - a read or write of a target no pass creates (an unknown target);
 - a read or write before the pass that creates the target (no earlier producer);
 - a target sampled by the pass that draws into it (a GL feedback loop: snapshot it first with
-  :func:`deferred.passes.copy_pass`).
+  :func:`deferred.passes.copy_pass`);
+- a pass writing G-buffer surfaces (the surface id's target) with no depth target: the
+  deferred lighting runs where the depth is nearer than the far plane
+  (:func:`deferred.light_lists.list_shading_pass`), so such a surface would go unlit. (One
+  that tests against the depth without writing it draws over surfaces already there.)
 
 What it returns is every target of the frame with its format: the renderer creates exactly
 those, and clears each when its creating pass runs.
@@ -21,6 +25,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from .errors import RenderError
+from .gbuffer import DEPTH, NORMAL_EXPONENT_ID
 from .passes import RenderPass
 from .targets_spec import TargetSpec
 
@@ -65,6 +70,11 @@ def compile_graph(passes: Sequence[RenderPass]) -> PassGraph:
             if target in render_pass.writes:
                 raise PassGraphError(f"pass {render_pass.name}: samples target '{target}' while "
                                      "writing it (snapshot it first with copy_pass)")
+        if NORMAL_EXPONENT_ID in render_pass.writes and DEPTH not in render_pass.writes \
+                and DEPTH not in render_pass.reads:
+            raise PassGraphError(f"pass {render_pass.name}: writes G-buffer surfaces "
+                                 f"('{NORMAL_EXPONENT_ID}') with no '{DEPTH}': the lighting "
+                                 "runs only where a surface's depth was written")
         for kind, used in (("reads", render_pass.reads), ("writes", render_pass.writes)):
             for target in used:
                 if target in created:

@@ -145,8 +145,9 @@ def light_dispatch_glsl(light_types: list[type[Light]]) -> str:
     def loops(name: str, types: list[type[Light]], fetch: str) -> list[str]:
         # do-while: the test at the end of the body. Where a shader runs as SIMD lanes with
         # masks (llvmpipe), a for loop runs its body once more than it has lights, all lanes
-        # masked, to find that every lane is done; the `if` saves nothing there (its body runs
-        # masked), but keeps other GPUs from reading a record where a type has none.
+        # masked, to find that every lane is done. The `if` keeps a type with no lights from
+        # adding one (on llvmpipe by masking the body, which still runs; elsewhere by
+        # skipping it).
         body = [f"vec3 {name}(Surface s, vec3 P, vec3 V) {{", "    vec3 total = vec3(0.0);"]
         for cls in types:
             r = light_range_uniform(cls)

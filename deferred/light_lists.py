@@ -567,6 +567,6 @@ def list_shading_pass(name: str, clustered: bool, gbuffer: tuple[str, ...],
         defines["WRITE_COMPOSITE"] = "1"
     return FullscreenPass(name, Phase.LIGHTING, "lights/list_shading.frag", inputs, outputs,
                           defines=defines, creates=creates,
-                          uniforms=lambda frame: {"u_background": frame.scene.background},
+                          uniforms=lambda frame: {"u_background": background},
                           depth=DEPTH, depth_test=True, depth_func="greater",
                           order=Order.FIRST)

@@ -144,12 +144,13 @@ class DeferredPipeline(Pipeline):
             # each light type's pass adds into it
             # (cleared to the background, then drawn on the surfaces only: the depth test of
             # light_lists.list_shading_pass)
-            accumulation = replace(LIGHT_ACCUMULATION_SPEC, clear=(*scene.background, 0.0))
+            background_color = scene.background  # fixed when built (Renderer)
+            accumulation = replace(LIGHT_ACCUMULATION_SPEC, clear=(*background_color, 0.0))
             background = FullscreenPass(
                 "lighting.background", Phase.LIGHTING, "lights/background.frag",
                 {"u_normal_exponent_id": NORMAL_EXPONENT_ID}, (LIGHT_ACCUMULATION,),
                 creates={LIGHT_ACCUMULATION: accumulation}, order=Order.FIRST,
-                uniforms=lambda frame: {"u_background": frame.scene.background},
+                uniforms=lambda frame: {"u_background": background_color},
                 defines={"FULLSCREEN_AT_FAR": "1"}, depth=DEPTH, depth_test=True,
                 depth_func="greater")
             lights = [background, *(LightTypePass(cls, occlusion, layout.color_targets)

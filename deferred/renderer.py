@@ -80,6 +80,11 @@ class Renderer:
     (default: the ``DEFERRED_STRICT`` environment variable). ``light_path`` chooses how lights
     reach the pixels (:mod:`deferred.light_lists`; default: the scene's ``light_path``, else
     the fastest the context allows).
+
+    The scene's objects, lights, camera and materials' parameters may change between frames.
+    Its background and tone mapping operator are read when the passes are built, here (the
+    background is the clear value of the targets the lighting creates, the operator a define
+    of the tone mapping pass): a change to either takes a new renderer.
     """
 
     def __init__(self, scene: Scene, pipeline: str = "deferred",

@@ -1,7 +1,8 @@
 // Deferred lighting from light lists (the tiled and clustered paths): each pixel reads the
 // G-buffer once and loops over the full-screen lights and the volume lights of its tile or
-// cluster - one pass for every light, which writes the light accumulation whole (the
-// background where there is no surface).
+// cluster - one pass for every light. It runs on surface pixels only (its triangle on the far
+// plane, the depth test "greater": deferred.light_lists.list_shading_pass); its targets are
+// cleared to the background first, so it writes the light accumulation whole.
 #include "gbuffer/fetch.glsl"
 #include "common/light_buffer.glsl"
 #include "generated/lights.glsl"
@@ -30,7 +31,7 @@ void write_light(vec4 light) {
 void main() {
     ivec2 pixel = ivec2(gl_FragCoord.xy);
     GBufferSample g = gbuffer_fetch(pixel);
-    if (g.surface_id <= 0.0) {  // the pass creates the light accumulation: every pixel
+    if (g.surface_id <= 0.0) {  // depth written but no surface: the background here too
         write_light(vec4(u_background, 0.0));
         return;
     }

@@ -27,7 +27,7 @@ vec3 evaluate_listed_lights(int list, Surface s, vec3 P, vec3 V) {
     vec3 total = vec3(0.0);
     int length = light_list_length(list);
     int first = light_list_first_slot(list);
-    if (length > 0) {  // masked on llvmpipe, as above; a real branch elsewhere
+    if (length > 0) {  // an empty list adds nothing (masked on llvmpipe, skipped elsewhere)
         int k = 0;
         do {
             ListedLight listed = listed_light(first + k);

@@ -1,6 +1,7 @@
 // One triangle covering the screen; v_uv is 0..1 over the viewport.
 // FULLSCREEN_AT_FAR puts it on the far plane (depth 1), where a depth test "greater" against
-// the scene's depth passes on its surfaces only (deferred.light_lists.ListShadingPass).
+// the scene's depth passes on its surfaces only (deferred.light_lists.list_shading_pass, the
+// volumes path's background pass).
 out vec2 v_uv;
 
 void main() {

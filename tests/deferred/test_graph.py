@@ -259,3 +259,23 @@ def test_a_parameter_may_not_shadow_a_framework_uniform(render):
     with pytest.raises(RenderError, match="parameters would set the framework's uniform "
                                           "u_resolution"):
         render(scene)
+
+
+def test_a_gbuffer_pass_writing_surfaces_without_depth_is_refused(render):
+    """The lighting runs where the G-buffer's depth is nearer than the far plane: a pass that
+    wrote surfaces without depth would leave them unlit, so it is refused before it runs."""
+    from deferred.material import GBufferPass
+
+    scene = scene_from_dict(SCENE)
+    _, renderer = render(scene)
+    obj = scene.objects[0]
+    without = GBufferPass("test.no_depth", Phase.GEOMETRY, obj, depth=None)
+    with pytest.raises(PassGraphError, match="pass test.no_depth: writes G-buffer surfaces "
+                                             r"\('normal_exponent_id'\) with no 'depth'"):
+        renderer.insert_pass(without, after="gbuffer.clear")
+    # the same pass writing depth, or testing against it to draw over surfaces already there
+    renderer.insert_pass(GBufferPass("test.with_depth", Phase.GEOMETRY, obj),
+                         after="gbuffer.clear")
+    renderer.insert_pass(GBufferPass("test.over_depth", Phase.GEOMETRY, obj, depth_write=False,
+                                     depth_func="lequal"), after="test.with_depth")
+    assert {"test.with_depth", "test.over_depth"} <= {p.name for p in renderer.passes}
