@@ -15,6 +15,7 @@ from deferred.dump import contact_tiles, write_dump
 from deferred.dump_compare import compare_dumps
 from deferred.gbuffer import decode
 from deferred.imageio import read_channels, read_image, write_image
+from deferred.passes import FullscreenPass, Phase
 from deferred.pixel_history import pixel_history
 from deferred.renderer import Renderer
 from deferred.scene import scene_from_dict
@@ -351,6 +352,41 @@ def test_full_screen_lighting_runs_on_surfaces_only(gl, light_path, passes):
         background = np.array(capture.target("light_accumulation")[sky_y, sky_x], np.float32)
         np.testing.assert_allclose(background, [0.25, 0.5, 0.75, 0.0], atol=1e-3)
         assert capture.target("light_accumulation")[floor_y, floor_x][3] == 1.0  # coverage
+    finally:
+        r.release()
+
+
+@pytest.mark.parametrize("light_path", ["volumes", "tiled", "clustered"])
+def test_depth_without_a_surface_holds_the_background(gl, light_path):
+    """A pixel whose depth was written with no G-buffer surface (a depth-only pass over the
+    sky) passes the lighting's depth test; the shaders then write the background there, as
+    the clear does on the rest of the sky."""
+    from pathlib import Path
+
+    from deferred.gbuffer import DEPTH
+
+    scene = small_scene()
+    scene.background = (0.25, 0.5, 0.75)
+    r = Renderer(scene, "deferred", gl=gl, light_path=light_path)
+    try:
+        r.shaders.add_root(Path(__file__).parents[1] / "fixtures" / "depth_only")
+        depth_only = FullscreenPass("test.depth_only", Phase.GEOMETRY, "depth_only.frag", {},
+                                    (), depth=DEPTH, depth_test=True, depth_func="always",
+                                    depth_write=True)  # GL writes depth only when testing it
+        r.insert_pass(depth_only, after="gbuffer.clear")
+        capture = capture_frame(r)
+        depth = capture.target("depth")[..., 0]
+        width = depth.shape[1]
+        light = np.asarray(capture.target("light_accumulation"), np.float32)
+        ids = capture.target("normal_exponent_id")[..., 3]
+        sky_left = (ids <= 0.0) & (np.arange(width) < width // 2)[None, :]
+        sky_right = (ids <= 0.0) & (np.arange(width) >= width // 2)[None, :]
+        assert sky_left.any() and sky_right.any()
+        assert np.all(depth[sky_left] < 1.0) and np.all(depth[sky_right] >= 1.0)
+        for sky in (sky_left, sky_right):
+            np.testing.assert_allclose(light[sky], np.broadcast_to([0.25, 0.5, 0.75, 0.0],
+                                                                   light[sky].shape), atol=1e-3)
+        assert np.all(light[ids > 0.0][:, 3] == 1.0)
     finally:
         r.release()
 
