@@ -14,7 +14,14 @@ from .gbuffer import (
     data_write_file,
     data_write_glsl,
 )
-from .light import DISPATCH_FILE, SHADING_DISPATCH_FILE, Light, light_dispatch_glsl
+from .light import (
+    DISPATCH_FILE,
+    LISTED_DISPATCH_FILE,
+    SHADING_DISPATCH_FILE,
+    Light,
+    light_dispatch_glsl,
+    listed_dispatch_glsl,
+)
 from .material import Material
 from .shading import GBufferLayout, ShadingModel, material_data, shading_dispatch_glsl
 
@@ -25,6 +32,7 @@ def generated_glsl(light_types: list[type[Light]], shading_models: list[type[Sha
     names = list(layout.data)
     files = {
         DISPATCH_FILE: light_dispatch_glsl(light_types),
+        LISTED_DISPATCH_FILE: listed_dispatch_glsl(light_types),
         SHADING_DISPATCH_FILE: shading_dispatch_glsl(shading_models),
         DATA_STRUCT_FILE: data_struct_glsl(names),
         DATA_FETCH_FILE: data_fetch_glsl(names),

@@ -69,6 +69,12 @@ ListedLight listed_light(int slot) {
                        int(texel.w >> 16));
 }
 
+// Whether the listed light's sphere holds P (the shading's test before evaluating it).
+bool listed_light_reaches(ListedLight listed, vec3 P) {
+    vec3 to_light = listed.sphere.xyz - P;
+    return dot(to_light, to_light) <= listed.sphere.w * listed.sphere.w;
+}
+
 // Its whole record: the light buffer's (only what the light's type reads is read), with the
 // sphere as listed. Its radius is a half float rounded up, so a light's window reaches 0 up
 // to 2^-10 of the radius further out than on the volumes and naive paths (PSNR 61 dB at 1024

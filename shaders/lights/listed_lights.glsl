@@ -22,19 +22,9 @@
 #include "common/light_buffer.glsl"
 #include "generated/lights.glsl"
 #include "lights/light_lists.glsl"
+#include "generated/listed_lights.glsl"
 
 vec3 evaluate_listed_lights(int list, Surface s, vec3 P, vec3 V) {
-    vec3 total = vec3(0.0);
-    int length = light_list_length(list);
-    int first = light_list_first_slot(list);
-    if (length > 0) {  // an empty list adds nothing (masked on llvmpipe, skipped elsewhere)
-        int k = 0;
-        do {
-            ListedLight listed = listed_light(first + k);
-            vec3 to_light = listed.sphere.xyz - P;
-            if (dot(to_light, to_light) <= listed.sphere.w * listed.sphere.w)
-                total += evaluate_volume_light(listed_light_record(listed), s, P, V);
-        } while (++k < length);
-    }
-    return total;
+    // the loops, a do-while per volume light type: deferred.light.listed_dispatch_glsl
+    return evaluate_listed_slots(light_list_first_slot(list), light_list_length(list), s, P, V);
 }

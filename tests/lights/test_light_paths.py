@@ -658,3 +658,54 @@ def test_the_light_lists_view_needs_a_path_with_lists(gl):
         with pytest.raises(InputError, match=r"^--view: view 'light_lists' shows the light "
                                              r"lists, which only the tiled and clustered"):
             resolve_view("light_lists", renderer.passes)
+
+
+def mixed_scene(points_culled: bool):
+    """scene_with(120) with every other extra light a spot of the same sphere; with
+    ``points_culled``, the point lights all behind the camera (culled before upload: the point
+    type's range is empty this frame while the spots are listed)."""
+    from deferred.lights.point import PointLight
+    from deferred.lights.spot import SpotLight
+
+    scene = scene_with(120)
+    lights = []
+    for index, light in enumerate(scene.lights):
+        if light.name != "point":
+            lights.append(light)
+            continue
+        p = light.params
+        if index % 2:
+            lights.append(SpotLight.from_dict({
+                "position": tuple(p.position), "radius": p.radius, "color": tuple(p.color),
+                "intensity": p.intensity, "direction": (0.3, -1.0, 0.2), "inner_angle": 25.0,
+                "outer_angle": 50.0}))
+        elif points_culled:
+            lights.append(PointLight.from_dict({"position": (0.0, 1.6, 9.0), "radius": 1.0}))
+        else:
+            lights.append(light)
+    scene.lights = lights
+    return scene
+
+
+@pytest.mark.parametrize("points_culled", [False, True])
+@pytest.mark.parametrize("pipeline, path, reference_path", [
+    ("deferred", "tiled", "volumes"), ("deferred", "clustered", "volumes"),
+    ("forward", "tiled", "naive")])
+def test_lists_of_point_and_spot_lights_give_the_reference_image(gl, points_culled, pipeline,
+                                                                  path, reference_path):
+    """The list loops run a loop per light type over its entries (a list holds its lights in
+    light order, the light buffer its types in order): points and spots mixed, and spots alone
+    where every point light is culled, give the image of the path with no lists."""
+    from deferred.registry import lights as light_types
+
+    scene = mixed_scene(points_culled)
+    reference, _ = render(gl, scene, pipeline, reference_path)
+    result, used = render(gl, scene, pipeline, path)
+    assert used == path
+    peak = float(reference.hdr[..., :3].max())
+    assert psnr(result.hdr[..., :3], reference.hdr[..., :3], peak) >= 40.0
+    with Renderer(scene, pipeline, gl=gl, light_path=path) as renderer:
+        renderer.render()
+        point, spot = (renderer.light_buffer.range(light_types.get(name))[1]
+                       for name in ("point", "spot"))
+    assert spot == 61 and point == (0 if points_culled else 61)  # with the scene's own two
