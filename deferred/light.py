@@ -240,7 +240,9 @@ class LightTypePass(RenderPass):
             return
         sphere = self.light_type.volume == "sphere"
         vertex = "lights/volume.vert" if sphere else "lights/fullscreen.vert"
-        defines = {"HAS_SSAO": "1"} if self.occlusion else {}
+        defines = {"LIGHT_FUNCTION": self.light_type.glsl_function}
+        if self.occlusion:
+            defines["HAS_SSAO"] = "1"
         if not sphere:
             defines["FULLSCREEN_AT_FAR"] = "1"
         program = frame.shaders.program(vertex, "lights/accumulate.frag", defines=defines)

@@ -20,5 +20,11 @@ void main() {
 #endif
     vec3 P = view_position(gl_FragCoord.xy, g.linear_depth, u_resolution, u_inverse_projection);
     vec3 V = normalize(-P);
+#ifdef LIGHT_FUNCTION
+    // the pass's one type (deferred.light.LightTypePass): the switch of evaluate_light would run
+    // every type's evaluation on llvmpipe, where an `if` skips nothing
+    out_light = vec4(LIGHT_FUNCTION(fetch_light(v_light_index), g.surface, P, V), 0.0);
+#else
     out_light = vec4(evaluate_light(fetch_light(v_light_index), g.surface, P, V), 0.0);
+#endif
 }
