@@ -2,11 +2,13 @@
 
 DESIGN.md, "Benchmarks". Every (pipeline, light path, lights, shells) point of a sweep gets its
 own renderer on one shared GL context: ``warmup`` untimed frames (shaders compile there), then
-``runs`` rounds, each of one frame timed by wall clock around ``render()`` plus ``ctx.finish()``,
-one frame timing each pass the same way (kept apart so the per-pass ``finish()`` calls do not
-inflate the totals), one frame of CPU time, and one with GL timer queries where the driver
-answers them. The points of one shell count are timed together, their rounds interleaved
-(:func:`run_bench`), so that ratios between them survive the machine's drift.
+``runs`` rounds, each of frames timed by wall clock around ``render()`` plus ``ctx.finish()``
+(back to back for ``round_ms``, the first dropped: a 20 ms frame is timed four times a round, a
+3 s one once), one frame timing each pass the same way (kept apart so the per-pass
+``finish()`` calls do not inflate the totals), one frame of CPU time, and one with GL timer
+queries where the driver answers them. The points of one shell count are timed together,
+their rounds interleaved (:func:`run_bench`), so that ratios between them survive the
+machine's drift.
 
 The light sweep adds ``L`` point lights to the scene's own, placed by a seeded generator inside
 the objects' world bounds where the camera sees them, each with a radius covering a fixed share
@@ -59,6 +61,7 @@ DEFAULT_SHELLS = (0, 16, 64)
 MAX_LIGHTS = 16384  # the GL 3.3 path keeps one light per row of a texture
 LIGHT_SEED = 0
 ROUND_ORDER_SEED = 0  # run_bench: the order of the points in each round
+ROUND_FRAMES = 5  # the most frames a point renders back to back in a round (Sweep.round_ms)
 # A light's radius is this share of the half-height of the view at its depth: on screen each
 # sphere spans about 15% of the image height, in any scene at any scale.
 LIGHT_VIEW_SHARE = 0.3
@@ -427,6 +430,9 @@ class Sweep:
     runs: int = 10
     warmup: int = 2
     interleave: bool = True  # the points of a shell count timed together (run_bench)
+    # a point's timed frames in a round: back to back until they make this (ROUND_FRAMES at
+    # most, the first dropped where there are more); 0: one a round
+    round_ms: float = 100.0
 
 
 def sweep_shells(scene: Scene, shells: Sequence[int]) -> list[int]:
@@ -449,10 +455,15 @@ class _TimedPoint:
     gpu_ms: dict[str, list[float]] = field(default_factory=dict)
     draw_calls: int = 0
 
-    def time_round(self) -> None:
-        """One timed frame, one with every pass fenced, one of CPU time, and one with timer
+    def time_round(self, round_ms: float) -> None:
+        """Timed frames back to back until they make ``round_ms`` (at most ROUND_FRAMES; the
+        first dropped where there are more, since it pays for the frame of another point just
+        before it), one frame with every pass fenced, one of CPU time, and one with timer
         queries where the driver answers them."""
-        self.times_ms.append(time_frame(self.renderer))
+        frames = [time_frame(self.renderer)]
+        while len(frames) < ROUND_FRAMES and sum(frames) < round_ms:
+            frames.append(time_frame(self.renderer))
+        self.times_ms += frames[1:] if len(frames) > 1 else frames
         for name, values in pass_frame(self.renderer).items():
             self.passes_ms.setdefault(name, []).extend(values)
         cpu, self.draw_calls = cpu_frame(self.renderer)
@@ -488,8 +499,9 @@ def run_bench(scene: Scene, sweep: Sweep, gl: GLContext | None = None,
 
     With ``sweep.interleave`` (the default) the points of one shell count are timed together:
     every point's renderer is built and warmed up, then each of ``runs`` rounds gives every
-    point one frame of each kind (timed, passes fenced, CPU time, timer queries where the
-    driver answers them), the points in a shuffled
+    point its frames (timed ones back to back for ``sweep.round_ms``, the first of them
+    dropped, then one with its passes fenced, one of CPU time, one with timer queries where
+    the driver answers them), the points in a shuffled
     order (seeded: the same orders each sweep). A drift in the machine's speed (other load,
     clocks, llvmpipe's threads) then falls on every point alike, and so does whatever one point's
     frames do to the next one's: in a fixed order each point followed the same one every round,
@@ -544,7 +556,7 @@ def run_bench(scene: Scene, sweep: Sweep, gl: GLContext | None = None,
                         report(f"round {round_index + 1} of {sweep.runs}: {what}, "
                                f"{shells} shells")
                         for k in order.sample(range(len(timed)), len(timed)):
-                            timed[k].time_round()
+                            timed[k].time_round(sweep.round_ms)
                     results += [point.result(shells) for point in timed]
                 finally:
                     for point in timed:

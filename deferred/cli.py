@@ -298,8 +298,8 @@ def _compare(first: str, second: str, output: str | None) -> None:
               help="Shell counts for every object whose material has 'shells'.")
 @click.option("--size", help="WIDTHxHEIGHT, overrides the scene's size.")
 @click.option("--runs", type=click.IntRange(min=1, max=10_000), default=10, show_default=True,
-              help="Timed frames per point (and as many again for the per-pass times and the "
-                   "CPU times).")
+              help="Rounds per point: in each, its frames timed back to back for 100 ms (1 to "
+                   "4 counted), then one with each pass timed and one of CPU time.")
 @click.option("--warmup", type=click.IntRange(min=0, max=10_000), default=2, show_default=True,
               help="Untimed frames first (shader compilation, first uploads).")
 @click.option("--pipelines", default="deferred,forward", show_default=True, metavar="NAME,...")

@@ -76,8 +76,9 @@ def test_cli_sweep_writes_json_csv_plot(tmp_path, capsys):
     demo = load_scene(None)
     for r in results:
         assert list(r) == list(COLUMNS)
-        assert (r["width"], r["height"], r["runs"]) == (64, 36, 2)
-        assert len(r["times_ms"]) == 2 and all(t > 0.0 for t in r["times_ms"])
+        # two rounds, each 1-4 timed frames (back to back for 100 ms, the first dropped)
+        assert (r["width"], r["height"]) == (64, 36) and 2 <= r["runs"] <= 8
+        assert len(r["times_ms"]) == r["runs"] and all(t > 0.0 for t in r["times_ms"])
         assert r["min_ms"] <= r["median_ms"] <= r["max_ms"]
         assert r["min_ms"] <= r["mean_ms"] <= r["max_ms"]
         assert r["min_ms"] == min(r["times_ms"]) and r["max_ms"] == max(r["times_ms"])
@@ -124,7 +125,7 @@ def test_scene_without_shells_sweeps_one_value(gl, capsys):
     scene = standard_scene()
     assert shell_objects(scene) == []
     report = run_bench(scene, Sweep(lights=[0, 2], shells=[0, 16, 64], runs=1, warmup=0,
-                                    light_paths=["volumes", "naive"]), gl=gl)
+                                    light_paths=["volumes", "naive"], round_ms=0.0), gl=gl)
     assert [(r.pipeline, r.lights, r.shells) for r in report.results] == [
         ("deferred", 0, 0), ("forward", 0, 0), ("deferred", 2, 0), ("forward", 2, 0)]
     assert all(r.runs == 1 and r.stddev_ms == 0.0 for r in report.results)
@@ -304,7 +305,7 @@ def test_interleaved_points_alternate_their_frames_round_by_round(gl, monkeypatc
     events = _record_frames(monkeypatch)
     steps = []
     sweep = Sweep(lights=[0, 3], runs=3, warmup=1, light_paths=["tiled"],
-                  interleave=interleave)
+                  interleave=interleave, round_ms=0.0)  # one timed frame a round
     report = run_bench(scene, sweep, gl=gl, progress=steps.append)
     from deferred.bench import sweep_steps
 
@@ -346,3 +347,19 @@ def test_interleaved_points_alternate_their_frames_round_by_round(gl, monkeypatc
     if report.renderer["gl_timer_queries"]:
         assert all(r.gpu_passes_ms and set(r.gpu_passes_ms) == set(r.passes_ms)
                    for r in report.results)
+
+
+def test_a_round_times_a_cheap_point_back_to_back_and_drops_the_first(gl, monkeypatch):
+    """Within a round a point's timed frames run back to back until they make round_ms (at
+    most ROUND_FRAMES), and the first, which follows another point's frames, is dropped."""
+    from deferred.bench import ROUND_FRAMES
+
+    events = _record_frames(monkeypatch)
+    scene = standard_scene()
+    report = run_bench(scene, Sweep(lights=[0], runs=2, warmup=0, light_paths=["naive"],
+                                    pipelines=["forward"], round_ms=1e9), gl=gl)
+    kinds = 4 if report.renderer["gl_timer_queries"] else 3
+    (result,) = report.results
+    assert result.runs == len(result.times_ms) == 2 * (ROUND_FRAMES - 1)
+    frames = [p for kind, p in events if kind == "frame"]
+    assert len(frames) == 2 * (ROUND_FRAMES + kinds - 1)
