@@ -12,7 +12,7 @@ and refuses, naming the pass and the target:
   :func:`deferred.passes.copy_pass`);
 - a pass writing G-buffer surfaces (the surface id's target) with no depth target: the
   deferred lighting runs where the depth is nearer than the far plane
-  (:func:`deferred.light_lists.list_shading_pass`), so such a surface would go unlit. (One
+  (:func:`deferred.light.surface_pass`), so such a surface would go unlit. (One
   that tests against the depth without writing it draws over surfaces already there.)
 
 What it returns is every target of the frame with its format: the renderer creates exactly

@@ -13,6 +13,7 @@ cost follows the pixels a light touches.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from functools import lru_cache
 from importlib.resources.abc import Traversable
 from pathlib import Path
@@ -25,8 +26,9 @@ from .context import GL_DEPTH_CLAMP
 from .gbuffer import DEPTH, GBUFFER_COLOR_TARGETS
 from .mesh import MeshData, build_mesh
 from .params import Params, validate_params
-from .passes import Phase, RenderPass
+from .passes import FullscreenPass, Order, Phase, RenderPass
 from .targets import LIGHT_ACCUMULATION
+from .targets_spec import TargetSpec
 from .validation import Radiance
 
 if TYPE_CHECKING:
@@ -214,6 +216,26 @@ def light_volume_mesh() -> tuple[MeshData, float]:
     mesh = build_mesh("light-volume", vertices, faces, vertices,
                       uvs=np.zeros((len(vertices), 2)))
     return mesh, 1.0 / float(inscribed)
+
+
+def surface_pass(name: str, fragment: str, inputs: dict[str, str],
+                 creates: dict[str, TargetSpec], background: tuple[float, float, float],
+                 defines: dict[str, str] | None = None) -> FullscreenPass:
+    """A full-screen pass of the lighting phase that runs on the scene's surfaces only: it
+    creates ``creates`` cleared to ``background`` (alpha 0; its shader's ``u_background``, for
+    pixels with depth but no surface), and draws its triangle on the far plane with the depth
+    test "greater" against the G-buffer's depth (``common/fullscreen_triangle.glsl``). On
+    llvmpipe a block of pixels failing that test is skipped, where an ``if`` in the shader
+    skips nothing: the list shading (``deferred.light_lists.list_shading_pass``) and the
+    volumes path's background pass."""
+    cleared = (*background, 0.0)
+    return FullscreenPass(name, Phase.LIGHTING, fragment, inputs, tuple(creates),
+                          defines={"FULLSCREEN_AT_FAR": "1", **(defines or {})},
+                          creates={target: replace(spec, clear=cleared)
+                                   for target, spec in creates.items()},
+                          uniforms=lambda frame: {"u_background": background},
+                          depth=DEPTH, depth_test=True, depth_func="greater",
+                          order=Order.FIRST)
 
 
 class LightTypePass(RenderPass):

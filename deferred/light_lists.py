@@ -35,15 +35,15 @@ CPU (:func:`list_capacity`), so no list overflows.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import moderngl
 import numpy as np
 
 from .errors import InputError, RenderError
-from .gbuffer import DEPTH, LINEAR_DEPTH
-from .light import FULLSCREEN_LIGHT_CAPACITY
+from .gbuffer import LINEAR_DEPTH
+from .light import FULLSCREEN_LIGHT_CAPACITY, surface_pass
 from .lightbuffer import fullscreen_overflow
 from .passes import FullscreenPass, Order, Phase, RenderPass
 
@@ -544,29 +544,20 @@ def list_shading_pass(name: str, clustered: bool, gbuffer: tuple[str, ...],
     With ``composite`` it creates the composition buffer too, the same values (a frame with
     no material pass: the copy between them would be all the material phase did).
 
-    Its targets are cleared to the background, and its triangle lies on the far plane with the
-    depth test "greater" against the G-buffer's depth, so the shader runs on surfaces only: on
-    llvmpipe, where an ``if`` skips nothing, a block of pixels that fails the depth test is the
-    one thing skipped (lights.toml, 640x360, about a third background: the pass 14.2 -> 11.3 ms
-    at 1 light, 20.7 -> 16.3 at 256, 40.0 -> 35.7 at 1024)."""
+    It runs on surfaces only (:func:`deferred.light.surface_pass`: lights.toml, 640x360, about
+    a third background: the pass 14.2 -> 11.3 ms at 1 light, 20.7 -> 16.3 at 256, 40.0 -> 35.7
+    at 1024)."""
     from .targets import COMPOSITE, COMPOSITE_SPEC, LIGHT_ACCUMULATION, LIGHT_ACCUMULATION_SPEC
 
     inputs = {f"u_{target}": target for target in gbuffer}
-    defines = {"FULLSCREEN_AT_FAR": "1"}
+    defines = {}
     if occlusion:
         inputs["u_ssao"] = occlusion
         defines["HAS_SSAO"] = "1"
     if clustered:
         defines["LIGHT_LISTS_CLUSTERED"] = "1"
-    cleared = (*background, 0.0)
-    outputs = (LIGHT_ACCUMULATION,)
-    creates = {LIGHT_ACCUMULATION: replace(LIGHT_ACCUMULATION_SPEC, clear=cleared)}
+    creates = {LIGHT_ACCUMULATION: LIGHT_ACCUMULATION_SPEC}
     if composite:
-        outputs += (COMPOSITE,)
-        creates[COMPOSITE] = replace(COMPOSITE_SPEC, clear=cleared)
+        creates[COMPOSITE] = COMPOSITE_SPEC
         defines["WRITE_COMPOSITE"] = "1"
-    return FullscreenPass(name, Phase.LIGHTING, "lights/list_shading.frag", inputs, outputs,
-                          defines=defines, creates=creates,
-                          uniforms=lambda frame: {"u_background": background},
-                          depth=DEPTH, depth_test=True, depth_func="greater",
-                          order=Order.FIRST)
+    return surface_pass(name, "lights/list_shading.frag", inputs, creates, background, defines)

@@ -23,7 +23,7 @@ from .effect import AMBIENT_OCCLUSION
 from .errors import InputError
 from .gbuffer import DEPTH, GBUFFER_TARGETS, LINEAR_DEPTH, NORMAL_EXPONENT_ID
 from .graph import compile_graph
-from .light import LightTypePass
+from .light import LightTypePass, surface_pass
 from .light_lists import LightCullPass, list_shading_pass
 from .material import ForwardLitPass
 from .passes import ClearPass, FullscreenPass, ObjectPass, Order, Phase, RenderPass, copy_pass
@@ -140,19 +140,12 @@ class DeferredPipeline(Pipeline):
             else None
         folded = False  # the composition made by the lighting pass (below)
         if self.light_path == "volumes":
-            # the light accumulation starts as 0 on surfaces and the background elsewhere;
-            # each light type's pass adds into it
-            # (cleared to the background, then drawn on the surfaces only: the depth test of
-            # light_lists.list_shading_pass)
-            background_color = scene.background  # fixed when built (Renderer)
-            accumulation = replace(LIGHT_ACCUMULATION_SPEC, clear=(*background_color, 0.0))
-            background = FullscreenPass(
-                "lighting.background", Phase.LIGHTING, "lights/background.frag",
-                {"u_normal_exponent_id": NORMAL_EXPONENT_ID}, (LIGHT_ACCUMULATION,),
-                creates={LIGHT_ACCUMULATION: accumulation}, order=Order.FIRST,
-                uniforms=lambda frame: {"u_background": background_color},
-                defines={"FULLSCREEN_AT_FAR": "1"}, depth=DEPTH, depth_test=True,
-                depth_func="greater")
+            # the light accumulation starts as 0 on surfaces and the background elsewhere
+            # (its clear); each light type's pass adds into it
+            background = surface_pass("lighting.background", "lights/background.frag",
+                                      {"u_normal_exponent_id": NORMAL_EXPONENT_ID},
+                                      {LIGHT_ACCUMULATION: LIGHT_ACCUMULATION_SPEC},
+                                      scene.background)
             lights = [background, *(LightTypePass(cls, occlusion, layout.color_targets)
                                     for cls in scene.light_types())]
         else:
