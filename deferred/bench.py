@@ -501,17 +501,15 @@ def run_bench(scene: Scene, sweep: Sweep, gl: GLContext | None = None,
     every point's renderer is built and warmed up, then each of ``runs`` rounds gives every
     point its frames (timed ones back to back for ``sweep.round_ms``, the first of them
     dropped, then one with its passes fenced, one of CPU time, one with timer queries where
-    the driver answers them), the points in a shuffled
-    order (seeded: the same orders each sweep). A drift in the machine's speed (other load,
-    clocks, llvmpipe's threads) then falls on every point alike, and so does whatever one point's
-    frames do to the next one's: in a fixed order each point followed the same one every round,
-    and one point's G-buffer passes, the same work as another's, ran 40% slower
-    (benchmarks/README.md). Ratios between
-    points (a light count against another, a path against another) hold where timing one
-    point after another moved them by 40%. The cost: all those renderers are alive at once
-    (about 50-90 MB each at 1280x720 on lights.toml). Without it, one point is built, timed and
-    released after another. ``progress(description)`` is called before each warm-up and each
-    round.
+    the driver answers them), the points in a shuffled order (seeded: the same orders each
+    sweep). A drift in the machine's speed (other load, clocks, llvmpipe's threads) then falls
+    on every point alike, and so does whatever one point's frames do to the next one's: in a
+    fixed order each point followed the same one every round, and one point's G-buffer passes,
+    the same work as another's, ran 40% slower (benchmarks/README.md). Ratios between points
+    (a light count against another, a path against another) hold where timing one point after
+    another moved them by 40%. The cost: all those renderers are alive at once (about 50-90 MB
+    each at 1280x720 on lights.toml). Without it, one point is built, timed and released
+    after another. ``progress(description)`` is called before each warm-up and each round.
     """
     from .renderer import Renderer
 

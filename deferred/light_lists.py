@@ -484,9 +484,9 @@ class LightCullPass(RenderPass):
                                                   frame.inverse_projection, frame.width,
                                                   frame.height, tile, slices)
 
-        coarse = 1 if self.clustered else capacity(coarse_grid(grid).tile)
+        coarse_capacity = 1 if self.clustered else capacity(coarse_grid(grid).tile)
         frame.light_lists.prepare(grid, capacity(grid.tile, slices), camera.near, camera.far,
-                                  coarse)
+                                  coarse_capacity)
         defines = {"CULL_GROUP_SIZE": str(CULL_GROUP_SIZE), "LIST_IMAGE_UNIT": str(LIST_IMAGE_UNIT)}
         if self.from_near:
             defines["CULL_FROM_NEAR"] = "1"
