@@ -80,6 +80,12 @@ class Material:
     # parameters the material reads once, at t = 0 (a simulation's set-up): a scene timeline
     # may not change them
     timeline_fixed: ClassVar[tuple[str, ...]] = ()
+    # Whether uniforms() and textures() are a function of the params alone (textures made
+    # through frame.resources, which last as long as the renderer): the renderer then keeps
+    # them from frame to frame while the params are the same object. None: where the class
+    # keeps Material's own uniforms and textures (Material.keeps_inputs). A material reading
+    # the frame (its time, size or targets) in them leaves it unset or False.
+    inputs_from_params: ClassVar[bool | None] = None
     # debug views (``deferred render --view <material>.<name>``): name -> (what it shows, the
     # parameters that make the material draw it)
     debug_views: ClassVar[dict[str, tuple[str, dict[str, Any]]]] = {}
@@ -116,7 +122,9 @@ class Material:
         return cls.surface_shader.rpartition("/")[0]
 
     def defines(self, obj: SceneObject) -> dict[str, str]:
-        """Preprocessor defines of this material's programs for ``obj``."""
+        """Preprocessor defines of this material's programs for ``obj``: a function of the
+        params and ``obj.mesh`` only (an object pass keeps its program while those are the
+        same objects; params are replaced whole, never changed in place)."""
         # every pass of every object asks, every frame: made once (the class, its shading
         # model and so its data never change), copied for the caller to extend
         base = self.__dict__.get("_base_defines")
@@ -154,6 +162,21 @@ class Material:
 
     def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
         return {}
+
+    @classmethod
+    def keeps_inputs(cls) -> bool:
+        """Whether the renderer may keep this material's inputs across frames: the
+        ``inputs_from_params`` of the nearest class that sets it, unless a class below that
+        one overrides ``uniforms`` or ``textures`` (it may read the frame: not kept)."""
+        for klass in cls.__mro__:
+            flag = klass.__dict__.get("inputs_from_params")
+            if flag is not None:
+                return flag
+            if klass is Material:
+                return True
+            if "uniforms" in klass.__dict__ or "textures" in klass.__dict__:
+                return False
+        return False  # not a Material subclass's MRO (a mixin listed after it)
 
     def check_time(self, time: float, where: str) -> None:
         """Refuse (``InputError`` naming ``where``) a frame time this material cannot reach in

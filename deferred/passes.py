@@ -179,6 +179,7 @@ class ObjectPass(RenderPass):
     extra_reads: tuple[str, ...] = ()
     constants: dict[str, Any] | None = None  # uniforms fixed at construction
     extra_defines: dict[str, str] | None = None
+    # the last program lookup: (shaders, generation, material, params, mesh, defines, program)
     _program_memo: tuple | None = None
 
     def __init__(self, name: str, phase: Phase, obj: SceneObject, **options: Any):
@@ -221,14 +222,22 @@ class ObjectPass(RenderPass):
         frame.draw_mesh(self.obj.mesh, program)
 
     def program(self, frame: Frame) -> moderngl.Program:
-        defines = self.defines(frame)
         shaders = frame.shaders
         memo = self._program_memo  # the last lookup: the same defines give the same program
-        if memo is not None and memo[0] is shaders and memo[1] == shaders.generation and \
-                memo[2] == defines:
-            return memo[3]
-        program = shaders.program(self.vertex, self.fragment, self.geometry, defines=defines)
-        self._program_memo = (shaders, shaders.generation, defines, program)
+        material = self.obj.material
+        fresh = memo is not None and memo[0] is shaders and memo[1] == shaders.generation
+        # Where the pass keeps ObjectPass.defines, its defines are the material's, a function
+        # of its params and the object's mesh (Material.defines), and its own fixed ones: while
+        # those are the same objects, so is the program (building and comparing the defines
+        # cost 2 us of a 12 us draw).
+        if fresh and memo[2] is material and memo[3] is material.params and \
+                memo[4] is self.obj.mesh and type(self).defines is ObjectPass.defines:
+            return memo[6]
+        defines = self.defines(frame)
+        program = memo[6] if fresh and memo[5] == defines else \
+            shaders.program(self.vertex, self.fragment, self.geometry, defines=defines)
+        self._program_memo = (shaders, shaders.generation, material, material.params,
+                              self.obj.mesh, defines, program)
         return program
 
     def execute(self, frame: Frame) -> None:

@@ -12,7 +12,7 @@ import numpy as np
 
 from .context import Features, GLContext, acquire_context, give_back_context
 from .errors import DeferredError, InputError, RenderError, gl_error
-from .frame import Frame, ObjectTransforms, Resources
+from .frame import Frame, KeptMaterialInputs, ObjectTransforms, Resources
 from .generated import generated_glsl
 from .graph import PassGraph, PassGraphError, compile_graph
 from .light_lists import LightLists, check_light_limits, resolve_light_path
@@ -108,6 +108,7 @@ class Renderer:
         light_types = scene.light_types()
         shading_models = self.shading_models = scene.shading_models()
         self.object_transforms = ObjectTransforms()  # kept across frames
+        self.kept_inputs = KeptMaterialInputs()  # materials' inputs, kept across frames
         generated = generated_glsl(light_types, shading_models, scene.gbuffer_layout(),
                                    [obj.material for obj in scene.objects])
         roots = [cls.shader_root for cls in [
@@ -204,7 +205,7 @@ class Renderer:
                       self.light_buffer, strict=self.strict, light_lists=self.light_lists,
                       time=time, time_gl_calls=time_gl_calls,
                       shading_models=self.shading_models,
-                      object_transforms=self.object_transforms)
+                      object_transforms=self.object_transforms, kept_inputs=self.kept_inputs)
         self.light_buffer.upload(self.scene.lights, frame.view, frame.projection)
         self._check_gl("uploading the lights")
         for render_pass in self.passes:
@@ -276,7 +277,8 @@ class Renderer:
         self.gl.make_current()
         self.gl.park()
         # every part made so far (a constructor that failed part way made only some)
-        for name in ("light_buffer", "light_lists", "resources", "targets", "shaders"):
+        for name in ("kept_inputs", "light_buffer", "light_lists", "resources", "targets",
+                     "shaders"):
             part = getattr(self, name, None)
             if part is not None:
                 part.release()

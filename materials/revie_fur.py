@@ -97,6 +97,7 @@ class RevieFurMaterial(Material):
     name = "revie_fur"
     Params = RevieFurParams
     surface_shader = "materials/revie_fur/surface.glsl"
+    inputs_from_params = True  # uniforms from the params, textures from frame.resources
     # pass counts and switches compiled as defines are not uniforms; density becomes tiles
     uniform_overrides = {**FUR_UNIFORM_OVERRIDES, "stipple": None, "occlusion_test": None}
     debug_views = FUR_DEBUG_VIEWS

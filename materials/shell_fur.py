@@ -423,6 +423,7 @@ class ShellFurMaterial(Material):
     name = "shell_fur"
     Params = ShellFurParams
     surface_shader = "materials/shell_fur/surface.glsl"
+    inputs_from_params = True  # uniforms from the params, textures from frame.resources
     shading_model = "kajiya_kay"
     uniform_overrides = {**FUR_UNIFORM_OVERRIDES, **{key: None for key in NOT_UNIFORMS},
                          "shells": _layers_uniform}

@@ -26,6 +26,7 @@ class StandardMaterial(Material):
     name = "standard"
     Params = StandardParams
     surface_shader = "materials/standard/surface.glsl"
+    inputs_from_params = True  # uniforms from the params, textures from frame.resources
 
     def check_files(self, where: str | None) -> None:
         if self.params.texture is None:
