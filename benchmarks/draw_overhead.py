@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import statistics
+import timeit
 
 import numpy as np
 
@@ -48,12 +49,20 @@ def cube_grid(count: int) -> Scene:
     return scene
 
 
+def python_loop_ms() -> float:
+    """The machine's speed at running Python: the best of 5 runs of ``sum(range(10000))``
+    2000 times, in ms (about 300 on this machine when it is calm, up to 450 when it is not:
+    the per-draw figures move with it)."""
+    return 1000.0 * min(timeit.repeat("sum(range(10000))", number=2000, repeat=5))
+
+
 def measure(counts: list[int], size: tuple[int, int], runs: int, trials: int) -> None:
     """Per light path of each pipeline: the CPU time per frame at each count (median over the
     trials), and the slope of a line through them per trial: median and range over trials.
     The counts' renderers are kept side by side and measured in turn in every trial, so a
     change in the machine's speed falls on all of them alike."""
     gl = create_context()
+    print(f"the Python loop before: {python_loop_ms():.0f} ms")
     print(f"{'pipeline':9} {'path':9} " + " ".join(f"{n:>6} ms" for n in counts) +
           "   us/draw: median (range over trials)   fixed ms   draws")
     for pipeline, paths in PATHS.items():
@@ -82,6 +91,7 @@ def measure(counts: list[int], size: tuple[int, int], runs: int, trials: int) ->
                   f"   {statistics.median(slopes):6.1f} ({min(slopes):.1f}-{max(slopes):.1f})"
                   f"{'':21}{statistics.median(intercepts):6.2f}   " +
                   ",".join(str(d) for d in draws))
+    print(f"the Python loop after: {python_loop_ms():.0f} ms")
 
 
 def main() -> None:
@@ -89,7 +99,7 @@ def main() -> None:
     parser.add_argument("counts", nargs="?", default="25,100,400")
     parser.add_argument("--size", default="160x90")
     parser.add_argument("--runs", type=int, default=8, help="frames per measurement")
-    parser.add_argument("--trials", type=int, default=7)
+    parser.add_argument("--trials", type=int, default=15)
     args = parser.parse_args()
     width, height = (int(v) for v in args.size.split("x"))
     measure([int(n) for n in args.counts.split(",")], (width, height), args.runs, args.trials)

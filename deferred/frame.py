@@ -375,9 +375,9 @@ class Frame:
         # in order, a later value of a name winning (no merged copies: a pass of many objects
         # binds once a draw)
         if offered:
-            program_uniforms.set(offered)
+            program_uniforms.set_stable(offered)
         if material is not None and material.uniforms:
-            program_uniforms.set(material.uniforms)
+            program_uniforms.set_stable(material.uniforms)
         if uniforms:
             program_uniforms.set(uniforms)
         shading = self.shading_textures()

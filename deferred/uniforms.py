@@ -21,6 +21,9 @@ import moderngl
 import numpy as np
 
 _UNSET = object()
+# the dicts a program keeps plans for (set_stable): more than the objects of a large scene,
+# each with its transforms and its material's inputs
+MAX_PLANS = 8192
 
 
 def gl_value(value: Any) -> Any:
@@ -44,7 +47,7 @@ class ProgramUniforms:
     through, which is most of the saving for a program drawing many objects.
     """
 
-    __slots__ = ("members", "_program", "_writers", "_values", "_shared", "_owner")
+    __slots__ = ("members", "_program", "_writers", "_values", "_shared", "_owner", "_plans")
 
     def __init__(self, program: moderngl.Program | moderngl.ComputeShader,
                  members: frozenset[str] | None = None):
@@ -55,6 +58,8 @@ class ProgramUniforms:
         self._values: dict[str, Any] = {}
         self._shared: dict[str, Mapping[str, Any]] = {}  # group -> the dict the program holds
         self._owner: dict[str, str] = {}  # uniform name -> the group it was last set by
+        # id(dict) -> (the dict, its (name, GL value) pairs the program has): set_stable
+        self._plans: dict[int, tuple[Mapping[str, Any], tuple[tuple[str, Any], ...]]] = {}
 
     def set(self, values: Mapping[str, Any], _group: str | None = None) -> None:
         """Write the values the program has and does not hold already; names it lacks are
@@ -80,6 +85,33 @@ class ProgramUniforms:
                 owner = owners.get(name)
                 if owner is not None and owner != _group:  # a shared dict's value overwritten
                     self._shared.pop(owner, None)
+
+    def set_stable(self, values: Mapping[str, Any]) -> None:
+        """:meth:`set` for a dict that is replaced, never changed in place (a material's
+        inputs, an object's transforms): which of its names the program has, and their GL
+        values, are worked out once per dict, not at every draw."""
+        plan = self._plans.get(id(values))
+        if plan is None or plan[0] is not values:
+            if len(self._plans) >= MAX_PLANS:  # dicts replaced many times (an animation)
+                self._plans.clear()
+            plan = self._plans[id(values)] = (values, tuple(
+                (name, gl_value(value)) for name, value in values.items()
+                if name in self.members))
+        held = self._values
+        for name, value in plan[1]:
+            if held.get(name, _UNSET) != value:
+                self._write(name, value)
+
+    def _write(self, name: str, value: Any) -> None:
+        writer = self._writers.get(name)
+        if writer is None:  # the first write: made once, then the one kept
+            self._writers[name] = uniform_writer(self._program[name])
+            writer = self._writers[name]
+        writer(value)
+        self._values[name] = value
+        owner = self._owner.get(name)
+        if owner is not None:  # a shared dict's value overwritten
+            self._shared.pop(owner, None)
 
     def set_shared(self, group: str, values: Mapping[str, Any]) -> None:
         """:meth:`set` for a dict shared by many passes, skipped while the program holds its

@@ -79,6 +79,37 @@ def test_a_shared_dict_is_set_again_after_a_pass_overwrote_one_of_its_values(pro
     assert uniforms.writes[2:] == ["u_x", "u_x"]  # only the overwritten value, twice
 
 
+def test_a_stable_dict_is_planned_once_and_its_replacement_reaches_gl(program, monkeypatch):
+    """set_stable works out once per dict which names the program has and their GL values;
+    a dict replacing it (new values) is planned again, and the plans stay bounded."""
+    import deferred.uniforms as uniforms_module
+
+    uniforms = CountingUniforms(program)
+    view = np.arange(16, dtype=np.float64).reshape(4, 4)
+    first = {"u_view": view, "u_x": 0.5, "u_unknown": 1.0}
+    uniforms.set_stable(first)
+    uniforms.set_stable(first)
+    assert sorted(uniforms.writes) == ["u_view", "u_x"]  # once; the unknown name skipped
+    np.testing.assert_array_equal(np.array(program["u_view"].value, np.float32),
+                                  view.T.reshape(-1))
+    uniforms.set_stable({"u_view": view, "u_x": 0.75})
+    assert uniforms.writes[2:] == ["u_x"]
+    assert program["u_x"].value == pytest.approx(0.75)
+    uniforms.set_stable(first)  # the first dict again: its value is written back
+    assert program["u_x"].value == pytest.approx(0.5)
+    # a shared dict's value overwritten by a stable one is set again with the dict
+    camera = {"u_x": 1.0}
+    uniforms.set_shared("camera", camera)
+    uniforms.set_stable(first)
+    uniforms.set_shared("camera", camera)
+    assert program["u_x"].value == pytest.approx(1.0)
+    monkeypatch.setattr(uniforms_module, "MAX_PLANS", 4)
+    for index in range(10):
+        uniforms.set_stable({"u_x": float(index)})
+        assert program["u_x"].value == pytest.approx(float(index))
+    assert len(uniforms._plans) <= 4
+
+
 def test_forgotten_values_are_written_again(program):
     # between frames code may write a program directly; the frame forgets what it wrote
     uniforms = ProgramUniforms(program)
