@@ -12,7 +12,7 @@ from abc import ABC, abstractmethod
 from collections.abc import Callable, Mapping
 from enum import Enum
 from types import MappingProxyType
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import moderngl
 
@@ -181,6 +181,14 @@ class ObjectPass(RenderPass):
     extra_defines: dict[str, str] | None = None
     # the last program lookup: (shaders, generation, material, params, mesh, defines, program)
     _program_memo: tuple | None = None
+    # whether uniforms, textures, draws and draw_uniforms are ObjectPass's own (set for each
+    # subclass as it is made)
+    _hooks_unchanged: ClassVar[bool] = True
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        cls._hooks_unchanged = all(getattr(cls, hook) is getattr(ObjectPass, hook) for hook in
+                                   ("uniforms", "textures", "draws", "draw_uniforms"))
 
     def __init__(self, name: str, phase: Phase, obj: SceneObject, **options: Any):
         self.name = name
@@ -246,6 +254,14 @@ class ObjectPass(RenderPass):
         frame.set_state(depth_test=self.depth_test, depth_func=self.depth_func, cull=self.cull,
                         blend=self.blend, depth_offset=self.depth_offset)
         material = frame.material_inputs(self.obj.material)
+        if self._hooks_unchanged and not self.extra_reads:
+            # one draw and nothing of the pass's own but its constants (most objects'
+            # G-buffer and forward passes): the hooks' empty answers are not asked for, 1.4 us
+            # of a 16 us draw
+            frame.bind(program, self.constants, None, offered=frame.object_uniforms(self.obj),
+                       material=material)
+            self.draw(frame, program)
+            return
         uniforms = self.uniforms(frame)
         if self.constants:
             uniforms = {**self.constants, **uniforms}

@@ -131,3 +131,36 @@ def test_an_object_pass_whose_own_defines_change_gets_another_program(gl):
             probe.vertex, probe.fragment, defines={**probe.defines(frame)}) is on
         probe.flag = "0"
         assert probe.program(frame) is off
+
+
+def test_an_object_pass_subclass_overriding_a_hook_is_asked_for_it(gl):
+    """Passes keeping ObjectPass's hooks draw once with nothing of their own; a subclass that
+    overrides one is asked (its uniforms set, its draws made)."""
+
+    class Twice(GBufferPass):
+        def draws(self, frame):
+            return 2
+
+    class Green(GBufferPass):
+        def uniforms(self, frame):
+            return {"u_color": (0.0, 1.0, 0.0)}
+
+    assert GBufferPass._hooks_unchanged and not Twice._hooks_unchanged
+    with Renderer(sphere_scene(), "deferred", gl=gl) as renderer:
+        sphere = renderer.scene.objects[0]
+        renderer.render()
+        frame = renderer.last_frame
+        albedo = {}
+        for kind in (GBufferPass, Twice, Green):
+            # lequal: drawn over the frame's own G-buffer, at the depths it holds
+            probe = kind(f"probe.{kind.__name__}", Phase.GEOMETRY, sphere, depth_func="lequal")
+            draws = frame.stats.draw_calls
+            frame.run_pass(probe)
+            assert frame.stats.draw_calls - draws == (2 if kind is Twice else 1)
+            texture = frame.targets["albedo_specular"]
+            pixels = np.frombuffer(texture.read(), np.float16 if texture.dtype == "f2" else
+                                   np.uint8).reshape(48, 64, -1)
+            albedo[kind] = pixels[24, 32, :3].astype(np.float64)
+    np.testing.assert_array_equal(albedo[Twice], albedo[GBufferPass])
+    assert albedo[GBufferPass][0] > albedo[GBufferPass][1]  # the sphere's own red
+    assert albedo[Green][1] > albedo[Green][0]  # the pass's uniform won
