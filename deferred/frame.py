@@ -134,6 +134,9 @@ class MaterialInputs:
     uniforms: dict[str, Any]
     textures: dict[str, moderngl.Texture]
     params: Any = None  # the material's params they were made from
+    # kept across frames (KeptMaterialInputs): its dicts are never changed in place, so the
+    # programs plan them once (ProgramUniforms.set_stable)
+    kept: bool = False
     declared: set[str] = field(default_factory=set)
     programs: list[str] = field(default_factory=list)
 
@@ -145,20 +148,32 @@ class KeptMaterialInputs:
     made 400 uniform dicts a frame otherwise."""
 
     def __init__(self) -> None:
+        # this frame's and the last frame's: a material no frame asks for (replaced on its
+        # object) is dropped after one frame
         self._kept: dict[int, MaterialInputs] = {}
+        self._last: dict[int, MaterialInputs] = {}
+
+    def start_frame(self) -> None:
+        self._last, self._kept = self._kept, {}
 
     def of(self, material: Material, frame: Frame) -> MaterialInputs:
-        kept = self._kept.get(id(material))
+        key = id(material)
+        kept = self._kept.get(key)
+        if kept is None:
+            kept = self._last.pop(key, None)
         if kept is not None and kept.material is material and kept.params is material.params:
+            self._kept[key] = kept
             return kept
+        kept = material.keeps_inputs()
         inputs = MaterialInputs(material, material.uniforms(frame), material.textures(frame),
-                                params=material.params)
-        if material.keeps_inputs():
+                                params=material.params, kept=kept)
+        if kept:
             self._kept[id(material)] = inputs
         return inputs
 
     def release(self) -> None:  # the textures are Resources', released there
         self._kept.clear()
+        self._last.clear()
 
 
 class ObjectTransforms:
@@ -261,8 +276,8 @@ class Frame:
         # whether GL's depth mask is the bound framebuffer's: a clear through another
         # framebuffer (moderngl's clear) sets GL's and binds this one back without it
         self._depth_mask_known = False
-        # the last framebuffer request set in full, (key, depth_write, framebuffer): the same
-        # request again, with the framebuffer still bound and no clear since, sets nothing
+        # the last framebuffer request set in full, (key, depth_write, framebuffer, viewport):
+        # the same request again, with nothing changed since, sets nothing (use_framebuffer)
         self._bound: tuple | None = None
 
     # -- passes --------------------------------------------------------------------------------
@@ -346,7 +361,8 @@ class Frame:
         if inputs is None:
             inputs = self._kept_inputs.of(material, self)
             if self.strict:  # what this frame's programs declare is the frame's own
-                inputs = MaterialInputs(material, inputs.uniforms, inputs.textures)
+                inputs = MaterialInputs(material, inputs.uniforms, inputs.textures,
+                                        params=inputs.params, kept=inputs.kept)
             self._materials[id(material)] = inputs
         return inputs
 
@@ -358,8 +374,9 @@ class Frame:
 
         ``uniforms`` and ``textures`` are what the pass means to set: in strict mode each must
         be declared by the program. The camera's values (:attr:`camera_values`), the lights',
-        ``offered`` values (an object's transforms) and the ``material``'s are set where the
-        program has them. A value the program holds already is not written again.
+        ``offered`` values (an object's transforms: a dict replaced, never changed in place,
+        as :meth:`object_uniforms` gives) and the ``material``'s are set where the program has
+        them. A value the program holds already is not written again.
         """
         if self.strict:
             declared = self.shaders.declared_uniforms(program)
@@ -377,7 +394,10 @@ class Frame:
         if offered:
             program_uniforms.set_stable(offered)
         if material is not None and material.uniforms:
-            program_uniforms.set_stable(material.uniforms)
+            if material.kept:
+                program_uniforms.set_stable(material.uniforms)
+            else:  # a material's own dict each frame, which it may change in place
+                program_uniforms.set(material.uniforms)
         if uniforms:
             program_uniforms.set(uniforms)
         shading = self._shading_textures  # made once a frame (a method call a draw: 0.2 us)
@@ -503,9 +523,14 @@ class Frame:
                 self.target(name)  # declared by the pass, and existing
             checked[request] = self.current_pass  # kept alive: its id stays its own
         bound = self._bound
-        if bound is not None and bound[0] == key and bound[1] == depth_write and \
-                self.ctx.fbo is bound[2]:
-            return bound[2]  # one pass of many objects after another: 1.2 -> 0.5 us
+        # one pass of many objects after another: the same request, still bound, no clear
+        # since, and the framebuffer's mask and viewport as this frame left them (a pass may
+        # have set them on it): nothing to look up or set, 1.2 -> 0.7 us
+        if bound is not None and bound[0] == key and bound[1] == depth_write:
+            fbo = bound[2]
+            if self.ctx.fbo is fbo and fbo.depth_mask == depth_write and \
+                    fbo.viewport == bound[3]:
+                return fbo
         known = self._framebuffers.get(key)
         if known is None:  # once a frame: the targets' scissor is set on it then
             fbo = self.targets.framebuffer(colors, depth)
@@ -520,7 +545,7 @@ class Frame:
             self._depth_mask_known = True
         if fbo.viewport != full:
             fbo.viewport = full
-        self._bound = (key, depth_write, fbo)
+        self._bound = (key, depth_write, fbo, full)
         return fbo
 
     def set_state(self, depth_test: bool = False, depth_func: str = "less",

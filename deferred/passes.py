@@ -163,6 +163,10 @@ class ObjectPass(RenderPass):
     targets and state, and a ``uniforms`` hook. ``draws`` > 1 renders the mesh that many times,
     each draw with its own ``draw_uniforms`` (e.g. one shell per draw; ``None`` skips the draw).
     ``draw`` issues one draw call (override it to draw other primitives of the mesh).
+
+    What a subclass overrides of those hooks is found when the class is made (a pass keeping
+    them all draws without asking them), so change a hook by subclassing, not by patching the
+    class later. Options (``extra_defines``, ``constants``...) are fixed at construction.
     """
 
     vertex: str = "common/mesh.vert"

@@ -21,9 +21,6 @@ import moderngl
 import numpy as np
 
 _UNSET = object()
-# the dicts a program keeps plans for (set_stable): more than the objects of a large scene,
-# each with its transforms and its material's inputs
-MAX_PLANS = 8192
 
 
 def gl_value(value: Any) -> Any:
@@ -47,7 +44,8 @@ class ProgramUniforms:
     through, which is most of the saving for a program drawing many objects.
     """
 
-    __slots__ = ("members", "_program", "_writers", "_values", "_shared", "_owner", "_plans")
+    __slots__ = ("members", "_program", "_writers", "_values", "_shared", "_owner", "_plans",
+                 "_last_plans")
 
     def __init__(self, program: moderngl.Program | moderngl.ComputeShader,
                  members: frozenset[str] | None = None):
@@ -58,8 +56,10 @@ class ProgramUniforms:
         self._values: dict[str, Any] = {}
         self._shared: dict[str, Mapping[str, Any]] = {}  # group -> the dict the program holds
         self._owner: dict[str, str] = {}  # uniform name -> the group it was last set by
-        # id(dict) -> (the dict, its (name, GL value) pairs the program has): set_stable
+        # id(dict) -> (the dict, its (name, GL value) pairs the program has), for set_stable:
+        # this frame's, and the last frame's (a plan not used for a whole frame is dropped)
         self._plans: dict[int, tuple[Mapping[str, Any], tuple[tuple[str, Any], ...]]] = {}
+        self._last_plans: dict[int, tuple[Mapping[str, Any], tuple[tuple[str, Any], ...]]] = {}
 
     def set(self, values: Mapping[str, Any], _group: str | None = None) -> None:
         """Write the values the program has and does not hold already; names it lacks are
@@ -87,16 +87,18 @@ class ProgramUniforms:
                     self._shared.pop(owner, None)
 
     def set_stable(self, values: Mapping[str, Any]) -> None:
-        """:meth:`set` for a dict that is replaced, never changed in place (a material's
-        inputs, an object's transforms): which of its names the program has, and their GL
-        values, are worked out once per dict, not at every draw."""
-        plan = self._plans.get(id(values))
+        """:meth:`set` for a dict the framework replaces and never changes in place (an
+        object's transforms, a material's kept inputs): which of its names the program has,
+        and their GL values, are worked out once per dict, not at every draw. A plan is kept
+        while the dict is set at least once a frame (:meth:`forget` starts a frame)."""
+        key = id(values)
+        plan = self._plans.get(key)
         if plan is None or plan[0] is not values:
-            if len(self._plans) >= MAX_PLANS:  # dicts replaced many times (an animation)
-                self._plans.clear()
-            plan = self._plans[id(values)] = (values, tuple(
-                (name, gl_value(value)) for name, value in values.items()
-                if name in self.members))
+            plan = self._last_plans.pop(key, None)
+            if plan is None or plan[0] is not values:
+                plan = (values, tuple((name, gl_value(value)) for name, value in values.items()
+                                      if name in self.members))
+            self._plans[key] = plan
         held = self._values
         for name, value in plan[1]:
             if held.get(name, _UNSET) != value:
@@ -129,9 +131,12 @@ class ProgramUniforms:
             self.set({name: gl_value(value)})
 
     def forget(self) -> None:
-        """Drop the remembered values: the next write of each name reaches GL."""
+        """Drop the remembered values: the next write of each name reaches GL. A frame
+        starts: the plans the last frame did not use are dropped (:meth:`set_stable`)."""
         self._values.clear()
         self._shared.clear()
+        self._last_plans = self._plans
+        self._plans = {}
 
 
 def uniform_writer(handle: Any) -> Callable[[Any], None]:

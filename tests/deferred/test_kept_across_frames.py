@@ -164,3 +164,132 @@ def test_an_object_pass_subclass_overriding_a_hook_is_asked_for_it(gl):
     np.testing.assert_array_equal(albedo[Twice], albedo[GBufferPass])
     assert albedo[GBufferPass][0] > albedo[GBufferPass][1]  # the sphere's own red
     assert albedo[Green][1] > albedo[Green][0]  # the pass's uniform won
+
+
+class PulsingInPlace(StandardMaterial):
+    """Reads the frame's time into one dict it keeps and changes in place."""
+
+    def uniforms(self, frame):
+        values = self.__dict__.setdefault("_values", dict(super().uniforms(frame)))
+        values["u_color"] = (0.5 + 0.5 * np.sin(frame.time), 0.2, 0.2)
+        return values
+
+
+@pytest.mark.parametrize("pipeline", ["deferred", "forward"])
+def test_a_material_changing_its_uniforms_in_place_gets_them_each_frame(gl, pipeline):
+    def scene():
+        made = sphere_scene()
+        made.objects[0].material = PulsingInPlace(made.objects[0].material.params)
+        return made
+
+    with Renderer(scene(), pipeline, gl=gl) as renderer:
+        renderer.render(time=0.0)
+        at_one = renderer.render(time=1.0).hdr
+    np.testing.assert_array_equal(at_one, fresh_render(gl, scene(), pipeline, time=1.0))
+
+
+@pytest.mark.parametrize("pipeline", ["deferred", "forward"])
+def test_a_mesh_or_material_replaced_between_frames_is_drawn(gl, pipeline):
+    from deferred.mesh import load_mesh
+
+    def replace_mesh(scene):
+        scene.objects[0].mesh = load_mesh("builtin:torus")
+
+    def replace_material(scene):
+        scene.objects[0].material = StandardMaterial(
+            scene.objects[0].material.params.model_copy(update={"color": (0.2, 0.3, 0.9)}))
+
+    for change in (replace_mesh, replace_material):
+        scene = sphere_scene()
+        with Renderer(scene, pipeline, gl=gl) as renderer:
+            first = renderer.render().hdr
+            change(scene)
+            changed = renderer.render().hdr
+        expected = sphere_scene()
+        change(expected)
+        assert not np.array_equal(first, changed)
+        np.testing.assert_array_equal(changed, fresh_render(gl, expected, pipeline))
+
+
+def test_a_program_released_by_a_changed_virtual_file_is_not_drawn_with(gl):
+    """A changed generated file releases the programs that include it (ShaderLibrary
+    .generation): an object pass looks its program up again, never drawing with the old."""
+    from deferred.gbuffer import data_write_file
+
+    with Renderer(sphere_scene(), "deferred", gl=gl) as renderer:
+        first = renderer.render().hdr
+        name = data_write_file([])
+        shaders = renderer.shaders
+        shaders.set_virtual_file(name, shaders.read(name) + "\n// changed\n")
+        np.testing.assert_array_equal(renderer.render().hdr, first)
+
+
+def test_strict_frames_do_not_pile_up_on_kept_inputs(gl):
+    scene = sphere_scene()
+    with Renderer(scene, "deferred", gl=gl, strict=True) as renderer:
+        for _ in range(3):
+            renderer.render()
+        kept = renderer.kept_inputs.of(scene.objects[0].material, renderer.last_frame)
+        assert kept.kept and kept.programs == [] and not kept.declared
+        assert renderer.last_frame.material_inputs(scene.objects[0].material).programs
+
+
+def test_a_pass_keeping_the_hooks_sets_its_constants(gl):
+    with Renderer(sphere_scene(), "deferred", gl=gl) as renderer:
+        renderer.render()
+        frame = renderer.last_frame
+        probe = GBufferPass("probe.constants", Phase.GEOMETRY, renderer.scene.objects[0],
+                            depth_func="lequal", constants={"u_color": (0.0, 0.0, 1.0)})
+        assert probe._hooks_unchanged
+        frame.run_pass(probe)
+        pixels = np.frombuffer(frame.targets["albedo_specular"].read(), np.uint8)
+        centre = pixels.reshape(48, 64, 4)[24, 32]
+        assert centre[2] > 200 and centre[0] < 10 and centre[1] < 10
+
+
+def test_a_mesh_whose_comb_makes_another_define_gets_another_program(gl):
+    """revie_fur's defines read the mesh (VERTEX_COMB where it has comb colours): an object
+    given such a mesh between frames is drawn with the program a fresh renderer uses."""
+    import dataclasses
+
+    from deferred.mesh import load_mesh
+
+    def fur_scene():
+        return scene_from_dict({
+            "size": [64, 48], "camera": {"position": [0.0, 0.6, 2.6]},
+            "object": [{"mesh": "builtin:sphere", "material": "revie_fur",
+                        "params": {"shells": 0, "stipple": False, "comb_strength": 1.0}}],
+            "light": [{"type": "directional", "direction": [-0.3, -1.0, -0.5]}]})
+
+    sphere = load_mesh("builtin:sphere")
+    comb = np.tile(np.array([1.0, 0.5, 0.5, 1.0], np.float32), (sphere.vertex_count, 1))
+    combed = dataclasses.replace(sphere, comb=comb, has_comb=True)
+    scene = fur_scene()
+    with Renderer(scene, "deferred", gl=gl) as renderer:
+        renderer.render()
+        scene.objects[0].mesh = combed
+        changed = renderer.render().hdr
+        memos = [p._program_memo for p in renderer.passes if getattr(p, "_program_memo", None)
+                 and getattr(p, "obj", None) is scene.objects[0]]
+        assert memos and all("VERTEX_COMB" in memo[5] for memo in memos)
+    expected = fur_scene()
+    expected.objects[0].mesh = combed
+    np.testing.assert_array_equal(changed, fresh_render(gl, expected, "deferred"))
+
+
+def test_the_same_framebuffer_request_gets_the_full_viewport_and_its_depth_mask(gl):
+    """A pass may change the framebuffer it was given; the next pass asking for the same one
+    gets it as it asks (the request memo checks what the last pass may have set)."""
+    from deferred.gbuffer import DEPTH, GBUFFER_COLOR_TARGETS
+
+    with Renderer(sphere_scene(), "deferred", gl=gl) as renderer:
+        renderer.render()
+        frame = renderer.last_frame
+        # a G-buffer pass: it declares the targets
+        frame.current_pass = next(p for p in renderer.passes if p.name.endswith(".gbuffer"))
+        fbo = frame.use_framebuffer(GBUFFER_COLOR_TARGETS, DEPTH)
+        full = fbo.viewport
+        fbo.viewport = (0, 0, 8, 8)
+        fbo.depth_mask = False
+        again = frame.use_framebuffer(GBUFFER_COLOR_TARGETS, DEPTH)
+        assert again is fbo and again.viewport == full and again.depth_mask

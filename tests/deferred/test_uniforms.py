@@ -79,11 +79,9 @@ def test_a_shared_dict_is_set_again_after_a_pass_overwrote_one_of_its_values(pro
     assert uniforms.writes[2:] == ["u_x", "u_x"]  # only the overwritten value, twice
 
 
-def test_a_stable_dict_is_planned_once_and_its_replacement_reaches_gl(program, monkeypatch):
+def test_a_stable_dict_is_planned_once_and_its_replacement_reaches_gl(program):
     """set_stable works out once per dict which names the program has and their GL values;
-    a dict replacing it (new values) is planned again, and the plans stay bounded."""
-    import deferred.uniforms as uniforms_module
-
+    a dict replacing it (new values) is planned again, and a plan unused for a frame goes."""
     uniforms = CountingUniforms(program)
     view = np.arange(16, dtype=np.float64).reshape(4, 4)
     first = {"u_view": view, "u_x": 0.5, "u_unknown": 1.0}
@@ -103,11 +101,16 @@ def test_a_stable_dict_is_planned_once_and_its_replacement_reaches_gl(program, m
     uniforms.set_stable(first)
     uniforms.set_shared("camera", camera)
     assert program["u_x"].value == pytest.approx(1.0)
-    monkeypatch.setattr(uniforms_module, "MAX_PLANS", 4)
+    # a frame keeps the plans the last one used and drops the others
     for index in range(10):
         uniforms.set_stable({"u_x": float(index)})
         assert program["u_x"].value == pytest.approx(float(index))
-    assert len(uniforms._plans) <= 4
+    uniforms.forget()
+    uniforms.set_stable(first)
+    uniforms.forget()
+    planned = [plan[0] for plan in (*uniforms._plans.values(),
+                                    *uniforms._last_plans.values())]
+    assert len(planned) == 1 and planned[0] is first
 
 
 def test_forgotten_values_are_written_again(program):
