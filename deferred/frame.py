@@ -16,7 +16,7 @@ from .errors import DeferredError, InputError, RenderError, gl_error
 from .mesh import GpuMesh, MeshData
 from .shaderlib import ShaderLibrary
 from .targets import FrameTargets
-from .uniforms import ProgramUniforms, gl_value
+from .uniforms import ProgramUniforms, StableValues, gl_value
 
 if TYPE_CHECKING:
     from .light_lists import LightLists
@@ -134,8 +134,7 @@ class MaterialInputs:
     uniforms: dict[str, Any]
     textures: dict[str, moderngl.Texture]
     params: Any = None  # the material's params they were made from
-    # kept across frames (KeptMaterialInputs): its dicts are never changed in place, so the
-    # programs plan them once (ProgramUniforms.set_stable)
+    # kept across frames (KeptMaterialInputs); its uniforms are then StableValues
     kept: bool = False
     declared: set[str] = field(default_factory=set)
     programs: list[str] = field(default_factory=list)
@@ -148,32 +147,30 @@ class KeptMaterialInputs:
     made 400 uniform dicts a frame otherwise."""
 
     def __init__(self) -> None:
-        # this frame's and the last frame's: a material no frame asks for (replaced on its
-        # object) is dropped after one frame
         self._kept: dict[int, MaterialInputs] = {}
-        self._last: dict[int, MaterialInputs] = {}
 
-    def start_frame(self) -> None:
-        self._last, self._kept = self._kept, {}
+    def start_frame(self, scene: Scene) -> None:
+        """Drop the materials no object of ``scene`` has (replaced on their objects), once
+        they outnumber the objects: a scene that keeps its materials pays one comparison."""
+        if len(self._kept) > len(scene.objects):
+            present = {id(obj.material) for obj in scene.objects}
+            self._kept = {key: inputs for key, inputs in self._kept.items() if key in present}
 
     def of(self, material: Material, frame: Frame) -> MaterialInputs:
         key = id(material)
         kept = self._kept.get(key)
-        if kept is None:
-            kept = self._last.pop(key, None)
         if kept is not None and kept.material is material and kept.params is material.params:
-            self._kept[key] = kept
             return kept
         kept = material.keeps_inputs()
-        inputs = MaterialInputs(material, material.uniforms(frame), material.textures(frame),
-                                params=material.params, kept=kept)
+        uniforms = material.uniforms(frame)
+        inputs = MaterialInputs(material, StableValues(uniforms) if kept else uniforms,
+                                material.textures(frame), params=material.params, kept=kept)
         if kept:
-            self._kept[id(material)] = inputs
+            self._kept[key] = inputs
         return inputs
 
     def release(self) -> None:  # the textures are Resources', released there
         self._kept.clear()
-        self._last.clear()
 
 
 class ObjectTransforms:
@@ -216,9 +213,9 @@ class ObjectTransforms:
         values = {}
         for index, (obj, surface_id) in enumerate(zip(objects, surface_ids, strict=True)):
             mat4, mat3 = slice(64 * index, 64 * index + 64), slice(36 * index, 36 * index + 36)
-            values[id(obj)] = {
-                "u_model": model_bytes[mat4], "u_model_view": view_bytes[mat4],
-                "u_normal_matrix": normal_bytes[mat3], "u_surface_id": surface_id}
+            values[id(obj)] = StableValues(  # replaced whole when they change
+                u_model=model_bytes[mat4], u_model_view=view_bytes[mat4],
+                u_normal_matrix=normal_bytes[mat3], u_surface_id=surface_id)
         return values
 
 
@@ -374,9 +371,9 @@ class Frame:
 
         ``uniforms`` and ``textures`` are what the pass means to set: in strict mode each must
         be declared by the program. The camera's values (:attr:`camera_values`), the lights',
-        ``offered`` values (an object's transforms: a dict replaced, never changed in place,
-        as :meth:`object_uniforms` gives) and the ``material``'s are set where the program has
-        them. A value the program holds already is not written again.
+        ``offered`` values (an object's transforms, :meth:`object_uniforms`) and the
+        ``material``'s are set where the program has them. A value the program holds already
+        is not written again; :class:`StableValues` are planned once (``set_stable``).
         """
         if self.strict:
             declared = self.shaders.declared_uniforms(program)
@@ -394,10 +391,7 @@ class Frame:
         if offered:
             program_uniforms.set_stable(offered)
         if material is not None and material.uniforms:
-            if material.kept:
-                program_uniforms.set_stable(material.uniforms)
-            else:  # a material's own dict each frame, which it may change in place
-                program_uniforms.set(material.uniforms)
+            program_uniforms.set_stable(material.uniforms)  # kept inputs are StableValues
         if uniforms:
             program_uniforms.set(uniforms)
         shading = self._shading_textures  # made once a frame (a method call a draw: 0.2 us)

@@ -201,7 +201,7 @@ class Renderer:
         if stale != "GL_NO_ERROR":
             warnings.warn(f"GL error {stale} left by code outside the renderer", stacklevel=2)
         self.shaders.forget_uniform_values()  # code between frames may have written them
-        self.kept_inputs.start_frame()
+        self.kept_inputs.start_frame(self.scene)
         frame = Frame(self.gl, self.shaders, self.targets, self.resources, self.scene,
                       self.light_buffer, strict=self.strict, light_lists=self.light_lists,
                       time=time, time_gl_calls=time_gl_calls,

@@ -23,6 +23,19 @@ import numpy as np
 _UNSET = object()
 
 
+class StableValues(dict):
+    """Uniform values that are replaced, never changed in place (:meth:`ProgramUniforms
+    .set_stable`). They hold what each program works out from them (``plans``), which so
+    goes with them."""
+
+    __slots__ = ("plans",)
+
+    def __init__(self, *args: Any, **kwargs: Any):
+        super().__init__(*args, **kwargs)
+        # ProgramUniforms -> the (name, GL value) pairs of these values that its program has
+        self.plans: dict[ProgramUniforms, tuple[tuple[str, Any], ...]] = {}
+
+
 def gl_value(value: Any) -> Any:
     """``value`` as moderngl takes it: a 2-D array becomes column-major float32 bytes (GLSL's
     matrix order), a 1-D array a tuple of floats; bytes (a matrix already converted) and
@@ -44,8 +57,7 @@ class ProgramUniforms:
     through, which is most of the saving for a program drawing many objects.
     """
 
-    __slots__ = ("members", "_program", "_writers", "_values", "_shared", "_owner", "_plans",
-                 "_last_plans")
+    __slots__ = ("members", "_program", "_writers", "_values", "_shared", "_owner")
 
     def __init__(self, program: moderngl.Program | moderngl.ComputeShader,
                  members: frozenset[str] | None = None):
@@ -56,10 +68,6 @@ class ProgramUniforms:
         self._values: dict[str, Any] = {}
         self._shared: dict[str, Mapping[str, Any]] = {}  # group -> the dict the program holds
         self._owner: dict[str, str] = {}  # uniform name -> the group it was last set by
-        # id(dict) -> (the dict, its (name, GL value) pairs the program has), for set_stable:
-        # this frame's, and the last frame's (a plan not used for a whole frame is dropped)
-        self._plans: dict[int, tuple[Mapping[str, Any], tuple[tuple[str, Any], ...]]] = {}
-        self._last_plans: dict[int, tuple[Mapping[str, Any], tuple[tuple[str, Any], ...]]] = {}
 
     def set(self, values: Mapping[str, Any], _group: str | None = None) -> None:
         """Write the values the program has and does not hold already; names it lacks are
@@ -87,20 +95,20 @@ class ProgramUniforms:
                     self._shared.pop(owner, None)
 
     def set_stable(self, values: Mapping[str, Any]) -> None:
-        """:meth:`set` for a dict the framework replaces and never changes in place (an
-        object's transforms, a material's kept inputs): which of its names the program has,
-        and their GL values, are worked out once per dict, not at every draw. A plan is kept
-        while the dict is set at least once a frame (:meth:`forget` starts a frame)."""
-        key = id(values)
-        plan = self._plans.get(key)
-        if plan is None or plan[0] is not values:
-            plan = self._last_plans.pop(key, None)
-            if plan is None or plan[0] is not values:
-                plan = (values, tuple((name, gl_value(value)) for name, value in values.items()
-                                      if name in self.members))
-            self._plans[key] = plan
+        """:meth:`set` for :class:`StableValues` (an object's transforms, a material's kept
+        inputs): which of their names the program has, and their GL values, are worked out
+        once, not at every draw; the plan lasts as long as the values. Any other mapping is
+        set by :meth:`set` (it may change in place)."""
+        if values.__class__ is not StableValues:
+            self.set(values)
+            return
+        plan = values.plans.get(self)
+        if plan is None:
+            plan = values.plans[self] = tuple((name, gl_value(value))
+                                              for name, value in values.items()
+                                              if name in self.members)
         held = self._values
-        for name, value in plan[1]:
+        for name, value in plan:
             if held.get(name, _UNSET) != value:
                 self._write(name, value)
 
@@ -131,12 +139,9 @@ class ProgramUniforms:
             self.set({name: gl_value(value)})
 
     def forget(self) -> None:
-        """Drop the remembered values: the next write of each name reaches GL. A frame
-        starts: the plans the last frame did not use are dropped (:meth:`set_stable`)."""
+        """Drop the remembered values: the next write of each name reaches GL."""
         self._values.clear()
         self._shared.clear()
-        self._last_plans = self._plans
-        self._plans = {}
 
 
 def uniform_writer(handle: Any) -> Callable[[Any], None]:

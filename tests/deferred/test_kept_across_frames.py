@@ -293,3 +293,17 @@ def test_the_same_framebuffer_request_gets_the_full_viewport_and_its_depth_mask(
         fbo.depth_mask = False
         again = frame.use_framebuffer(GBUFFER_COLOR_TARGETS, DEPTH)
         assert again is fbo and again.viewport == full and again.depth_mask
+
+
+def test_materials_replaced_on_their_objects_are_not_kept_for_long(gl):
+    scene = sphere_scene()
+    with Renderer(scene, "deferred", gl=gl) as renderer:
+        for index in range(5):
+            scene.objects[0].material = StandardMaterial(
+                scene.objects[0].material.params.model_copy(update={"color": (0.1 * index,
+                                                                              0.2, 0.3)}))
+            renderer.render()
+        kept = renderer.kept_inputs._kept
+        assert len(kept) <= len(scene.objects) + 1
+        assert {inputs.material for inputs in kept.values()} >= {
+            obj.material for obj in scene.objects}

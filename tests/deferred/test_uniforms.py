@@ -79,38 +79,43 @@ def test_a_shared_dict_is_set_again_after_a_pass_overwrote_one_of_its_values(pro
     assert uniforms.writes[2:] == ["u_x", "u_x"]  # only the overwritten value, twice
 
 
-def test_a_stable_dict_is_planned_once_and_its_replacement_reaches_gl(program):
-    """set_stable works out once per dict which names the program has and their GL values;
-    a dict replacing it (new values) is planned again, and a plan unused for a frame goes."""
+def test_stable_values_are_planned_once_and_their_replacement_reaches_gl(program):
+    """set_stable works out once per StableValues which names the program has and their GL
+    values; values replacing them are planned again, the values hold their plans, and a
+    plain dict (which its owner may change in place) is set as by set."""
+    from deferred.uniforms import StableValues
+
     uniforms = CountingUniforms(program)
     view = np.arange(16, dtype=np.float64).reshape(4, 4)
-    first = {"u_view": view, "u_x": 0.5, "u_unknown": 1.0}
+    first = StableValues(u_view=view, u_x=0.5, u_unknown=1.0)
     uniforms.set_stable(first)
     uniforms.set_stable(first)
     assert sorted(uniforms.writes) == ["u_view", "u_x"]  # once; the unknown name skipped
     np.testing.assert_array_equal(np.array(program["u_view"].value, np.float32),
                                   view.T.reshape(-1))
-    uniforms.set_stable({"u_view": view, "u_x": 0.75})
+    uniforms.set_stable(StableValues(u_view=view, u_x=0.75))
     assert uniforms.writes[2:] == ["u_x"]
     assert program["u_x"].value == pytest.approx(0.75)
-    uniforms.set_stable(first)  # the first dict again: its value is written back
+    uniforms.set_stable(first)  # the first values again: their value is written back
     assert program["u_x"].value == pytest.approx(0.5)
-    # a shared dict's value overwritten by a stable one is set again with the dict
+    # a shared dict's value overwritten by stable values is set again with the dict
     camera = {"u_x": 1.0}
     uniforms.set_shared("camera", camera)
     uniforms.set_stable(first)
     uniforms.set_shared("camera", camera)
     assert program["u_x"].value == pytest.approx(1.0)
-    # a frame keeps the plans the last one used and drops the others
+    # a plain dict changed in place reaches GL each time
+    changing = {"u_x": 2.0}
+    uniforms.set_stable(changing)
+    changing["u_x"] = 3.0
+    uniforms.set_stable(changing)
+    assert program["u_x"].value == pytest.approx(3.0)
+    # values replaced many times: each set right, each plan held by its values
     for index in range(10):
-        uniforms.set_stable({"u_x": float(index)})
+        values = StableValues(u_x=float(index))
+        uniforms.set_stable(values)
         assert program["u_x"].value == pytest.approx(float(index))
-    uniforms.forget()
-    uniforms.set_stable(first)
-    uniforms.forget()
-    planned = [plan[0] for plan in (*uniforms._plans.values(),
-                                    *uniforms._last_plans.values())]
-    assert len(planned) == 1 and planned[0] is first
+        assert values.plans == {uniforms: (("u_x", float(index)),)}
 
 
 def test_forgotten_values_are_written_again(program):
