@@ -11,6 +11,7 @@ frames are small (160x90 by default): the GL work is not what is measured. Run f
 repository root:
 
     python benchmarks/draw_overhead.py [N,N,...] [--size WxH] [--runs R] [--trials T]
+                                       [--moving]
 """
 
 from __future__ import annotations
@@ -18,10 +19,11 @@ from __future__ import annotations
 import argparse
 import statistics
 import timeit
+from dataclasses import replace
 
 import numpy as np
 
-from deferred.bench import time_cpu
+from deferred.bench import cpu_frame, time_cpu
 from deferred.camera import Camera
 from deferred.context import create_context
 from deferred.lights.ambient import AmbientLight
@@ -56,11 +58,26 @@ def python_loop_ms() -> float:
     return 1000.0 * min(timeit.repeat("sum(range(10000))", number=2000, repeat=5))
 
 
-def measure(counts: list[int], size: tuple[int, int], runs: int, trials: int) -> None:
+def moving_frames(renderer: Renderer, runs: int) -> tuple[float, int]:
+    """:func:`time_cpu` with the camera moved before each frame (outside the timing), so
+    every object's transforms are made again in each."""
+    samples = []
+    for index in range(runs):
+        camera = renderer.scene.camera
+        x, y, z = camera.position
+        renderer.scene.camera = replace(camera, position=(x + 0.01 * (-1) ** index, y, z))
+        samples.append(cpu_frame(renderer))
+    return statistics.median(ms for ms, _ in samples), samples[-1][1]
+
+
+def measure(counts: list[int], size: tuple[int, int], runs: int, trials: int,
+            moving: bool = False) -> None:
     """Per light path of each pipeline: the CPU time per frame at each count (median over the
     trials), and the slope of a line through them per trial: median and range over trials.
     The counts' renderers are kept side by side and measured in turn in every trial, so a
-    change in the machine's speed falls on all of them alike."""
+    change in the machine's speed falls on all of them alike. ``moving``: the camera moves
+    every frame."""
+    frames = moving_frames if moving else time_cpu
     gl = create_context()
     print(f"the Python loop before: {python_loop_ms():.0f} ms")
     print(f"{'pipeline':9} {'path':9} " + " ".join(f"{n:>6} ms" for n in counts) +
@@ -76,7 +93,7 @@ def measure(counts: list[int], size: tuple[int, int], runs: int, trials: int) ->
                 cpu, draws = [[] for _ in counts], []
                 slopes, intercepts = [], []
                 for _ in range(trials):
-                    measured = [time_cpu(renderer, runs) for renderer in renderers]
+                    measured = [frames(renderer, runs) for renderer in renderers]
                     draws = [d for _, d in measured]
                     for column, (ms, _) in zip(cpu, measured, strict=True):
                         column.append(ms)
@@ -100,9 +117,12 @@ def main() -> None:
     parser.add_argument("--size", default="160x90")
     parser.add_argument("--runs", type=int, default=8, help="frames per measurement")
     parser.add_argument("--trials", type=int, default=15)
+    parser.add_argument("--moving", action="store_true",
+                        help="move the camera every frame (every transform made again)")
     args = parser.parse_args()
     width, height = (int(v) for v in args.size.split("x"))
-    measure([int(n) for n in args.counts.split(",")], (width, height), args.runs, args.trials)
+    measure([int(n) for n in args.counts.split(",")], (width, height), args.runs, args.trials,
+            args.moving)
 
 
 if __name__ == "__main__":

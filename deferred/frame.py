@@ -16,7 +16,7 @@ from .errors import DeferredError, InputError, RenderError, gl_error
 from .mesh import GpuMesh, MeshData
 from .shaderlib import ShaderLibrary
 from .targets import FrameTargets
-from .uniforms import ProgramUniforms, StableValues, gl_value
+from .uniforms import ProgramUniforms, gl_value, stable_values
 
 if TYPE_CHECKING:
     from .light_lists import LightLists
@@ -163,7 +163,7 @@ class KeptMaterialInputs:
             return kept
         kept = material.keeps_inputs()
         uniforms = material.uniforms(frame)
-        inputs = MaterialInputs(material, StableValues(uniforms) if kept else uniforms,
+        inputs = MaterialInputs(material, stable_values(uniforms) if kept else uniforms,
                                 material.textures(frame), params=material.params, kept=kept)
         if kept:
             self._kept[key] = inputs
@@ -213,9 +213,9 @@ class ObjectTransforms:
         values = {}
         for index, (obj, surface_id) in enumerate(zip(objects, surface_ids, strict=True)):
             mat4, mat3 = slice(64 * index, 64 * index + 64), slice(36 * index, 36 * index + 36)
-            values[id(obj)] = StableValues(  # replaced whole when they change
-                u_model=model_bytes[mat4], u_model_view=view_bytes[mat4],
-                u_normal_matrix=normal_bytes[mat3], u_surface_id=surface_id)
+            values[id(obj)] = stable_values({  # replaced whole when they change
+                "u_model": model_bytes[mat4], "u_model_view": view_bytes[mat4],
+                "u_normal_matrix": normal_bytes[mat3], "u_surface_id": surface_id})
         return values
 
 
@@ -373,7 +373,7 @@ class Frame:
         be declared by the program. The camera's values (:attr:`camera_values`), the lights',
         ``offered`` values (an object's transforms, :meth:`object_uniforms`) and the
         ``material``'s are set where the program has them. A value the program holds already
-        is not written again; :class:`StableValues` are planned once (``set_stable``).
+        is not written again; ``StableValues`` are planned once (``set_stable``).
         """
         if self.strict:
             declared = self.shaders.declared_uniforms(program)

@@ -26,14 +26,20 @@ _UNSET = object()
 class StableValues(dict):
     """Uniform values that are replaced, never changed in place (:meth:`ProgramUniforms
     .set_stable`). They hold what each program works out from them (``plans``), which so
-    goes with them."""
+    goes with them. Make them with :func:`stable_values`."""
 
     __slots__ = ("plans",)
 
-    def __init__(self, *args: Any, **kwargs: Any):
-        super().__init__(*args, **kwargs)
-        # ProgramUniforms -> the (name, GL value) pairs of these values that its program has
-        self.plans: dict[ProgramUniforms, tuple[tuple[str, Any], ...]] = {}
+
+def stable_values(values: Mapping[str, Any]) -> StableValues:
+    """``values`` as :class:`StableValues` (with no plans yet: a Python ``__init__`` would
+    cost a moving camera's frame 0.5 us an object)."""
+    made = StableValues(values)
+    made.plans = {}
+    return made
+
+
+_ONCE = object()  # a plan's place after the values' first use (set_stable)
 
 
 def gl_value(value: Any) -> Any:
@@ -97,16 +103,20 @@ class ProgramUniforms:
     def set_stable(self, values: Mapping[str, Any]) -> None:
         """:meth:`set` for :class:`StableValues` (an object's transforms, a material's kept
         inputs): which of their names the program has, and their GL values, are worked out
-        once, not at every draw; the plan lasts as long as the values. Any other mapping is
-        set by :meth:`set` (it may change in place)."""
+        once, the second time they are set, not at every draw; the plan lasts as long as the
+        values. Any other mapping is set by :meth:`set` (it may change in place)."""
         if values.__class__ is not StableValues:
             self.set(values)
             return
-        plan = values.plans.get(self)
-        if plan is None:
-            plan = values.plans[self] = tuple((name, gl_value(value))
-                                              for name, value in values.items()
-                                              if name in self.members)
+        plans = values.plans
+        plan = plans.get(self)
+        if plan is None or plan is _ONCE:
+            if plan is None:  # values set once are set as a dict is (a moving camera's
+                plans[self] = _ONCE  # transforms, new every frame): planned the second time
+                self.set(values)
+                return
+            plan = plans[self] = tuple((name, gl_value(value)) for name, value in values.items()
+                                       if name in self.members)
         held = self._values
         for name, value in plan:
             if held.get(name, _UNSET) != value:
