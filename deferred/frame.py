@@ -174,48 +174,47 @@ class KeptMaterialInputs:
 
 
 class ObjectTransforms:
-    """Every object's transform uniforms (``u_model``, ``u_model_view``, ``u_normal_matrix`` as
-    GL bytes, ``u_surface_id``), made for all objects at once and kept while nothing they come
-    from changes: a scene whose objects and camera stand still reuses the last frame's (the
-    batched inverse and the conversions cost about 4 us an object a frame)."""
+    """Every object's transform uniforms (``u_model`` and ``u_model_normal_matrix``, the
+    inverse transpose of the model's 3x3, as GL bytes; ``u_surface_id``), made for all objects
+    at once and kept while the objects hold. The camera's view is apart (``u_view``,
+    ``shaders/common/object_transform.glsl``), so a camera that moves remakes none of them: the
+    batched inverse and the conversions cost about 3 us an object when they are remade."""
 
     def __init__(self) -> None:
         self._key: tuple | None = None
         self._values: dict[int, dict[str, Any]] = {}
 
-    def of(self, objects: list[SceneObject], view: np.ndarray) -> dict[int, dict[str, Any]]:
-        """id(object) -> its uniforms, for ``objects`` seen with ``view``."""
+    def of(self, objects: list[SceneObject]) -> dict[int, dict[str, Any]]:
+        """id(object) -> its uniforms."""
         if not objects:
             return {}
         surface_ids = [float(obj.material.surface_id()) for obj in objects]
         # what the values are made of (contents, not identities: a model may be written in
         # place), and which object each belongs to
-        key = (np.asarray(view).tobytes(), b"".join([obj.model.tobytes() for obj in objects]),
-               surface_ids, [id(obj) for obj in objects])
+        key = (b"".join([obj.model.tobytes() for obj in objects]), surface_ids,
+               [id(obj) for obj in objects])
         if key != self._key:
             models = np.stack([obj.model for obj in objects])
-            self._values = self._make(objects, view, models, surface_ids)
+            self._values = self._make(objects, models, surface_ids)
             self._key = key
         return self._values
 
     @staticmethod
-    def _make(objects: list[SceneObject], view: np.ndarray, models: np.ndarray,
+    def _make(objects: list[SceneObject], models: np.ndarray,
               surface_ids: list[float]) -> dict[int, dict[str, Any]]:
-        model_views = view @ models
-        normals = np.transpose(np.linalg.inv(model_views[:, :3, :3]), (0, 2, 1))
+        normals = np.transpose(np.linalg.inv(models[:, :3, :3]), (0, 2, 1))
 
         def column_major(matrices: np.ndarray) -> bytes:  # GLSL's order, all at once
             return np.ascontiguousarray(np.transpose(matrices, (0, 2, 1)),
                                         dtype=np.float32).tobytes()
 
-        model_bytes, view_bytes = column_major(models), column_major(model_views)
-        normal_bytes = column_major(normals)
+        model_bytes, normal_bytes = column_major(models), column_major(normals)
         values = {}
         for index, (obj, surface_id) in enumerate(zip(objects, surface_ids, strict=True)):
-            mat4, mat3 = slice(64 * index, 64 * index + 64), slice(36 * index, 36 * index + 36)
             values[id(obj)] = stable_values({  # replaced whole when they change
-                "u_model": model_bytes[mat4], "u_model_view": view_bytes[mat4],
-                "u_normal_matrix": normal_bytes[mat3], "u_surface_id": surface_id})
+                "u_model": model_bytes[64 * index:64 * index + 64],
+                "u_model_normal_matrix": normal_bytes[36 * index:36 * index + 36],
+                "u_surface_id": surface_id})
         return values
 
 
@@ -337,9 +336,9 @@ class Frame:
 
     def object_uniforms(self, obj: SceneObject) -> dict[str, Any]:
         """The object's transforms and id (for every object at once, kept across frames while
-        the camera and the objects hold: :class:`ObjectTransforms`)."""
+        the objects hold: :class:`ObjectTransforms`)."""
         if self._objects is None:
-            self._objects = self._object_transforms.of(self.scene.objects, self.view)
+            self._objects = self._object_transforms.of(self.scene.objects)
         return self._objects[id(obj)]
 
     def shading_textures(self) -> dict[str, moderngl.Texture]:

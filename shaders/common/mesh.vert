@@ -6,9 +6,8 @@ in vec3 in_tangent;
 in vec3 in_binormal;
 in vec4 in_comb;
 
-uniform mat4 u_model_view;
+#include "common/object_transform.glsl"
 uniform mat4 u_projection;
-uniform mat3 u_normal_matrix;
 
 out vec3 v_position;
 out vec3 v_normal;
@@ -21,11 +20,13 @@ out vec4 v_comb;
 invariant gl_Position;
 
 void main() {
-    vec4 position = u_model_view * vec4(in_position, 1.0);
+    mat4 model_view = object_model_view();
+    mat3 normal_matrix = object_normal_matrix();
+    vec4 position = model_view * vec4(in_position, 1.0);
     v_position = position.xyz;
-    v_normal = normalize(u_normal_matrix * in_normal);
-    v_tangent = normalize(mat3(u_model_view) * in_tangent);
-    v_binormal = normalize(mat3(u_model_view) * in_binormal);
+    v_normal = normalize(normal_matrix * in_normal);
+    v_tangent = normalize(mat3(model_view) * in_tangent);
+    v_binormal = normalize(mat3(model_view) * in_binormal);
     v_uv = in_uv;
     v_comb = in_comb;
     gl_Position = u_projection * position;

@@ -10,9 +10,8 @@ in vec3 in_tangent;
 in vec3 in_binormal;
 in vec4 in_comb;
 
-uniform mat4 u_model_view;
+#include "common/object_transform.glsl"
 uniform mat4 u_projection;
-uniform mat3 u_normal_matrix;
 uniform float u_shell_depth;
 uniform float u_fur_length;     // object units, scaled per vertex by the comb alpha
 uniform float u_comb_strength;
@@ -56,6 +55,8 @@ out vec3 v_tip_position;  // view space (fins)
 invariant gl_Position;
 
 void main() {
+    mat4 model_view = object_model_view();
+    mat3 normal_matrix = object_normal_matrix();
 #ifdef VERTEX_COMB
     vec3 comb_tangent = in_comb.xyz * 2.0 - 1.0;
     vec3 comb = in_tangent * comb_tangent.x + in_binormal * comb_tangent.y
@@ -70,13 +71,13 @@ void main() {
     vec3 shell = in_position + shell_offset(in_normal, comb, u_shell_depth, fur_length);
     vec3 tip = in_position + shell_offset(in_normal, comb, 1.0, fur_length);
 
-    vec4 position = u_model_view * vec4(shell, 1.0);
-    vec4 base_view = u_model_view * vec4(in_position, 1.0);
-    vec4 tip_view = u_model_view * vec4(tip, 1.0);
+    vec4 position = model_view * vec4(shell, 1.0);
+    vec4 base_view = model_view * vec4(in_position, 1.0);
+    vec4 tip_view = model_view * vec4(tip, 1.0);
     v_position = position.xyz;
-    v_normal = normalize(u_normal_matrix * in_normal);
-    v_tangent = normalize(mat3(u_model_view) * in_tangent);
-    v_binormal = normalize(mat3(u_model_view) * in_binormal);
+    v_normal = normalize(normal_matrix * in_normal);
+    v_tangent = normalize(mat3(model_view) * in_tangent);
+    v_binormal = normalize(mat3(model_view) * in_binormal);
     v_uv = in_uv;
     v_comb = vec4(comb_tangent * 0.5 + 0.5, in_comb.a);
     v_base_clip = u_projection * base_view;

@@ -17,9 +17,8 @@ in vec3 in_tangent;
 in vec3 in_binormal;
 in vec4 in_comb;
 
-uniform mat4 u_model_view;
+#include "common/object_transform.glsl"
 uniform mat4 u_projection;
-uniform mat3 u_normal_matrix;
 uniform float u_shell_depth;    // h
 uniform float u_fur_length;     // object units, scaled per vertex by the vertex colour alpha
 uniform vec3 u_fur_scale;       // object axes to world units (the model matrix's scale)
@@ -78,6 +77,8 @@ vec3 strand_offset(float h, vec3 rest_tip, vec3 tip, float wetness, vec3 u, vec3
 }
 
 void main() {
+    mat4 model_view = object_model_view();
+    mat3 normal_matrix = object_normal_matrix();
     float fur_length = u_fur_length * in_comb.a;
     vec3 rest_tip = in_position + in_normal * fur_length;  // p_0
     vec3 tip = constrain_tip(in_position, in_normal, fur_length, rest_tip + strand_texel(0));
@@ -96,13 +97,13 @@ void main() {
 #endif
     direction = dot(direction, direction) > 1e-20 ? direction : in_normal;
 
-    vec4 position = u_model_view * vec4(layer, 1.0);
-    vec4 base_view = u_model_view * vec4(in_position, 1.0);
-    vec4 tip_view = u_model_view * vec4(tip_point, 1.0);
+    vec4 position = model_view * vec4(layer, 1.0);
+    vec4 base_view = model_view * vec4(in_position, 1.0);
+    vec4 tip_view = model_view * vec4(tip_point, 1.0);
     v_position = position.xyz;
-    v_normal = normalize(u_normal_matrix * in_normal);
-    v_tangent = normalize(mat3(u_model_view) * in_tangent);
-    v_binormal = normalize(mat3(u_model_view) * in_binormal);
+    v_normal = normalize(normal_matrix * in_normal);
+    v_tangent = normalize(mat3(model_view) * in_tangent);
+    v_binormal = normalize(mat3(model_view) * in_binormal);
     v_uv = in_uv;
     v_comb = in_comb;
     v_base_clip = u_projection * base_view;
@@ -114,6 +115,6 @@ void main() {
     v_fur_position = in_position * u_fur_scale;
     v_fur_normal = in_normal;
     v_tip_position = tip_view.xyz;
-    v_strand_tangent = normalize(mat3(u_model_view) * direction);
+    v_strand_tangent = normalize(mat3(model_view) * direction);
     gl_Position = u_projection * position;
 }
