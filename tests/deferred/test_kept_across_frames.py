@@ -296,3 +296,37 @@ def test_materials_replaced_on_their_objects_are_not_kept_for_long(gl):
         assert len(kept) <= len(scene.objects) + 1
         assert {inputs.material for inputs in kept.values()} >= {
             obj.material for obj in scene.objects}
+
+
+@pytest.mark.parametrize("pipeline", ["deferred", "forward"])
+def test_a_camera_moved_between_frames_is_drawn_from_where_it_is_now(gl, pipeline):
+    """The view is a uniform of its own (common/object_transform.glsl): the objects' kept
+    transforms are drawn through the camera as it is now."""
+    import dataclasses
+
+    scene = sphere_scene()
+    with Renderer(scene, pipeline, gl=gl) as renderer:
+        first = renderer.render().hdr
+        scene.camera = dataclasses.replace(scene.camera, position=(0.8, 1.0, 2.2))
+        moved = renderer.render().hdr
+    expected = sphere_scene()
+    expected.camera = dataclasses.replace(expected.camera, position=(0.8, 1.0, 2.2))
+    assert not np.array_equal(first, moved)
+    np.testing.assert_array_equal(moved, fresh_render(gl, expected, pipeline))
+
+
+def test_the_normal_matrix_of_view_and_model_is_the_views_times_the_models():
+    """What object_normal_matrix relies on: for a look-at view V and any invertible model M,
+    inverse-transpose((V M)_3x3) = (V)_3x3 inverse-transpose(M_3x3) (numpy, float64)."""
+    from deferred.camera import Camera
+
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        camera = Camera(position=tuple(rng.uniform(-5, 5, 3)), target=tuple(rng.uniform(-1, 1, 3)))
+        view = np.asarray(camera.view(), np.float64)
+        model = np.eye(4)
+        model[:3, :3] = rng.normal(size=(3, 3)) + 2.0 * np.eye(3)
+        model[:3, 3] = rng.uniform(-3, 3, 3)
+        direct = np.linalg.inv((view @ model)[:3, :3]).T
+        split = view[:3, :3] @ np.linalg.inv(model[:3, :3]).T
+        np.testing.assert_allclose(split, direct, atol=1e-9)
