@@ -59,8 +59,9 @@ def python_loop_ms() -> float:
 
 
 def moving_frames(renderer: Renderer, runs: int) -> tuple[float, int]:
-    """:func:`time_cpu` with the camera moved before each frame (outside the timing), so
-    every object's transforms are made again in each."""
+    """:func:`time_cpu` with the camera moved before each frame (outside the timing): the
+    view changes each frame (before this stop's split of view and model, every object's
+    transforms were made again with it)."""
     samples = []
     for index in range(runs):
         camera = renderer.scene.camera
@@ -118,7 +119,7 @@ def main() -> None:
     parser.add_argument("--runs", type=int, default=8, help="frames per measurement")
     parser.add_argument("--trials", type=int, default=15)
     parser.add_argument("--moving", action="store_true",
-                        help="move the camera every frame (every transform made again)")
+                        help="move the camera before every frame")
     args = parser.parse_args()
     width, height = (int(v) for v in args.size.split("x"))
     measure([int(n) for n in args.counts.split(",")], (width, height), args.runs, args.trials,

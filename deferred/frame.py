@@ -16,7 +16,7 @@ from .errors import DeferredError, InputError, RenderError, gl_error
 from .mesh import GpuMesh, MeshData
 from .shaderlib import ShaderLibrary
 from .targets import FrameTargets
-from .uniforms import ProgramUniforms, gl_value, stable_values
+from .uniforms import ProgramUniforms, StableValues, gl_value
 
 if TYPE_CHECKING:
     from .light_lists import LightLists
@@ -163,7 +163,7 @@ class KeptMaterialInputs:
             return kept
         kept = material.keeps_inputs()
         uniforms = material.uniforms(frame)
-        inputs = MaterialInputs(material, stable_values(uniforms) if kept else uniforms,
+        inputs = MaterialInputs(material, StableValues(uniforms) if kept else uniforms,
                                 material.textures(frame), params=material.params, kept=kept)
         if kept:
             self._kept[key] = inputs
@@ -211,10 +211,10 @@ class ObjectTransforms:
         model_bytes, normal_bytes = column_major(models), column_major(normals)
         values = {}
         for index, (obj, surface_id) in enumerate(zip(objects, surface_ids, strict=True)):
-            values[id(obj)] = stable_values({  # replaced whole when they change
-                "u_model": model_bytes[64 * index:64 * index + 64],
-                "u_model_normal_matrix": normal_bytes[36 * index:36 * index + 36],
-                "u_surface_id": surface_id})
+            values[id(obj)] = StableValues(  # replaced whole when they change
+                u_model=model_bytes[64 * index:64 * index + 64],
+                u_model_normal_matrix=normal_bytes[36 * index:36 * index + 36],
+                u_surface_id=surface_id)
         return values
 
 

@@ -25,18 +25,12 @@ _UNSET = object()
 
 class StableValues(dict):
     """Uniform values that are replaced, never changed in place (:meth:`ProgramUniforms
-    .set_stable`). They hold what each program works out from them (``plans``), which so
-    goes with them. Make them with :func:`stable_values`."""
+    .set_stable`). They hold what each program works out from them (``plans``, made on their
+    first use), which so goes with them."""
 
-    __slots__ = ("plans",)
-
-
-def stable_values(values: Mapping[str, Any]) -> StableValues:
-    """``values`` as :class:`StableValues` (with no plans yet: a Python ``__init__`` would
-    cost a moving camera's frame 0.5 us an object)."""
-    made = StableValues(values)
-    made.plans = {}
-    return made
+    # ProgramUniforms -> the (name, GL value) pairs of these values that its program has: the
+    # instance's own once set (a class default, not an __init__, which would cost each a call)
+    plans: dict | None = None
 
 
 _ONCE = object()  # a plan's place after the values' first use (set_stable)
@@ -109,10 +103,12 @@ class ProgramUniforms:
             self.set(values)
             return
         plans = values.plans
+        if plans is None:
+            plans = values.plans = {}
         plan = plans.get(self)
         if plan is None or plan is _ONCE:
-            if plan is None:  # values set once are set as a dict is (a moving camera's
-                plans[self] = _ONCE  # transforms, new every frame): planned the second time
+            if plan is None:  # values set once are set as a dict is (objects that move: their
+                plans[self] = _ONCE  # transforms are new every frame): planned the second time
                 self.set(values)
                 return
             plan = plans[self] = tuple((name, gl_value(value)) for name, value in values.items()

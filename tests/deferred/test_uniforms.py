@@ -83,17 +83,17 @@ def test_stable_values_are_planned_once_and_their_replacement_reaches_gl(program
     """set_stable works out once per StableValues which names the program has and their GL
     values; values replacing them are planned again, the values hold their plans, and a
     plain dict (which its owner may change in place) is set as by set."""
-    from deferred.uniforms import stable_values
+    from deferred.uniforms import StableValues
 
     uniforms = CountingUniforms(program)
     view = np.arange(16, dtype=np.float64).reshape(4, 4)
-    first = stable_values({"u_view": view, "u_x": 0.5, "u_unknown": 1.0})
+    first = StableValues(u_view=view, u_x=0.5, u_unknown=1.0)
     uniforms.set_stable(first)
     uniforms.set_stable(first)
     assert sorted(uniforms.writes) == ["u_view", "u_x"]  # once; the unknown name skipped
     np.testing.assert_array_equal(np.array(program["u_view"].value, np.float32),
                                   view.T.reshape(-1))
-    uniforms.set_stable(stable_values({"u_view": view, "u_x": 0.75}))
+    uniforms.set_stable(StableValues(u_view=view, u_x=0.75))
     assert uniforms.writes[2:] == ["u_x"]
     assert program["u_x"].value == pytest.approx(0.75)
     uniforms.set_stable(first)  # the first values again: their value is written back
@@ -112,7 +112,7 @@ def test_stable_values_are_planned_once_and_their_replacement_reaches_gl(program
     assert program["u_x"].value == pytest.approx(3.0)
     # values replaced many times: each set right, each plan held by its values
     for index in range(10):
-        values = stable_values({"u_x": float(index)})
+        values = StableValues(u_x=float(index))
         uniforms.set_stable(values)
         assert program["u_x"].value == pytest.approx(float(index))
         uniforms.set_stable(values)  # planned the second time

@@ -414,8 +414,7 @@ def layer_positions(gl, shaders, mesh, h, wetness, curl_radius, curl_frequency, 
     ctx = gl.ctx
     program = fur_vertex_program(ctx, shaders)
     for name in ("u_view", "u_model"):  # identity transforms
-        if name in program:
-            program[name].write(np.eye(4, dtype=np.float32).tobytes())
+        program[name].write(np.eye(4, dtype=np.float32).tobytes())
     for name, value in (("u_shell_depth", h), ("u_fur_length", fur_length),
                         ("u_curl_radius", curl_radius), ("u_curl_frequency", curl_frequency)):
         program[name].value = value
