@@ -161,11 +161,11 @@ class KeptMaterialInputs:
         kept = self._kept.get(key)
         if kept is not None and kept.material is material and kept.params is material.params:
             return kept
-        kept = material.keeps_inputs()
+        keep = material.keeps_inputs()
         uniforms = material.uniforms(frame)
-        inputs = MaterialInputs(material, StableValues(uniforms) if kept else uniforms,
-                                material.textures(frame), params=material.params, kept=kept)
-        if kept:
+        inputs = MaterialInputs(material, StableValues(uniforms) if keep else uniforms,
+                                material.textures(frame), params=material.params, kept=keep)
+        if keep:
             self._kept[key] = inputs
         return inputs
 

@@ -72,27 +72,17 @@ class ProgramUniforms:
     def set(self, values: Mapping[str, Any], _group: str | None = None) -> None:
         """Write the values the program has and does not hold already; names it lacks are
         skipped (:meth:`Frame.bind` checks them in strict mode)."""
-        # the writes inline: a pass of many objects sets a few values a draw, and a call a
-        # value was most of the cost (3 values: 4.2 -> 2.0 us)
+        # the comparisons inline: a pass of many objects sets a few values a draw, and a call
+        # a value was most of the cost (3 values: 4.2 -> 2.0 us); a call a write remains
         held = self._values
         members = self.members
-        writers = self._writers
-        owners = self._owner
         for name, value in values.items():  # a few values: cheaper than a set intersection
             if name not in members:
                 continue
             if isinstance(value, np.ndarray):
                 value = gl_value(value)
             if held.get(name, _UNSET) != value:
-                writer = writers.get(name)
-                if writer is None:  # the first write: made once, then the one kept
-                    writers[name] = uniform_writer(self._program[name])
-                    writer = writers[name]
-                writer(value)
-                held[name] = value
-                owner = owners.get(name)
-                if owner is not None and owner != _group:  # a shared dict's value overwritten
-                    self._shared.pop(owner, None)
+                self._write(name, value, _group)
 
     def set_stable(self, values: Mapping[str, Any]) -> None:
         """:meth:`set` for :class:`StableValues` (an object's transforms, a material's kept
@@ -118,7 +108,8 @@ class ProgramUniforms:
             if held.get(name, _UNSET) != value:
                 self._write(name, value)
 
-    def _write(self, name: str, value: Any) -> None:
+    def _write(self, name: str, value: Any, group: str | None = None) -> None:
+        """Write ``value`` to GL and remember it; ``group``: the shared dict writing it."""
         writer = self._writers.get(name)
         if writer is None:  # the first write: made once, then the one kept
             self._writers[name] = uniform_writer(self._program[name])
@@ -126,7 +117,7 @@ class ProgramUniforms:
         writer(value)
         self._values[name] = value
         owner = self._owner.get(name)
-        if owner is not None:  # a shared dict's value overwritten
+        if owner is not None and owner != group:  # a shared dict's value overwritten
             self._shared.pop(owner, None)
 
     def set_shared(self, group: str, values: Mapping[str, Any]) -> None:
