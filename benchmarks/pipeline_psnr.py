@@ -15,8 +15,8 @@ import math
 
 import numpy as np
 
-from deferred.renderer import Renderer
-from deferred.scene import load_scene, parse_size
+from deferred.render.renderer import Renderer
+from deferred.scene.model import load_scene, parse_size
 
 
 def psnr(a: np.ndarray, b: np.ndarray) -> float:

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 __version__ = "0.1.0"
 
-from .context import create_context  # noqa: E402
-from .errors import DeferredError, InputError, RenderError, ShaderError  # noqa: E402
-from .renderer import Renderer, RenderResult, render_scene  # noqa: E402
-from .scene import Scene, load_scene, scene_from_dict, scene_from_toml  # noqa: E402
+from deferred.errors import DeferredError, InputError, RenderError, ShaderError  # noqa: E402
+from deferred.gl.context import create_context  # noqa: E402
+from deferred.render.renderer import Renderer, RenderResult, render_scene  # noqa: E402
+from deferred.scene.model import Scene, load_scene, scene_from_dict, scene_from_toml  # noqa: E402
 
 __all__ = ["DeferredError", "InputError", "RenderError", "RenderResult", "Renderer", "Scene",
            "ShaderError", "create_context", "load_scene", "render_scene", "scene_from_dict",

@@ -17,12 +17,12 @@ import click
 from rich.console import Console
 from rich.table import Table
 
-from . import registry
-from .errors import DeferredError, InputError, RenderError, ShaderError
-from .imageio import check_output_path, write_image
-from .output_safety import interrupt_exit_code, termination_as_interrupt
-from .pipeline import PIPELINES
-from .scene import load_scene, parse_size
+from deferred.errors import DeferredError, InputError, RenderError, ShaderError
+from deferred.interfaces import registry
+from deferred.io.images import check_output_path, write_image
+from deferred.io.safety import interrupt_exit_code, termination_as_interrupt
+from deferred.render.pipeline import PIPELINES
+from deferred.scene.model import load_scene, parse_size
 
 stderr = Console(stderr=True, soft_wrap=True)  # status lines never wrap on pipes
 
@@ -93,17 +93,17 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
            view_name: str | None) -> None:
     """Render SCENE (a TOML file; the built-in demo when omitted) to an image, a numbered
     image sequence or a video."""
-    from .animation import check_video_size, frame_times, output_kind
-    from .buffer_views import (
+    from deferred.debug.capture import capture_frame
+    from deferred.debug.views import (
         resolve_view,
         view,
         view_catalogue,
         with_material_view,
         write_view,
     )
-    from .capture import capture_frame
-    from .light_lists import resolve_light_path
-    from .renderer import FULL_FEATURES, Renderer
+    from deferred.io.video import check_video_size, frame_times, output_kind
+    from deferred.lighting.lists import resolve_light_path
+    from deferred.render.renderer import FULL_FEATURES, Renderer
 
     if view_name == "help":
         loaded = _scene(scene)
@@ -178,7 +178,7 @@ def _render_animation(renderer, out: Path, times: list[float],
         TimeRemainingColumn,
     )
 
-    from .animation import AnimationWriter, describe_written
+    from deferred.io.video import AnimationWriter, describe_written
 
     frame_ms = []
     with AnimationWriter(out, fps) as writer, \
@@ -227,11 +227,11 @@ def dump(scene: str | None, output: str | None, pipeline: str, size: str | None,
     a manifest (DESIGN.md, "Dumps")."""
     from rich.progress import Progress, SpinnerColumn, TextColumn
 
-    from .capture import select_passes
-    from .dump import check_dump_folder, check_dump_inputs, dump_scene
-    from .output_safety import scene_inputs
-    from .pixel_history import format_history, parse_pixel
-    from .renderer import Renderer
+    from deferred.debug.capture import select_passes
+    from deferred.debug.dump import check_dump_folder, check_dump_inputs, dump_scene
+    from deferred.debug.pixel_history import format_history, parse_pixel
+    from deferred.io.safety import scene_inputs
+    from deferred.render.renderer import Renderer
 
     if compare:
         if scene or passes or pixel or size:
@@ -267,7 +267,7 @@ def dump(scene: str | None, output: str | None, pipeline: str, size: str | None,
 
 
 def _compare(first: str, second: str, output: str | None) -> None:
-    from .dump_compare import compare_dumps
+    from deferred.debug.compare import compare_dumps
 
     b = Path(second).resolve()  # "." has no name to build the default from
     out = Path(output) if output else b.parent / f"{b.name}-diff"
@@ -319,7 +319,7 @@ def bench(scene: str | None, lights: str, shells: str, size: str | None, runs: i
     shell counts (DESIGN.md, "Benchmarks")."""
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
 
-    from . import bench as benchmark
+    from deferred.bench import harness as benchmark
 
     # Every option is checked before the first frame: bad input never costs a sweep.
     sweep = benchmark.Sweep(lights=benchmark.parse_counts(lights, "--lights"),
@@ -376,14 +376,14 @@ def _render_outputs(out: Path, kind: str, frames: int) -> list[Path]:
     """Every file ``render -o`` writes: a sequence's frames, or the one file."""
     if kind != "sequence":
         return [out]
-    from .animation import expand_pattern
+    from deferred.io.video import expand_pattern
 
     return [expand_pattern(out, index) for index in range(frames)]
 
 
 def _check_not_inputs(outputs: list[Path], loaded, scene: str | None, where: str) -> None:
     """No output may replace a file the scene reads (the scene, a mesh, a texture)."""
-    from .output_safety import check_not_inputs, scene_inputs
+    from deferred.io.safety import check_not_inputs, scene_inputs
 
     check_not_inputs(outputs, scene_inputs(loaded, scene), where)
 
@@ -416,7 +416,7 @@ def materials() -> None:
 def info(scene: str | None) -> None:
     """GL vendor, renderer, version, the optional features in use, and the G-buffer layout of
     SCENE (the built-in demo when omitted)."""
-    from .context import create_context
+    from deferred.gl.context import create_context
 
     layout = _scene(scene).gbuffer_layout()  # bad input fails before GL start-up
     gl = create_context()

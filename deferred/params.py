@@ -13,8 +13,8 @@ from typing import Any
 
 from pydantic import BaseModel, ConfigDict, ValidationError
 
-from .errors import InputError
-from .validation import StrictValues, format_validation_error
+from deferred.errors import InputError
+from deferred.validation import StrictValues, format_validation_error
 
 UniformOverrides = dict[str, Callable[[Any], dict[str, Any]] | None]
 

@@ -25,7 +25,7 @@ from pydantic import (
     field_validator,
 )
 
-from .errors import InputError
+from deferred.errors import InputError
 
 # Floats beyond this are refused (world units, intensities, rates): float32 shading has lost
 # every digit by then and a product of two overflows to inf.

@@ -1,3 +1,3 @@
-"""Built-in lights; importing this package registers them (see deferred.registry)."""
+"""Built-in lights; importing this package registers them (see deferred.interfaces.registry)."""
 
 from . import ambient, directional, point, spot  # noqa: F401

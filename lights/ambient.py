@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 from pydantic import Field
 
-from deferred.light import Light, LightParams, view_direction
-from deferred.registry import lights
+from deferred.interfaces.light import Light, LightParams, view_direction
+from deferred.interfaces.registry import lights
 from deferred.validation import NonZeroVec3, Radiance
 
 

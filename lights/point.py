@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 from pydantic import Field
 
-from deferred.light import Light, LightParams, radiances, view_points
-from deferred.registry import lights
+from deferred.interfaces.light import Light, LightParams, radiances, view_points
+from deferred.interfaces.registry import lights
 
 
 class PointParams(LightParams):

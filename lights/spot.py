@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 from pydantic import Field, model_validator
 
-from deferred.light import Light, radiances, view_directions, view_points
-from deferred.registry import lights
+from deferred.interfaces.light import Light, radiances, view_directions, view_points
+from deferred.interfaces.registry import lights
 from deferred.validation import NonZeroVec3
 
 from .point import PointParams

@@ -20,11 +20,11 @@ from typing import TYPE_CHECKING, Any
 import moderngl
 from pydantic import Field
 
-from deferred.gbuffer import ALBEDO_SPECULAR, LINEAR_DEPTH, NORMAL_EXPONENT_ID
-from deferred.material import BlinnPhongParams, ForwardLitPass, GBufferPass, Material
-from deferred.passes import Phase, RenderPass
-from deferred.registry import materials
-from deferred.targets import COMPOSITE, LIGHT_ACCUMULATION
+from deferred.core.passes import Phase, RenderPass
+from deferred.gbuffer.layout import ALBEDO_SPECULAR, LINEAR_DEPTH, NORMAL_EXPONENT_ID
+from deferred.gl.targets import COMPOSITE, LIGHT_ACCUMULATION
+from deferred.interfaces.material import BlinnPhongParams, ForwardLitPass, GBufferPass, Material
+from deferred.interfaces.registry import materials
 from deferred.validation import Albedo, NonZeroVec3
 
 from .techniques.fins import FinPass
@@ -47,8 +47,8 @@ from .techniques.stipple import (
 )
 
 if TYPE_CHECKING:
-    from deferred.frame import Frame
-    from deferred.scene import SceneObject
+    from deferred.core.frame import Frame
+    from deferred.scene.model import SceneObject
 
 Vec3 = tuple[float, float, float]
 FUR_VERTEX = "materials/revie_fur/fur.vert"

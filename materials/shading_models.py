@@ -1,4 +1,4 @@
-"""Built-in shading models (see :mod:`deferred.shading`); importing this module registers them.
+"""Built-in shading models (see :mod:`deferred.interfaces.shading`); importing this module registers them.
 
 - ``blinn_phong``: the standard model (albedo, specular intensity and exponent).
 - ``kajiya_kay``: strands (Silva et al. Eq. 6; Kajiya and Kay 1989): diffuse |T x L|, specular
@@ -14,11 +14,11 @@ from typing import TYPE_CHECKING
 import moderngl
 import numpy as np
 
-from deferred.registry import shading_models
-from deferred.shading import GBufferData, ShadingModel
+from deferred.interfaces.registry import shading_models
+from deferred.interfaces.shading import GBufferData, ShadingModel
 
 if TYPE_CHECKING:
-    from deferred.frame import Frame
+    from deferred.core.frame import Frame
 
 STRAND_TANGENT = GBufferData(
     "strand_tangent", "RG16F", ("u", "v"),

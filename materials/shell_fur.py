@@ -28,12 +28,12 @@ import moderngl
 import numpy as np
 from pydantic import Field, model_validator
 
+from deferred.core.passes import Phase, RenderPass
 from deferred.errors import InputError
-from deferred.imageio import read_image
-from deferred.material import BlinnPhongParams, ForwardLitPass, GBufferPass, Material
-from deferred.passes import Phase, RenderPass
-from deferred.registry import materials
-from deferred.targets import COMPOSITE
+from deferred.gl.targets import COMPOSITE
+from deferred.interfaces.material import BlinnPhongParams, ForwardLitPass, GBufferPass, Material
+from deferred.interfaces.registry import materials
+from deferred.io.images import read_image
 from deferred.validation import Albedo
 
 from .techniques.fins import FinPass
@@ -70,8 +70,8 @@ from .techniques.wetness import (
 )
 
 if TYPE_CHECKING:
-    from deferred.frame import Frame
-    from deferred.scene import SceneObject
+    from deferred.core.frame import Frame
+    from deferred.scene.model import SceneObject
 
 Vec3 = tuple[float, float, float]
 FUR_VERTEX = "materials/shell_fur/fur.vert"

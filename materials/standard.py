@@ -7,13 +7,13 @@ from typing import TYPE_CHECKING
 import moderngl
 from pydantic import Field
 
-from deferred.imageio import check_image
-from deferred.material import BlinnPhongParams, Material
-from deferred.registry import materials
+from deferred.interfaces.material import BlinnPhongParams, Material
+from deferred.interfaces.registry import materials
+from deferred.io.images import check_image
 from deferred.validation import Albedo, require_regular_file
 
 if TYPE_CHECKING:
-    from deferred.frame import Frame
+    from deferred.core.frame import Frame
 
 
 class StandardParams(BlinnPhongParams):

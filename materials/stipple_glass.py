@@ -14,11 +14,11 @@ from typing import TYPE_CHECKING, Literal
 
 from pydantic import Field
 
-from deferred.gbuffer import LINEAR_DEPTH, NORMAL_EXPONENT_ID
-from deferred.material import BlinnPhongParams, Material
-from deferred.passes import ObjectPass, Order, Phase, RenderPass
-from deferred.registry import materials
-from deferred.targets import COMPOSITE, LIGHT_ACCUMULATION
+from deferred.core.passes import ObjectPass, Order, Phase, RenderPass
+from deferred.gbuffer.layout import LINEAR_DEPTH, NORMAL_EXPONENT_ID
+from deferred.gl.targets import COMPOSITE, LIGHT_ACCUMULATION
+from deferred.interfaces.material import BlinnPhongParams, Material
+from deferred.interfaces.registry import materials
 from deferred.validation import Albedo
 
 from .techniques.stipple import (
@@ -29,7 +29,7 @@ from .techniques.stipple import (
 )
 
 if TYPE_CHECKING:
-    from deferred.scene import SceneObject
+    from deferred.scene.model import SceneObject
 
 
 class StippleGlassParams(BlinnPhongParams):

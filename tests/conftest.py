@@ -15,8 +15,8 @@ sys.path.insert(0, str(TESTS / "fixtures"))
 
 @pytest.fixture(scope="session")
 def gl():
-    from deferred.context import create_context
     from deferred.errors import RenderError
+    from deferred.gl.context import create_context
 
     try:
         context = create_context()
@@ -30,7 +30,7 @@ def gl():
 def render(gl):
     """render(scene, pipeline='deferred', size=None, light_path=None) -> (RenderResult, Renderer)
     released later."""
-    from deferred.renderer import Renderer
+    from deferred.render.renderer import Renderer
 
     made = []
 

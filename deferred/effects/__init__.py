@@ -1,4 +1,4 @@
 """Built-in scene effects (``[[effect]]`` in scene files: ssao, fxaa, edges); importing this
-package registers them (see :mod:`deferred.effect` and :mod:`deferred.registry`)."""
+package registers them (see :mod:`deferred.interfaces.effect` and :mod:`deferred.interfaces.registry`)."""
 
-from . import edges, fxaa, ssao  # noqa: F401
+from deferred.effects import edges, fxaa, ssao  # noqa: F401

@@ -6,13 +6,13 @@ from __future__ import annotations
 
 from pydantic import Field
 
-from ..effect import Effect, EffectParams
-from ..gbuffer import LINEAR_DEPTH, NORMAL_EXPONENT_ID
-from ..passes import FullscreenPass, Order, Phase, RenderPass
-from ..registry import effects
-from ..targets import FINAL
-from ..targets_spec import TargetSpec
-from ..validation import Albedo
+from deferred.core.passes import FullscreenPass, Order, Phase, RenderPass
+from deferred.gbuffer.layout import LINEAR_DEPTH, NORMAL_EXPONENT_ID
+from deferred.gl.target_spec import TargetSpec
+from deferred.gl.targets import FINAL
+from deferred.interfaces.effect import Effect, EffectParams
+from deferred.interfaces.registry import effects
+from deferred.validation import Albedo
 
 EDGES_RAW = "edges_raw"
 EDGES = "edges"

@@ -6,10 +6,10 @@ from __future__ import annotations
 
 from pydantic import Field
 
-from ..effect import Effect, EffectParams
-from ..passes import FullscreenPass, Order, Phase, RenderPass, copy_pass
-from ..registry import effects
-from ..targets import FINAL, FINAL_SPEC
+from deferred.core.passes import FullscreenPass, Order, Phase, RenderPass, copy_pass
+from deferred.gl.targets import FINAL, FINAL_SPEC
+from deferred.interfaces.effect import Effect, EffectParams
+from deferred.interfaces.registry import effects
 
 FXAA_SOURCE = "fxaa_source"
 

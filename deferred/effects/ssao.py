@@ -9,11 +9,11 @@ from __future__ import annotations
 
 from pydantic import Field
 
-from ..effect import AMBIENT_OCCLUSION, Effect, EffectParams
-from ..gbuffer import LINEAR_DEPTH, NORMAL_EXPONENT_ID
-from ..passes import FullscreenPass, Phase, RenderPass
-from ..registry import effects
-from ..targets_spec import TargetSpec
+from deferred.core.passes import FullscreenPass, Phase, RenderPass
+from deferred.gbuffer.layout import LINEAR_DEPTH, NORMAL_EXPONENT_ID
+from deferred.gl.target_spec import TargetSpec
+from deferred.interfaces.effect import AMBIENT_OCCLUSION, Effect, EffectParams
+from deferred.interfaces.registry import effects
 
 SSAO_RAW = "ssao_raw"
 SSAO_SPEC = TargetSpec(1, "f1", "ambient occlusion (1 = open)")

@@ -28,15 +28,15 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from deferred.buffer_views import with_material_view  # noqa: E402
-from deferred.imageio import read_image, write_image  # noqa: E402
+from deferred.debug.views import with_material_view  # noqa: E402
+from deferred.io.images import read_image, write_image  # noqa: E402
 from deferred.materials.techniques.wetness import (  # noqa: E402
     blend_droplet,
     dry_mask,
     random_droplets,
 )
-from deferred.renderer import Renderer  # noqa: E402
-from deferred.scene import scene_from_dict  # noqa: E402
+from deferred.render.renderer import Renderer  # noqa: E402
+from deferred.scene.model import scene_from_dict  # noqa: E402
 
 try:
     import tomllib

@@ -6,7 +6,7 @@ the cell lies inside its clump), A wetness 1. Texels outside the letters are dry
 
 The image is top row first, and its top row is v = 1 (``load_wetness_mask``): on
 ``builtin:plane`` (v = 1 at -z) the word reads left to right from a camera on +z looking at -z.
-It is written as a float EXR (R, G, B, A) with ``deferred.imageio.write_image``.
+It is written as a float EXR (R, G, B, A) with ``deferred.io.images.write_image``.
 
 Run from the repository root: python examples/shell_fur/word_mask.py [TEXT] [-o OUT.exr]
 """
@@ -23,7 +23,7 @@ import numpy as np  # noqa: E402
 from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
-from deferred.imageio import write_image  # noqa: E402
+from deferred.io.images import write_image  # noqa: E402
 
 HERE = Path(__file__).parent
 

@@ -11,9 +11,9 @@ from typing import Any
 import moderngl
 import numpy as np
 
-from deferred.gbuffer import DEPTH
-from deferred.mesh import GpuMesh, MeshData
-from deferred.passes import ObjectPass, Order
+from deferred.core.passes import ObjectPass, Order
+from deferred.gbuffer.layout import DEPTH
+from deferred.scene.meshes import GpuMesh, MeshData
 
 
 def edge_adjacency(mesh: MeshData, tolerance: float = 1e-6) -> np.ndarray:

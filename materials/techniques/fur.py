@@ -26,14 +26,14 @@ import numpy as np
 from pydantic import Field, model_validator
 
 from deferred.errors import InputError
-from deferred.material import MaterialParams
+from deferred.interfaces.material import MaterialParams
 
 from .fur_volume import FurPattern, pattern, strand_volume, volume_texture
 from .heightfield import heightfield_volume, load_heightfield
 
 if TYPE_CHECKING:
-    from deferred.frame import Frame
-    from deferred.scene import SceneObject
+    from deferred.core.frame import Frame
+    from deferred.scene.model import SceneObject
 
 # A heightfield image tile counts as this many strands when density converts to tiles per unit.
 IMAGE_TILE_STRANDS = 1024

@@ -28,13 +28,13 @@ from typing import TYPE_CHECKING
 
 import moderngl
 
-from deferred.gbuffer import ALBEDO_SPECULAR, LINEAR_DEPTH, NORMAL_EXPONENT_ID
-from deferred.passes import FullscreenPass, Order, Phase
-from deferred.targets import LIGHT_ACCUMULATION
-from deferred.targets_spec import TargetSpec
+from deferred.core.passes import FullscreenPass, Order, Phase
+from deferred.gbuffer.layout import ALBEDO_SPECULAR, LINEAR_DEPTH, NORMAL_EXPONENT_ID
+from deferred.gl.target_spec import TargetSpec
+from deferred.gl.targets import LIGHT_ACCUMULATION
 
 if TYPE_CHECKING:
-    from deferred.frame import Frame
+    from deferred.core.frame import Frame
 
 FUR_LIGHT_FRAGMENT = "techniques/fur_light.frag"
 

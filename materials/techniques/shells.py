@@ -9,8 +9,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from deferred.gbuffer import DEPTH
-from deferred.passes import ObjectPass, Order
+from deferred.core.passes import ObjectPass, Order
+from deferred.gbuffer.layout import DEPTH
 
 from .fur import shell_count, shell_layout
 from .fur_volume import VOLUME_LAYERS

@@ -14,10 +14,10 @@ under another's stipple samples.
 
 from __future__ import annotations
 
-from deferred.gbuffer import DEPTH, LINEAR_DEPTH, NORMAL_EXPONENT_ID
-from deferred.material import GBufferPass
-from deferred.passes import ObjectPass, Order, Phase, RenderPass, copy_pass
-from deferred.targets import COMPOSITE, COMPOSITE_SPEC
+from deferred.core.passes import ObjectPass, Order, Phase, RenderPass, copy_pass
+from deferred.gbuffer.layout import DEPTH, LINEAR_DEPTH, NORMAL_EXPONENT_ID
+from deferred.gl.targets import COMPOSITE, COMPOSITE_SPEC
+from deferred.interfaces.material import GBufferPass
 
 PATTERNS = (2, 4)
 COMPOSITE_SNAPSHOT = "composite_snapshot"

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from deferred.mesh import MeshData
+from deferred.scene.meshes import MeshData
 
 
 @dataclass(frozen=True)

@@ -3,11 +3,11 @@
 import numpy as np
 import pytest
 
-from deferred.animation import expand_pattern, frame_times, gif_durations, output_kind
 from deferred.cli import main
 from deferred.errors import InputError
-from deferred.imageio import read_image
-from deferred.scene import scene_from_toml
+from deferred.io.images import read_image
+from deferred.io.video import expand_pattern, frame_times, gif_durations, output_kind
+from deferred.scene.model import scene_from_toml
 
 SCENE = """
 size = [64, 48]
@@ -144,8 +144,8 @@ def test_timeline_errors_exit_2_with_one_line(tmp_path, capsys, event, expected)
 
 
 def test_same_time_same_image_and_frame_time(gl, scene_file):
-    from deferred.renderer import Renderer
-    from deferred.scene import load_scene
+    from deferred.render.renderer import Renderer
+    from deferred.scene.model import load_scene
 
     seen = []
     with Renderer(load_scene(scene_file), gl=gl) as renderer:
@@ -233,7 +233,7 @@ def test_mp4(tmp_path, capsys, scene_file):
 @pytest.mark.parametrize("suffix", [".gif", pytest.param(".mp4", marks=pytest.mark.skipif(
     not has_ffmpeg(), reason="no ffmpeg"))])
 def test_ctrl_c_mid_video_leaves_no_file(tmp_path, capsys, scene_file, monkeypatch, suffix):
-    from deferred.renderer import Renderer
+    from deferred.render.renderer import Renderer
 
     original = Renderer.render
 
@@ -273,7 +273,7 @@ def test_bad_animation_options_exit_2(tmp_path, capsys, monkeypatch, scene_file,
 
 
 def test_bench_shell_sweep_holds_over_a_timeline():
-    from deferred.bench import with_shells
+    from deferred.bench.harness import with_shells
 
     text = SCENE.replace('name = "ball"', 'name = "ball"\nmaterial = "revie_fur"').replace(
         "color = [0.8, 0.1, 0.1]", "shells = 8") + """

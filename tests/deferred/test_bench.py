@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from deferred.bench import (
+from deferred.bench.harness import (
     COLUMNS,
     Sweep,
     extra_point_lights,
@@ -19,9 +19,9 @@ from deferred.bench import (
 )
 from deferred.cli import main
 from deferred.errors import InputError
-from deferred.imageio import read_image
-from deferred.pipeline import PIPELINES
-from deferred.scene import load_scene, scene_from_dict
+from deferred.io.images import read_image
+from deferred.render.pipeline import PIPELINES
+from deferred.scene.model import load_scene, scene_from_dict
 
 LIGHTS_SCENE = Path(__file__).parents[2] / "benchmarks" / "lights.toml"
 FAST = ["--size", "64x36", "--runs", "2", "--warmup", "1"]
@@ -240,7 +240,7 @@ def test_builtin_overdraw_scene_has_objects_at_several_depths(render):
 
 
 def test_speedups_compare_the_fastest_deferred_path_at_the_most_lights():
-    from deferred.bench import BenchReport, BenchResult, speedups
+    from deferred.bench.harness import BenchReport, BenchResult, speedups
 
     def row(pipeline, path, lights, ms, shells=0):
         return BenchResult(pipeline, lights, shells, 64, 36, [ms], light_path=path)
@@ -260,7 +260,7 @@ def test_speedups_compare_the_fastest_deferred_path_at_the_most_lights():
 
 
 def test_growth_compares_the_best_deferred_path_with_its_own_frame_at_the_fewest_lights():
-    from deferred.bench import BenchReport, BenchResult, growth
+    from deferred.bench.harness import BenchReport, BenchResult, growth
 
     def row(pipeline, path, lights, ms, shells=0):
         return BenchResult(pipeline, lights, shells, 64, 36, [ms], light_path=path)
@@ -280,7 +280,7 @@ def test_growth_compares_the_best_deferred_path_with_its_own_frame_at_the_fewest
 
 def _record_frames(monkeypatch):
     """Log which renderer each frame and each release belongs to, in order."""
-    from deferred.renderer import Renderer
+    from deferred.render.renderer import Renderer
 
     events = []
     render, release = Renderer.render, Renderer.release
@@ -307,7 +307,7 @@ def test_interleaved_points_alternate_their_frames_round_by_round(gl, monkeypatc
     sweep = Sweep(lights=[0, 3], runs=3, warmup=1, light_paths=["tiled"],
                   interleave=interleave, round_ms=0.0)  # one timed frame a round
     report = run_bench(scene, sweep, gl=gl, progress=steps.append)
-    from deferred.bench import sweep_steps
+    from deferred.bench.harness import sweep_steps
 
     assert len(steps) == sweep_steps(scene, sweep)
     assert report.renderer["interleaved"] is interleave
@@ -352,7 +352,7 @@ def test_interleaved_points_alternate_their_frames_round_by_round(gl, monkeypatc
 def test_a_round_times_a_cheap_point_back_to_back_and_drops_the_first(gl, monkeypatch):
     """Within a round a point's timed frames run back to back until they make round_ms (at
     most ROUND_FRAMES), and the first, which follows another point's frames, is dropped."""
-    from deferred.bench import ROUND_FRAMES
+    from deferred.bench.harness import ROUND_FRAMES
 
     events = _record_frames(monkeypatch)
     scene = standard_scene()

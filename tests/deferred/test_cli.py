@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from deferred.cli import main
-from deferred.imageio import read_channels, read_image
+from deferred.io.images import read_channels, read_image
 
 
 def run(capsys, *args):

@@ -7,18 +7,18 @@ import numpy as np
 import OpenImageIO as oiio
 import pytest
 
-from deferred import registry
-from deferred.buffer_views import view
-from deferred.capture import GBUFFER_CHANNELS, capture_frame
 from deferred.cli import main
-from deferred.dump import contact_tiles, write_dump
-from deferred.dump_compare import compare_dumps
-from deferred.gbuffer import decode
-from deferred.imageio import read_channels, read_image, write_image
-from deferred.passes import FullscreenPass, Phase
-from deferred.pixel_history import pixel_history
-from deferred.renderer import Renderer
-from deferred.scene import scene_from_dict
+from deferred.core.passes import FullscreenPass, Phase
+from deferred.debug.capture import GBUFFER_CHANNELS, capture_frame
+from deferred.debug.compare import compare_dumps
+from deferred.debug.dump import contact_tiles, write_dump
+from deferred.debug.pixel_history import pixel_history
+from deferred.debug.views import view
+from deferred.gbuffer.layout import decode
+from deferred.interfaces import registry
+from deferred.io.images import read_channels, read_image, write_image
+from deferred.render.renderer import Renderer
+from deferred.scene.model import scene_from_dict
 
 SIZE = (160, 120)
 
@@ -363,7 +363,7 @@ def test_depth_without_a_surface_holds_the_background(gl, light_path):
     the clear does on the rest of the sky."""
     from pathlib import Path
 
-    from deferred.gbuffer import DEPTH
+    from deferred.gbuffer.layout import DEPTH
 
     scene = small_scene()
     scene.background = (0.25, 0.5, 0.75)
@@ -619,7 +619,7 @@ def test_a_dump_of_a_list_path_holds_the_light_lists(tmp_path, renderer, gl):
         pytest.skip("the driver has no compute shaders")
     from dataclasses import replace
 
-    from deferred.bench import with_extra_lights
+    from deferred.bench.harness import with_extra_lights
 
     scene = with_extra_lights(replace(small_scene(), light_path="tiled"), 40, SIZE[0] / SIZE[1])
     capture = capture_frame(renderer(scene))

@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 from model_materials import InvertEffect, TintMaterial
 
-from deferred import registry
 from deferred.errors import InputError
-from deferred.renderer import Renderer
-from deferred.scene import scene_from_dict
+from deferred.interfaces import registry
+from deferred.render.renderer import Renderer
+from deferred.scene.model import scene_from_dict
 
 OBJECTS = [
     {"mesh": "builtin:plane", "scale": 6.0, "params": {"color": [0.6, 0.6, 0.6]}},

@@ -5,9 +5,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from deferred.context import Features, GLContext
-from deferred.renderer import Renderer
-from deferred.scene import load_scene
+from deferred.gl.context import Features, GLContext
+from deferred.render.renderer import Renderer
+from deferred.scene.model import load_scene
 
 EXAMPLES = sorted((Path(__file__).parents[2] / "examples").glob("*.toml"))
 

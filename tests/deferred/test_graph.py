@@ -4,15 +4,15 @@ them, passes named in failures, strict uniforms, passes inserted from Python."""
 import numpy as np
 import pytest
 
+from deferred.core.graph import PassGraphError, compile_graph
+from deferred.core.passes import FullscreenPass, ObjectPass, Phase, RenderPass
 from deferred.errors import InputError, RenderError
-from deferred.gbuffer import LINEAR_DEPTH
-from deferred.graph import PassGraphError, compile_graph
-from deferred.material import Material
-from deferred.passes import FullscreenPass, ObjectPass, Phase, RenderPass
-from deferred.renderer import Renderer
-from deferred.scene import scene_from_dict
-from deferred.targets import COMPOSITE, FINAL
-from deferred.targets_spec import TargetSpec
+from deferred.gbuffer.layout import LINEAR_DEPTH
+from deferred.gl.target_spec import TargetSpec
+from deferred.gl.targets import COMPOSITE, FINAL
+from deferred.interfaces.material import Material
+from deferred.render.renderer import Renderer
+from deferred.scene.model import scene_from_dict
 
 SCENE = {
     "size": [48, 32],
@@ -222,7 +222,7 @@ def test_a_half_size_target_is_created_at_half_size_and_drawn_whole(render):
 
 
 def test_a_bad_layout_is_refused_before_any_gl_work():
-    from deferred.shading import GBufferData
+    from deferred.interfaces.shading import GBufferData
 
     class DeclaresFoo(Material):
         name = "test_declares_foo"
@@ -244,7 +244,7 @@ def test_a_bad_layout_is_refused_before_any_gl_work():
 def test_a_parameter_may_not_shadow_a_framework_uniform(render):
     from pydantic import Field
 
-    from deferred.material import MaterialParams
+    from deferred.interfaces.material import MaterialParams
 
     class ShadowingParams(MaterialParams):
         resolution: float = Field(2.0)
@@ -264,7 +264,7 @@ def test_a_parameter_may_not_shadow_a_framework_uniform(render):
 def test_a_gbuffer_pass_writing_surfaces_without_depth_is_refused(render):
     """The lighting runs where the G-buffer's depth is nearer than the far plane: a pass that
     wrote surfaces without depth would leave them unlit, so it is refused before it runs."""
-    from deferred.material import GBufferPass
+    from deferred.interfaces.material import GBufferPass
 
     scene = scene_from_dict(SCENE)
     _, renderer = render(scene)

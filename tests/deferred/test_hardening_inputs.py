@@ -12,12 +12,12 @@ import numpy as np
 import OpenImageIO as oiio
 import pytest
 
-import deferred.imageio
-import deferred.mesh
+import deferred.io.images
+import deferred.scene.meshes
 from deferred.cli import main
 from deferred.errors import InputError
-from deferred.imageio import check_image, read_channels, read_image, write_image
-from deferred.mesh import load_mesh
+from deferred.io.images import check_image, read_channels, read_image, write_image
+from deferred.scene.meshes import load_mesh
 
 TETRAHEDRON = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"
 
@@ -145,7 +145,7 @@ def test_bad_mesh_is_a_one_line_error(tmp_path, capfd, name):
                                           ("MAX_MESH_FILE_BYTES", 16)])
 def test_mesh_size_limits(tmp_path, capfd, monkeypatch, limit, value):
     (tmp_path / "tet.obj").write_text(TETRAHEDRON)
-    monkeypatch.setattr(deferred.mesh, limit, value)
+    monkeypatch.setattr(deferred.scene.meshes, limit, value)
     code, err, out = render_scene(tmp_path, capfd, {"mesh": "tet.obj", "material": "standard"})
     assert_one_line_error(code, err, "object[0].mesh", "tet.obj", "more than the")
     assert not out.exists()
@@ -161,7 +161,7 @@ def test_latin1_obj_loads(tmp_path):
 
 def test_far_but_sound_mesh_still_loads():
     """The span criterion is relative: a vertex 1e5 out on a mesh of 0.2 edges is accepted."""
-    from deferred.mesh import build_mesh
+    from deferred.scene.meshes import build_mesh
 
     positions = np.array([[0, 0, 0], [0.2, 0, 0], [0, 0.2, 0], [1e5, 0.2, 0]], float)
     mesh = build_mesh("far", positions, np.array([[0, 1, 2], [1, 3, 2]]))
@@ -184,7 +184,7 @@ def _raise(positions, indices):
 
 def test_unwrap_time_limit(tmp_path, capfd, monkeypatch):
     (tmp_path / "tet.obj").write_text(TETRAHEDRON)
-    monkeypatch.setattr(deferred.mesh, "_xatlas_parametrize", _sleep_for_ever)  # fork copies it
+    monkeypatch.setattr(deferred.scene.meshes, "_xatlas_parametrize", _sleep_for_ever)  # fork copies it
     monkeypatch.setenv("DEFERRED_UNWRAP_TIMEOUT", "0.3")
     start = time.monotonic()
     code, err, out = render_scene(tmp_path, capfd, {"mesh": "tet.obj", "material": "standard"})
@@ -197,7 +197,7 @@ def test_unwrap_time_limit(tmp_path, capfd, monkeypatch):
 
 def test_ctrl_c_ends_the_unwrap(tmp_path, monkeypatch):
     (tmp_path / "tet.obj").write_text(TETRAHEDRON)
-    monkeypatch.setattr(deferred.mesh, "_xatlas_parametrize", _sleep_for_ever)
+    monkeypatch.setattr(deferred.scene.meshes, "_xatlas_parametrize", _sleep_for_ever)
     main_thread = threading.main_thread().ident
     timer = threading.Timer(0.3, signal.pthread_kill, (main_thread, signal.SIGINT))
     start = time.monotonic()
@@ -215,7 +215,7 @@ def test_ctrl_c_ends_the_unwrap(tmp_path, monkeypatch):
                                              (_raise, "ValueError: xatlas said no")])
 def test_unwrap_failures_name_the_mesh(tmp_path, monkeypatch, child, fragment):
     (tmp_path / "tet.obj").write_text(TETRAHEDRON)
-    monkeypatch.setattr(deferred.mesh, "_xatlas_parametrize", child)
+    monkeypatch.setattr(deferred.scene.meshes, "_xatlas_parametrize", child)
     with pytest.raises(InputError, match="UV unwrap failed") as caught:
         load_mesh("tet.obj", tmp_path)
     assert fragment in str(caught.value) and "tet.obj" in str(caught.value)
@@ -272,14 +272,14 @@ def test_heightfield_memory_budget(tmp_path, capfd, images):
 
 
 def test_image_memory_budget(images, monkeypatch):
-    monkeypatch.setattr(deferred.imageio, "IMAGE_MEMORY_BUDGET", 48 * 48 * 16 - 1)
+    monkeypatch.setattr(deferred.io.images, "IMAGE_MEMORY_BUDGET", 48 * 48 * 16 - 1)
     for read in (read_image, check_image):
         with pytest.raises(InputError, match=r"good.png is 48x48: it would take 36.0 KiB"):
             read(images / "good.png", where="key")
     # read_channels counts the file's own channels (4 here)
     with pytest.raises(InputError, match="good.exr is 48x48"):
         read_channels(images / "good.exr")
-    monkeypatch.setattr(deferred.imageio, "IMAGE_MEMORY_BUDGET", 48 * 48 * 16)
+    monkeypatch.setattr(deferred.io.images, "IMAGE_MEMORY_BUDGET", 48 * 48 * 16)
     assert read_image(images / "good.png").shape == (48, 48, 4)
 
 
@@ -344,7 +344,7 @@ def test_channels_past_rgba_are_not_checked_and_ringing_reads_as_zero(tmp_path):
 def test_a_triangle_too_thin_to_unwrap_beside_good_ones_gets_finite_uvs(tmp_path):
     """A triangle thinner than float32 resolves, alone, is a degenerate mesh to the unwrap (the
     thin.obj case); beside a triangle it charts, the mesh loads with finite UVs everywhere."""
-    from deferred.mesh import load_mesh
+    from deferred.scene.meshes import load_mesh
 
     path = tmp_path / "sliver.obj"
     path.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1e-12\nf 1 2 3\nf 4 3 1\n")

@@ -19,14 +19,14 @@ import numpy as np
 import OpenImageIO as oiio
 import pytest
 
-import deferred.dump as dump_module
-from deferred.capture import capture_frame
+import deferred.debug.dump as dump_module
 from deferred.cli import main
-from deferred.dump import is_dump_folder, safe_name, write_dump
+from deferred.debug.capture import capture_frame
+from deferred.debug.dump import is_dump_folder, safe_name, write_dump
 from deferred.errors import InputError, RenderError
-from deferred.imageio import NAME_MAX, temporary_path, write_image, write_text
-from deferred.renderer import Renderer
-from deferred.scene import scene_from_dict
+from deferred.io.images import NAME_MAX, temporary_path, write_image, write_text
+from deferred.render.renderer import Renderer
+from deferred.scene.model import scene_from_dict
 
 REPO = Path(__file__).parents[2]
 

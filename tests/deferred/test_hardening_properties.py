@@ -10,8 +10,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from deferred.errors import InputError
-from deferred.renderer import Renderer
-from deferred.scene import scene_from_dict
+from deferred.render.renderer import Renderer
+from deferred.scene.model import scene_from_dict
 
 # Values of every kind a TOML document can hold, weighted to the troublesome ones.
 scalars = st.one_of(
@@ -143,7 +143,7 @@ def obj_documents(draw) -> str:
 @given(text=obj_documents())
 def test_a_random_mesh_file_is_a_mesh_or_one_input_error_in_bounded_time(
         text, tmp_path, monkeypatch):
-    from deferred.mesh import load_mesh
+    from deferred.scene.meshes import load_mesh
 
     monkeypatch.setenv("DEFERRED_UNWRAP_TIMEOUT", "5")
     path = tmp_path / "random.obj"

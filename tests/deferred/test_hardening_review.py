@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from deferred.cli import main
-from deferred.imageio import write_image
+from deferred.io.images import write_image
 
 SPHERE = """size = [48, 32]
 [[object]]

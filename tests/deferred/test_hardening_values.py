@@ -197,10 +197,10 @@ def test_the_python_api_takes_numpy_values_and_a_fields_own_conversion():
     import numpy as np
     from pydantic import BeforeValidator
 
-    from deferred import registry
     from deferred.errors import InputError
+    from deferred.interfaces import registry
     from deferred.params import Params, validate_params
-    from deferred.scene import scene_from_dict
+    from deferred.scene.model import scene_from_dict
 
     point = registry.lights.get("point").from_dict(
         {"intensity": np.float32(2.0), "radius": np.int64(3), "position": np.array([0., 1., 2.])})

@@ -5,12 +5,12 @@ change is the frame a fresh renderer draws."""
 import numpy as np
 import pytest
 
-from deferred.imageio import write_image
-from deferred.material import GBufferPass
+from deferred.core.passes import Phase
+from deferred.interfaces.material import GBufferPass
+from deferred.io.images import write_image
 from deferred.materials.standard import StandardMaterial
-from deferred.passes import Phase
-from deferred.renderer import Renderer
-from deferred.scene import scene_from_dict
+from deferred.render.renderer import Renderer
+from deferred.scene.model import scene_from_dict
 
 
 def sphere_scene():
@@ -179,7 +179,7 @@ def test_an_object_pass_subclass_overriding_a_hook_is_asked_for_it(gl):
 
 @pytest.mark.parametrize("pipeline", ["deferred", "forward"])
 def test_a_mesh_or_material_replaced_between_frames_is_drawn(gl, pipeline):
-    from deferred.mesh import load_mesh
+    from deferred.scene.meshes import load_mesh
 
     def replace_mesh(scene):
         scene.objects[0].mesh = load_mesh("builtin:torus")
@@ -203,7 +203,7 @@ def test_a_mesh_or_material_replaced_between_frames_is_drawn(gl, pipeline):
 def test_a_program_released_by_a_changed_virtual_file_is_not_drawn_with(gl):
     """A changed generated file releases the programs that include it (ShaderLibrary
     .generation): an object pass looks its program up again, never drawing with the old."""
-    from deferred.gbuffer import data_write_file
+    from deferred.gbuffer.layout import data_write_file
 
     with Renderer(sphere_scene(), "deferred", gl=gl) as renderer:
         first = renderer.render().hdr
@@ -241,7 +241,7 @@ def test_a_mesh_whose_comb_makes_another_define_gets_another_program(gl):
     given such a mesh between frames is drawn with the program a fresh renderer uses."""
     import dataclasses
 
-    from deferred.mesh import load_mesh
+    from deferred.scene.meshes import load_mesh
 
     def fur_scene():
         return scene_from_dict({
@@ -269,7 +269,7 @@ def test_a_mesh_whose_comb_makes_another_define_gets_another_program(gl):
 def test_the_same_framebuffer_request_gets_the_full_viewport_and_its_depth_mask(gl):
     """A pass may change the framebuffer it was given; the next pass asking for the same one
     gets it as it asks (the request memo checks what the last pass may have set)."""
-    from deferred.gbuffer import DEPTH, GBUFFER_COLOR_TARGETS
+    from deferred.gbuffer.layout import DEPTH, GBUFFER_COLOR_TARGETS
 
     with Renderer(sphere_scene(), "deferred", gl=gl) as renderer:
         renderer.render()
@@ -318,7 +318,7 @@ def test_a_camera_moved_between_frames_is_drawn_from_where_it_is_now(gl, pipelin
 def test_the_normal_matrix_of_view_and_model_is_the_views_times_the_models():
     """What object_normal_matrix relies on: for a look-at view V and any invertible model M,
     inverse-transpose((V M)_3x3) = (V)_3x3 inverse-transpose(M_3x3) (numpy, float64)."""
-    from deferred.camera import Camera
+    from deferred.scene.camera import Camera
 
     rng = np.random.default_rng(3)
     for _ in range(20):

@@ -3,7 +3,7 @@ import pytest
 import trimesh
 
 from deferred.errors import InputError
-from deferred.mesh import BUILTIN_MESHES, comb_to_tangent_space, load_mesh
+from deferred.scene.meshes import BUILTIN_MESHES, comb_to_tangent_space, load_mesh
 
 
 def listing_2_7_reference(color, normal, tangent, binormal):

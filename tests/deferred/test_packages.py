@@ -9,11 +9,11 @@ import sys
 import numpy as np
 from model_materials import StrandMaterial
 
-from deferred import registry
 from deferred.cli import main
-from deferred.imageio import read_image
-from deferred.renderer import Renderer
-from deferred.scene import load_scene
+from deferred.interfaces import registry
+from deferred.io.images import read_image
+from deferred.render.renderer import Renderer
+from deferred.scene.model import load_scene
 
 
 def test_nothing_is_importable_as_a_top_level_materials_lights_or_shaders(tmp_path):

@@ -13,8 +13,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from deferred.imageio import read_image, write_image
-from deferred.scene import load_scene
+from deferred.io.images import read_image, write_image
+from deferred.scene.model import load_scene
 
 ROOT = Path(__file__).parents[2]
 REFERENCES = ROOT / "tests" / "reference"

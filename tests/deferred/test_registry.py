@@ -3,7 +3,7 @@
 import pytest
 
 from deferred.errors import InputError
-from deferred.registry import PluginWarning, Registry
+from deferred.interfaces.registry import PluginWarning, Registry
 
 
 def fake_distribution(tmp_path, group, line):

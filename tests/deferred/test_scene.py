@@ -1,7 +1,7 @@
 import pytest
 
 from deferred.errors import InputError
-from deferred.scene import load_scene, parse_size, scene_from_toml
+from deferred.scene.model import load_scene, parse_size, scene_from_toml
 
 GOOD = """
 size = [320, 200]

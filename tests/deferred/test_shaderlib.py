@@ -3,7 +3,7 @@ from pathlib import Path
 import pytest
 
 from deferred.errors import ShaderError
-from deferred.shaderlib import MAX_INCLUDE_DEPTH, ShaderLibrary
+from deferred.gl.shaderlib import MAX_INCLUDE_DEPTH, ShaderLibrary
 
 
 @pytest.fixture
@@ -91,10 +91,10 @@ def test_every_packaged_shader_program_compiles(gl):
     """The built-in programs compile on this driver (both light-buffer variants), with every
     built-in light type and shading model and their G-buffer data; installed plugins play no
     part."""
-    from deferred import registry
-    from deferred.generated import generated_glsl
+    from deferred.interfaces import registry
+    from deferred.interfaces.shading import GBufferLayout
     from deferred.materials.standard import StandardMaterial
-    from deferred.shading import GBufferLayout
+    from deferred.render.generated import generated_glsl
 
     lights = registry.lights.builtins()
     models = registry.shading_models.builtins()
@@ -157,7 +157,7 @@ def test_a_root_added_first_replaces_files_and_only_before_any_program(library, 
 
 
 def test_declared_uniforms_read_through_layouts_and_qualifiers():
-    from deferred.shaderlib import declared_uniforms
+    from deferred.gl.shaderlib import declared_uniforms
 
     text = ("layout(rgba32f) uniform writeonly image2D u_image;\n"
             "uniform highp float u_a, u_b[4];\n"

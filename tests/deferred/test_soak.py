@@ -10,8 +10,8 @@ import moderngl
 import numpy as np
 import pytest
 
-from deferred.renderer import Renderer
-from deferred.scene import scene_from_dict
+from deferred.render.renderer import Renderer
+from deferred.scene.model import scene_from_dict
 
 FRAMES = 1000
 GL_CLASSES = tuple(getattr(moderngl, name) for name in (

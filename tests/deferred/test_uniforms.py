@@ -1,10 +1,10 @@
-"""Uniforms written only when they change (deferred.uniforms) and the frame's GL state memo: what
+"""Uniforms written only when they change (deferred.gl.uniforms) and the frame's GL state memo: what
 the program and the context end up holding is what the last caller asked for."""
 
 import numpy as np
 import pytest
 
-from deferred.uniforms import ProgramUniforms, gl_value
+from deferred.gl.uniforms import ProgramUniforms, gl_value
 
 VERTEX = """#version 330
 uniform mat4 u_view;
@@ -83,7 +83,7 @@ def test_stable_values_are_planned_once_and_their_replacement_reaches_gl(program
     """set_stable works out once per StableValues which names the program has and their GL
     values; values replacing them are planned again, the values hold their plans, and a
     plain dict (which its owner may change in place) is set as by set."""
-    from deferred.uniforms import StableValues
+    from deferred.gl.uniforms import StableValues
 
     uniforms = CountingUniforms(program)
     view = np.arange(16, dtype=np.float64).reshape(4, 4)
@@ -132,7 +132,7 @@ def test_forgotten_values_are_written_again(program):
 def test_the_state_memo_sets_what_a_pass_states(render):
     # A pass stating the last pass's state sets nothing; one changing only the depth offset
     # between draws (the root shell) must not leave the next pass with its offset.
-    from deferred.scene import load_scene
+    from deferred.scene.model import load_scene
 
     _, renderer = render(load_scene("builtin:demo"), size=(32, 18))
     frame = renderer.last_frame
@@ -148,7 +148,7 @@ def test_the_state_memo_sets_what_a_pass_states(render):
 
 
 def test_gl_call_times_are_measured_only_when_asked(render):
-    from deferred.scene import load_scene
+    from deferred.scene.model import load_scene
 
     result, renderer = render(load_scene("builtin:overdraw"), size=(64, 36))
     assert result.gl_call_seconds == 0.0
@@ -191,7 +191,7 @@ WRITER_VALUES = {
 def test_the_uniform_writer_leaves_what_moderngls_own_setter_does(gl):
     """uniform_writer packs and writes past moderngl's Python layers: every type of uniform
     (arrays through the handle) holds the value moderngl's own setter gives it."""
-    from deferred.uniforms import uniform_writer
+    from deferred.gl.uniforms import uniform_writer
 
     ours = gl.ctx.program(vertex_shader=WRITER_VERTEX, fragment_shader=FRAGMENT)
     theirs = gl.ctx.program(vertex_shader=WRITER_VERTEX, fragment_shader=FRAGMENT)

@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 from plane_reference import plane_points
 
-from deferred.context import Features, GLContext
+from deferred.gl.context import Features, GLContext
 from deferred.lights.point import distance_falloff
 from deferred.lights.spot import cone_falloff
-from deferred.renderer import Renderer
-from deferred.scene import scene_from_dict
+from deferred.render.renderer import Renderer
+from deferred.scene.model import scene_from_dict
 
 SIZE = (96, 72)
 CAMERA = {"position": [0.0, 4.0, 0.0], "target": [0.0, 0.0, 0.0], "up": [0.0, 0.0, -1.0],

@@ -7,12 +7,12 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from deferred.bench import with_extra_lights
-from deferred.context import Features, GLContext
+from deferred.bench.harness import with_extra_lights
 from deferred.errors import InputError
-from deferred.lightbuffer import visible_spheres
-from deferred.renderer import Renderer
-from deferred.scene import load_scene, scene_from_dict
+from deferred.gl.context import Features, GLContext
+from deferred.lighting.buffer import visible_spheres
+from deferred.render.renderer import Renderer
+from deferred.scene.model import load_scene, scene_from_dict
 
 ALL_TYPES = [
     {"type": "ambient", "color": [0.2, 0.22, 0.25], "ground": [0.1, 0.08, 0.06]},
@@ -123,7 +123,7 @@ def listed_frame(gl, path: str, extra: int, size: tuple[int, int] | None = None
 @pytest.mark.parametrize("size", [None, (157, 93)])  # 160x96; odd: tiles of odd width, height
 @pytest.mark.parametrize("split", [2, 1])  # lists of 8x8 quadrants (the default), or 16x16
 def test_tile_lists_hold_every_light_that_reaches_a_pixel(gl, size, split, monkeypatch):
-    import deferred.light_lists as light_lists
+    import deferred.lighting.lists as light_lists
 
     monkeypatch.setattr(light_lists, "LIST_SPLIT", split)
     frame = listed_frame(gl, "tiled", 120, size)
@@ -182,7 +182,7 @@ def test_lists_hold_their_lights_in_light_order_and_clusters_every_light_reachin
 
 
 def test_lights_outside_the_view_are_culled_on_the_cpu(gl):
-    from deferred.camera import Camera
+    from deferred.scene.camera import Camera
 
     view_projection = Camera(fov=90.0, near=0.1, far=50.0).projection(1.0)
     records = np.zeros((4, 4, 4), np.float32)
@@ -251,7 +251,7 @@ def test_more_lights_than_the_coarse_lists_hold_is_refused_before_a_frame(gl, mo
     # coarse lists, every volume light in each at the most (6 coarse lists)
     if not gl.features.compute_shaders:
         pytest.skip("the driver has no compute shaders")
-    import deferred.light_lists as light_lists
+    import deferred.lighting.lists as light_lists
 
     scene = scene_with(200)
     monkeypatch.setattr(light_lists, "MAX_LIST_BYTES", 4096)
@@ -266,7 +266,7 @@ def test_lists_past_the_limit_refuse_the_frame_in_one_line(gl, monkeypatch):
     # the shading's texture, sized to the frame's capacity: checked each frame
     if not gl.features.compute_shaders:
         pytest.skip("the driver has no compute shaders")
-    import deferred.light_lists as light_lists
+    import deferred.lighting.lists as light_lists
     from deferred.errors import RenderError
 
     monkeypatch.setattr(light_lists, "MAX_LIST_BYTES", 64 * 1024)
@@ -288,7 +288,7 @@ def test_the_shading_lists_texture_is_sized_to_the_frame_and_refused_past_the_ro
     """The shading reads the lists from a texture of SLOT_TEXELS texels a slot, sized each frame
     to the lists' capacity: past the rows the driver allows, the frame is refused in one line."""
     from deferred.errors import RenderError
-    from deferred.light_lists import (
+    from deferred.lighting.lists import (
         LIST_ROW_BYTES,
         LIST_TEXTURE_WIDTH,
         SLOT_TEXELS,
@@ -334,8 +334,8 @@ def test_a_renderer_reused_with_other_light_counts_draws_what_a_fresh_one_does(g
 def test_pixel_to_view_is_the_inverse_projection_at_pixel_centres():
     """The culling's view positions of pixels (one multiply-add) against the lighting's (the
     inverse projection), for a wide and a tall frame."""
-    from deferred.camera import Camera
-    from deferred.light_lists import pixel_to_view
+    from deferred.lighting.lists import pixel_to_view
+    from deferred.scene.camera import Camera
 
     for width, height, fov in ((640, 360, 50.0), (200, 500, 90.0)):
         projection = Camera(fov=fov, near=0.1, far=80.0).projection(width / height)
@@ -357,8 +357,8 @@ def test_a_types_records_in_one_go_are_each_lights_record(kind):
     here light by light), the others through each light's own record."""
     import math
 
-    from deferred.camera import Camera
-    from deferred.registry import lights as light_registry
+    from deferred.interfaces.registry import lights as light_registry
+    from deferred.scene.camera import Camera
 
     rng = np.random.default_rng(7)
     cls = light_registry.get(kind)
@@ -474,13 +474,13 @@ def test_several_full_screen_lights_of_a_type_each_light_the_list_and_forward_pa
 
 
 def scene_light(values: dict):
-    from deferred.registry import lights
+    from deferred.interfaces.registry import lights
 
     return lights.get(values["type"]).from_dict({k: v for k, v in values.items() if k != "type"})
 
 
 def test_more_full_screen_lights_than_a_frame_holds_is_refused_before_a_frame(gl):
-    from deferred.light import FULLSCREEN_LIGHT_CAPACITY
+    from deferred.interfaces.light import FULLSCREEN_LIGHT_CAPACITY
 
     scene = scene_with(0)
     scene.lights = [*scene.lights, *(scene_light({"type": "directional", "intensity": 0.1})
@@ -515,7 +515,7 @@ def test_the_shading_copy_of_the_lists_holds_each_listed_lights_sphere_and_index
 
 
 def test_a_radius_past_a_half_float_is_refused_on_the_list_paths(gl):
-    from deferred.scene import scene_from_dict
+    from deferred.scene.model import scene_from_dict
 
     if not gl.features.compute_shaders:
         pytest.skip("the driver has no compute shaders")
@@ -569,7 +569,7 @@ def side_plane_counts(spheres, inverse, width, height, tile, slices=None):
 @pytest.mark.parametrize("size", [(320, 192), (317, 189)])  # odd: partial tiles
 def test_the_lists_capacity_bounds_every_list_and_is_the_side_planes_count(gl, pipeline, path,
                                                                            size):
-    from deferred.light_lists import coarse_grid, list_capacity
+    from deferred.lighting.lists import coarse_grid, list_capacity
 
     if not gl.features.compute_shaders:
         pytest.skip("the driver has no compute shaders")
@@ -603,7 +603,7 @@ def test_the_lists_capacity_bounds_every_list_and_is_the_side_planes_count(gl, p
 
 def test_more_lights_than_a_listed_lights_index_holds_is_refused(monkeypatch):
     # a listed light's texel holds its index in 16 bits beside its half-float radius
-    import deferred.light_lists as light_lists
+    import deferred.lighting.lists as light_lists
 
     assert light_lists.MAX_LISTED_LIGHTS <= 1 << 16  # a listed light's index: 16 bits
     monkeypatch.setattr(light_lists, "MAX_LISTED_LIGHTS", 41)
@@ -616,8 +616,8 @@ def test_more_lights_than_a_listed_lights_index_holds_is_refused(monkeypatch):
 @pytest.mark.parametrize("pipeline, path", [("deferred", "tiled"), ("deferred", "clustered"),
                                             ("forward", "tiled")])
 def test_the_light_lists_view_shows_the_length_of_each_pixels_list(gl, pipeline, path):
-    from deferred.buffer_views import view
-    from deferred.capture import capture_frame
+    from deferred.debug.capture import capture_frame
+    from deferred.debug.views import view
 
     if not gl.features.compute_shaders:
         pytest.skip("the driver has no compute shaders")
@@ -652,7 +652,7 @@ def test_the_light_lists_view_shows_the_length_of_each_pixels_list(gl, pipeline,
 
 
 def test_the_light_lists_view_needs_a_path_with_lists(gl):
-    from deferred.buffer_views import resolve_view
+    from deferred.debug.views import resolve_view
 
     with Renderer(scene_with(4), gl=gl, light_path="volumes") as renderer:
         with pytest.raises(InputError, match=r"^--view: view 'light_lists' shows the light "
@@ -696,7 +696,7 @@ def test_lists_of_point_and_spot_lights_give_the_reference_image(gl, points_cull
     """The list loops run a loop per light type over its entries (a list holds its lights in
     light order, the light buffer its types in order): points and spots mixed, and spots alone
     where every point light is culled, give the image of the path with no lists."""
-    from deferred.registry import lights as light_types
+    from deferred.interfaces.registry import lights as light_types
 
     scene = mixed_scene(points_culled)
     reference, _ = render(gl, scene, pipeline, reference_path)

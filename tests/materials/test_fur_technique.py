@@ -8,7 +8,8 @@ import moderngl
 import numpy as np
 import pytest
 
-from deferred.buffer_views import with_material_view
+from deferred.debug.views import with_material_view
+from deferred.gl.shaderlib import ShaderLibrary
 from deferred.materials.techniques.fins import edge_adjacency
 from deferred.materials.techniques.fur import shell_layout
 from deferred.materials.techniques.fur_volume import (
@@ -21,10 +22,9 @@ from deferred.materials.techniques.fur_volume import (
     volume_texture,
 )
 from deferred.materials.techniques.heightfield import heightfield_volume
-from deferred.mesh import load_mesh
-from deferred.renderer import Renderer
-from deferred.scene import scene_from_dict
-from deferred.shaderlib import ShaderLibrary
+from deferred.render.renderer import Renderer
+from deferred.scene.meshes import load_mesh
+from deferred.scene.model import scene_from_dict
 
 LIGHTS = [{"type": "ambient", "color": [0.2, 0.2, 0.25]},
           {"type": "directional", "direction": [-0.5, -0.7, -0.6], "intensity": 1.5}]

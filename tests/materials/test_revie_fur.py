@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 import trimesh
 
-from deferred import registry
-from deferred.scene import scene_from_dict
-from deferred.shading import split_surface_id
+from deferred.interfaces import registry
+from deferred.interfaces.shading import split_surface_id
+from deferred.scene.model import scene_from_dict
 
 
 def fur_scene(params=None, size=(160, 120), lights=None, objects=(), camera=None, mesh=None,
@@ -207,7 +207,7 @@ def test_ssao_runs_before_stipple_and_never_sees_it(render):
 
 
 def test_heightfield_image_controls_the_strands(render, tmp_path):
-    from deferred.imageio import write_image
+    from deferred.io.images import write_image
 
     results = {}
     for name, value in (("bald", 0.0), ("full", 1.0)):
@@ -236,7 +236,7 @@ def test_vertex_colour_comb_and_length_are_used(render, tmp_path):
     A plane seen from above, combed along +X or -X by its vertex colours: the stippled outer
     shell slides off the plane's edge on the combed side only, by less when A is smaller.
     """
-    from deferred.mesh import builtin_plane
+    from deferred.scene.meshes import builtin_plane
 
     plane = builtin_plane(divisions=8)
     overhang = {}

@@ -7,12 +7,12 @@ import pytest
 from model_materials import StrandMaterial, ToonMaterial
 from plane_reference import plane_points
 
-from deferred import registry
-from deferred.capture import capture_frame
-from deferred.gbuffer import octahedral_decode
+from deferred.debug.capture import capture_frame
+from deferred.gbuffer.layout import octahedral_decode
+from deferred.interfaces import registry
 from deferred.materials.shading_models import toon_ramps
-from deferred.renderer import Renderer
-from deferred.scene import scene_from_dict
+from deferred.render.renderer import Renderer
+from deferred.scene.model import scene_from_dict
 
 SIZE = (96, 72)
 CAMERA = {"position": [0.0, 4.0, 0.0], "target": [0.0, 0.0, 0.0], "up": [0.0, 0.0, -1.0],

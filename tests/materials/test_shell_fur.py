@@ -10,7 +10,8 @@ import moderngl
 import numpy as np
 import pytest
 
-from deferred.imageio import write_image
+from deferred.gl.shaderlib import ShaderLibrary
+from deferred.io.images import write_image
 from deferred.materials.shell_fur import ShellFurMaterial, ShellFurState, layer_layout
 from deferred.materials.techniques.strands import StrandForces, StrandSimulation, triangle_strands
 from deferred.materials.techniques.wetness import (
@@ -22,9 +23,8 @@ from deferred.materials.techniques.wetness import (
     load_wetness_mask,
     mask_image,
 )
-from deferred.mesh import builtin_plane, builtin_sphere
-from deferred.scene import scene_from_dict
-from deferred.shaderlib import ShaderLibrary
+from deferred.scene.meshes import builtin_plane, builtin_sphere
+from deferred.scene.model import scene_from_dict
 
 HARNESS = Path(__file__).parents[1] / "fixtures" / "shell_fur_harness"
 
@@ -409,7 +409,7 @@ def tangent_frames(mesh):
 def layer_positions(gl, shaders, mesh, h, wetness, curl_radius, curl_frequency, fur_length,
                     deflection=None, frames=None):
     """fur.vert's layer positions and strand tangents (object space: identity transforms)."""
-    from deferred.mesh import GpuMesh
+    from deferred.scene.meshes import GpuMesh
 
     ctx = gl.ctx
     program = fur_vertex_program(ctx, shaders)
@@ -855,7 +855,7 @@ def test_fur_over_the_screen_border_is_lit_as_inside(render):
     """Fur whose root lies just off the screen takes the light of the pixels inside, as the
     search did: the deferred image does not differ from the forward one more along the border
     than inside (``fig12_word``: a furry square filling the frame)."""
-    from deferred.scene import load_scene
+    from deferred.scene.model import load_scene
 
     scene = load_scene(Path(__file__).parents[2] / "examples" / "shell_fur" / "fig12_word.toml")
     deferred, _ = render(scene, size=(320, 240))  # roots 1 pixel off the screen

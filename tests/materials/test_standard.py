@@ -2,9 +2,9 @@
 
 import numpy as np
 
-from deferred.gbuffer import decode
-from deferred.imageio import write_image
-from deferred.scene import load_scene
+from deferred.gbuffer.layout import decode
+from deferred.io.images import write_image
+from deferred.scene.model import load_scene
 
 
 def test_texture_and_specular_land_in_the_gbuffer(render, tmp_path):

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from deferred.scene import scene_from_dict
+from deferred.scene.model import scene_from_dict
 
 
 def glass_scene(pattern, opacity=0.4):
@@ -97,7 +97,7 @@ def test_glass_and_fur_samples_coexist(render, pattern):
             shots["ids"] = frame.targets.read("normal_exponent_id")[..., 3]
 
     render(scene, on_pass=grab)
-    from deferred import registry
+    from deferred.interfaces import registry
 
     ids = shots["ids"] % 64
     y, x = np.mgrid[0:ids.shape[0], 0:ids.shape[1]]

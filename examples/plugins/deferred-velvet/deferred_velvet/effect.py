@@ -2,9 +2,9 @@
 
 from pydantic import Field
 
-from deferred.effect import Effect, EffectParams
-from deferred.passes import FullscreenPass, Order, Phase
-from deferred.targets import FINAL
+from deferred.core.passes import FullscreenPass, Order, Phase
+from deferred.gl.targets import FINAL
+from deferred.interfaces.effect import Effect, EffectParams
 
 from . import SHADERS
 

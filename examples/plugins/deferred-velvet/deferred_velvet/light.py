@@ -3,7 +3,7 @@
 import numpy as np
 from pydantic import Field
 
-from deferred.light import Light, LightParams, view_direction
+from deferred.interfaces.light import Light, LightParams, view_direction
 from deferred.validation import NonZeroVec3
 
 from . import SHADERS

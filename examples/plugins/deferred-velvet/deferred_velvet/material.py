@@ -2,7 +2,7 @@
 
 from pydantic import Field
 
-from deferred.material import Material, MaterialParams
+from deferred.interfaces.material import Material, MaterialParams
 
 from . import SHADERS
 

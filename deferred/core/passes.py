@@ -1,0 +1,286 @@
+"""Passes: the pipeline is an ordered list of these (Revie section 2.1, Figure 2.3).
+
+Each pass has a unique name, the phase it belongs to, and the targets it creates (with their
+format and clear value), reads and writes; :mod:`deferred.core.graph` checks these declarations before
+any GL work, dumps capture a pass's ``writes`` after it runs and benchmarks time it. Passes set all
+the GL state they need (``Frame.set_state``), so their order is the only coupling between them.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Callable, Mapping
+from enum import Enum
+from types import MappingProxyType
+from typing import TYPE_CHECKING, Any, ClassVar
+
+import moderngl
+
+from deferred.gl.target_spec import TargetSpec
+
+if TYPE_CHECKING:
+    from deferred.core.frame import Frame
+    from deferred.scene.model import SceneObject
+
+
+class Phase(str, Enum):
+    GEOMETRY = "geometry"  # opaque G-buffer passes
+    SCREEN = "screen"  # effects needing a clean G-buffer (SSAO, edges), before stipple
+    STIPPLE = "stipple"  # stippled G-buffer passes
+    LIGHTING = "lighting"  # lights add into the light accumulation
+    MATERIAL = "material"  # materials re-render meshes over the composition buffer
+    FORWARD = "forward"  # the forward pipeline's lit passes and forward shells
+    POST = "post"  # tone mapping etc.; knows no light and no object
+    OUTPUT = "output"
+
+
+PHASE_ORDER = (Phase.GEOMETRY, Phase.SCREEN, Phase.STIPPLE, Phase.LIGHTING, Phase.MATERIAL,
+               Phase.FORWARD, Phase.POST, Phase.OUTPUT)
+
+
+class Order:
+    """Where a pass runs within its phase (the pipeline sorts by it).
+
+    In the material phase, materials first alter their own opaque pixels of the composition
+    buffer, then the opaque scene is restored where stipple samples lie (obliteration copies
+    from what the composition holds by then), then volumes (fur shells) and transparent surfaces
+    are composited over it, far to near, so the image does not depend on the order of objects in
+    the scene. The forward phase uses the same ranks: opaque lit passes, then blended ones. Post
+    passes use them too: tone mapping first (``FIRST``), effects composited over the final image
+    (``TRANSPARENT``), anti-aliasing last (``LAST``).
+    """
+
+    FIRST = -10  # passes that must precede every object's (clears, copies, tone mapping)
+    OPAQUE = 0  # an object's own opaque pixels
+    RESTORE = 5  # erasing stipple samples, which restores the opaque scene
+    VOLUME = 10  # blended, depth-tested without depth writes: sorted far to near
+    TRANSPARENT = 20  # blended surfaces over everything above: sorted far to near
+    LAST = 30  # scene-wide passes over the finished phase (outlines, anti-aliasing)
+
+
+class RenderPass(ABC):
+    """One step of a frame."""
+
+    name: str
+    phase: Phase
+    creates: Mapping[str, TargetSpec] = MappingProxyType({})
+    reads: tuple[str, ...] = ()
+    writes: tuple[str, ...] = ()
+    samples: tuple[str, ...] = ()  # the reads bound as textures: never also written (GL feedback)
+    order: int = Order.OPAQUE
+
+    def prepare(self, frame: Frame) -> None:  # noqa: B027 - optional hook
+        """Upload per-frame data; called once per frame before any pass runs."""
+
+    @abstractmethod
+    def execute(self, frame: Frame) -> None:
+        """Issue the GL work of this pass."""
+
+    def describe(self) -> dict[str, Any]:
+        return {"name": self.name, "phase": self.phase.value, "reads": list(self.reads),
+                "writes": list(self.writes),
+                "creates": {name: spec.format_name for name, spec in self.creates.items()}}
+
+    def __repr__(self) -> str:
+        return f"<{type(self).__name__} {self.name} ({self.phase.value})>"
+
+
+class ClearPass(RenderPass):
+    """Create targets and nothing else: the renderer clears each to its declared value when this
+    pass runs (the G-buffer's ``gbuffer.clear``)."""
+
+    order = Order.FIRST
+
+    def __init__(self, name: str, phase: Phase, creates: dict[str, TargetSpec]):
+        missing = [target for target, spec in creates.items() if spec.clear is None]
+        if missing:
+            raise ValueError(f"{name}: targets without a clear value: {', '.join(missing)}")
+        self.name = name
+        self.phase = phase
+        self.creates = dict(creates)
+        self.writes = tuple(creates)
+
+    def execute(self, frame: Frame) -> None:
+        pass  # the clears of ``creates`` are all there is
+
+
+class FullscreenPass(RenderPass):
+    """Run a fragment shader over every pixel (``post/fullscreen.vert``)."""
+
+    def __init__(self, name: str, phase: Phase, fragment: str, inputs: dict[str, str],
+                 outputs: tuple[str, ...], blend: str | None = None,
+                 defines: dict[str, str] | None = None,
+                 uniforms: Callable[[Frame], dict[str, Any]] | None = None,
+                 depth: str | None = None, depth_test: bool = False, depth_func: str = "less",
+                 depth_write: bool = False, instances: Callable[[Frame], int] | None = None,
+                 vertex: str = "post/fullscreen.vert", creates: dict[str, TargetSpec] | None = None,
+                 order: int = Order.OPAQUE):
+        self.name = name
+        self.creates = dict(creates or {})
+        self.order = order
+        self.phase = phase
+        self.fragment = fragment
+        self.vertex = vertex
+        self.inputs = inputs  # sampler uniform -> target name
+        self.outputs = outputs
+        self.blend = blend
+        self.defines = defines or {}
+        self.uniforms = uniforms
+        self.depth = depth
+        self.depth_test = depth_test
+        self.depth_func = depth_func
+        self.depth_write = depth_write
+        self.instances = instances
+        self.samples = tuple(dict.fromkeys(inputs.values()))
+        self.reads = tuple(dict.fromkeys(
+            [*inputs.values(), *(outputs if blend else ()),
+             *((depth,) if depth and (depth_test or not depth_write) else ())]))
+        self.writes = outputs + ((depth,) if depth and depth_write else ())
+
+    def execute(self, frame: Frame) -> None:
+        program = frame.shaders.program(self.vertex, self.fragment, defines=self.defines)
+        frame.use_framebuffer(self.outputs, self.depth, depth_write=self.depth_write)
+        frame.set_state(depth_test=self.depth_test, depth_func=self.depth_func, blend=self.blend)
+        frame.bind(program, self.uniforms(frame) if self.uniforms else {},
+                   {u: frame.target(t) for u, t in self.inputs.items()})
+        count = self.instances(frame) if self.instances else 1
+        if count > 0:
+            frame.draw_fullscreen(program, instances=count)
+
+
+def copy_pass(name: str, phase: Phase, source: str, target: str, spec: TargetSpec,
+              order: int = Order.OPAQUE) -> FullscreenPass:
+    """A pass creating ``target`` as a copy of ``source`` (a snapshot a later pass reads while it
+    writes ``source``: GL forbids reading a texture while rendering into it)."""
+    return FullscreenPass(name, phase, "post/copy.frag", {"u_source": source}, (target,),
+                          creates={target: spec}, order=order)
+
+
+class ObjectPass(RenderPass):
+    """Draw one scene object's mesh with a program; materials build their passes on this.
+
+    Subclasses (or callers) give the shader files (a geometry shader too, if any), defines, the
+    targets and state, and a ``uniforms`` hook. ``draws`` > 1 renders the mesh that many times,
+    each draw with its own ``draw_uniforms`` (e.g. one shell per draw; ``None`` skips the draw).
+    ``draw`` issues one draw call (override it to draw other primitives of the mesh).
+
+    What a subclass overrides of those hooks is found when the class is made (a pass keeping
+    them all draws without asking them), so change a hook by subclassing, not by patching the
+    class later. Options (``extra_defines``, ``constants``...) are fixed at construction.
+    """
+
+    vertex: str = "common/mesh.vert"
+    fragment: str = ""
+    geometry: str | None = None
+    colors: tuple[str, ...] = ()
+    depth: str | None = "depth"
+    depth_test: bool = True
+    depth_func: str = "less"
+    depth_write: bool = True
+    cull: str | None = "back"
+    blend: str | None = None
+    depth_offset: tuple[float, float] = (0.0, 0.0)  # glPolygonOffset (factor, units)
+    extra_reads: tuple[str, ...] = ()
+    constants: dict[str, Any] | None = None  # uniforms fixed at construction
+    extra_defines: dict[str, str] | None = None
+    # the last program lookup: (shaders, generation, material, params, mesh, defines, program)
+    _program_memo: tuple | None = None
+    # whether uniforms, textures, draws and draw_uniforms are ObjectPass's own (set for each
+    # subclass as it is made)
+    _hooks_unchanged: ClassVar[bool] = True
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        cls._hooks_unchanged = all(getattr(cls, hook) is getattr(ObjectPass, hook) for hook in
+                                   ("uniforms", "textures", "draws", "draw_uniforms"))
+
+    def __init__(self, name: str, phase: Phase, obj: SceneObject, **options: Any):
+        self.name = name
+        self.phase = phase
+        self.obj = obj
+        for key, value in options.items():
+            if key.startswith("_") or callable(getattr(type(self), key, None)) or \
+                    not hasattr(type(self), key):
+                raise TypeError(f"{type(self).__name__} has no option '{key}'")
+            setattr(self, key, value)
+        self.samples = tuple(self.extra_reads)
+        self.reads = tuple(dict.fromkeys(
+            [*self.extra_reads, *(self.colors if self.blend else ()),
+             *((self.depth,) if self.depth and (self.depth_test or not self.depth_write)
+               else ())]))
+        self.writes = tuple(self.colors) + ((self.depth,) if self.depth and self.depth_write
+                                            else ())
+
+    def defines(self, frame: Frame) -> dict[str, str]:
+        defines = self.obj.material.defines(self.obj)
+        return {**defines, **self.extra_defines} if self.extra_defines else defines
+
+    def uniforms(self, frame: Frame) -> dict[str, Any]:
+        return {}
+
+    def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
+        """Samplers of the pass: each target in ``extra_reads`` as ``u_<target>``."""
+        return frame.target_samplers(self.extra_reads)
+
+    def draws(self, frame: Frame) -> int:
+        return 1
+
+    def draw_uniforms(self, frame: Frame, index: int, count: int) -> dict[str, Any] | None:
+        """Uniforms that change from one draw of the pass to the next (e.g. a shell's depth);
+        ``None`` skips draw ``index``."""
+        return {}
+
+    def draw(self, frame: Frame, program: moderngl.Program) -> None:
+        frame.draw_mesh(self.obj.mesh, program)
+
+    def program(self, frame: Frame) -> moderngl.Program:
+        shaders = frame.shaders
+        memo = self._program_memo  # the last lookup: the same defines give the same program
+        material = self.obj.material
+        fresh = memo is not None and memo[0] is shaders and memo[1] == shaders.generation
+        # Where the pass keeps ObjectPass.defines, its defines are the material's, a function
+        # of its params and the object's mesh (Material.defines), and its own fixed ones: while
+        # those are the same objects, so is the program (building and comparing the defines
+        # cost 2 us of a 12 us draw).
+        if fresh and memo[2] is material and memo[3] is material.params and \
+                memo[4] is self.obj.mesh and type(self).defines is ObjectPass.defines:
+            return memo[6]
+        defines = self.defines(frame)
+        program = memo[6] if fresh and memo[5] == defines else \
+            shaders.program(self.vertex, self.fragment, self.geometry, defines=defines)
+        self._program_memo = (shaders, shaders.generation, material, material.params,
+                              self.obj.mesh, defines, program)
+        return program
+
+    def execute(self, frame: Frame) -> None:
+        program = self.program(frame)
+        frame.use_framebuffer(self.colors, self.depth, depth_write=self.depth_write)
+        frame.set_state(depth_test=self.depth_test, depth_func=self.depth_func, cull=self.cull,
+                        blend=self.blend, depth_offset=self.depth_offset)
+        material = frame.material_inputs(self.obj.material)
+        if self._hooks_unchanged and not self.extra_reads:
+            # one draw and nothing of the pass's own but its constants (most objects'
+            # G-buffer and forward passes): the hooks' empty answers are not asked for, 1.4 us
+            # of a 16 us draw
+            frame.bind(program, self.constants, None, offered=frame.object_uniforms(self.obj),
+                       material=material)
+            self.draw(frame, program)
+            return
+        uniforms = self.uniforms(frame)
+        if self.constants:
+            uniforms = {**self.constants, **uniforms}
+        textures = self.textures(frame)
+        offered = frame.object_uniforms(self.obj)
+        count = self.draws(frame)
+        bound = False
+        for index in range(count):
+            per_draw = self.draw_uniforms(frame, index, count)
+            if per_draw is None:
+                continue
+            if bound:  # everything else is set already: only what changes per draw
+                frame.set_uniforms(program, per_draw)
+            else:
+                frame.bind(program, {**uniforms, **per_draw} if per_draw else uniforms,
+                           textures, offered=offered, material=material)
+                bound = True
+            self.draw(frame, program)

@@ -1,0 +1,467 @@
+"""Writing a dump folder (DESIGN.md, "Dumps"; ``deferred dump``): every buffer of every pass of
+a captured frame as float EXR with named channels, the frame's decoded buffers, a contact sheet
+and a manifest; :func:`write_dump` describes the files.
+"""
+
+from __future__ import annotations
+
+import fcntl
+import hashlib
+import json
+import os
+import re
+import secrets
+import shutil
+import stat
+from collections.abc import Callable, Iterator, Sequence
+from concurrent.futures import ThreadPoolExecutor
+from contextlib import contextmanager
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from deferred.debug.capture import FrameCapture, PassCapture, capture_frame, fits_half, to_float
+from deferred.debug.pixel_history import PixelEvent, pixel_history
+from deferred.debug.preview import Tile, contact_sheet, target_views
+from deferred.debug.views import view
+from deferred.errors import InputError, RenderError
+from deferred.gbuffer.layout import GBUFFER_COLOR_TARGETS
+from deferred.gl.target_spec import TargetSpec
+from deferred.gl.targets import COMPOSITE, LIGHT_ACCUMULATION
+from deferred.io.images import NAME_MAX, write_image, write_text
+from deferred.io.safety import signals_deferred
+from deferred.render.renderer import Renderer
+
+MANIFEST_FORMAT = "deferred-dump/1"
+
+
+def stack_buffers(raws: Sequence[np.ndarray], dtype: type = np.float32) -> np.ndarray:
+    """Read-back buffers side by side as one (H, W, C) array of ``dtype``, 8-bit as [0, 1],
+    filled in place (one pass over memory: this is most of a dump's numpy time)."""
+    count = sum(raw.shape[2] for raw in raws)
+    out = np.empty(raws[0].shape[:2] + (count,), dtype)
+    k = 0
+    for raw in raws:
+        part = out[..., k: k + raw.shape[2]]
+        if raw.dtype == np.uint8:
+            np.divide(raw, np.float32(255.0), out=part, casting="unsafe")
+        else:
+            part[...] = raw
+        k += raw.shape[2]
+    return out
+
+
+# Bytes of a pass name in a file name: object labels come from scene files and may be of any
+# length, and a file name may hold NAME_MAX bytes with the index and temporary suffix too.
+PASS_NAME_MAX = 100
+
+
+def safe_name(name: str, limit: int = PASS_NAME_MAX) -> str:
+    """A pass name as a file name: characters outside ``[A-Za-z0-9._-]`` become ``_`` (object
+    labels come from scene files), and a name longer than ``limit`` is cut, with a hash of the
+    whole name appended so names that share a long prefix stay distinct."""
+    safe = re.sub(r"[^A-Za-z0-9._-]", "_", name)
+    if len(safe) > limit:
+        digest = hashlib.sha1(name.encode()).hexdigest()[:8]
+        safe = f"{safe[:limit - len(digest) - 1]}-{digest}"
+    return safe
+
+
+def pass_file(capture: PassCapture, count: int) -> str:
+    digits = max(2, len(str(count - 1)))
+    return f"passes/{capture.index:0{digits}d}_{safe_name(capture.name)}.exr"
+
+
+# -- the dump folder as a whole ------------------------------------------------------------------
+
+# The files a dump writes at the top of its folder; with "passes/NN_<pass>.exr" (PASS_FILE),
+# everything else in a dump folder is the user's and is kept.
+DUMP_FILES = frozenset({"gbuffer.exr", "light.exr", "final.exr", "final.png", "contact.png",
+                        "manifest.json"})
+PASS_FILE = re.compile(r"\d+_.+\.exr")
+
+
+def is_dump_folder(directory: str | Path) -> bool:
+    """Whether ``directory`` holds a dump: a manifest of the dump format (written last)."""
+    try:
+        with open(Path(directory) / "manifest.json", encoding="utf-8") as handle:
+            manifest = json.load(handle)
+    except (OSError, ValueError):
+        return False
+    return isinstance(manifest, dict) and \
+        str(manifest.get("format", "")).startswith("deferred-dump/")
+
+
+def check_dump_folder(directory: str | Path, where: str = "-o") -> Path:
+    """A folder a dump may replace: missing, empty, or an earlier dump. Anything else is
+    refused (``InputError``) before any work: a dump replaces its folder as a whole, and a
+    folder of other files is not a dump's to replace."""
+    directory = Path(directory)
+    if directory.exists() and not directory.is_dir():
+        raise InputError("exists and is not a folder", str(directory))
+    if directory.is_dir() and not is_dump_folder(directory):
+        try:
+            empty = next(os.scandir(directory), None) is None
+        except OSError as exc:
+            raise InputError(f"cannot read the folder: {exc.strerror}", str(directory)) \
+                from None
+        if not empty:
+            raise InputError(f"{directory} is not empty and holds no dump (no manifest.json); "
+                             "give a new or empty folder, or an earlier dump", where)
+    return directory
+
+
+def is_dump_file(relative: str) -> bool:
+    """Whether a path inside a dump folder (``passes/03_x.exr``) is one a dump writes."""
+    parts = Path(relative).parts
+    return (len(parts) == 1 and parts[0] in DUMP_FILES) or \
+        (len(parts) == 2 and parts[0] == "passes" and PASS_FILE.fullmatch(parts[1]) is not None)
+
+
+def check_dump_inputs(directory: str | Path, inputs: Sequence[Path], where: str = "-o") -> None:
+    """``InputError`` when a file the scene reads (``inputs``) is one the dump into
+    ``directory`` would replace (its ``final.png`` used as a texture, say)."""
+    folder = Path(directory).resolve()
+    for source in inputs:
+        resolved = source.resolve()
+        if folder in resolved.parents and is_dump_file(resolved.relative_to(folder).as_posix()):
+            raise InputError(f"would overwrite {source}, a file the scene reads", where)
+
+
+def _sibling(directory: Path, tag: str) -> Path:
+    """A hidden name next to ``directory``: ``.<name>.<tag>``, the name cut (with a hash) where
+    it would take the result past NAME_MAX bytes."""
+    name = directory.name
+    if len(name.encode()) > NAME_MAX - 40:
+        digest = hashlib.sha1(name.encode()).hexdigest()[:8]
+        name = name.encode()[:NAME_MAX - 60].decode(errors="ignore") + "-" + digest
+    return directory.parent / f".{name}.{tag}"
+
+
+def _stale_siblings(directory: Path) -> list[Path]:
+    """Staging and replaced folders of dumps into ``directory`` that were killed (SIGKILL,
+    power loss) before they could remove them; only safe to touch under the folder's lock."""
+    prefixes = (_sibling(directory, "dump-").name, _sibling(directory, "old-").name)
+    try:
+        return sorted(entry for entry in directory.parent.iterdir()
+                      if entry.name.startswith(prefixes))
+    except OSError:
+        return []
+
+
+@contextmanager
+def _folder_lock(directory: Path) -> Iterator[None]:
+    """An exclusive ``flock`` on ``.<name>.lock`` next to ``directory``: dumps into one folder
+    take turns. The lock file is removed on release; a waiter that then holds a lock on the
+    removed file sees that its inode is no longer the path's and tries again."""
+    path = _sibling(directory, "lock")
+    while True:
+        fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX)
+            try:
+                current = os.stat(path)
+            except FileNotFoundError:
+                current = None
+            mine = os.fstat(fd)
+            if current is not None and (current.st_ino, current.st_dev) == \
+                    (mine.st_ino, mine.st_dev):
+                break
+        except BaseException:
+            os.close(fd)
+            raise
+        os.close(fd)
+    try:
+        yield
+    finally:
+        try:
+            os.unlink(path)
+        except OSError:
+            pass
+        os.close(fd)
+
+
+def _remove(path: Path) -> None:
+    if path.is_dir() and not path.is_symlink():
+        shutil.rmtree(path, ignore_errors=True)
+    else:
+        try:
+            path.unlink()
+        except OSError:
+            pass
+
+
+def _recover(directory: Path) -> None:
+    """Under the lock: put back a dump whose replacement was killed between its two renames,
+    then remove what killed dumps left next to the folder."""
+    stale = _stale_siblings(directory)
+    if not os.path.lexists(directory):
+        replaced = [p for p in stale if p.name.startswith(_sibling(directory, "old-").name)]
+        if replaced:
+            os.rename(replaced[0], directory)
+            stale.remove(replaced[0])
+    for path in stale:
+        _remove(path)
+
+
+def _link_or_copy(source: str, target: str) -> None:
+    try:
+        os.link(source, target)
+    except OSError:
+        shutil.copy2(source, target)
+
+
+def _carry_over(old: Path, new: Path) -> None:
+    """Files in the old dump folder that no dump writes (the user's notes, a scene) go into
+    the new one: hard links where the file system has them, so the old folder keeps its copy
+    until the swap and an interrupted dump loses nothing."""
+    for entry in old.iterdir():
+        if entry.name in DUMP_FILES:
+            continue
+        if entry.name == "passes" and entry.is_dir() and not entry.is_symlink():
+            (new / "passes").mkdir(exist_ok=True)
+            for item in entry.iterdir():
+                if PASS_FILE.fullmatch(item.name) is None:
+                    _carry(item, new / "passes" / item.name)
+            continue
+        _carry(entry, new / entry.name)
+
+
+def _carry(source: Path, target: Path) -> None:
+    if os.path.lexists(target):
+        return  # the new dump wrote this name
+    if source.is_symlink():
+        os.symlink(os.readlink(source), target)
+    elif source.is_dir():
+        shutil.copytree(source, target, symlinks=True, copy_function=_link_or_copy)
+    else:
+        _link_or_copy(str(source), str(target))
+
+
+def swap_in_folder(staging: Path, directory: Path) -> None:
+    """Replace ``directory`` with ``staging``: two renames with signals held between them, so
+    the folder is always the old dump or the new one; then the old one is removed."""
+    old = _sibling(directory, f"old-{secrets.token_hex(4)}")
+    with signals_deferred():
+        had_old = os.path.lexists(directory)
+        if had_old:
+            os.rename(directory, old)
+        try:
+            os.rename(staging, directory)
+        except BaseException:
+            if had_old:
+                os.rename(old, directory)
+            raise
+        if had_old:
+            shutil.rmtree(old, ignore_errors=True)
+
+
+@contextmanager
+def _staging_folder(directory: Path) -> Iterator[Path]:
+    """Lock ``directory``, recover from killed dumps, and give a new hidden folder next to it to
+    write the dump into; it is removed if the block fails (an error, Ctrl-C, SIGTERM)."""
+    directory.parent.mkdir(parents=True, exist_ok=True)
+    with _folder_lock(directory):
+        _recover(directory)
+        check_dump_folder(directory)  # again, under the lock: another dump may have run
+        staging = _sibling(directory, f"dump-{secrets.token_hex(4)}")
+        os.mkdir(staging)  # under the umask, not mkdtemp's 0700: it becomes the dump folder
+        try:
+            if directory.is_dir():
+                os.chmod(staging, stat.S_IMODE(directory.stat().st_mode))
+            (staging / "passes").mkdir()
+            yield staging
+        finally:
+            if os.path.lexists(staging):
+                with signals_deferred():
+                    shutil.rmtree(staging, ignore_errors=True)
+
+
+def write_dump(capture: FrameCapture, directory: str | Path,
+               history: Sequence[PixelEvent] | None = None,
+               pixel: tuple[int, int] | None = None, scene_file: str | None = None,
+               progress: Callable[[str], None] | None = None) -> dict[str, Any]:
+    """Write a capture as a dump folder; returns the manifest::
+
+        DIR/gbuffer.exr       decoded G-buffer: albedo.R albedo.G albedo.B specular.intensity
+                              specular.exponent N.X N.Y N.Z Z material.id shading.model (Z is
+                              the z_channel), then declared data as <name>.<channel>
+        DIR/light.exr         light accumulation, R G B
+        DIR/final.exr         composition buffer (linear HDR), R G B A; DIR/final.png the frame
+        DIR/light_lists.exr   tiled and clustered paths: the volume lights in each pixel's light
+                              list, lights.listed (``--view light_lists``)
+        DIR/passes/NN_<pass>.exr   what pass NN wrote, channels "<target>.R", ... ("<target>.Z")
+        DIR/contact.png       every buffer as a labelled thumbnail, in pass order
+        DIR/manifest.json     passes (phase, inputs, outputs, formats, time), G-buffer layout, GL
+
+    A file whose buffers are all 8-bit or 16-bit is half float (8-bit codes stay distinct in half);
+    one holding any 32-bit buffer, and ``gbuffer.exr`` (decoded normals, linear depth), is float.
+    (Mixed per-channel formats would be exact too, but OIIO writes them at half the speed.)
+
+    The dump is written as a whole: into a hidden folder next to ``directory``, which then
+    replaces it (under a lock on the folder, so concurrent dumps take turns). An error or an
+    interruption (Ctrl-C, SIGTERM) leaves the earlier dump as it was and no temporary files;
+    pass files of the earlier dump are gone with it, so the folder never mixes two frames,
+    and files no dump writes are kept. ``directory`` must be missing, empty or an earlier
+    dump (:func:`check_dump_folder`). Write failures raise ``RenderError`` with the reason.
+    """
+    directory = check_dump_folder(Path(directory).resolve())  # "." has no name for siblings
+    step = progress or (lambda _: None)
+    files: dict[str, str] = {}
+    try:
+        with _staging_folder(directory) as staging:
+            _write_files(capture, staging, files, step)
+            manifest = build_manifest(capture, files, history, pixel, scene_file)
+            write_text(staging / "manifest.json", json.dumps(manifest, indent=2) + "\n")
+            if directory.is_dir():
+                _carry_over(directory, staging)
+            swap_in_folder(staging, directory)
+    except OSError as exc:  # the lock, the folders, the renames; files report their own
+        raise RenderError(f"cannot write {directory}: {_reason(exc)}") from exc
+    return manifest
+
+
+def _reason(exc: OSError) -> str:
+    reason = exc.strerror or str(exc) or type(exc).__name__
+    return f"{reason}: {exc.filename}" if exc.filename else reason
+
+
+def _write_files(capture: FrameCapture, directory: Path, files: dict[str, str],
+                 step: Callable[[str], None]) -> None:
+    """Every image of the dump into ``directory``; ``files`` gets the manifest's entries."""
+    # OIIO drops the GIL while it compresses: files compress in parallel while numpy prepares
+    # the next one (this is most of a dump's time). Pass files go first so the pool starts
+    # at once; the contact sheet is built in the pool too.
+    pool = ThreadPoolExecutor(max_workers=2)
+    try:
+        pending = []
+
+        def write(name: str, *args: Any, **kwargs: Any) -> None:
+            step(name)
+            pending.append(pool.submit(write_image, directory / name, *args, **kwargs))
+
+        for p in capture.passes:
+            if not p.captured:
+                continue
+            name = pass_file(p, len(capture.passes))
+            half = fits_half([p.specs[t] for t in p.raw])
+            pixels = stack_buffers(list(p.raw.values()), np.float16 if half else np.float32)
+            write(name, pixels, channels=p.channel_names(), half=half,
+                  attributes={"deferred:pass": p.name, "deferred:phase": p.phase})
+        if all(capture.written(t) for t in GBUFFER_COLOR_TARGETS):
+            g = capture.gbuffer()
+            write("gbuffer.exr", np.stack(list(g.values()), axis=-1),
+                  channels=capture.gbuffer_channels())
+            files["gbuffer"] = "gbuffer.exr"
+        if capture.written(LIGHT_ACCUMULATION):
+            write("light.exr", capture.target(LIGHT_ACCUMULATION)[..., :3],
+                  channels=("R", "G", "B"), half=True)
+            files["light"] = "light.exr"
+        if capture.light_lists is not None:
+            lists = view(capture, "light_lists")
+            write("light_lists.exr", lists.pixels, channels=lists.channels, half=lists.half)
+            files["light_lists"] = "light_lists.exr"
+        write("final.exr", capture.target(COMPOSITE), channels=("R", "G", "B", "A"), half=True)
+        write("final.png", capture.image)
+        files.update({"final": "final.exr", "final_png": "final.png", "contact": "contact.png"})
+        step("contact.png")
+        pending.append(pool.submit(lambda: write_image(
+            directory / "contact.png", contact_sheet(contact_tiles(capture)))))
+        for future in pending:
+            future.result()  # re-raise the first failure here
+    finally:
+        # On a failure or Ctrl-C, queued files are dropped rather than written into a folder
+        # about to be removed; the ones being written finish first, so nothing writes into
+        # the folder after it is gone.
+        with signals_deferred():
+            pool.shutdown(wait=True, cancel_futures=True)
+
+
+def contact_tiles(capture: FrameCapture, thumb_width: int = 240) -> list[Tile]:
+    """Every captured buffer in pass order, then the frame's decoded buffers.
+
+    Buffers are subsampled to about ``thumb_width`` before they are decoded and coloured, which
+    is what keeps the sheet cheap at full HD (a stipple pattern shows as dots)."""
+    step = max(1, capture.size[0] // thumb_width)
+    tiles = []
+    for p in capture.passes:
+        for target, raw in p.raw.items():
+            for label, rgb in target_views(target, to_float(raw[::step, ::step]),
+                                           p.specs[target], capture.tonemap, capture.exposure):
+                tiles.append(Tile(f"{p.index:02d} {p.name}",
+                                  f"{target}: {label}" if label else target, rgb))
+    names = ["albedo", "normal", "depth", "specular", "material"] \
+        if all(capture.written(t) for t in GBUFFER_COLOR_TARGETS) else []
+    names += ["light"] if capture.written(LIGHT_ACCUMULATION) else []
+    names += ["light_lists"] if capture.light_lists is not None else []
+    for name in names + ["composite"]:
+        tiles.append(Tile("frame", name, view(capture, name).preview[::step, ::step]))
+    tiles.append(Tile("frame", "final.png", capture.image[::step, ::step, :3] / 255.0))
+    return tiles
+
+
+def _format(spec: TargetSpec) -> dict[str, Any]:
+    return {"format": spec.format_name, "bytes_per_pixel": spec.bytes_per_pixel,
+            "description": spec.description}
+
+
+def build_manifest(capture: FrameCapture, files: dict[str, str],
+                   history: Sequence[PixelEvent] | None = None,
+                   pixel: tuple[int, int] | None = None,
+                   scene_file: str | None = None) -> dict[str, Any]:
+    passes = []
+    for p in capture.passes:
+        passes.append({
+            "index": p.index, "name": p.name, "phase": p.phase, "inputs": list(p.reads),
+            "outputs": list(p.writes),
+            "formats": {t: p.specs[t].format_name for t in (*p.reads, *p.writes)
+                        if t in p.specs},
+            "time_ms": round(p.time_ms, 4), "draw_calls": p.draw_calls,
+            "file": pass_file(p, len(capture.passes)) if p.captured else None,
+            "channels": p.channel_names() if p.captured else [],
+        })
+    manifest: dict[str, Any] = {
+        "format": MANIFEST_FORMAT,
+        "created": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        "scene": scene_file or capture.scene,
+        "pipeline": capture.pipeline,
+        "size": list(capture.size),
+        "gl": capture.gl_info,
+        "frame_ms": round(capture.frame_ms, 4),
+        "timing": "wall clock around ctx.finish() per pass; a one-pixel warm-up frame "
+                  "first compiles shaders and uploads meshes and textures",
+        "orientation": "top row first",
+        "gbuffer": {
+            "bytes_per_pixel": capture.layout.bytes_per_pixel,
+            "targets": capture.layout.describe(),
+            "file": files.get("gbuffer"),
+            "channels": list(capture.gbuffer_channels()),
+            "precision": "float",
+            "notes": "decoded values: octahedral normals as N.X N.Y N.Z (0 where material.id "
+                     "is 0), Z = linear view depth (the z_channel, 0 = background), "
+                     "material.id and shading.model unpacked from the id channel; declared "
+                     "data as stored, valid where the material that wrote the pixel declares "
+                     "it",
+        },
+        "targets": {name: _format(spec) for name, spec in capture.specs.items()},
+        "files": files,
+        "passes": passes,
+    }
+    if history is not None and pixel is not None:
+        manifest["pixel_history"] = {
+            "pixel": list(pixel), "coordinates": "top-down, x right, y down",
+            "passes": [e.describe() for e in history if e.wrote]}
+    return manifest
+
+
+def dump_scene(renderer: Renderer, directory: str | Path, passes: Sequence[str] | None = None,
+               pixel: tuple[int, int] | None = None, scene_file: str | None = None,
+               progress: Callable[[str], None] | None = None
+               ) -> tuple[dict[str, Any], list[PixelEvent] | None]:
+    """Capture a frame with ``renderer`` (and the pixel's history) and write the dump."""
+    capture = capture_frame(renderer, passes)
+    history = pixel_history(renderer, *pixel) if pixel is not None else None
+    manifest = write_dump(capture, directory, history, pixel, scene_file, progress)
+    return manifest, history

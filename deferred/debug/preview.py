@@ -1,0 +1,203 @@
+"""Looking at buffers: display colours for any target, false colour, labelled contact sheets.
+
+Everything here turns float buffers (top row first) into RGB in [0, 1] for PNG previews; the
+values themselves go to EXR unchanged (:mod:`deferred.debug.dump`). Normals show as ``N * 0.5 + 0.5``,
+depths through the ``turbo`` colour map over the covered range, material ids as categorical
+colours (0, the background, is black).
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from deferred.gbuffer.layout import (
+    ALBEDO_SPECULAR,
+    DEPTH,
+    LINEAR_DEPTH,
+    NORMAL_EXPONENT_ID,
+    octahedral_decode,
+)
+from deferred.gl.target_spec import TargetSpec
+from deferred.gl.targets import COMPOSITE, FINAL, LIGHT_ACCUMULATION
+from deferred.io.images import srgb_encode
+
+BACKGROUND = 0.12  # contact sheet grey
+TEXT = 0.9
+
+
+@dataclass(frozen=True)
+class Tile:
+    title: str  # first label line (the pass)
+    subtitle: str  # second label line (the buffer)
+    rgb: np.ndarray  # (H, W, 3) float in [0, 1], top row first
+
+
+# -- colour maps -------------------------------------------------------------------------------
+@lru_cache(maxsize=4)
+def _lut(name: str) -> np.ndarray:
+    from matplotlib import colormaps
+
+    return np.asarray(colormaps[name](np.linspace(0.0, 1.0, 256))[:, :3], dtype=np.float32)
+
+
+def tonemap(hdr: np.ndarray, method: str = "aces", exposure: float = 1.0) -> np.ndarray:
+    """numpy twin of ``post/tonemap.frag``: exposure, tone map, sRGB encode."""
+    color = np.maximum(np.asarray(hdr, dtype=np.float32)[..., :3], 0.0) * exposure
+    if method == "reinhard":
+        color = color / (1.0 + color)
+    elif method == "aces":
+        color = np.clip((color * (2.51 * color + 0.03)) / (color * (2.43 * color + 0.59) + 0.14),
+                        0.0, 1.0)
+    return srgb_encode(color).astype(np.float32)
+
+
+def normal_colors(normals: np.ndarray, covered: np.ndarray) -> np.ndarray:
+    rgb = np.clip(normals * 0.5 + 0.5, 0.0, 1.0)
+    return np.where(covered[..., None], rgb, 0.0).astype(np.float32)
+
+
+def depth_colors(depth: np.ndarray, covered: np.ndarray) -> np.ndarray:
+    """Turbo over the covered range (near blue, far red); uncovered pixels black."""
+    rgb = np.zeros(depth.shape + (3,), np.float32)
+    if covered.any():
+        lo, hi = float(depth[covered].min()), float(depth[covered].max())
+        t = (depth - lo) / (hi - lo) if hi > lo else np.zeros_like(depth)
+        index = np.clip(np.nan_to_num(t) * 255.0, 0, 255).astype(np.int32)
+        rgb[covered] = _lut("turbo")[index[covered]]
+    return rgb
+
+
+def heat_colors(values: np.ndarray) -> np.ndarray:
+    """Turbo from 0 to the largest finite value (infinite ones at the top); exact 0 black."""
+    values = np.asarray(values, dtype=np.float32)
+    finite = np.isfinite(values)
+    peak = float(values[finite].max()) if finite.any() else 0.0
+    t = np.where(finite, values / peak if peak > 0.0 else 0.0, 1.0)
+    rgb = _lut("turbo")[np.clip(t * 255.0, 0, 255).astype(np.int32)]
+    return np.where((values != 0.0)[..., None], rgb, 0.0).astype(np.float32)
+
+
+def id_colors(ids: np.ndarray) -> np.ndarray:
+    """Categorical colours by integer id; 0 (background) black."""
+    from matplotlib import colormaps
+
+    palette = np.asarray(colormaps["tab10"].colors, dtype=np.float32)
+    index = np.rint(np.nan_to_num(ids)).astype(np.int64)
+    rgb = palette[(np.maximum(index, 1) - 1) % len(palette)]
+    return np.where((index > 0)[..., None], rgb, 0.0).astype(np.float32)
+
+
+def grey(values: np.ndarray) -> np.ndarray:
+    """Values already in [0, 1] as they are; anything else stretched over its own range."""
+    v = np.nan_to_num(np.asarray(values, dtype=np.float32))
+    lo, hi = float(v.min()), float(v.max())
+    if lo < 0.0 or hi > 1.0:
+        v = (v - lo) / (hi - lo) if hi > lo else np.zeros_like(v)
+    return np.repeat(v[..., None], 3, axis=2)
+
+
+def target_views(name: str, pixels: np.ndarray, spec: TargetSpec, tonemap_method: str = "aces",
+                 exposure: float = 1.0) -> list[tuple[str, np.ndarray]]:
+    """Display images of one target's raw contents: [(label, RGB)], known targets decoded."""
+    if name == ALBEDO_SPECULAR:
+        return [("albedo", srgb_encode(pixels[..., :3]).astype(np.float32))]
+    if name == NORMAL_EXPONENT_ID:
+        covered = pixels[..., 3] > 0.0
+        normals = octahedral_decode(pixels[..., :2]).astype(np.float32)
+        return [("normal", normal_colors(normals, covered)), ("material id",
+                                                              id_colors(pixels[..., 3]))]
+    if name == LINEAR_DEPTH:
+        return [("linear depth", depth_colors(pixels[..., 0], pixels[..., 0] > 0.0))]
+    if spec.depth or name == DEPTH:
+        return [("depth", depth_colors(pixels[..., 0], pixels[..., 0] < 1.0))]
+    if name in (LIGHT_ACCUMULATION, COMPOSITE):
+        return [("tone mapped", tonemap(pixels, tonemap_method, exposure))]
+    if name == FINAL:
+        return [("", np.clip(pixels[..., :3], 0.0, 1.0))]
+    components = pixels.shape[2]
+    if components == 1:
+        return [("", grey(pixels[..., 0]))]
+    rgb = np.zeros(pixels.shape[:2] + (3,), np.float32)
+    rgb[..., : min(components, 3)] = pixels[..., :3]
+    return [("", np.clip(rgb, 0.0, 1.0))]
+
+
+def to_uint8(rgb: np.ndarray) -> np.ndarray:
+    return np.clip(np.rint(np.asarray(rgb) * 255.0), 0, 255).astype(np.uint8)
+
+
+# -- contact sheet -----------------------------------------------------------------------------
+def thumbnail(rgb: np.ndarray, width: int) -> np.ndarray:
+    """Shrink by a whole factor with a box filter, so a stipple pattern averages to grey
+    instead of aliasing away."""
+    height_px, width_px = rgb.shape[:2]
+    factor = max(1, width_px // width)
+    if factor == 1:
+        return rgb
+    h, w = height_px // factor, width_px // factor
+    blocks = rgb[: h * factor, : w * factor].reshape(h, factor, w, factor, rgb.shape[2])
+    return blocks.mean(axis=(1, 3))
+
+
+@lru_cache(maxsize=1)
+def _font():
+    """matplotlib's bundled DejaVu Sans, so labels look the same on every machine."""
+    from pathlib import Path
+
+    import matplotlib
+    from matplotlib.ft2font import FT2Font
+
+    return FT2Font(str(Path(matplotlib.get_data_path()) / "fonts" / "ttf" / "DejaVuSans.ttf"))
+
+
+def text_mask(text: str, pixels: int = 12) -> np.ndarray | None:
+    """Coverage (H, W) in [0, 1] of ``text`` rendered ``pixels`` high; None if no font."""
+    if not text:
+        return None
+    try:
+        font = _font()
+        font.clear()
+        font.set_size(pixels * 0.75, 96)  # points at 96 dpi
+        with warnings.catch_warnings():
+            # a glyph the font lacks (CJK in an object's name) is drawn as a box; no warning
+            warnings.simplefilter("ignore")
+            font.set_text(text, 0.0)
+        font.draw_glyphs_to_bitmap(antialiased=True)
+        return np.asarray(font.get_image(), dtype=np.float32) / 255.0
+    except (ImportError, OSError, RuntimeError, ValueError):
+        return None  # a sheet without labels beats no sheet
+
+
+def _draw_text(sheet: np.ndarray, text: str, x: int, y: int, width: int) -> None:
+    mask = text_mask(text)
+    if mask is None:
+        return
+    mask = mask[: max(0, sheet.shape[0] - y), : max(0, min(width, sheet.shape[1] - x))]
+    region = sheet[y: y + mask.shape[0], x: x + mask.shape[1]]
+    region[:] = region * (1.0 - mask[..., None]) + TEXT * mask[..., None]
+
+
+def contact_sheet(tiles: Sequence[Tile], thumb_width: int = 240, columns: int = 6) -> np.ndarray:
+    """Tiles in order, left to right, top to bottom, each under a two-line label; uint8 RGB."""
+    if not tiles:
+        return np.full((16, 16, 3), to_uint8(BACKGROUND), np.uint8)
+    thumbs = [thumbnail(tile.rgb, thumb_width) for tile in tiles]
+    cell_w = max(t.shape[1] for t in thumbs)
+    cell_h = max(t.shape[0] for t in thumbs)
+    label_h, pad = 32, 6
+    columns = min(columns, len(tiles))
+    rows = -(-len(tiles) // columns)
+    sheet = np.full((rows * (cell_h + label_h + pad) + pad, columns * (cell_w + pad) + pad, 3),
+                    BACKGROUND, np.float32)
+    for k, (tile, thumb) in enumerate(zip(tiles, thumbs, strict=True)):
+        x = pad + (k % columns) * (cell_w + pad)
+        y = pad + (k // columns) * (cell_h + label_h + pad)
+        _draw_text(sheet, tile.title, x, y, cell_w)
+        _draw_text(sheet, tile.subtitle, x, y + label_h // 2, cell_w)
+        sheet[y + label_h: y + label_h + thumb.shape[0], x: x + thumb.shape[1]] = thumb
+    return to_uint8(sheet)

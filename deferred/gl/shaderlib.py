@@ -1,0 +1,310 @@
+"""The shader library: GLSL files with ``#include``, injected defines, cached programs.
+
+GLSL lives in ``.glsl`` files under the ``shaders`` package (found with ``importlib.resources``) or
+under extra roots a plugin adds. A file may ``#include "path/from/a/root.glsl"``; the argument may
+also be the name of an injected define whose value is a quoted path (``#include SURFACE_FILE``),
+which is how a generic pass pulls in a material's surface function. Each file is included once per
+program (include-once), nesting is limited to ``MAX_INCLUDE_DEPTH``, and a cycle is an error.
+
+The assembled source keeps a line map, so a compile error reported by the driver as ``0:57(3)``
+(Mesa) or ``0(57)`` (NVIDIA) is reported as ``materials/standard/surface.glsl:12``.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from importlib import resources
+from importlib.resources.abc import Traversable
+from pathlib import Path
+
+import moderngl
+
+from deferred.errors import ShaderError
+from deferred.gl.uniforms import ProgramUniforms
+
+MAX_INCLUDE_DEPTH = 16
+
+# Uniform declarations of assembled GLSL (strict mode checks names against them; blocks excluded).
+_QUALIFIERS = r"(?:(?:lowp|mediump|highp|coherent|volatile|restrict|readonly|writeonly)\s+)*"
+_UNIFORM = re.compile(r"^\s*(?:layout\s*\([^)]*\)\s*)?" + _QUALIFIERS + r"uniform\s+" +
+                      _QUALIFIERS + r"\w+\s+([^;{]+);", re.MULTILINE)
+_INCLUDE = re.compile(r'^\s*#\s*include\s+(?:"([^"]+)"|<([^>]+)>|([A-Za-z_]\w*))\s*$')
+# Mesa "0:57(3):", NVIDIA "0(57) :" - the location and the colon after it.
+_ERROR_LOCATION = re.compile(r"\b(\d+)(?::(\d+)\((\d+)\)|\((\d+)\))\s*:?")
+
+
+@dataclass
+class Source:
+    """Assembled GLSL text and, per output line, the (file, line) it came from."""
+
+    text: str
+    line_map: list[tuple[str, int]]
+
+    def locate(self, line: int) -> tuple[str, int]:
+        """File and line (1-based) of assembled line ``line`` (1-based)."""
+        if 1 <= line <= len(self.line_map):
+            return self.line_map[line - 1]
+        return ("<generated>", line)
+
+
+_registered_roots: list[Traversable | Path] = []
+
+
+def register_shader_root(root: Traversable | Path | str) -> None:
+    """Search ``root`` for GLSL in every shader library from now on: the public way for a
+    plugin to ship shader files (a package's ``importlib.resources.files(...)`` or a folder).
+    Roots are searched in order, the framework's own first; a class's ``shader_root``
+    (materials, lights, shading models, effects) is added for the scenes that use it."""
+    root = Path(root) if isinstance(root, str) else root
+    if not root.is_dir():
+        raise ValueError(f"shader root is not a folder: {root}")
+    if root not in _registered_roots:
+        _registered_roots.append(root)
+
+
+class ShaderLibrary:
+    """Resolves, assembles, compiles and caches GLSL programs for one context."""
+
+    def __init__(self, ctx: moderngl.Context, glsl_version: int = 330,
+                 defines: dict[str, str] | None = None):
+        self.ctx = ctx
+        self.glsl_version = glsl_version
+        self.global_defines = dict(defines or {})
+        self.roots: list[Traversable | Path] = [resources.files("deferred.shaders"),
+                                                *_registered_roots]
+        self.virtual_files: dict[str, str] = {}
+        self._programs: dict[tuple, moderngl.Program] = {}
+        self._declared: dict[int, frozenset[str]] = {}  # program glo -> declared uniform names
+        self._labels: dict[int, str] = {}  # program glo -> its files, for messages
+        # program glo -> its active uniforms and the values last written to them
+        self._uniforms: dict[int, ProgramUniforms] = {}
+        self._virtual_key: tuple[str, ...] = ()  # the virtual files' names, in program keys
+        # counts the times programs were released: a program looked up before is still valid
+        # while it is unchanged
+        self.generation = 0
+
+    # -- files -------------------------------------------------------------------------------
+    def add_root(self, root: Traversable | Path, first: bool = False) -> None:
+        """Search ``root`` for shader files too (plugins ship their GLSL this way); ``first``:
+        before every other root, so that its files replace theirs (benchmarks/shader_ab.py)."""
+        if root in self.roots:
+            return
+        if first:
+            if self._programs:  # they (and what is cached by them) hold the files replaced
+                raise RuntimeError("a root replacing shader files is added before any "
+                                   "program is compiled")
+            self.roots.insert(0, root)
+        else:
+            self.roots.append(root)
+
+    def set_virtual_file(self, name: str, text: str) -> None:
+        """Provide generated GLSL under ``name`` (e.g. the light dispatch of the registry)."""
+        if self.virtual_files.get(name) != text:
+            self.virtual_files[name] = text
+            self._virtual_key = tuple(sorted(self.virtual_files))
+            self.generation += 1
+            for key in [k for k in self._programs if name in k[-1]]:
+                program = self._programs.pop(key)
+                self._uniforms.pop(program.glo, None)
+                program.release()
+
+    def read(self, name: str) -> str:
+        if name in self.virtual_files:
+            return self.virtual_files[name]
+        for root in self.roots:
+            candidate = root.joinpath(*name.split("/"))
+            if candidate.is_file():
+                return candidate.read_text(encoding="utf-8")
+        searched = ", ".join(str(root) for root in self.roots)
+        raise ShaderError(f"shader file not found: {name} (searched: {searched})")
+
+    def assemble(self, name: str, defines: dict[str, str] | None = None) -> Source:
+        """Resolve includes of ``name`` and inject ``#version`` and defines."""
+        defines = {**self.global_defines, **(defines or {})}
+        lines: list[str] = [f"#version {self.glsl_version} core"]
+        line_map: list[tuple[str, int]] = [("<version>", 0)]
+        for key, value in defines.items():
+            lines.append(f"#define {key} {value}".rstrip())
+            line_map.append(("<defines>", 0))
+        included: set[str] = set()
+        self._expand(name, defines, lines, line_map, included, stack=[])
+        return Source("\n".join(lines) + "\n", line_map)
+
+    def _expand(self, name: str, defines: dict[str, str], lines: list[str],
+                line_map: list[tuple[str, int]], included: set[str], stack: list[str]) -> None:
+        # Include-once (below) makes cycles harmless; the depth limit bounds what is left.
+        if len(stack) >= MAX_INCLUDE_DEPTH:
+            raise ShaderError(f"{stack[-1]}: includes nested deeper than {MAX_INCLUDE_DEPTH}")
+        included.add(name)
+        text = self.read(name)
+        for number, line in enumerate(text.splitlines(), start=1):
+            match = _INCLUDE.match(line)
+            if not match:
+                if line.lstrip().startswith("#version"):
+                    continue  # the library owns the version line
+                lines.append(line)
+                line_map.append((name, number))
+                continue
+            target = match.group(1) or match.group(2)
+            if match.group(3):
+                value = defines.get(match.group(3))
+                if value is None:
+                    raise ShaderError(f"{name}:{number}: #include {match.group(3)}: "
+                                      "no such define was injected")
+                target = value.strip().strip('"')
+            if target in included:
+                continue
+            self._expand(target, defines, lines, line_map, included, stack + [name])
+
+    # -- programs ----------------------------------------------------------------------------
+    def program(self, vertex: str, fragment: str | None = None, geometry: str | None = None,
+                defines: dict[str, str] | None = None) -> moderngl.Program:
+        """Compile (or return the cached) program of these files with these defines."""
+        defines = defines or {}
+        # a frozenset of the defines: hashing it is cheaper than sorting them on every lookup
+        key = (vertex, fragment, geometry, frozenset(defines.items()), self._virtual_key)
+        cached = self._programs.get(key)
+        if cached is not None:
+            return cached
+        stages = {"vertex_shader": vertex, "fragment_shader": fragment,
+                  "geometry_shader": geometry}
+        sources = {stage: self.assemble(name, defines)
+                   for stage, name in stages.items() if name is not None}
+        try:
+            program = self.ctx.program(**{stage: src.text for stage, src in sources.items()})
+        except moderngl.Error as exc:
+            raise ShaderError(self._map_error(str(exc), sources, stages)) from None
+        self._programs[key] = program
+        self._declared[program.glo] = frozenset(
+            name for source in sources.values() for name in declared_uniforms(source.text))
+        self._labels[program.glo] = " + ".join(n for n in stages.values() if n is not None)
+        self._uniforms[program.glo] = ProgramUniforms(program)
+        return program
+
+    def declared_uniforms(self, program: moderngl.Program) -> frozenset[str]:
+        """Names of the uniforms (and samplers) the program's sources declare, used or not."""
+        return self._declared.get(program.glo, frozenset())
+
+    def declared_in_folder(self, folder: str) -> frozenset[str]:
+        """Uniforms declared by the shader files of ``folder`` (in any root) and the files they
+        include by path: what a material's programs can declare, whichever of them run."""
+        names: set[str] = set()
+        seen: set[str] = set()
+        pending = [f"{folder}/{entry.name}" for root in self.roots
+                   for entry in _folder_entries(root, folder)]
+        while pending:
+            name = pending.pop()
+            if name in seen:
+                continue
+            seen.add(name)
+            try:
+                text = self.read(name)
+            except ShaderError:
+                continue
+            names |= declared_uniforms(text)
+            for line in text.splitlines():
+                match = _INCLUDE.match(line)
+                if match and (match.group(1) or match.group(2)):
+                    pending.append(match.group(1) or match.group(2))
+        return frozenset(names)
+
+    def members(self, program) -> frozenset[str]:
+        """The program's active uniforms and blocks (``name in program`` walks them all)."""
+        return self.uniforms(program).members
+
+    def uniforms(self, program) -> ProgramUniforms:
+        """The program's uniforms, written only when their values change."""
+        uniforms = self._uniforms.get(program.glo)
+        if uniforms is None:
+            uniforms = self._uniforms[program.glo] = ProgramUniforms(program)
+        return uniforms
+
+    def forget_uniform_values(self) -> None:
+        """Forget what each program holds (a frame starts: code between frames may have
+        written uniforms directly)."""
+        for uniforms in self._uniforms.values():
+            uniforms.forget()
+
+    def describe(self, program: moderngl.Program) -> str:
+        return self._labels.get(program.glo, "<program>")
+
+    def compute(self, name: str, defines: dict[str, str] | None = None) -> moderngl.ComputeShader:
+        """Compile (or return the cached) compute shader of this file with these defines."""
+        defines = defines or {}
+        key = ("compute", name, frozenset(defines.items()), self._virtual_key)
+        cached = self._programs.get(key)
+        if cached is not None:
+            return cached
+        source = self.assemble(name, defines)
+        try:
+            shader = self.ctx.compute_shader(source.text)
+        except moderngl.Error as exc:
+            raise ShaderError(self._map_error(str(exc), {"compute_shader": source},
+                                              {"compute_shader": name})) from None
+        self._programs[key] = shader
+        self._declared[shader.glo] = frozenset(declared_uniforms(source.text))
+        self._labels[shader.glo] = name
+        self._uniforms[shader.glo] = ProgramUniforms(shader, frozenset(
+            name for name in declared_uniforms(source.text) if name in shader))
+        return shader
+
+    @staticmethod
+    def _map_error(message: str, sources: dict[str, Source], stages: dict[str, str | None]) -> str:
+        """Rewrite driver line references to ``file:line`` of the stage that failed."""
+        headers = {line.strip() for line in message.splitlines()}
+        stage = next((s for s in sources if s in headers), None)
+        if stage is None and len(sources) == 1:
+            stage = next(iter(sources))
+        lines_out: list[str] = []
+        first_location = None
+        for raw in message.splitlines():
+            raw = raw.strip()
+            if not raw or set(raw) <= {"=", "-"} or raw in sources:
+                continue
+            if stage is not None:
+                source = sources[stage]
+
+                def replace(m: re.Match, source: Source = source) -> str:
+                    nonlocal first_location
+                    line = int(m.group(2) or m.group(4))
+                    file, file_line = source.locate(line)
+                    if first_location is None:
+                        first_location = f"{file}:{file_line}"
+                    return f"{file}:{file_line}:"
+
+                raw = _ERROR_LOCATION.sub(replace, raw, count=1)
+            lines_out.append(raw)
+        head = first_location or (stages.get(stage) if stage else None) or "shader"
+        detail = "; ".join(line for line in lines_out if "error" in line.lower()) or \
+            "; ".join(lines_out)
+        return f"{head}: {detail}" if not detail.startswith(head) else detail
+
+    def release(self) -> None:
+        self.generation += 1
+        for program in self._programs.values():
+            program.release()
+        self._programs.clear()
+        self._declared.clear()
+        self._labels.clear()
+        self._uniforms.clear()
+
+
+def _folder_entries(root: Traversable | Path, folder: str) -> list[Traversable]:
+    directory = root.joinpath(*folder.split("/"))
+    if not directory.is_dir():
+        return []
+    return [entry for entry in directory.iterdir() if entry.is_file()]
+
+
+def declared_uniforms(text: str) -> set[str]:
+    """Uniform names declared in GLSL ``text`` (``uniform vec3 a, b[4];`` gives a and b)."""
+    text = re.sub(r"/\*.*?\*/", " ", text, flags=re.DOTALL)
+    text = re.sub(r"//[^\n]*", "", text)
+    names = set()
+    for match in _UNIFORM.finditer(text):
+        for part in match.group(1).split(","):
+            name = part.split("[")[0].split("=")[0].strip()
+            if name:
+                names.add(name)
+    return names

@@ -1,0 +1,55 @@
+"""The effect interface: scene-wide screen and post passes (pygfx's effect passes).
+
+An effect is a class with a unique ``name`` (the scene file's ``[[effect]] type``), a validated
+``Params`` model and ``passes(scene, pipeline)``: the passes it adds, in any phase (typically
+``screen``, over the clean G-buffer before any stipple, and ``post``, over the tone-mapped frame),
+ranked by ``Order`` within the phase. Parameters become ``u_<field>`` uniforms
+(:mod:`deferred.params`). ``pipelines`` names the pipelines it applies to (an effect reading the
+G-buffer has nothing to read in the forward pipeline). Register with
+``@deferred.interfaces.registry.effects.register`` or the entry-point group ``deferred.effects``.
+
+A screen effect that creates the target ``ssao`` (:data:`AMBIENT_OCCLUSION`) feeds the
+ambient light, whichever effect it is.
+"""
+
+from __future__ import annotations
+
+from importlib.resources.abc import Traversable
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, ClassVar
+
+from deferred.params import Params, UniformOverrides, params_uniforms, validate_params
+
+if TYPE_CHECKING:
+    from deferred.core.frame import Frame
+    from deferred.core.passes import RenderPass
+    from deferred.scene.model import Scene
+
+AMBIENT_OCCLUSION = "ssao"
+
+
+class EffectParams(Params):
+    """Base of every effect's parameter model."""
+
+
+class Effect:
+    name: ClassVar[str]
+    Params: ClassVar[type[EffectParams]] = EffectParams
+    pipelines: ClassVar[tuple[str, ...]] = ("deferred", "forward")
+    shader_root: ClassVar[Traversable | Path | None] = None
+    uniform_overrides: ClassVar[UniformOverrides] = {}
+    type_id: ClassVar[int] = 0  # set by the registry
+
+    def __init__(self, params: EffectParams | None = None):
+        self.params = params if params is not None else self.Params()
+
+    @classmethod
+    def from_dict(cls, values: dict[str, Any], where: str | None = None) -> Effect:
+        return cls(validate_params(cls.Params, values, where))
+
+    def uniforms(self, frame: Frame) -> dict[str, Any]:
+        """``u_<field>`` for every parameter that is a uniform."""
+        return params_uniforms(self.params, self.uniform_overrides)
+
+    def passes(self, scene: Scene, pipeline: str) -> list[RenderPass]:
+        raise NotImplementedError

@@ -1,0 +1,234 @@
+"""The material interface: plain parameter data, GLSL files, and the passes a material contributes.
+
+A material is a class with a unique ``name``, a pydantic ``Params`` model (defaults, ranges, a
+one-line description per field) and a ``surface_shader``: a GLSL file defining
+``Surface material_surface(SurfaceInput i)`` (``common/surface.glsl``). With only that, the base
+class gives it a G-buffer pass (geometry phase) and a forward lit pass (forward pipeline). Materials
+that need more (stipple, shells, composition) override the ``*_passes`` hooks, and may add passes
+once per scene (``scene_passes``); they never edit the pipeline. Register with
+``@deferred.interfaces.registry.materials.register`` or the entry-point group ``deferred.materials``.
+
+Parameters become uniforms by name (:mod:`deferred.params`): field ``fur_length`` is
+``u_fur_length``; ``uniform_overrides`` maps a field to ``None`` (not a uniform: a pass count, a
+file, a define) or to a function giving the uniforms it becomes.
+"""
+
+from __future__ import annotations
+
+from importlib.resources.abc import Traversable
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, ClassVar
+
+import moderngl
+from pydantic import BaseModel, Field
+
+from deferred.core.passes import ObjectPass, Phase, RenderPass
+from deferred.gbuffer.layout import DEPTH, GBUFFER_COLOR_TARGETS, data_write_file
+from deferred.gl.targets import COMPOSITE
+from deferred.interfaces.shading import GBufferData, material_data, surface_id
+from deferred.params import Params, UniformOverrides, params_uniforms, validate_params
+
+if TYPE_CHECKING:
+    from deferred.core.frame import Frame
+    from deferred.scene.model import SceneObject
+
+
+class MaterialParams(Params):
+    """Base of every material's parameter model: unknown keys are errors."""
+
+
+class BlinnPhongParams(MaterialParams):
+    """The Blinn-Phong parameters the G-buffer stores (a mixin: redefine a field to change its
+    default)."""
+
+    specular_intensity: float = Field(0.5, ge=0.0, le=1.0, description="Blinn-Phong intensity")
+    specular_exponent: float = Field(32.0, ge=1.0, le=2048.0, description="Blinn-Phong exponent")
+
+
+class GBufferPass(ObjectPass):
+    """Geometry phase: the material's surface written into the G-buffer: the core targets and
+    the G-buffer data the material declares (``Material.gbuffer_targets``)."""
+
+    fragment = "gbuffer/geometry.frag"
+    depth = DEPTH
+
+    def __init__(self, name: str, phase: Phase, obj: SceneObject, **options: Any):
+        options.setdefault("colors", obj.material.gbuffer_targets())
+        super().__init__(name, phase, obj, **options)
+
+
+class ForwardLitPass(ObjectPass):
+    """Forward pipeline: the material's surface lit by every light in one pass (``lequal``:
+    Forward+ lays the same depth down in its pre-pass first)."""
+
+    fragment = "forward/lit.frag"
+    colors = (COMPOSITE,)
+    depth = DEPTH
+    depth_func = "lequal"
+
+
+class Material:
+    name: ClassVar[str]
+    Params: ClassVar[type[MaterialParams]] = MaterialParams
+    surface_shader: ClassVar[str] = ""
+    shader_root: ClassVar[Traversable | Path | None] = None  # extra GLSL root (plugins)
+    type_id: ClassVar[int] = 0  # set by the registry; written to the G-buffer's id channel
+    shading_model: str = "blinn_phong"  # the BRDF lights call (a registered shading model)
+    gbuffer_data: tuple[GBufferData, ...] = ()  # extra per-pixel data (deferred.interfaces.shading)
+    # field -> None (not a uniform) or value -> {uniform: value} (see the module documentation)
+    uniform_overrides: ClassVar[UniformOverrides] = {}
+    # parameters the material reads once, at t = 0 (a simulation's set-up): a scene timeline
+    # may not change them
+    timeline_fixed: ClassVar[tuple[str, ...]] = ()
+    # Whether uniforms() and textures() are a function of the params alone (textures made
+    # through frame.resources, which last as long as the renderer): the renderer then keeps
+    # them from frame to frame while the params are the same object. None: where the class
+    # keeps Material's own uniforms and textures (Material.keeps_inputs). A material reading
+    # the frame (its time, size or targets) in them leaves it unset or False.
+    inputs_from_params: ClassVar[bool | None] = None
+    # debug views (``deferred render --view <material>.<name>``): name -> (what it shows, the
+    # parameters that make the material draw it)
+    debug_views: ClassVar[dict[str, tuple[str, dict[str, Any]]]] = {}
+
+    def __init__(self, params: MaterialParams | None = None, base_dir: Path | None = None):
+        self.params = params if params is not None else self.Params()
+        self.base_dir = base_dir
+
+    @classmethod
+    def from_dict(cls, values: dict[str, Any], base_dir: Path | None = None,
+                  where: str | None = None) -> Material:
+        """Validate ``values`` against ``Params``; errors name the offending key."""
+        material = cls(validate_params(cls.Params, values, where), base_dir)
+        from deferred.interfaces import registry
+
+        registry.shading_models.get(material.shading_model,
+                                    f"{where}: shading model" if where else "shading model")
+        material.check_files(where)
+        return material
+
+    def check_files(self, where: str | None) -> None:
+        """Raise ``InputError`` for parameters naming files that do not exist."""
+
+    def resolve_path(self, value: str | Path) -> Path:
+        path = Path(value)
+        if not path.is_absolute() and self.base_dir is not None:
+            path = self.base_dir / path
+        return path
+
+    # -- shader inputs -----------------------------------------------------------------------
+    @classmethod
+    def shader_folder(cls) -> str:
+        """The folder of the material's own GLSL (that of ``surface_shader``)."""
+        return cls.surface_shader.rpartition("/")[0]
+
+    def defines(self, obj: SceneObject) -> dict[str, str]:
+        """Preprocessor defines of this material's programs for ``obj``: a function of the
+        params and ``obj.mesh`` only (an object pass keeps its program while those are the
+        same objects; params are replaced whole, never changed in place)."""
+        # every pass of every object asks, every frame: made once (the class, its shading
+        # model and so its data never change), copied for the caller to extend
+        base = self.__dict__.get("_base_defines")
+        if base is None:
+            names = [data.name for data in material_data(self)]
+            base = self.__dict__["_base_defines"] = {
+                "SURFACE_FILE": f'"{self.surface_shader}"',
+                "GBUFFER_DATA_WRITE": f'"{data_write_file(names)}"'}
+        return dict(base)
+
+    def gbuffer_targets(self) -> tuple[str, ...]:
+        """The targets this material's G-buffer passes write: the core G-buffer, then its data
+        (its own and its shading model's), in the order of ``gbuffer/write.glsl``'s outputs."""
+        return (*GBUFFER_COLOR_TARGETS, *(data.name for data in material_data(self)))
+
+    def surface_id(self) -> int:
+        """The G-buffer id of this material's pixels: its shading model and its type id."""
+        key = (self.type_id, self.shading_model)
+        cached = self.__dict__.get("_surface_id")  # asked for by every object, every frame
+        if cached is None or cached[0] != key:
+            from deferred.interfaces import registry
+
+            model_id = registry.shading_models.get(self.shading_model).type_id
+            cached = self.__dict__["_surface_id"] = (key, surface_id(self.type_id, model_id))
+        return cached[1]
+
+    def uniforms(self, frame: Frame) -> dict[str, Any]:
+        """``u_<field>`` for every parameter that is a uniform (``uniform_overrides``)."""
+        # params are frozen and replaced whole (a timeline event): made once per params
+        cached = self.__dict__.get("_params_uniforms")
+        if cached is None or cached[0] is not self.params:
+            cached = self.__dict__["_params_uniforms"] = (
+                self.params, params_uniforms(self.params, self.uniform_overrides))
+        return dict(cached[1])
+
+    def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
+        return {}
+
+    @classmethod
+    def keeps_inputs(cls) -> bool:
+        """Whether the renderer may keep this material's inputs across frames: the
+        ``inputs_from_params`` of the nearest class that sets it, unless a class below that
+        one overrides ``uniforms`` or ``textures`` (it may read the frame: not kept)."""
+        for klass in cls.__mro__:
+            flag = klass.__dict__.get("inputs_from_params")
+            if flag is not None:
+                return flag
+            if klass is Material:
+                return True
+            if "uniforms" in klass.__dict__ or "textures" in klass.__dict__:
+                return False
+        return False  # not a Material subclass's MRO (a mixin listed after it)
+
+    def check_time(self, time: float, where: str) -> None:
+        """Refuse (``InputError`` naming ``where``) a frame time this material cannot reach in
+        bounded work, before any frame is rendered: a simulation stepping from 0 to it."""
+
+    # -- passes per phase --------------------------------------------------------------------
+    def geometry_passes(self, obj: SceneObject) -> list[RenderPass]:
+        return [GBufferPass(f"{obj.label}.gbuffer", Phase.GEOMETRY, obj)]
+
+    def screen_passes(self, obj: SceneObject) -> list[RenderPass]:
+        return []
+
+    def stipple_passes(self, obj: SceneObject) -> list[RenderPass]:
+        return []
+
+    def material_passes(self, obj: SceneObject) -> list[RenderPass]:
+        return []
+
+    def forward_passes(self, obj: SceneObject) -> list[RenderPass]:
+        return [ForwardLitPass(f"{obj.label}.forward", Phase.FORWARD, obj)]
+
+    @classmethod
+    def scene_passes(cls, objects: list[SceneObject], phase: Phase) -> list[RenderPass]:
+        """Passes this material adds once per scene, not per object, in ``phase`` (scene-wide
+        setup, screen or post effects of its own); ``objects`` are the scene's objects of this
+        material. Passes of one name from several materials (a shared technique's) run once."""
+        return []
+
+    def passes(self, phase: Phase, obj: SceneObject) -> list[RenderPass]:
+        hooks = {Phase.GEOMETRY: self.geometry_passes, Phase.SCREEN: self.screen_passes,
+                 Phase.STIPPLE: self.stipple_passes, Phase.MATERIAL: self.material_passes,
+                 Phase.FORWARD: self.forward_passes}
+        return hooks[phase](obj) if phase in hooks else []
+
+    @classmethod
+    def describe_params(cls) -> list[dict[str, Any]]:
+        """Name, type, default, range and doc of each parameter (for ``deferred materials``)."""
+        return describe_model(cls.Params)
+
+
+def describe_model(model: type[BaseModel]) -> list[dict[str, Any]]:
+    rows = []
+    for name, field in model.model_fields.items():
+        bounds = []
+        for meta in field.metadata:
+            for attr, symbol in (("ge", ">="), ("gt", ">"), ("le", "<="), ("lt", "<")):
+                value = getattr(meta, attr, None)
+                if value is not None:
+                    bounds.append(f"{symbol} {value}")
+        annotation = field.annotation
+        type_name = getattr(annotation, "__name__", None) or str(annotation).replace(
+            "typing.", "")
+        rows.append({"name": name, "type": type_name, "default": field.default,
+                     "range": ", ".join(bounds), "doc": field.description or ""})
+    return rows

@@ -1,0 +1,133 @@
+"""Registries of materials, lights, shading models and effects: built-ins plus plugins.
+
+Built-ins register themselves when their package is imported (``deferred.materials``,
+``deferred.lights``, ...). Third-party packages declare an entry point in the group
+``deferred.materials`` (``deferred.lights``, ``deferred.shading_models``, ``deferred.effects``)
+named as the class's ``name`` and pointing at the class; code can also call ``register``.
+
+Entry points load lazily: asking for a name loads that plugin only, so a broken plugin fails
+only the scenes that use it. Listing everything (``deferred materials``) loads every plugin and
+skips a broken one with a warning naming it.
+"""
+
+from __future__ import annotations
+
+import importlib
+import warnings
+from collections.abc import Iterator
+from importlib.metadata import EntryPoint, entry_points
+from typing import Generic, TypeVar
+
+from deferred.errors import InputError
+from deferred.interfaces.shading import MAX_MATERIAL_ID, MAX_SHADING_MODEL_ID
+
+T = TypeVar("T")
+
+
+class PluginWarning(UserWarning):
+    """A plugin that could not be loaded was skipped."""
+
+
+class Registry(Generic[T]):
+    def __init__(self, what: str, group: str, builtin_package: str, max_id: int | None = None):
+        self.what = what
+        self.group = group
+        self.builtin_package = builtin_package
+        self.max_id = max_id  # ids are stored in the G-buffer for some registries
+        self._classes: dict[str, type[T]] = {}
+        self._builtins_loaded = False
+        self._tried: dict[str, str | None] = {}  # entry point name -> error (None: loaded)
+        self._next_id = 1  # ids are never reused: 0 means "none" in GPU buffers
+
+    def register(self, cls: type[T]) -> type[T]:
+        """Register ``cls`` under ``cls.name``; usable as a class decorator."""
+        name = getattr(cls, "name", None)
+        if not isinstance(name, str) or not name:
+            raise TypeError(f"{cls.__name__} has no 'name' to register it under")
+        existing = self._classes.get(name)
+        if existing is not None and existing is not cls:
+            raise ValueError(f"{self.what} '{name}' is already registered by "
+                             f"{existing.__module__}.{existing.__qualname__}")
+        if existing is None:
+            if self.max_id is not None and self._next_id > self.max_id:
+                raise ValueError(f"cannot register {self.what} '{name}': ids 1..{self.max_id} "
+                                 "are used up (the G-buffer has room for no more)")
+            self._classes[name] = cls
+            cls.type_id = self._next_id
+            self._next_id += 1
+        return cls
+
+    def unregister(self, name: str) -> None:
+        self._classes.pop(name, None)
+
+    # -- loading -----------------------------------------------------------------------------
+    def _load_builtins(self) -> None:
+        if not self._builtins_loaded:
+            self._builtins_loaded = True
+            importlib.import_module(self.builtin_package)
+
+    def _entry_points(self) -> list[EntryPoint]:
+        return list(entry_points(group=self.group))
+
+    def _load_entry(self, entry: EntryPoint) -> str | None:
+        """Load and register one plugin; the error message, or None."""
+        if entry.name in self._tried:
+            return self._tried[entry.name]
+        error = None
+        try:
+            self.register(entry.load())
+        except Exception as exc:  # noqa: BLE001 - plugins fail in many ways; say which
+            dist = f" ({entry.dist.name})" if entry.dist is not None else ""
+            error = f"cannot load {self.what} plugin '{entry.name}'{dist}: " \
+                    f"{type(exc).__name__}: {exc}"
+        self._tried[entry.name] = error
+        return error
+
+    def _load_all(self) -> None:
+        self._load_builtins()
+        for entry in self._entry_points():
+            first_time = entry.name not in self._tried
+            error = self._load_entry(entry)
+            if error and first_time:
+                warnings.warn(f"{error} (skipped)", PluginWarning, stacklevel=3)
+
+    # -- lookup ------------------------------------------------------------------------------
+    def get(self, name: str, where: str | None = None) -> type[T]:
+        self._load_builtins()
+        cls = self._classes.get(name)
+        if cls is not None:
+            return cls
+        for entry in self._entry_points():
+            if entry.name == name:
+                error = self._load_entry(entry)
+                if error:
+                    raise InputError(error, where or f"entry point {self.group}")
+        cls = self._classes.get(name)
+        if cls is None:
+            raise InputError(f"unknown {self.what} '{name}' (choose from {', '.join(self)})",
+                             where)
+        return cls
+
+    def builtins(self) -> list[type[T]]:
+        """The classes of the built-in package, whatever plugins are installed."""
+        self._load_builtins()
+        return [cls for cls in self._classes.values()
+                if cls.__module__.startswith(self.builtin_package)]
+
+    def __iter__(self) -> Iterator[str]:
+        self._load_all()
+        return iter(list(self._classes))
+
+    def items(self) -> list[tuple[str, type[T]]]:
+        self._load_all()
+        return list(self._classes.items())
+
+
+materials: Registry = Registry("material", "deferred.materials", "deferred.materials",
+                               max_id=MAX_MATERIAL_ID)
+# a listed light's colour texel holds its type id in w's low 8 bits (lights/light_lists.glsl)
+lights: Registry = Registry("light", "deferred.lights", "deferred.lights", max_id=255)
+shading_models: Registry = Registry("shading model", "deferred.shading_models",
+                                    "deferred.materials.shading_models",
+                                    max_id=MAX_SHADING_MODEL_ID)
+effects: Registry = Registry("effect", "deferred.effects", "deferred.effects")

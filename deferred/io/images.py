@@ -1,0 +1,464 @@
+"""Image files through OpenImageIO: PNG/EXR out (atomically), any OIIO format in.
+
+``deferred render`` also writes numbered sequences (``out_####.png``) and videos (``.mp4``,
+``.gif``): :mod:`deferred.io.video`.
+"""
+
+from __future__ import annotations
+
+import os
+import secrets
+import stat
+import sys
+import tempfile
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
+from pathlib import Path
+
+import numpy as np
+
+from deferred.errors import InputError, RenderError
+
+IMAGE_SUFFIXES = (".png", ".exr")
+VIDEO_SUFFIXES = (".mp4", ".gif")
+OUTPUT_SUFFIXES = (*IMAGE_SUFFIXES, *VIDEO_SUFFIXES)  # what ``deferred render -o`` writes
+
+
+def srgb_encode(linear: np.ndarray) -> np.ndarray:
+    linear = np.clip(linear, 0.0, 1.0)
+    return np.where(linear <= 0.0031308, linear * 12.92,
+                    1.055 * np.power(linear, 1.0 / 2.4) - 0.055)
+
+
+def srgb_decode(encoded: np.ndarray) -> np.ndarray:
+    encoded = np.asarray(encoded, dtype=np.float64)
+    return np.where(encoded <= 0.04045, encoded / 12.92, np.power((encoded + 0.055) / 1.055, 2.4))
+
+
+def check_output_path(path: str | Path, where: str = "-o",
+                      suffixes: tuple[str, ...] = OUTPUT_SUFFIXES,
+                      patterns: bool = True) -> Path:
+    """An output file named by option ``where``: one of ``suffixes``, in an existing folder,
+    not itself a folder. With ``patterns``, a name with a run of ``#`` is a numbered image
+    sequence (:func:`deferred.io.video.expand_pattern`), checked as its first file."""
+    path = Path(path)
+    shown = str(path) if len(str(path)) <= 120 else f"{str(path)[:60]}...{str(path)[-40:]}"
+    if path.suffix.lower() not in suffixes:
+        raise InputError(f"output must end in {_either(suffixes)}: {shown}", where)
+    if any(len(part.encode()) > NAME_MAX for part in path.parent.parts):
+        raise InputError(f"folder name longer than {NAME_MAX} bytes: {shown}", where)
+    if len(path.name.encode()) > NAME_MAX:
+        raise InputError(f"file name longer than {NAME_MAX} bytes: {path.name[:40]}...", where)
+    if len(str(path.absolute()).encode()) >= PATH_MAX:
+        raise InputError(f"path longer than {PATH_MAX} bytes: {shown}", where)
+    if not path.parent.is_dir():
+        raise InputError(f"output folder does not exist: {path.parent}", where)
+    first = path
+    if patterns and "#" in path.name:
+        from deferred.io.video import expand_pattern
+
+        first = expand_pattern(path, 0, where)
+    if len(first.name.encode()) > NAME_MAX:
+        # caught here, not after the frame is rendered and written to a temporary name
+        raise InputError(f"file name longer than {NAME_MAX} bytes: {first.name[:40]}...", where)
+    if first.is_dir():
+        raise InputError(f"output is a folder, not a file: {first}", where)
+    return path
+
+
+def _either(suffixes: Sequence[str]) -> str:
+    return suffixes[0] if len(suffixes) == 1 else \
+        f"{', '.join(suffixes[:-1])} or {suffixes[-1]}"
+
+
+# OpenEXR stores channels sorted by name; this attribute keeps the order they were written in.
+CHANNEL_ORDER_ATTRIBUTE = "deferred:channels"
+
+
+def write_image(path: str | Path, pixels: np.ndarray, channels: Sequence[str] | None = None,
+                attributes: dict[str, object] | None = None, half: bool = False) -> Path:
+    """Write ``pixels`` (H, W, C), top row first, atomically (temporary file, then rename).
+
+    uint8 data is written as 8-bit; float data as float (or half) EXR with ``channels`` names.
+    A channel named ``Z`` becomes the image's ``z_channel``, one named ``A`` its alpha channel.
+    """
+    import OpenImageIO as oiio
+
+    path = Path(path)
+    pixels = np.ascontiguousarray(pixels)
+    if pixels.ndim == 2:
+        pixels = pixels[..., None]
+    height, width, count = pixels.shape
+    if pixels.dtype == np.uint8:
+        fmt = oiio.UINT8
+    else:
+        pixels = pixels.astype(np.float16 if half else np.float32)
+        fmt = oiio.HALF if half else oiio.FLOAT
+    spec = oiio.ImageSpec(width, height, count, fmt)
+    if channels is not None:
+        if len(channels) != count:
+            raise ValueError(f"{len(channels)} channel names for {count} channels")
+        names = tuple(channels)
+        spec.channelnames = names
+        spec.alpha_channel = names.index("A") if "A" in names else -1
+        spec.z_channel = names.index("Z") if "Z" in names else -1
+        spec.attribute(CHANNEL_ORDER_ATTRIBUTE, ",".join(names))
+    for key, value in (attributes or {}).items():
+        spec.attribute(key, value)
+
+    def write(temporary: str) -> None:
+        def failed(*messages: str) -> RenderError:
+            # the reader knows the file by its name, not by the temporary one
+            reason = _reason(*messages).replace(os.path.basename(temporary), path.name)
+            return RenderError(f"cannot write {path}: {reason}")
+
+        output = oiio.ImageOutput.create(temporary)
+        if output is None:
+            raise failed(oiio.geterror())
+        try:
+            if not output.open(temporary, spec):
+                raise failed(output.geterror(), oiio.geterror())
+            ok = output.write_image(pixels)
+        finally:
+            closed = output.close()
+        # OIIO's PNG writer returns True from write_image and close on a full disk: only
+        # has_error tells. Collect every signal, then check the file it left.
+        if not ok or not closed or output.has_error:
+            raise failed(output.geterror(), oiio.geterror())
+        _fsync(temporary, path)
+        _check_image_file(temporary, path, width, height, count)
+
+    _write_atomically(path, write)
+    return path
+
+
+def _reason(*messages: str) -> str:
+    """The first line of the first non-empty writer message: errors are one line, and a
+    failure always says why, even when the writer did not."""
+    for message in messages:
+        lines = [line.strip() for line in (message or "").splitlines() if line.strip()]
+        if lines:
+            return lines[0]
+    return "the writer reported an error without a reason"
+
+
+def _os_reason(exc: OSError) -> str:
+    return exc.strerror or str(exc) or type(exc).__name__
+
+
+def _fsync(temporary: str, path: Path) -> None:
+    """Flush the written file to the disk: delayed allocation and network file systems report
+    a full disk only here, after the writer closed the file without complaint."""
+    try:
+        fd = os.open(temporary, os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+    except OSError as exc:
+        raise RenderError(f"cannot write {path}: {_os_reason(exc)}") from exc
+
+
+def _check_image_file(temporary: str, path: Path, width: int, height: int, count: int) -> None:
+    """Read back the header of a written image: a writer that lost data without saying so
+    leaves an empty or unreadable file, caught here before it replaces the old one."""
+    import OpenImageIO as oiio
+
+    if os.path.getsize(temporary) == 0:
+        raise RenderError(f"cannot write {path}: the writer left an empty file")
+    image = oiio.ImageInput.open(temporary)
+    if image is None:
+        raise RenderError(f"cannot write {path}: the written file does not read back: "
+                          f"{_reason(oiio.geterror())}")
+    try:
+        spec = image.spec()
+        got = (spec.width, spec.height, spec.nchannels)
+    finally:
+        image.close()
+    if got != (width, height, count):
+        raise RenderError(f"cannot write {path}: the written file reads back as "
+                          f"{got[0]}x{got[1]} with {got[2]} channels, not "
+                          f"{width}x{height} with {count}")
+
+
+def write_text(path: str | Path, text: str) -> Path:
+    """Write a text file atomically (JSON manifests, CSV), flushed to the disk before the
+    rename so a full disk fails here instead of leaving a short file."""
+    path = Path(path)
+
+    def write(temporary: str) -> None:
+        with open(temporary, "w", encoding="utf-8") as handle:
+            handle.write(text)
+            handle.flush()
+            os.fsync(handle.fileno())
+
+    _write_atomically(path, write)
+    return path
+
+
+# A file name may hold 255 bytes on the common file systems (ext4, XFS, btrfs, APFS, NTFS).
+NAME_MAX = 255
+PATH_MAX = 4096  # bytes of a whole path (Linux)
+NEGATIVE_TOLERANCE = 1e-3  # image values this far below 0 read as 0 (HDR filter ringing)
+# What temporary_path adds to a name: ".", ".", 12 hex digits, ".tmp".
+_TEMPORARY_EXTRA = 18
+
+
+def temporary_path(path: str | Path) -> Path:
+    """A hidden name next to ``path`` to write to before renaming over it; the suffix stays
+    last so writers pick the format from it. The stem is shortened where the extra characters
+    would take the name past ``NAME_MAX`` bytes (the random part keeps it unique)."""
+    path = Path(path)
+    directory = path.parent if str(path.parent) else Path(".")
+    stem = path.stem
+    room = NAME_MAX - _TEMPORARY_EXTRA - len(path.suffix.encode())
+    if len(stem.encode()) > room:
+        stem = stem.encode()[:max(room, 1)].decode(errors="ignore")
+    # Not mkstemp: its 0600 mode would survive the rename; the writer creates the file under
+    # the umask like any other output.
+    return directory / f".{stem}.{secrets.token_hex(6)}.tmp{path.suffix}"
+
+
+def _write_atomically(path: Path, write: Callable[[str], None]) -> None:
+    """``write(temporary)`` next to ``path``, then rename over it: readers never see half a file,
+    and a failure (an error, Ctrl-C) leaves the old file as it was and no temporary.
+
+    OS errors become a ``RenderError`` naming the file and the reason."""
+    temporary = str(temporary_path(path))
+    try:
+        write(temporary)
+        os.replace(temporary, path)
+    except OSError as exc:
+        raise RenderError(f"cannot write {path}: {_os_reason(exc)}") from exc
+    finally:
+        try:
+            if os.path.lexists(temporary):
+                os.unlink(temporary)
+        except OSError:
+            pass  # the write's own error (or success) is what the caller needs to hear
+
+
+# -- reading ----------------------------------------------------------------------------------
+# Every read opens the header first and refuses, before decoding a pixel, an image larger than a
+# GL texture may be or one whose decoded pixels would take more than the memory budget: a
+# 16384 x 16384 texture is 4 GiB as float RGBA (more again on its way to the GPU) and would get
+# the process killed, not a one-line error.
+MAX_TEXTURE_SIZE = 16384  # GL_MAX_TEXTURE_SIZE of desktop GPUs and llvmpipe; the context's own
+#                           value where one is at hand (``max_size``)
+IMAGE_MEMORY_BUDGET = 1 << 30  # bytes an image may take once decoded (``bytes_per_pixel`` each)
+RGBA_FLOAT_BYTES = 16  # what read_image makes of every pixel: float32 RGBA
+
+
+def read_image(path: str | Path, srgb_to_linear: bool = False,
+               unassociated_alpha: bool = False, *, where: str | None = None,
+               max_size: int | None = MAX_TEXTURE_SIZE,
+               bytes_per_pixel: int = RGBA_FLOAT_BYTES) -> np.ndarray:
+    """Read an image as float32 RGBA (H, W, 4), top row first. ``unassociated_alpha`` keeps the
+    colour channels as stored where a format would associate them with alpha (PNG: data in
+    RGBA channels, such as a wetness mask, must not be premultiplied).
+
+    A missing, empty, truncated or corrupt file, one over ``max_size`` pixels a side or over
+    ``IMAGE_MEMORY_BUDGET`` at ``bytes_per_pixel`` (what the caller makes of each pixel), or one
+    holding NaN, infinite or negative values, is an ``InputError`` naming the file, and
+    ``where`` (a scene key) where given.
+    """
+    import OpenImageIO as oiio
+
+    path = Path(path)
+    config = oiio.ImageSpec()
+    if unassociated_alpha:
+        config.attribute("oiio:UnassociatedAlpha", 1)
+    pixels, spec = _decode(path, where, config, max_size, lambda _: bytes_per_pixel)
+    if pixels.ndim == 2:
+        pixels = pixels[..., None]
+    count = pixels.shape[2]
+    if count < 3:
+        pixels = np.concatenate([np.repeat(pixels[..., :1], 3, axis=2),
+                                 pixels[..., 1:2] if count == 2 else
+                                 np.ones(pixels.shape[:2] + (1,), np.float32)], axis=2)
+    elif count == 3:
+        pixels = np.concatenate([pixels, np.ones(pixels.shape[:2] + (1,), np.float32)], axis=2)
+    pixels = pixels[..., :4]  # extra channels (a depth, an id) are not read: not checked
+    # Every image a scene reads (colours, heights, wetness) holds values from 0 up: NaN,
+    # infinity or a clearly negative value (a float EXR) would shade black or spread NaN
+    # through the frame. Slightly negative values (filter ringing in an HDR image) are 0.
+    bad = ~np.isfinite(pixels) | (pixels < -NEGATIVE_TOLERANCE)
+    if bad.any():
+        y, x = np.argwhere(bad.any(axis=-1))[0]
+        raise InputError(f"image {_culprit(path, where)} has {int(bad.sum()):,} values that are "
+                         f"NaN, infinite or negative (the first at pixel {x}, {y}: "
+                         f"{np.array2string(pixels[y, x], precision=3)}); images hold values "
+                         ">= 0", where)
+    np.maximum(pixels, 0.0, out=pixels)
+    if srgb_to_linear and spec.format.basetype != oiio.FLOAT and spec.format.basetype != oiio.HALF:
+        pixels[..., :3] = srgb_decode(pixels[..., :3])
+    return pixels
+
+
+def read_channels(path: str | Path, *, where: str | None = None, max_size: int | None = None
+                  ) -> tuple[np.ndarray, list[str], dict[str, object]]:
+    """Read every channel of an image (EXR dumps): pixels (H, W, C), names, a few attributes.
+
+    Channels come back in the order they were written when the file records it (EXR itself
+    sorts them by name); ``z_channel`` and ``alpha_channel`` index into that order (-1: none).
+    Bad files are ``InputError`` as in :func:`read_image` (the budget counts float32 channels).
+    """
+    pixels, spec = _decode(Path(path), where, None, max_size, lambda count: 4 * count)
+    names = list(spec.channelnames)
+    order = spec.getattribute(CHANNEL_ORDER_ATTRIBUTE)
+    if pixels.ndim == 2:
+        pixels = pixels[..., None]
+    if isinstance(order, str) and sorted(order.split(",")) == sorted(names):
+        wanted = order.split(",")
+        pixels = pixels[..., [names.index(n) for n in wanted]]
+        names = wanted
+    attributes = {"z_channel": names.index("Z") if "Z" in names else -1,
+                  "alpha_channel": names.index("A") if "A" in names else -1}
+    return pixels, names, attributes
+
+
+def check_image(path: str | Path, where: str | None = None, *,
+                max_size: int | None = MAX_TEXTURE_SIZE,
+                bytes_per_pixel: int = RGBA_FLOAT_BYTES) -> tuple[int, int, int]:
+    """``(width, height, channels)`` of an image that :func:`read_image` will read, checked as
+    it checks, without decoding it: for scene validation, before GL starts, of files read later.
+
+    The file must be complete too: a PNG ends in its IEND chunk; otherwise (a PNG with bytes
+    after it, another format) the last row is read, which for EXR is one chunk and finds the
+    chunks a truncated file lacks.
+    """
+    path = Path(path)
+    image, spec = _open(path, where, None, max_size, lambda _: bytes_per_pixel)
+    try:
+        if not _ends_in_png_iend(path):
+            with _quiet_stderr() as chatter:
+                row = image.read_scanlines(0, 0, spec.y + spec.height - 1, spec.y + spec.height,
+                                           0, 0, spec.nchannels, _oiio().FLOAT)
+            if row is None or image.has_error:
+                raise _unreadable(path, where, image.geterror(), chatter)
+            _echo(chatter)
+        return spec.width, spec.height, spec.nchannels
+    finally:
+        image.close()
+
+
+def _oiio():
+    import OpenImageIO as oiio
+
+    return oiio
+
+
+def _culprit(path: Path, where: str | None) -> str:
+    # under a scene key the file's name is enough; alone the message is all there is
+    return path.name if where else str(path)
+
+
+def _unreadable(path: Path, where: str | None, error: str, chatter: list[str]) -> InputError:
+    lines = [line.strip() for text in (error, *chatter) for line in (text or "").splitlines()
+             if line.strip()]
+    reason = lines[0] if lines else "not an image it can read"
+    return InputError(f"cannot read image {_culprit(path, where)}: {reason} (truncated or "
+                      f"corrupt?)", where)
+
+
+def _open(path: Path, where: str | None, config, max_size: int | None, bytes_per_pixel):
+    """An open ``ImageInput`` and its spec, the file's size checked; ``bytes_per_pixel`` maps a
+    channel count to the bytes the caller's pixels take."""
+    oiio = _oiio()
+    name = _culprit(path, where)
+    try:
+        size = path.stat().st_size
+    except OSError as exc:
+        reason = "not found" if isinstance(exc, FileNotFoundError) else exc.strerror or str(exc)
+        raise InputError(f"cannot read image {name}: {reason}", where) from None
+    if not stat.S_ISREG(path.stat().st_mode):
+        kind = "a folder" if path.is_dir() else "not a regular file (a device or pipe)"
+        raise InputError(f"cannot read image {name}: it is {kind}", where)
+    if size == 0:
+        raise InputError(f"cannot read image {name}: the file is empty (0 bytes)", where)
+    with _quiet_stderr() as chatter:
+        image = oiio.ImageInput.open(str(path), config) if config is not None else \
+            oiio.ImageInput.open(str(path))
+    if image is None:
+        raise _unreadable(path, where, oiio.geterror(), chatter)
+    _echo(chatter)
+    spec = image.spec()
+    width, height, count = spec.width, spec.height, spec.nchannels
+    problem = None
+    if max_size is not None and max(width, height) > max_size:
+        problem = (f"is {width}x{height}, larger than the {max_size} pixels a side a GL "
+                   f"texture may have; scale it down")
+    elif width * height * bytes_per_pixel(count) > IMAGE_MEMORY_BUDGET:
+        need = width * height * bytes_per_pixel(count)
+        problem = (f"is {width}x{height}: it would take {_amount(need)} of memory here, more "
+                   f"than the {_amount(IMAGE_MEMORY_BUDGET)} allowed; scale it down")
+    if problem is not None:
+        image.close()
+        raise InputError(f"image {name} {problem}", where)
+    return image, spec
+
+
+def _decode(path: Path, where: str | None, config, max_size: int | None, bytes_per_pixel):
+    """The pixels (float32, as OIIO gives them) and spec of a checked image."""
+    oiio = _oiio()
+    image, spec = _open(path, where, config, max_size, bytes_per_pixel)
+    try:
+        with _quiet_stderr() as chatter:
+            pixels = image.read_image(format=oiio.FLOAT)
+        # OIIO answers a failed read with None (a truncated file), not an exception
+        if pixels is None or image.has_error:
+            raise _unreadable(path, where, image.geterror(), chatter)
+        _echo(chatter)
+    finally:
+        image.close()
+    return np.asarray(pixels, dtype=np.float32), spec
+
+
+def _amount(size: int) -> str:
+    for unit, scale in (("GiB", 1 << 30), ("MiB", 1 << 20), ("KiB", 1 << 10)):
+        if size >= scale:
+            return f"{size / scale:.1f} {unit}"
+    return f"{size} bytes"
+
+
+_PNG_IEND = b"\x00\x00\x00\x00IEND\xaeB`\x82"
+
+
+def _ends_in_png_iend(path: Path) -> bool:
+    """A PNG whose last bytes are its IEND chunk is complete (the cheap completeness check)."""
+    if path.suffix.lower() != ".png":
+        return False
+    with open(path, "rb") as file:
+        file.seek(max(0, path.stat().st_size - len(_PNG_IEND)))
+        return file.read() == _PNG_IEND
+
+
+@contextmanager
+def _quiet_stderr() -> Iterator[list[str]]:
+    """File descriptor 2 into a temporary file while OIIO reads: libpng prints its errors
+    itself (``libpng error: IDAT: ...``), which would break the command line's one-line errors.
+    The list yielded gets what was printed: after a successful read the caller prints it after
+    all (:func:`_echo`: warnings stay visible), after a failure its error says it.
+    Process-wide, like the descriptor: output of other threads in between is held back too."""
+    chatter: list[str] = []
+    try:
+        saved = os.dup(2)
+    except OSError:  # no descriptor 2 at all: nothing to keep quiet
+        yield chatter
+        return
+    with tempfile.TemporaryFile() as capture:
+        sys.stderr.flush()
+        os.dup2(capture.fileno(), 2)
+        try:
+            yield chatter
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            capture.seek(0)
+            chatter.append(capture.read().decode(errors="replace"))
+
+
+def _echo(chatter: list[str]) -> None:
+    text = "".join(chatter)
+    if text:
+        sys.stderr.write(text)

@@ -1,0 +1,229 @@
+"""Animation output: the times of a run of frames, numbered image sequences and videos.
+
+``deferred render --frames N --fps F --time T`` renders frame ``i`` at ``T + i / F`` seconds (the
+scene's ``[[event]]`` timeline and animated materials follow ``frame.time``) and writes
+
+- a numbered sequence for a name with a run of ``#`` (``out_####.png``, ``.exr`` too): the run
+  becomes the frame number, zero-padded to its length (wider numbers keep every digit);
+- a video for ``.mp4`` (H.264, yuv420p, through imageio's ffmpeg plugin; even sizes only) or
+  ``.gif`` (imageio's pillow plugin, looping forever; Pillow merges identical consecutive frames
+  into one longer frame).
+
+A video is written to a hidden temporary file next to the output and renamed when complete, so
+a failure or Ctrl-C leaves no partial file; each file of a sequence is written atomically.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Literal
+
+import numpy as np
+
+from deferred.errors import InputError, RenderError
+from deferred.io.images import IMAGE_SUFFIXES, VIDEO_SUFFIXES, temporary_path, write_image
+
+OutputKind = Literal["image", "sequence", "video"]
+FRAME_RUN = re.compile(r"#+")
+GIF_TICK_MS = 10  # GIF frame delays are whole hundredths of a second
+MP4_QUALITY = 7  # imageio's 0..10 scale: libx264 CRF 15
+
+
+def frame_times(frames: int, fps: float, start: float = 0.0) -> list[float]:
+    """The time in seconds of each of ``frames`` frames: ``start + i / fps``."""
+    if not (isinstance(frames, int) and frames >= 1):
+        raise InputError(f"must be a whole number >= 1, got {frames!r}", "--frames")
+    if not (math.isfinite(fps) and fps > 0.0):
+        raise InputError(f"must be a finite number > 0, got {fps!r}", "--fps")
+    if not (math.isfinite(start) and start >= 0.0):
+        raise InputError(f"must be a finite number of seconds >= 0, got {start!r}", "--time")
+    return [start + index / fps for index in range(frames)]
+
+
+def is_pattern(path: str | Path) -> bool:
+    """Whether ``path``'s file name has a run of ``#`` (a numbered sequence)."""
+    return "#" in Path(path).name
+
+
+def expand_pattern(path: str | Path, index: int, where: str = "-o") -> Path:
+    """``out_####.png``, 7 -> ``out_0007.png``: the file name's run of ``#`` becomes ``index``
+    zero-padded to the run's length. A name must have exactly one run."""
+    path = Path(path)
+    runs = FRAME_RUN.findall(path.name)
+    if len(runs) != 1:
+        raise InputError(f"a frame pattern has one run of '#' (out_####.png), got {path.name}",
+                         where)
+    if path.suffix.lower() not in IMAGE_SUFFIXES:
+        raise InputError(f"a frame pattern must end in {' or '.join(IMAGE_SUFFIXES)}: {path}",
+                         where)
+    if index < 0:
+        raise ValueError(f"frame number {index} < 0")
+    width = len(runs[0])
+    return path.with_name(FRAME_RUN.sub(f"{index:0{width}d}", path.name))
+
+
+def output_kind(path: str | Path) -> OutputKind:
+    """``"sequence"`` (a ``#`` pattern), ``"video"`` (.mp4, .gif) or ``"image"``."""
+    if is_pattern(path):
+        return "sequence"
+    return "video" if Path(path).suffix.lower() in VIDEO_SUFFIXES else "image"
+
+
+def check_video_size(path: str | Path, size: tuple[int, int], where: str = "-o") -> None:
+    """H.264 in yuv420p halves the colour resolution: an .mp4 needs an even width and
+    height (``InputError`` otherwise, before anything is rendered)."""
+    width, height = size
+    if Path(path).suffix.lower() == ".mp4" and (width % 2 or height % 2):
+        even = f"{width + width % 2}x{height + height % 2}"
+        raise InputError(f"an .mp4 (H.264, yuv420p) needs an even width and height, got "
+                         f"{width}x{height}; render at --size {even}", where)
+
+
+def gif_durations(frames: int, fps: float) -> list[int]:
+    """Delay of each frame in ms, whole GIF ticks, rounded on the running total so the
+    animation keeps its rate (24 fps: 40, 40, 40, 50, ...); at least one tick each."""
+    ticks = [round(index * 1000.0 / fps / GIF_TICK_MS) for index in range(frames + 1)]
+    return [max(1, b - a) * GIF_TICK_MS for a, b in zip(ticks, ticks[1:], strict=False)]
+
+
+def ffmpeg_executable() -> str:
+    """The ffmpeg imageio uses (imageio-ffmpeg's own binary unless ``IMAGEIO_FFMPEG_EXE``
+    names another); ``RenderError`` when there is none."""
+    try:
+        import imageio_ffmpeg
+
+        return imageio_ffmpeg.get_ffmpeg_exe()
+    except (ImportError, RuntimeError) as exc:
+        raise RenderError(f"mp4 output needs ffmpeg (pip install imageio-ffmpeg): {exc}") \
+            from None
+
+
+class AnimationWriter:
+    """Writes the frames of an animation to a numbered sequence or a video, in order.
+
+    ``write(pixels)`` takes one frame, top row first: (H, W, 4) uint8 sRGB, or float32 linear
+    RGBA where :attr:`wants_hdr` (an ``.exr`` sequence). ``close()`` completes the output (a
+    video is renamed into place); ``abort()``, or leaving a ``with`` block by an exception,
+    removes an unfinished video. Frames of a sequence are written as they come.
+    """
+
+    def __init__(self, path: str | Path, fps: float, where: str = "-o"):
+        self.path = Path(path)
+        self.fps = float(fps)
+        self.kind = output_kind(self.path)
+        if self.kind == "image":
+            raise ValueError(f"{self.path}: not a frame pattern or a video")
+        if not (math.isfinite(self.fps) and self.fps > 0.0):
+            raise InputError(f"must be a finite number > 0, got {fps!r}", "--fps")
+        self.suffix = self.path.suffix.lower()
+        if self.kind == "sequence":
+            expand_pattern(self.path, 0, where)  # one run of '#', an image suffix
+        elif self.suffix == ".mp4":
+            ffmpeg_executable()  # before any frame is rendered
+        self.written: list[Path] = []  # files completed
+        self.frames = 0
+        self._temporary: Path | None = None
+        self._video = None  # the imageio ffmpeg writer
+        self._gif_frames: list[np.ndarray] = []
+        self._closed = False
+
+    @property
+    def wants_hdr(self) -> bool:
+        """Whether frames should be the linear float composite (``.exr`` sequences)."""
+        return self.kind == "sequence" and self.suffix == ".exr"
+
+    def write(self, pixels: np.ndarray) -> None:
+        if self._closed:
+            raise ValueError("the writer is closed")
+        if self.kind == "sequence":
+            target = expand_pattern(self.path, self.frames)
+            if self.wants_hdr:
+                write_image(target, pixels, channels=("R", "G", "B", "A"))
+            else:
+                write_image(target, pixels)
+            self.written.append(target)
+        else:
+            rgb = np.ascontiguousarray(np.asarray(pixels)[..., :3])
+            if rgb.dtype != np.uint8:
+                raise ValueError("video frames are uint8 sRGB")
+            if self.suffix == ".gif":
+                self._gif_frames.append(rgb)
+            else:
+                self._mp4().append_data(rgb)
+        self.frames += 1
+
+    def _mp4(self):
+        if self._video is None:
+            import imageio.v2 as iio
+
+            self._temporary = temporary_path(self.path)
+            self._video = iio.get_writer(
+                str(self._temporary), format="FFMPEG", mode="I", fps=self.fps,
+                codec="libx264", pixelformat="yuv420p", quality=MP4_QUALITY,
+                macro_block_size=1, ffmpeg_log_level="error")
+        return self._video
+
+    def close(self) -> list[Path]:
+        """Complete the output; returns the files written."""
+        if self._closed:
+            return self.written
+        try:
+            if self.kind == "video" and self.frames:
+                if self.suffix == ".gif":
+                    self._write_gif()
+                else:
+                    video, self._video = self._video, None
+                    video.close()
+                os.replace(self._temporary, self.path)
+                self._temporary = None
+                self.written.append(self.path)
+        except Exception as exc:
+            self.abort()
+            if isinstance(exc, RenderError | InputError):
+                raise
+            raise RenderError(f"cannot write {self.path}: {type(exc).__name__}: {exc}") \
+                from exc
+        self._closed = True
+        return self.written
+
+    def _write_gif(self) -> None:
+        import imageio.v3 as iio
+
+        self._temporary = temporary_path(self.path)
+        iio.imwrite(self._temporary, np.stack(self._gif_frames), plugin="pillow",
+                    extension=".gif", duration=gif_durations(self.frames, self.fps), loop=0)
+        self._gif_frames.clear()
+
+    def abort(self) -> None:
+        """Stop and remove an unfinished video (completed sequence frames stay)."""
+        self._closed = True
+        self._gif_frames.clear()
+        video, self._video = self._video, None
+        if video is not None:
+            try:
+                video.close()
+            except Exception:  # noqa: BLE001 - ffmpeg may already be gone (Ctrl-C)
+                pass
+        if self._temporary is not None:
+            self._temporary.unlink(missing_ok=True)
+            self._temporary = None
+
+    def __enter__(self) -> AnimationWriter:
+        return self
+
+    def __exit__(self, kind, value, traceback) -> None:
+        if kind is None:
+            self.close()
+        else:
+            self.abort()
+
+
+def describe_written(files: Sequence[Path]) -> str:
+    """``out_00.png`` .. ``out_09.png`` (10 files), or the one file."""
+    if len(files) == 1:
+        return str(files[0])
+    return f"{files[0]} .. {files[-1].name} ({len(files)} files)"

@@ -1,0 +1,217 @@
+"""The deferred and forward pipelines: each builds the ordered pass list for a scene.
+
+Deferred (Revie 2.1): geometry -> screen -> stipple -> lighting -> material -> post -> output.
+Forward: one lit pass per object (every light looped per fragment), then the materials' forward
+passes, then the same post. Both see the scene only through the material, light and effect
+interfaces.
+
+Within a phase, passes run by ``Order`` rank; at one rank the pipeline's own passes come first,
+then scene-wide passes (effects, materials' ``scene_passes``) in scene order, then the objects':
+opaque ones in scene order, blended ones (volumes, transparent surfaces) far to near, so object
+order never changes the image. A scene-wide pass that several materials contribute under one
+name (a shared technique's) runs once.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import replace
+
+import numpy as np
+
+from deferred.core.graph import compile_graph
+from deferred.core.passes import (
+    ClearPass,
+    FullscreenPass,
+    ObjectPass,
+    Order,
+    Phase,
+    RenderPass,
+    copy_pass,
+)
+from deferred.errors import InputError
+from deferred.gbuffer.layout import DEPTH, GBUFFER_TARGETS, LINEAR_DEPTH, NORMAL_EXPONENT_ID
+from deferred.gl.targets import (
+    COMPOSITE,
+    COMPOSITE_SPEC,
+    FINAL,
+    FINAL_SPEC,
+    LIGHT_ACCUMULATION,
+    LIGHT_ACCUMULATION_SPEC,
+)
+from deferred.interfaces.effect import AMBIENT_OCCLUSION
+from deferred.interfaces.light import LightTypePass, surface_pass
+from deferred.interfaces.material import ForwardLitPass
+from deferred.lighting.lists import LightCullPass, list_shading_pass
+from deferred.scene.model import Scene
+
+TONEMAPS = {"none": 0, "reinhard": 1, "aces": 2}
+
+PIPELINE_PASS, SCENE_PASS, OBJECT_PASS = 0, 1, 2  # groups within one Order rank
+
+
+def tonemap_pass(scene: Scene) -> RenderPass:
+    """Exposure, the scene's tone mapping operator (fixed when the passes are built, as the
+    background is) and sRGB encoding."""
+    return FullscreenPass(
+        "post.tonemap", Phase.POST, "post/tonemap.frag", {"u_source": COMPOSITE}, (FINAL,),
+        creates={FINAL: FINAL_SPEC}, order=Order.FIRST,
+        defines={"TONEMAP": str(TONEMAPS[scene.tonemap])},
+        uniforms=lambda frame: {"u_exposure": frame.scene.exposure})
+
+
+def scene_passes(scene: Scene, pipeline: str) -> list[RenderPass]:
+    """Scene-wide passes of every phase: the effects' (those applying to ``pipeline``), then the
+    materials' (once per material class, shared names once)."""
+    passes: list[RenderPass] = []
+    for effect in scene.effects:
+        if pipeline in effect.pipelines:
+            passes += effect.passes(scene, pipeline)
+        else:
+            warnings.warn(f"effect {effect.name} applies to the {', '.join(effect.pipelines)} "
+                          f"pipeline only; skipped in the {pipeline} pipeline", stacklevel=2)
+    by_class: dict[type, list] = {}
+    for obj in scene.objects:
+        by_class.setdefault(type(obj.material), []).append(obj)
+    phases = [Phase.FORWARD] if pipeline == "forward" else \
+        [Phase.GEOMETRY, Phase.SCREEN, Phase.STIPPLE, Phase.LIGHTING, Phase.MATERIAL]
+    shared: dict[str, RenderPass] = {}
+    for cls, objects in by_class.items():
+        for phase in [*phases, Phase.POST]:
+            for render_pass in cls.scene_passes(objects, phase):
+                first = shared.get(render_pass.name)
+                if first is None:
+                    shared[render_pass.name] = render_pass
+                    passes.append(render_pass)
+                elif type(first) is not type(render_pass) or \
+                        first.describe() != render_pass.describe():
+                    raise InputError(f"two materials add different scene passes named "
+                                     f"'{render_pass.name}'", f"material {cls.name}")
+    return passes
+
+
+def phase_passes(scene: Scene, phase: Phase, fixed: list[RenderPass],
+                 scene_wide: list[RenderPass]) -> list[RenderPass]:
+    """Every pass of ``phase``: the pipeline's own (``fixed``), the scene-wide ones of this
+    phase and the objects', ranked as the module documentation says."""
+    keyed = [((p.order, PIPELINE_PASS, 0.0, k), p) for k, p in enumerate(fixed)]
+    keyed += [((p.order, SCENE_PASS, 0.0, k), p) for k, p in enumerate(scene_wide)
+              if p.phase == phase]
+    view = scene.camera.view()
+    for index, obj in enumerate(scene.objects):
+        low, high = obj.mesh.bounds()
+        centre = obj.model @ np.append((low + high) / 2.0, 1.0)
+        distance = -(view @ centre)[2]
+        for render_pass in obj.material.passes(phase, obj):
+            blended = render_pass.order >= Order.VOLUME
+            keyed.append(((render_pass.order, OBJECT_PASS, -distance if blended else 0.0, index),
+                          render_pass))
+    return [render_pass for _, render_pass in sorted(keyed, key=lambda item: item[0])]
+
+
+class Pipeline:
+    """A pipeline for one light path (:mod:`deferred.lighting.lists`)."""
+
+    name = ""
+    light_paths: tuple[str, ...] = ()
+
+    def __init__(self, light_path: str | None = None):
+        self.light_path = light_path or self.light_paths[0]
+        if self.light_path not in self.light_paths:
+            raise InputError(f"the {self.name} pipeline has no light path '{self.light_path}' "
+                             f"(choose from {', '.join(self.light_paths)})", "--light-path")
+
+    def build(self, scene: Scene) -> list[RenderPass]:
+        raise NotImplementedError
+
+    def shader_defines(self) -> dict[str, str]:
+        """Defines every program of this pipeline gets (the light path's)."""
+        return {}
+
+    def passes(self, scene: Scene) -> list[RenderPass]:
+        """The pass list for ``scene``, checked (:func:`deferred.core.graph.compile_graph`)."""
+        return compile_graph(self.build(scene)).passes
+
+
+class DeferredPipeline(Pipeline):
+    name = "deferred"
+    light_paths = ("tiled", "clustered", "volumes")
+
+    def build(self, scene: Scene) -> list[RenderPass]:
+        layout = scene.gbuffer_layout()
+        wide = scene_passes(scene, self.name)
+        clear = ClearPass("gbuffer.clear", Phase.GEOMETRY, layout.targets)
+        passes = phase_passes(scene, Phase.GEOMETRY, [clear], wide)
+        passes += phase_passes(scene, Phase.SCREEN, [], wide)
+        passes += phase_passes(scene, Phase.STIPPLE, [], wide)
+        occlusion = AMBIENT_OCCLUSION if any(AMBIENT_OCCLUSION in p.creates for p in passes) \
+            else None
+        folded = False  # the composition made by the lighting pass (below)
+        if self.light_path == "volumes":
+            # the light accumulation starts as 0 on surfaces and the background elsewhere
+            # (its clear); each light type's pass adds into it
+            background = surface_pass("lighting.background", "lights/background.frag",
+                                      {"u_normal_exponent_id": NORMAL_EXPONENT_ID},
+                                      {LIGHT_ACCUMULATION: LIGHT_ACCUMULATION_SPEC},
+                                      scene.background)
+            lights = [background, *(LightTypePass(cls, occlusion, layout.color_targets)
+                                    for cls in scene.light_types())]
+        else:
+            # One pass shades every light and writes the background where there is no surface.
+            # Where no other pass writes the light accumulation and the material phase has no
+            # pass, the composition is the light accumulation: the same pass writes both, and
+            # there is nothing to copy.
+            clustered = self.light_path == "clustered"
+            folded = not phase_passes(scene, Phase.MATERIAL, [], wide) and not any(
+                LIGHT_ACCUMULATION in p.writes
+                for p in phase_passes(scene, Phase.LIGHTING, [], wide))
+            lights = [LightCullPass(f"lighting.cull_{'clusters' if clustered else 'tiles'}",
+                                    Phase.LIGHTING, clustered),
+                      list_shading_pass(f"lighting.{self.light_path}", clustered,
+                                        layout.color_targets, occlusion, scene.background,
+                                        composite=folded)]
+        passes += phase_passes(scene, Phase.LIGHTING, lights, wide)
+        if not folded:
+            composite = copy_pass("material.composite_copy", Phase.MATERIAL,
+                                  LIGHT_ACCUMULATION, COMPOSITE, COMPOSITE_SPEC,
+                                  order=Order.FIRST)
+            passes += phase_passes(scene, Phase.MATERIAL, [composite], wide)
+        passes += phase_passes(scene, Phase.POST, [tonemap_pass(scene)], wide)
+        return passes
+
+
+class ForwardPipeline(Pipeline):
+    name = "forward"
+    light_paths = ("tiled", "naive")
+
+    def build(self, scene: Scene) -> list[RenderPass]:
+        wide = scene_passes(scene, self.name)
+        creates = {COMPOSITE: replace(COMPOSITE_SPEC, clear=(*scene.background, 0.0)),
+                   DEPTH: GBUFFER_TARGETS[DEPTH]}
+        fixed: list[RenderPass] = []
+        if self.light_path == "tiled":  # Forward+: depth pre-pass, tiled culling
+            creates[LINEAR_DEPTH] = GBUFFER_TARGETS[LINEAR_DEPTH]
+            fixed += [depth_prepass(p) for obj in scene.objects
+                      for p in obj.material.passes(Phase.FORWARD, obj)
+                      if isinstance(p, ForwardLitPass)]
+            fixed.append(LightCullPass("forward.cull_tiles", Phase.FORWARD, clustered=False,
+                                       from_near=True))
+        clear = ClearPass("forward.clear", Phase.FORWARD, creates)
+        passes = phase_passes(scene, Phase.FORWARD, [clear, *fixed], wide)
+        passes += phase_passes(scene, Phase.POST, [tonemap_pass(scene)], wide)
+        return passes
+
+    def shader_defines(self) -> dict[str, str]:
+        return {"FORWARD_PLUS": "1"} if self.light_path == "tiled" else {}
+
+
+def depth_prepass(lit: ForwardLitPass) -> RenderPass:
+    """Forward+'s depth pre-pass twin of an object's lit pass: the same vertex stage and
+    constants, depth and linear depth only."""
+    return ObjectPass(f"{lit.obj.label}.depth_prepass", Phase.FORWARD, lit.obj,
+                      vertex=lit.vertex, fragment="forward/depth_prepass.frag",
+                      colors=(LINEAR_DEPTH,), constants=lit.constants, order=Order.FIRST)
+
+
+PIPELINES: dict[str, type[Pipeline]] = {"deferred": DeferredPipeline,
+                                        "forward": ForwardPipeline}

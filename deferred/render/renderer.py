@@ -1,0 +1,299 @@
+"""The renderer: owns GL resources for a scene at a size and runs a pipeline's passes."""
+
+from __future__ import annotations
+
+import math
+import os
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from deferred.core.frame import Frame, KeptMaterialInputs, ObjectTransforms, Resources
+from deferred.core.graph import PassGraph, PassGraphError, compile_graph
+from deferred.core.passes import RenderPass
+from deferred.errors import DeferredError, InputError, RenderError, gl_error
+from deferred.gl.context import Features, GLContext, acquire_context, give_back_context
+from deferred.gl.shaderlib import ShaderLibrary
+from deferred.gl.target_spec import targets_bytes
+from deferred.gl.targets import COMPOSITE, FINAL, FrameTargets
+from deferred.interfaces.material import Material
+from deferred.lighting.buffer import LightBuffer
+from deferred.lighting.lists import LightLists, check_light_limits, resolve_light_path
+from deferred.render.generated import generated_glsl
+from deferred.render.pipeline import PIPELINES
+from deferred.scene.model import Scene, check_size
+
+PassCallback = Callable[[RenderPass, Frame], None]
+FULL_FEATURES = Features(storage_buffers=True, compute_shaders=True)
+
+
+@dataclass
+class RenderResult:
+    image: np.ndarray | None  # (H, W, 4) uint8, sRGB, top row first (None: no readback)
+    hdr: np.ndarray | None  # (H, W, 4) float32, linear composite, top row first
+    draw_calls: int
+    draws_by_pass: dict[str, int]
+    gl_call_seconds: float = 0.0  # inside drawing GL calls (FrameStats; time_gl_calls only)
+
+
+def strict_default() -> bool:
+    """Whether renderers are strict when not told: ``DEFERRED_STRICT=1`` (the tests set it)."""
+    return os.environ.get("DEFERRED_STRICT", "") in ("1", "true", "yes")
+
+
+# Render targets live in system memory on llvmpipe: a size whose targets pass this is refused
+# before the context allocates them (one that does not fit would be killed, without a message).
+TARGET_MEMORY_BUDGET = 4 << 30  # bytes; DEFERRED_TARGET_MEMORY overrides it
+
+
+def target_memory_budget() -> int:
+    """:data:`TARGET_MEMORY_BUDGET`, or the environment's ``DEFERRED_TARGET_MEMORY`` (bytes)."""
+    text = os.environ.get("DEFERRED_TARGET_MEMORY")
+    if text is None:
+        return TARGET_MEMORY_BUDGET
+    try:
+        budget = int(text)
+    except ValueError:
+        budget = 0
+    if budget <= 0:
+        raise InputError(f"must be a whole number of bytes > 0, got {text[:40]!r}",
+                         "DEFERRED_TARGET_MEMORY")
+    return budget
+
+
+def check_target_memory(graph: PassGraph, size: tuple[int, int], where: str = "size") -> None:
+    """Refuse a frame size whose render targets need more than the budget."""
+    needed = targets_bytes(graph.targets.values(), *size)
+    budget = target_memory_budget()
+    if needed > budget:
+        raise InputError(f"{size[0]}x{size[1]} needs {needed >> 20} MiB of render targets "
+                         f"({len(graph.targets)} targets); the budget is "
+                         f"{budget >> 20} MiB (DEFERRED_TARGET_MEMORY)", where)
+
+
+class Renderer:
+    """Renders one scene with one pipeline; reuse it for many frames, then ``release()``.
+
+    ``strict`` turns a uniform set by name that a program does not declare into an error
+    (default: the ``DEFERRED_STRICT`` environment variable). ``light_path`` chooses how lights
+    reach the pixels (:mod:`deferred.lighting.lists`; default: the scene's ``light_path``, else
+    the fastest the context allows).
+
+    The scene's objects, lights, camera and materials' parameters may change between frames.
+    Its background and tone mapping operator are read when the passes are built, here (the
+    background is the clear value of the targets the lighting creates, the operator a define
+    of the tone mapping pass): a change to either takes a new renderer.
+    """
+
+    def __init__(self, scene: Scene, pipeline: str = "deferred",
+                 size: tuple[int, int] | None = None, gl: GLContext | None = None,
+                 strict: bool | None = None, light_path: str | None = None):
+        if pipeline not in PIPELINES:
+            raise InputError(f"unknown pipeline '{pipeline}' (choose from "
+                             f"{', '.join(PIPELINES)})", "--pipeline")
+        self.scene = scene
+        self.pipeline_name = pipeline
+        self.strict = strict_default() if strict is None else strict
+        self.size = check_size(size or scene.size, "size" if size else f"{scene.source}: size")
+        # The pass graph and the generated GLSL are built and checked before any GL object
+        # exists: bad input never leaves a context behind. The light path is checked by name
+        # now and against the context's features once it exists; the provisional graph (the
+        # requested path, else tiled) only changes where the context cannot run that path.
+        requested = light_path if light_path is not None else scene.light_path
+        provisional = resolve_light_path(pipeline, requested, FULL_FEATURES)
+        self.graph: PassGraph = compile_graph(PIPELINES[pipeline](provisional).build(scene))
+        check_target_memory(self.graph, self.size, "size" if size else f"{scene.source}: size")
+        light_types = scene.light_types()
+        shading_models = self.shading_models = scene.shading_models()
+        self.object_transforms = ObjectTransforms()  # kept across frames
+        self.kept_inputs = KeptMaterialInputs()  # materials' inputs, kept across frames
+        generated = generated_glsl(light_types, shading_models, scene.gbuffer_layout(),
+                                   [obj.material for obj in scene.objects])
+        roots = [cls.shader_root for cls in [
+            *(type(obj.material) for obj in scene.objects), *light_types, *shading_models,
+            *(type(effect) for effect in scene.effects)] if cls.shader_root is not None]
+        self._owns_context = gl is None
+        self.gl = gl or acquire_context()
+        self.gl.make_current()
+        try:
+            self._build(scene, pipeline, requested, provisional, roots, generated)
+        except BaseException:
+            # nothing made here outlives a failed constructor, and the context goes back
+            self._release_partial()
+            raise
+
+    def _build(self, scene: Scene, pipeline: str, requested: str | None, provisional: str,
+               roots: list, generated: dict[str, str]) -> None:
+        ctx = self.gl.ctx
+        features = self.gl.features
+        self.light_path = resolve_light_path(pipeline, requested, features)
+        volume_lights = sum(1 for light in scene.lights if light.volume != "fullscreen")
+        check_light_limits(self.light_path, self.size, volume_lights, len(scene.lights),
+                           self.gl.max_texture_size)
+        self.pipeline = PIPELINES[pipeline](self.light_path)
+        if self.light_path != provisional:
+            self.graph = compile_graph(self.pipeline.build(scene))
+        defines = dict(self.pipeline.shader_defines())
+        self.shaders = ShaderLibrary(ctx, features.glsl_version(), defines)
+        for root in roots:
+            self.shaders.add_root(root)
+        for name, text in generated.items():
+            self.shaders.set_virtual_file(name, text)
+        self.targets = FrameTargets(ctx, *self.size)
+        self._declare_targets()
+        self.resources = Resources(ctx)
+        self.light_buffer = LightBuffer(ctx, features)
+        self.light_lists = LightLists(ctx) if features.compute_shaders else None
+        self.last_frame: Frame | None = None
+        error = ctx.error
+        if error != "GL_NO_ERROR":  # the targets did not fit
+            raise gl_error("creating the render targets", error, self.size)
+
+    def _release_partial(self) -> None:
+        self.release()  # an owned context is released instead where it holds a GL error
+        if not self._owns_context:
+            _ = self.gl.ctx.error  # reading clears it: the caller's next renderer starts clean
+
+    @property
+    def passes(self) -> list[RenderPass]:
+        return self.graph.passes
+
+    def _declare_targets(self) -> None:
+        for name, spec in self.graph.targets.items():
+            self.targets.declare(name, spec)
+
+    def insert_pass(self, render_pass: RenderPass, *, before: str | None = None,
+                    after: str | None = None) -> None:
+        """Insert ``render_pass`` before or after the pass named so; the graph is checked again
+        (and left as it was if the new pass does not fit) and new targets are created."""
+        if (before is None) == (after is None):
+            raise TypeError("insert_pass needs exactly one of before= or after=")
+        index = self.graph.index(before if before is not None else after)
+        passes = list(self.graph.passes)
+        passes.insert(index if before is not None else index + 1, render_pass)
+        graph = compile_graph(passes)
+        for name, spec in graph.targets.items():
+            if name in self.targets and not self.targets.specs[name].same_format(spec):
+                raise PassGraphError(f"pass {render_pass.name}: target '{name}' exists with "
+                                     "another format")
+        self.graph = graph
+        self.gl.make_current()
+        self._declare_targets()
+
+    def render(self, on_pass: PassCallback | None = None,
+               before_pass: PassCallback | None = None, readback: bool = True,
+               time: float = 0.0, time_gl_calls: bool = False) -> RenderResult:
+        """Run every pass once for the frame at ``time`` (seconds: the scene's timeline is
+        applied first, and passes see it as ``frame.time``). ``on_pass``/``before_pass`` are
+        called around each pass; ``readback=False`` skips reading the images back (timing
+        loops); ``time_gl_calls`` measures the CPU time of the drawing GL calls
+        (``RenderResult.gl_call_seconds``, for the bench: two clock reads per call)."""
+        time = float(time)
+        if not math.isfinite(time):
+            raise InputError(f"frame time must be a finite number of seconds, got {time}", "time")
+        self.check_times([time], "time")
+        self.scene.apply_timeline(time)
+        self.gl.make_current()
+        ctx = self.gl.ctx
+        stale = ctx.error  # reading clears it: errors from here on are this frame's
+        if stale != "GL_NO_ERROR":
+            warnings.warn(f"GL error {stale} left by code outside the renderer", stacklevel=2)
+        self.shaders.forget_uniform_values()  # code between frames may have written them
+        self.kept_inputs.start_frame(self.scene)
+        frame = Frame(self.gl, self.shaders, self.targets, self.resources, self.scene,
+                      self.light_buffer, strict=self.strict, light_lists=self.light_lists,
+                      time=time, time_gl_calls=time_gl_calls,
+                      shading_models=self.shading_models,
+                      object_transforms=self.object_transforms, kept_inputs=self.kept_inputs)
+        self.light_buffer.upload(self.scene.lights, frame.view, frame.projection)
+        self._check_gl("uploading the lights")
+        for render_pass in self.passes:
+            if type(render_pass).prepare is RenderPass.prepare:
+                continue  # nothing to prepare (most passes: skipping them saves a GL error read)
+            try:
+                render_pass.prepare(frame)
+            except DeferredError:
+                raise
+            except Exception as exc:  # noqa: BLE001 - a plugin's prepare: say which pass
+                raise RenderError(f"pass {render_pass.name}: preparing: "
+                                  f"{type(exc).__name__}: {exc}") from exc
+            self._check_gl(f"pass {render_pass.name}: preparing")
+        self.gl.park()  # whatever framebuffer was bound may have been released since
+        # The GL error flag is read once a run of passes of one kind and phase (the objects'
+        # G-buffer passes, say), not once a pass: Frame.check_errors names the pass. Hooks
+        # look at each pass, so with them each is checked.
+        unchecked: list[RenderPass] = []
+        passes = self.passes
+        hooked = before_pass is not None or on_pass is not None
+        for index, render_pass in enumerate(passes):
+            if before_pass:
+                before_pass(render_pass, frame)
+            try:
+                frame.run_pass(render_pass, check_errors=hooked)
+            except Exception:
+                if unchecked:  # the raised error is the one to report: drop the earlier flag
+                    _ = self.gl.ctx.error  # reading it clears it
+                raise
+            if not hooked:
+                unchecked.append(render_pass)
+                following = passes[index + 1] if index + 1 < len(passes) else None
+                if following is None or type(following) is not type(render_pass) or \
+                        following.phase != render_pass.phase:
+                    frame.check_errors(unchecked)
+                    unchecked = []
+            if on_pass:
+                on_pass(render_pass, frame)
+        frame.current_pass = None
+        if self.strict:
+            frame.check_material_uniforms()
+        self.last_frame = frame
+        image, hdr = (self.read_final(), self.read_hdr()) if readback else (None, None)
+        return RenderResult(image, hdr, frame.stats.draw_calls, dict(frame.stats.draws_by_pass),
+                            frame.stats.gl_call_seconds)
+
+    def check_times(self, times: list[float], where: str = "--time") -> None:
+        """Every material's :meth:`~deferred.interfaces.material.Material.check_time` for the latest of
+        ``times``: an animation is refused before its first frame, not part way."""
+        if times:
+            latest = max(times)
+            for obj in self.scene.objects:
+                if type(obj.material).check_time is not Material.check_time:  # most have none
+                    obj.material.check_time(latest, where)
+
+    def _check_gl(self, stage: str) -> None:
+        error = self.gl.ctx.error
+        if error != "GL_NO_ERROR":
+            raise gl_error(stage, error, self.size)
+
+    def read_final(self) -> np.ndarray:
+        data = np.frombuffer(self.targets[FINAL].read(alignment=1), dtype=np.uint8)
+        return data.reshape(self.size[1], self.size[0], 4)[::-1].copy()
+
+    def read_hdr(self) -> np.ndarray:
+        return self.targets.read(COMPOSITE)[::-1].copy()
+
+    def release(self) -> None:
+        self.gl.make_current()
+        self.gl.park()
+        # every part made so far (a constructor that failed part way made only some)
+        for name in ("kept_inputs", "light_buffer", "light_lists", "resources", "targets",
+                     "shaders"):
+            part = getattr(self, name, None)
+            if part is not None:
+                part.release()
+        if self._owns_context:
+            give_back_context(self.gl)
+
+    def __enter__(self) -> Renderer:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.release()
+
+
+def render_scene(scene: Scene, pipeline: str = "deferred", size: tuple[int, int] | None = None,
+                 gl: GLContext | None = None, time: float = 0.0) -> RenderResult:
+    with Renderer(scene, pipeline, size, gl) as renderer:
+        return renderer.render(time=time)
