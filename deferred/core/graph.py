@@ -10,10 +10,9 @@ and refuses, naming the pass and the target:
 - a read or write before the pass that creates the target (no earlier producer);
 - a target sampled by the pass that draws into it (a GL feedback loop: snapshot it first with
   :func:`deferred.core.passes.copy_pass`);
-- a pass writing G-buffer surfaces (the surface id's target) with no depth target: the
-  deferred lighting runs where the depth is nearer than the far plane
-  (:func:`deferred.interfaces.light.surface_pass`), so such a surface would go unlit. (One
-  that tests against the depth without writing it draws over surfaces already there.)
+- a pass that breaks one of the ``rules`` the caller gives, each a function of the pass
+  answering what is wrong with it or ``None``: the layers above the core know what their
+  targets mean (the G-buffer's rule: :func:`deferred.gbuffer.layout.surfaces_need_depth`).
 
 What it returns is every target of the frame with its format: the renderer creates exactly
 those, and clears each when its creating pass runs.
@@ -21,12 +20,11 @@ those, and clears each when its creating pass runs.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from deferred.core.passes import RenderPass
 from deferred.errors import RenderError
-from deferred.gbuffer.layout import DEPTH, NORMAL_EXPONENT_ID
 from deferred.gl.target_spec import TargetSpec
 
 
@@ -48,8 +46,12 @@ class PassGraph:
                              f"{', '.join(p.name for p in self.passes)})")
 
 
-def compile_graph(passes: Sequence[RenderPass]) -> PassGraph:
-    """Check ``passes`` (in order) and collect the targets they create."""
+PassRule = Callable[[RenderPass], "str | None"]
+
+
+def compile_graph(passes: Sequence[RenderPass], rules: Sequence[PassRule] = ()) -> PassGraph:
+    """Check ``passes`` (in order, each against ``rules`` too) and collect the targets they
+    create."""
     names: set[str] = set()
     creators: dict[str, str] = {}
     targets: dict[str, TargetSpec] = {}
@@ -70,11 +72,10 @@ def compile_graph(passes: Sequence[RenderPass]) -> PassGraph:
             if target in render_pass.writes:
                 raise PassGraphError(f"pass {render_pass.name}: samples target '{target}' while "
                                      "writing it (snapshot it first with copy_pass)")
-        if NORMAL_EXPONENT_ID in render_pass.writes and DEPTH not in render_pass.writes \
-                and DEPTH not in render_pass.reads:
-            raise PassGraphError(f"pass {render_pass.name}: writes G-buffer surfaces "
-                                 f"('{NORMAL_EXPONENT_ID}') with no '{DEPTH}': the lighting "
-                                 "runs only where a surface's depth was written")
+        for rule in rules:
+            problem = rule(render_pass)
+            if problem:
+                raise PassGraphError(f"pass {render_pass.name}: {problem}")
         for kind, used in (("reads", render_pass.reads), ("writes", render_pass.writes)):
             for target in used:
                 if target in created:

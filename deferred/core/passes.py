@@ -20,7 +20,7 @@ from deferred.gl.target_spec import TargetSpec
 
 if TYPE_CHECKING:
     from deferred.core.frame import Frame
-    from deferred.scene.model import SceneObject
+    from deferred.core.protocols import SceneObjectLike
 
 
 class Phase(str, Enum):
@@ -194,7 +194,7 @@ class ObjectPass(RenderPass):
         cls._hooks_unchanged = all(getattr(cls, hook) is getattr(ObjectPass, hook) for hook in
                                    ("uniforms", "textures", "draws", "draw_uniforms"))
 
-    def __init__(self, name: str, phase: Phase, obj: SceneObject, **options: Any):
+    def __init__(self, name: str, phase: Phase, obj: SceneObjectLike, **options: Any):
         self.name = name
         self.phase = phase
         self.obj = obj

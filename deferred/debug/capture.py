@@ -15,9 +15,14 @@ import numpy as np
 
 from deferred.core.passes import RenderPass
 from deferred.errors import InputError
-from deferred.gbuffer.layout import ALBEDO_SPECULAR, LINEAR_DEPTH, NORMAL_EXPONENT_ID, decode
+from deferred.gbuffer.layout import (
+    ALBEDO_SPECULAR,
+    LINEAR_DEPTH,
+    NORMAL_EXPONENT_ID,
+    GBufferLayout,
+    decode,
+)
 from deferred.gl.target_spec import TargetSpec
-from deferred.interfaces.shading import GBufferLayout
 from deferred.render.renderer import Renderer
 
 GBUFFER_CHANNELS = ("albedo.R", "albedo.G", "albedo.B", "specular.intensity",

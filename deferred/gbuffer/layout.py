@@ -15,17 +15,20 @@ Normals are octahedral-encoded [Cigolle et al. 2014] so a view-space unit vector
 floats. The id channel packs the registry ``type_id`` of the material that wrote the pixel and of
 its shading model (:func:`deferred.interfaces.shading.surface_id`), exact in a half float.
 
-Materials may add targets of their own (:class:`deferred.interfaces.shading.GBufferData`); the GLSL that
+Materials may add targets of their own (:class:`deferred.gbuffer.GBufferData`); the GLSL that
 declares, writes and fetches them is generated per scene (:func:`data_struct_glsl`,
 :func:`data_write_glsl`, :func:`data_fetch_glsl`).
 """
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
+from deferred.gbuffer.surface_id import split_surface_id
 from deferred.gl.target_spec import TargetSpec
 
 ALBEDO_SPECULAR = "albedo_specular"
@@ -43,6 +46,76 @@ GBUFFER_TARGETS: dict[str, TargetSpec] = {
     LINEAR_DEPTH: TargetSpec(1, "f4", "linear view depth (0 = background)", clear=(0.0,)),
     DEPTH: TargetSpec(1, "f4", "hardware depth", depth=True, clear=(1.0,)),
 }
+
+
+_NAME = re.compile(r"^[a-z][a-z0-9_]*$")
+
+
+@dataclass(frozen=True)
+class GBufferData:
+    """Per-pixel data beyond the core G-buffer: a target ``name`` of ``format`` (R8 ... RGBA32F)
+    whose channels are called ``channels`` in ``gbuffer.exr`` (as ``name.channel``)."""
+
+    name: str
+    format: str
+    channels: tuple[str, ...]
+    description: str = ""
+
+    def __post_init__(self) -> None:
+        if not _NAME.match(self.name) or self.name in GBUFFER_TARGETS:
+            raise ValueError(f"G-buffer data name '{self.name}' must be lower_snake_case and not "
+                             f"a core target ({', '.join(GBUFFER_TARGETS)})")
+        spec = self.spec  # validates the format
+        if len(self.channels) != spec.components:
+            raise ValueError(f"G-buffer data '{self.name}': {self.format} has "
+                             f"{spec.components} channels, {len(self.channels)} names given")
+
+    @property
+    def spec(self) -> TargetSpec:
+        return TargetSpec.from_format(self.format, self.description or self.name)
+
+
+@dataclass
+class GBufferLayout:
+    """The G-buffer of one scene: the core targets plus the data its materials declare."""
+
+    data: dict[str, GBufferData]
+
+    @property
+    def targets(self) -> dict[str, TargetSpec]:
+        return {**GBUFFER_TARGETS, **{name: d.spec for name, d in self.data.items()}}
+
+    @property
+    def color_targets(self) -> tuple[str, ...]:
+        return (*GBUFFER_COLOR_TARGETS, *self.data)
+
+    @property
+    def bytes_per_pixel(self) -> int:
+        return sum(spec.bytes_per_pixel for spec in self.targets.values())
+
+    def describe(self) -> dict[str, dict[str, object]]:
+        """Target -> format, bytes per pixel, what it holds (``deferred info``, bench, dump)."""
+        out = {}
+        for name, spec in self.targets.items():
+            entry = {"format": spec.format_name, "bytes_per_pixel": spec.bytes_per_pixel,
+                     "description": spec.description}
+            if name in self.data:
+                entry["channels"] = [f"{name}.{c}" for c in self.data[name].channels]
+            out[name] = entry
+        return out
+
+
+def surfaces_need_depth(render_pass) -> str | None:
+    """The G-buffer's rule for the pass graph (:func:`deferred.core.graph.compile_graph`): a
+    pass writing surfaces (the surface id's target) writes or tests the depth too. The
+    deferred lighting runs where the depth is nearer than the far plane
+    (:func:`deferred.lighting.volumes.surface_pass`), so a surface without it would go unlit;
+    one that tests against the depth without writing it draws over surfaces already there."""
+    if NORMAL_EXPONENT_ID in render_pass.writes and DEPTH not in render_pass.writes \
+            and DEPTH not in render_pass.reads:
+        return (f"writes G-buffer surfaces ('{NORMAL_EXPONENT_ID}') with no '{DEPTH}': the "
+                "lighting runs only where a surface's depth was written")
+    return None
 
 
 DATA_STRUCT_FILE = "generated/gbuffer_data.glsl"
@@ -111,8 +184,6 @@ def octahedral_decode(e: np.ndarray) -> np.ndarray:
 def decode(albedo_specular: np.ndarray, normal_exponent_id: np.ndarray,
            linear_depth: np.ndarray) -> dict[str, np.ndarray]:
     """Decode read-back G-buffer targets to named arrays (albedo, normal, depth, ...)."""
-    from deferred.interfaces.shading import split_surface_id
-
     ids = np.rint(normal_exponent_id[..., 3])
     material_id, shading_model = split_surface_id(ids)
     return {

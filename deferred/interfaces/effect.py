@@ -23,7 +23,7 @@ from deferred.params import Params, UniformOverrides, params_uniforms, validate_
 if TYPE_CHECKING:
     from deferred.core.frame import Frame
     from deferred.core.passes import RenderPass
-    from deferred.scene.model import Scene
+    from deferred.core.protocols import SceneLike
 
 AMBIENT_OCCLUSION = "ssao"
 
@@ -51,5 +51,5 @@ class Effect:
         """``u_<field>`` for every parameter that is a uniform."""
         return params_uniforms(self.params, self.uniform_overrides)
 
-    def passes(self, scene: Scene, pipeline: str) -> list[RenderPass]:
+    def passes(self, scene: SceneLike, pipeline: str) -> list[RenderPass]:
         raise NotImplementedError

@@ -23,14 +23,15 @@ import moderngl
 from pydantic import BaseModel, Field
 
 from deferred.core.passes import ObjectPass, Phase, RenderPass
-from deferred.gbuffer.layout import DEPTH, GBUFFER_COLOR_TARGETS, data_write_file
+from deferred.gbuffer.layout import DEPTH, GBUFFER_COLOR_TARGETS, GBufferData, data_write_file
+from deferred.gbuffer.surface_id import surface_id
 from deferred.gl.targets import COMPOSITE
-from deferred.interfaces.shading import GBufferData, material_data, surface_id
+from deferred.interfaces.shading import material_data
 from deferred.params import Params, UniformOverrides, params_uniforms, validate_params
 
 if TYPE_CHECKING:
     from deferred.core.frame import Frame
-    from deferred.scene.model import SceneObject
+    from deferred.core.protocols import SceneObjectLike
 
 
 class MaterialParams(Params):
@@ -52,7 +53,7 @@ class GBufferPass(ObjectPass):
     fragment = "gbuffer/geometry.frag"
     depth = DEPTH
 
-    def __init__(self, name: str, phase: Phase, obj: SceneObject, **options: Any):
+    def __init__(self, name: str, phase: Phase, obj: SceneObjectLike, **options: Any):
         options.setdefault("colors", obj.material.gbuffer_targets())
         super().__init__(name, phase, obj, **options)
 
@@ -121,7 +122,7 @@ class Material:
         """The folder of the material's own GLSL (that of ``surface_shader``)."""
         return cls.surface_shader.rpartition("/")[0]
 
-    def defines(self, obj: SceneObject) -> dict[str, str]:
+    def defines(self, obj: SceneObjectLike) -> dict[str, str]:
         """Preprocessor defines of this material's programs for ``obj``: a function of the
         params and ``obj.mesh`` only (an object pass keeps its program while those are the
         same objects; params are replaced whole, never changed in place)."""
@@ -183,29 +184,29 @@ class Material:
         bounded work, before any frame is rendered: a simulation stepping from 0 to it."""
 
     # -- passes per phase --------------------------------------------------------------------
-    def geometry_passes(self, obj: SceneObject) -> list[RenderPass]:
+    def geometry_passes(self, obj: SceneObjectLike) -> list[RenderPass]:
         return [GBufferPass(f"{obj.label}.gbuffer", Phase.GEOMETRY, obj)]
 
-    def screen_passes(self, obj: SceneObject) -> list[RenderPass]:
+    def screen_passes(self, obj: SceneObjectLike) -> list[RenderPass]:
         return []
 
-    def stipple_passes(self, obj: SceneObject) -> list[RenderPass]:
+    def stipple_passes(self, obj: SceneObjectLike) -> list[RenderPass]:
         return []
 
-    def material_passes(self, obj: SceneObject) -> list[RenderPass]:
+    def material_passes(self, obj: SceneObjectLike) -> list[RenderPass]:
         return []
 
-    def forward_passes(self, obj: SceneObject) -> list[RenderPass]:
+    def forward_passes(self, obj: SceneObjectLike) -> list[RenderPass]:
         return [ForwardLitPass(f"{obj.label}.forward", Phase.FORWARD, obj)]
 
     @classmethod
-    def scene_passes(cls, objects: list[SceneObject], phase: Phase) -> list[RenderPass]:
+    def scene_passes(cls, objects: list[SceneObjectLike], phase: Phase) -> list[RenderPass]:
         """Passes this material adds once per scene, not per object, in ``phase`` (scene-wide
         setup, screen or post effects of its own); ``objects`` are the scene's objects of this
         material. Passes of one name from several materials (a shared technique's) run once."""
         return []
 
-    def passes(self, phase: Phase, obj: SceneObject) -> list[RenderPass]:
+    def passes(self, phase: Phase, obj: SceneObjectLike) -> list[RenderPass]:
         hooks = {Phase.GEOMETRY: self.geometry_passes, Phase.SCREEN: self.screen_passes,
                  Phase.STIPPLE: self.stipple_passes, Phase.MATERIAL: self.material_passes,
                  Phase.FORWARD: self.forward_passes}

@@ -19,7 +19,7 @@ from importlib.metadata import EntryPoint, entry_points
 from typing import Generic, TypeVar
 
 from deferred.errors import InputError
-from deferred.interfaces.shading import MAX_MATERIAL_ID, MAX_SHADING_MODEL_ID
+from deferred.gbuffer.surface_id import MAX_MATERIAL_ID, MAX_SHADING_MODEL_ID
 
 T = TypeVar("T")
 

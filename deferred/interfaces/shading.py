@@ -21,49 +21,21 @@ passes it straight through.
 
 from __future__ import annotations
 
-import re
 from collections.abc import Iterable
-from dataclasses import dataclass
 from importlib.resources.abc import Traversable
 from pathlib import Path
 from typing import TYPE_CHECKING, ClassVar
 
 import moderngl
 
+from deferred.core.frame import bind_samplers
 from deferred.errors import InputError
-from deferred.gbuffer.layout import GBUFFER_COLOR_TARGETS, GBUFFER_TARGETS
-from deferred.gl.target_spec import TargetSpec
+from deferred.gbuffer.layout import GBufferData, GBufferLayout
 
 if TYPE_CHECKING:
     from deferred.core.frame import Frame
+    from deferred.gl.uniforms import ProgramUniforms
     from deferred.interfaces.material import Material
-
-_NAME = re.compile(r"^[a-z][a-z0-9_]*$")
-
-
-@dataclass(frozen=True)
-class GBufferData:
-    """Per-pixel data beyond the core G-buffer: a target ``name`` of ``format`` (R8 ... RGBA32F)
-    whose channels are called ``channels`` in ``gbuffer.exr`` (as ``name.channel``)."""
-
-    name: str
-    format: str
-    channels: tuple[str, ...]
-    description: str = ""
-
-    def __post_init__(self) -> None:
-        if not _NAME.match(self.name) or self.name in GBUFFER_TARGETS:
-            raise ValueError(f"G-buffer data name '{self.name}' must be lower_snake_case and not "
-                             f"a core target ({', '.join(GBUFFER_TARGETS)})")
-        spec = self.spec  # validates the format
-        if len(self.channels) != spec.components:
-            raise ValueError(f"G-buffer data '{self.name}': {self.format} has "
-                             f"{spec.components} channels, {len(self.channels)} names given")
-
-    @property
-    def spec(self) -> TargetSpec:
-        return TargetSpec.from_format(self.format, self.description or self.name)
-
 
 class ShadingModel:
     """A BRDF the lights call (see the module documentation)."""
@@ -82,54 +54,23 @@ class ShadingModel:
         return {}
 
 
-# The G-buffer's id channel (a half float) holds shading model * MATERIAL_IDS + material id:
-# integers up to 2048 are exact in a half, so 63 materials and 31 shading models fit.
-MATERIAL_IDS = 64
-MAX_MATERIAL_ID = MATERIAL_IDS - 1
-MAX_SHADING_MODEL_ID = 2047 // MATERIAL_IDS
+class ShadingTextures:
+    """The samplers of a scene's shading models (ramps...), offered to every program a frame
+    binds (a binding source of the frame: wherever lights run); asked of the models once a
+    frame, at the first program bound."""
 
+    def __init__(self, models: Iterable[type[ShadingModel]], frame: Frame):
+        self.models = list(models)
+        self.frame = frame
+        self._textures: dict[str, moderngl.Texture] | None = None
 
-def surface_id(material_id: int, shading_model_id: int) -> int:
-    """The value an object writes to the G-buffer's id channel (``gbuffer/layout.glsl``)."""
-    if not 0 < material_id <= MAX_MATERIAL_ID or not 0 < shading_model_id <= MAX_SHADING_MODEL_ID:
-        raise ValueError(f"ids out of range: material {material_id}, shading model "
-                         f"{shading_model_id}")
-    return shading_model_id * MATERIAL_IDS + material_id
-
-
-def split_surface_id(value):
-    """(material id, shading model id) of G-buffer id values (numpy arrays or numbers)."""
-    return value % MATERIAL_IDS, value // MATERIAL_IDS
-
-
-@dataclass
-class GBufferLayout:
-    """The G-buffer of one scene: the core targets plus the data its materials declare."""
-
-    data: dict[str, GBufferData]
-
-    @property
-    def targets(self) -> dict[str, TargetSpec]:
-        return {**GBUFFER_TARGETS, **{name: d.spec for name, d in self.data.items()}}
-
-    @property
-    def color_targets(self) -> tuple[str, ...]:
-        return (*GBUFFER_COLOR_TARGETS, *self.data)
-
-    @property
-    def bytes_per_pixel(self) -> int:
-        return sum(spec.bytes_per_pixel for spec in self.targets.values())
-
-    def describe(self) -> dict[str, dict[str, object]]:
-        """Target -> format, bytes per pixel, what it holds (``deferred info``, bench, dump)."""
-        out = {}
-        for name, spec in self.targets.items():
-            entry = {"format": spec.format_name, "bytes_per_pixel": spec.bytes_per_pixel,
-                     "description": spec.description}
-            if name in self.data:
-                entry["channels"] = [f"{name}.{c}" for c in self.data[name].channels]
-            out[name] = entry
-        return out
+    def bind(self, uniforms: ProgramUniforms, texture_unit: int) -> int:
+        textures = self._textures
+        if textures is None:
+            textures = self._textures = {}
+            for model in self.models:
+                textures.update(model.textures(self.frame))
+        return bind_samplers(uniforms, textures, texture_unit) if textures else texture_unit
 
 
 def material_data(material: Material) -> tuple[GBufferData, ...]:

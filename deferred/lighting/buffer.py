@@ -21,16 +21,17 @@ import numpy as np
 
 from deferred.errors import InputError
 from deferred.gl.context import Features
-from deferred.interfaces.light import (
+from deferred.interfaces.light import Light
+from deferred.lighting.dispatch import (
     FULLSCREEN_LIGHT_CAPACITY,
     FULLSCREEN_UNIFORM,
-    Light,
     light_range_uniform,
 )
 
 if TYPE_CHECKING:
     from deferred.gl.uniforms import ProgramUniforms
 
+LIGHT_BUFFER = "light_buffer"  # its name on a frame's blackboard
 RECORD_VEC4S = 4
 
 
@@ -157,13 +158,15 @@ class LightBuffer:
         """The records' texture (``u_lights``), for compute shaders to sample."""
         return self._texture
 
-    def bind(self, uniforms: ProgramUniforms, texture_unit: int) -> None:
+    def bind(self, uniforms: ProgramUniforms, texture_unit: int) -> int:
         """Set the counts and ranges on a program, and bind the records at ``texture_unit``
-        where it reads them."""
+        where it reads them (a binding source of the frame); the next free unit."""
         uniforms.set_shared("lights", self._uniforms)  # a new dict each upload
         if "u_lights" in uniforms.members:
             self._texture.use(location=texture_unit)
             uniforms.set_one("u_lights", texture_unit)
+            return texture_unit + 1
+        return texture_unit
 
     def _release_storage(self) -> None:
         self._packed = None

@@ -44,14 +44,16 @@ import numpy as np
 from deferred.core.passes import FullscreenPass, Order, Phase, RenderPass
 from deferred.errors import InputError, RenderError
 from deferred.gbuffer.layout import LINEAR_DEPTH
-from deferred.interfaces.light import FULLSCREEN_LIGHT_CAPACITY, surface_pass
-from deferred.lighting.buffer import fullscreen_overflow
+from deferred.lighting.buffer import LIGHT_BUFFER, fullscreen_overflow
+from deferred.lighting.dispatch import FULLSCREEN_LIGHT_CAPACITY
+from deferred.lighting.volumes import surface_pass
 
 if TYPE_CHECKING:
     from deferred.core.frame import Frame
     from deferred.gl.context import Features
     from deferred.gl.uniforms import ProgramUniforms
 
+LIGHT_LISTS = "light_lists"  # its name on a frame's blackboard
 DEFERRED_PATHS = ("volumes", "tiled", "clustered")
 FORWARD_PATHS = ("naive", "tiled")
 # A path named for one pipeline, in the other: forward has no volumes or clusters.
@@ -300,17 +302,19 @@ class LightLists:
                   "u_candidate_capacity": self.coarse_capacity}
         return {"first": first, "second": second}
 
-    def bind(self, uniforms: ProgramUniforms, texture_unit: int) -> None:
+    def bind(self, uniforms: ProgramUniforms, texture_unit: int) -> int:
         """Set the list uniforms, bind the buffer and the texture (at ``texture_unit``) for a
-        shading program using the lists (the culling binds the texture as its image:
-        :meth:`bind_image`)."""
+        shading program using the lists (a binding source of the frame; the culling binds the
+        texture as its image: :meth:`bind_image`); the next free unit."""
         if self.buffer is None or "u_list_count" not in uniforms.members:
-            return
+            return texture_unit
         self.buffer.bind_to_storage_buffer(1)
+        uniforms.set_shared("light_lists", self.uniforms())
         if "u_light_list_texture" in uniforms.members:
             self.texture.use(location=texture_unit)
             uniforms.set_one("u_light_list_texture", texture_unit)
-        uniforms.set_shared("light_lists", self.uniforms())
+            return texture_unit + 1
+        return texture_unit
 
     def bind_image(self, uniforms: ProgramUniforms) -> None:
         """Bind the shading's lists texture as the image a culling shader writes (at the unit
@@ -472,7 +476,8 @@ class LightCullPass(RenderPass):
         if LIST_SPLIT not in (1, 2):  # the culling writes 16x16 lists or their quadrants
             raise RenderError(f"LIST_SPLIT is {LIST_SPLIT}; the tiled culling splits a tile "
                               "into 1 or 2 lists a side")
-        lights = frame.light_buffer
+        lights = frame.blackboard[LIGHT_BUFFER]
+        light_lists = frame.blackboard[LIGHT_LISTS]
         grid = list_grid(frame.width, frame.height, self.clustered)
         camera = frame.scene.camera
         # every list is a subset of its tile's side-plane set (and slice), every coarse list
@@ -480,13 +485,12 @@ class LightCullPass(RenderPass):
         slices = (camera.near, camera.far, grid.slices) if self.clustered else None
 
         def capacity(tile: int, slices: tuple | None = None) -> int:
-            return frame.light_lists.capacity_for(lights.volume_spheres,
-                                                  frame.inverse_projection, frame.width,
-                                                  frame.height, tile, slices)
+            return light_lists.capacity_for(lights.volume_spheres, frame.inverse_projection,
+                                            frame.width, frame.height, tile, slices)
 
         coarse_capacity = 1 if self.clustered else capacity(coarse_grid(grid).tile)
-        frame.light_lists.prepare(grid, capacity(grid.tile, slices), camera.near, camera.far,
-                                  coarse_capacity)
+        light_lists.prepare(grid, capacity(grid.tile, slices), camera.near, camera.far,
+                            coarse_capacity)
         defines = {"CULL_GROUP_SIZE": str(CULL_GROUP_SIZE), "LIST_IMAGE_UNIT": str(LIST_IMAGE_UNIT)}
         if self.from_near:
             defines["CULL_FROM_NEAR"] = "1"
@@ -502,14 +506,14 @@ class LightCullPass(RenderPass):
         counts = {"u_light_count": lights.count, "u_global_light_count": lights.global_count}
         textures = {"u_lights": lights.texture}
         if self.clustered:
-            dispatches = [(shader, {**frame.light_lists.uniforms(), **counts}, grid.count //
-                           grid.slices)]
+            dispatches = [(shader, {**light_lists.uniforms(), **counts},
+                           grid.count // grid.slices)]
         else:
             textures["u_linear_depth"] = frame.target(LINEAR_DEPTH)
             counts["u_pixel_to_view"] = pixel_to_view(frame.projection, frame.width,
                                                       frame.height)
             # coarse tiles against every light, then the tiles against their coarse tile's
-            coarse = frame.light_lists.coarse_uniforms()
+            coarse = light_lists.coarse_uniforms()
             first = frame.shaders.compute("lights/cull_tiles.comp",
                                           {**defines, "CULL_COARSE": "1"})
             dispatches = [(first, {**coarse["first"], **counts}, coarse_grid(grid).count),
@@ -518,7 +522,7 @@ class LightCullPass(RenderPass):
             if index:
                 frame.ctx.memory_barrier()
             frame.bind_compute(program, uniforms, textures)
-            frame.light_lists.bind_image(frame.shaders.uniforms(program))
+            light_lists.bind_image(frame.shaders.uniforms(program))
             groups = math.ceil(tiles / CULL_GROUP_SIZE)  # an invocation a tile
             frame.gl_call(lambda program=program, groups=groups: program.run(groups, 1, 1))
         frame.ctx.memory_barrier()
@@ -544,7 +548,7 @@ def list_shading_pass(name: str, clustered: bool, gbuffer: tuple[str, ...],
     With ``composite`` it creates the composition buffer too, the same values (a frame with
     no material pass: the copy between them would be all the material phase did).
 
-    It runs on surfaces only (:func:`deferred.interfaces.light.surface_pass`: lights.toml, 640x360, about
+    It runs on surfaces only (:func:`deferred.lighting.volumes.surface_pass`: lights.toml, 640x360, about
     a third background: the pass 14.2 -> 11.3 ms at 1 light, 20.7 -> 16.3 at 256, 40.0 -> 35.7
     at 1024)."""
     from deferred.gl.targets import (

@@ -14,20 +14,21 @@ from deferred.gbuffer.layout import (
     data_write_file,
     data_write_glsl,
 )
-from deferred.interfaces.light import (
-    DISPATCH_FILE,
-    LISTED_DISPATCH_FILE,
-    SHADING_DISPATCH_FILE,
-    Light,
-    light_dispatch_glsl,
-    listed_dispatch_glsl,
-)
+from deferred.gbuffer.surface_id import SURFACE_ID_FILE, surface_id_glsl
+from deferred.interfaces.light import Light
 from deferred.interfaces.material import Material
 from deferred.interfaces.shading import (
     GBufferLayout,
     ShadingModel,
     material_data,
     shading_dispatch_glsl,
+)
+from deferred.lighting.dispatch import (
+    DISPATCH_FILE,
+    LISTED_DISPATCH_FILE,
+    SHADING_DISPATCH_FILE,
+    light_dispatch_glsl,
+    listed_dispatch_glsl,
 )
 
 
@@ -42,6 +43,7 @@ def generated_glsl(light_types: list[type[Light]], shading_models: list[type[Sha
         DATA_STRUCT_FILE: data_struct_glsl(names),
         DATA_FETCH_FILE: data_fetch_glsl(names),
         data_write_file([]): data_write_glsl([]),
+        SURFACE_ID_FILE: surface_id_glsl(),
     }
     for material in materials:
         written = [data.name for data in material_data(material)]

@@ -19,7 +19,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from deferred.core.graph import compile_graph
+from deferred.core.graph import PassGraph, compile_graph
 from deferred.core.passes import (
     ClearPass,
     FullscreenPass,
@@ -30,7 +30,13 @@ from deferred.core.passes import (
     copy_pass,
 )
 from deferred.errors import InputError
-from deferred.gbuffer.layout import DEPTH, GBUFFER_TARGETS, LINEAR_DEPTH, NORMAL_EXPONENT_ID
+from deferred.gbuffer.layout import (
+    DEPTH,
+    GBUFFER_TARGETS,
+    LINEAR_DEPTH,
+    NORMAL_EXPONENT_ID,
+    surfaces_need_depth,
+)
 from deferred.gl.targets import (
     COMPOSITE,
     COMPOSITE_SPEC,
@@ -40,10 +46,20 @@ from deferred.gl.targets import (
     LIGHT_ACCUMULATION_SPEC,
 )
 from deferred.interfaces.effect import AMBIENT_OCCLUSION
-from deferred.interfaces.light import LightTypePass, surface_pass
 from deferred.interfaces.material import ForwardLitPass
 from deferred.lighting.lists import LightCullPass, list_shading_pass
+from deferred.lighting.volumes import LightTypePass, surface_pass
 from deferred.scene.model import Scene
+
+# what the pass graph checks beyond the core's rules: the G-buffer's
+GRAPH_RULES = (surfaces_need_depth,)
+
+
+def check_passes(passes: list[RenderPass]) -> PassGraph:
+    """The checked pass graph of ``passes`` (:func:`deferred.core.graph.compile_graph` with
+    :data:`GRAPH_RULES`)."""
+    return compile_graph(passes, GRAPH_RULES)
+
 
 TONEMAPS = {"none": 0, "reinhard": 1, "aces": 2}
 
@@ -129,8 +145,8 @@ class Pipeline:
         return {}
 
     def passes(self, scene: Scene) -> list[RenderPass]:
-        """The pass list for ``scene``, checked (:func:`deferred.core.graph.compile_graph`)."""
-        return compile_graph(self.build(scene)).passes
+        """The pass list for ``scene``, checked (:func:`check_passes`)."""
+        return check_passes(self.build(scene)).passes
 
 
 class DeferredPipeline(Pipeline):

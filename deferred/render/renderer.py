@@ -10,19 +10,22 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from deferred.core.frame import Frame, KeptMaterialInputs, ObjectTransforms, Resources
-from deferred.core.graph import PassGraph, PassGraphError, compile_graph
+from deferred.core.frame import Frame
+from deferred.core.graph import PassGraph, PassGraphError
 from deferred.core.passes import RenderPass
 from deferred.errors import DeferredError, InputError, RenderError, gl_error
 from deferred.gl.context import Features, GLContext, acquire_context, give_back_context
+from deferred.gl.resources import Resources
 from deferred.gl.shaderlib import ShaderLibrary
 from deferred.gl.target_spec import targets_bytes
 from deferred.gl.targets import COMPOSITE, FINAL, FrameTargets
 from deferred.interfaces.material import Material
-from deferred.lighting.buffer import LightBuffer
-from deferred.lighting.lists import LightLists, check_light_limits, resolve_light_path
+from deferred.interfaces.shading import ShadingTextures
+from deferred.lighting.buffer import LIGHT_BUFFER, LightBuffer
+from deferred.lighting.lists import LIGHT_LISTS, LightLists, check_light_limits, resolve_light_path
+from deferred.render.caches import FrameInputs, KeptMaterialInputs, ObjectTransforms
 from deferred.render.generated import generated_glsl
-from deferred.render.pipeline import PIPELINES
+from deferred.render.pipeline import PIPELINES, check_passes
 from deferred.scene.model import Scene, check_size
 
 PassCallback = Callable[[RenderPass, Frame], None]
@@ -103,7 +106,7 @@ class Renderer:
         # requested path, else tiled) only changes where the context cannot run that path.
         requested = light_path if light_path is not None else scene.light_path
         provisional = resolve_light_path(pipeline, requested, FULL_FEATURES)
-        self.graph: PassGraph = compile_graph(PIPELINES[pipeline](provisional).build(scene))
+        self.graph: PassGraph = check_passes(PIPELINES[pipeline](provisional).build(scene))
         check_target_memory(self.graph, self.size, "size" if size else f"{scene.source}: size")
         light_types = scene.light_types()
         shading_models = self.shading_models = scene.shading_models()
@@ -134,7 +137,7 @@ class Renderer:
                            self.gl.max_texture_size)
         self.pipeline = PIPELINES[pipeline](self.light_path)
         if self.light_path != provisional:
-            self.graph = compile_graph(self.pipeline.build(scene))
+            self.graph = check_passes(self.pipeline.build(scene))
         defines = dict(self.pipeline.shader_defines())
         self.shaders = ShaderLibrary(ctx, features.glsl_version(), defines)
         for root in roots:
@@ -173,7 +176,7 @@ class Renderer:
         index = self.graph.index(before if before is not None else after)
         passes = list(self.graph.passes)
         passes.insert(index if before is not None else index + 1, render_pass)
-        graph = compile_graph(passes)
+        graph = check_passes(passes)
         for name, spec in graph.targets.items():
             if name in self.targets and not self.targets.specs[name].same_format(spec):
                 raise PassGraphError(f"pass {render_pass.name}: target '{name}' exists with "
@@ -202,11 +205,15 @@ class Renderer:
             warnings.warn(f"GL error {stale} left by code outside the renderer", stacklevel=2)
         self.shaders.forget_uniform_values()  # code between frames may have written them
         self.kept_inputs.start_frame(self.scene)
-        frame = Frame(self.gl, self.shaders, self.targets, self.resources, self.scene,
-                      self.light_buffer, strict=self.strict, light_lists=self.light_lists,
-                      time=time, time_gl_calls=time_gl_calls,
-                      shading_models=self.shading_models,
-                      object_transforms=self.object_transforms, kept_inputs=self.kept_inputs)
+        inputs = FrameInputs(self.scene, self.object_transforms, self.kept_inputs, self.strict)
+        frame = Frame(self.gl, self.shaders, self.targets, self.resources, self.scene, inputs,
+                      strict=self.strict, time=time, time_gl_calls=time_gl_calls,
+                      blackboard={LIGHT_BUFFER: self.light_buffer, LIGHT_LISTS: self.light_lists})
+        inputs.frame = frame
+        # what every program the frame binds may read: the scene's shading models' samplers,
+        # the lights' records and, on the list paths, the lists
+        frame.binding_sources = [ShadingTextures(self.shading_models, frame), self.light_buffer,
+                                 *([self.light_lists] if self.light_lists is not None else [])]
         self.light_buffer.upload(self.scene.lights, frame.view, frame.projection)
         self._check_gl("uploading the lights")
         for render_pass in self.passes:
@@ -247,7 +254,7 @@ class Renderer:
                 on_pass(render_pass, frame)
         frame.current_pass = None
         if self.strict:
-            frame.check_material_uniforms()
+            inputs.check_material_uniforms()
         self.last_frame = frame
         image, hdr = (self.read_final(), self.read_hdr()) if readback else (None, None)
         return RenderResult(image, hdr, frame.stats.draw_calls, dict(frame.stats.draws_by_pass),

@@ -30,13 +30,12 @@ import signal
 import sys
 import time
 import warnings
-from dataclasses import dataclass, field
 from pathlib import Path
 
-import moderngl
 import numpy as np
 
 from deferred.errors import InputError
+from deferred.gl.meshes import MeshData
 from deferred.validation import require_regular_file
 
 BUILTIN_PREFIX = "builtin:"
@@ -51,46 +50,6 @@ MAX_COORDINATE = 1e6
 MAX_SPAN_TO_EDGE = 1e6
 UNWRAP_TIMEOUT_S = 60.0
 UNWRAP_TIMEOUT_ENV = "DEFERRED_UNWRAP_TIMEOUT"
-
-# (name, components) in buffer order; the GLSL attribute is ``in_<name>``.
-VERTEX_ATTRIBUTES = (("position", 3), ("normal", 3), ("uv", 2), ("tangent", 3),
-                     ("binormal", 3), ("comb", 4))
-VERTEX_FLOATS = sum(n for _, n in VERTEX_ATTRIBUTES)
-
-
-@dataclass
-class MeshData:
-    """CPU-side mesh in the framework's vertex format (float32 arrays, uint32 triangles)."""
-
-    name: str
-    positions: np.ndarray
-    normals: np.ndarray
-    uvs: np.ndarray
-    tangents: np.ndarray
-    binormals: np.ndarray
-    comb: np.ndarray  # (N, 4) in [0, 1]: tangent-space comb direction packed, length scale
-    indices: np.ndarray  # (M, 3)
-    has_comb: bool = False  # True when the comb came from the file's vertex colours
-    generated_uvs: bool = False
-
-    @property
-    def vertex_count(self) -> int:
-        return len(self.positions)
-
-    def interleaved(self) -> np.ndarray:
-        parts = [self.positions, self.normals, self.uvs, self.tangents, self.binormals, self.comb]
-        return np.ascontiguousarray(np.hstack(parts).astype(np.float32))
-
-    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        """(least, greatest) position per axis; made once per positions array (the GPU copy
-        assumes the arrays do not change either), as the fur's level of detail asks for it
-        every frame."""
-        cached = self.__dict__.get("_bounds")
-        if cached is None or cached[0] is not self.positions:
-            cached = self.__dict__["_bounds"] = (
-                self.positions, (self.positions.min(axis=0), self.positions.max(axis=0)))
-        return cached[1]
-
 
 # -- tangent frames and comb directions ------------------------------------------------------
 
@@ -606,51 +565,3 @@ def _vertex_colours(loaded) -> np.ndarray | None:
             scale = 255.0 if colours.dtype == np.uint8 or colours.max() > 1.0 else 1.0
             return colours.astype(np.float64) / scale
     return None
-
-
-# -- GPU side ----------------------------------------------------------------------------------
-
-@dataclass
-class GpuMesh:
-    """A mesh's vertex and index buffers, with one vertex array per program using it."""
-
-    ctx: moderngl.Context
-    data: MeshData
-    vbo: moderngl.Buffer = field(init=False)
-    ibo: moderngl.Buffer = field(init=False)
-    _arrays: dict[int, moderngl.VertexArray] = field(init=False, default_factory=dict)
-
-    def __post_init__(self) -> None:
-        self.vbo = self.ctx.buffer(self.data.interleaved().tobytes())
-        self.ibo = self.ctx.buffer(self.data.indices.astype(np.uint32).tobytes())
-
-    def vertex_buffer(self, program: moderngl.Program) -> tuple:
-        """The vertex buffer with the format of the attributes ``program`` reads (moderngl's
-        ``(buffer, format, *names)``), for vertex arrays over other index buffers too."""
-        fmt, names = [], []
-        for name, count in VERTEX_ATTRIBUTES:
-            attribute = f"in_{name}"
-            if attribute in program:
-                fmt.append(f"{count}f")
-                names.append(attribute)
-            else:
-                fmt.append(f"{count * 4}x")
-        return (self.vbo, " ".join(fmt), *names)
-
-    def vertex_array(self, program: moderngl.Program) -> moderngl.VertexArray:
-        vao = self._arrays.get(program.glo)
-        if vao is None:
-            vao = self.ctx.vertex_array(program, [self.vertex_buffer(program)],
-                                        index_buffer=self.ibo, index_element_size=4)
-            self._arrays[program.glo] = vao
-        return vao
-
-    def render(self, program: moderngl.Program, instances: int = 1) -> None:
-        self.vertex_array(program).render(moderngl.TRIANGLES, instances=instances)
-
-    def release(self) -> None:
-        for vao in self._arrays.values():
-            vao.release()
-        self._arrays.clear()
-        self.vbo.release()
-        self.ibo.release()

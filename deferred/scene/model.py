@@ -33,14 +33,16 @@ from pydantic import (
 
 from deferred.core.passes import Phase
 from deferred.errors import InputError
+from deferred.gbuffer.layout import GBufferLayout
+from deferred.gl.meshes import MeshData
 from deferred.interfaces import registry
 from deferred.interfaces.effect import Effect
 from deferred.interfaces.light import Light
 from deferred.interfaces.material import Material, MaterialParams
-from deferred.interfaces.shading import GBufferLayout, ShadingModel, compose_layout
+from deferred.interfaces.shading import ShadingModel, compose_layout
 from deferred.params import validate_params
 from deferred.scene.camera import Camera, model_matrix
-from deferred.scene.meshes import MeshData, load_mesh
+from deferred.scene.meshes import load_mesh
 from deferred.validation import (
     Radiance,
     StrictValues,

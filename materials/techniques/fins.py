@@ -13,7 +13,7 @@ import numpy as np
 
 from deferred.core.passes import ObjectPass, Order
 from deferred.gbuffer.layout import DEPTH
-from deferred.scene.meshes import GpuMesh, MeshData
+from deferred.gl.meshes import GpuMesh, MeshData
 
 
 def edge_adjacency(mesh: MeshData, tolerance: float = 1e-6) -> np.ndarray:

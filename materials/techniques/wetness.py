@@ -25,7 +25,7 @@ import numpy as np
 
 from deferred.errors import InputError
 from deferred.io.images import read_channels, read_image
-from deferred.scene.meshes import MeshData
+from deferred.gl.meshes import MeshData
 
 DRY_CENTRE = -8.0  # the (R, G) of a dry texel: no clump centre is ever within reach of it
 

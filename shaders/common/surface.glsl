@@ -21,8 +21,9 @@ struct Surface {
     SurfaceData data;          // G-buffer data the scene's materials declare, by name
 };
 
-// The G-buffer id channel packs shading model * MATERIAL_IDS + material id (deferred.shading).
-const float MATERIAL_IDS = 64.0;
+// The G-buffer id channel packs shading model * MATERIAL_IDS + material id
+// (deferred.gbuffer.surface_id, which generates the constant).
+#include "generated/surface_id.glsl"
 
 int surface_shading_model(float surface_id) {
     return int(floor((surface_id + 0.5) / MATERIAL_IDS));

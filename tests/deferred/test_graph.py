@@ -222,7 +222,7 @@ def test_a_half_size_target_is_created_at_half_size_and_drawn_whole(render):
 
 
 def test_a_bad_layout_is_refused_before_any_gl_work():
-    from deferred.interfaces.shading import GBufferData
+    from deferred.gbuffer.layout import GBufferData
 
     class DeclaresFoo(Material):
         name = "test_declares_foo"

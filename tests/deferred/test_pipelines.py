@@ -9,7 +9,7 @@ from deferred.core.passes import Phase
 from deferred.gbuffer.layout import decode
 from deferred.gl.context import Features, GLContext
 from deferred.interfaces import registry
-from deferred.interfaces.shading import surface_id
+from deferred.gbuffer.surface_id import surface_id
 from deferred.render.renderer import Renderer
 from deferred.scene.model import load_scene, scene_from_dict
 

@@ -92,7 +92,7 @@ def test_every_packaged_shader_program_compiles(gl):
     built-in light type and shading model and their G-buffer data; installed plugins play no
     part."""
     from deferred.interfaces import registry
-    from deferred.interfaces.shading import GBufferLayout
+    from deferred.gbuffer.layout import GBufferLayout
     from deferred.materials.standard import StandardMaterial
     from deferred.render.generated import generated_glsl
 

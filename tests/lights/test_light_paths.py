@@ -480,7 +480,7 @@ def scene_light(values: dict):
 
 
 def test_more_full_screen_lights_than_a_frame_holds_is_refused_before_a_frame(gl):
-    from deferred.interfaces.light import FULLSCREEN_LIGHT_CAPACITY
+    from deferred.lighting.dispatch import FULLSCREEN_LIGHT_CAPACITY
 
     scene = scene_with(0)
     scene.lights = [*scene.lights, *(scene_light({"type": "directional", "intensity": 0.1})

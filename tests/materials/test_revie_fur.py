@@ -5,7 +5,7 @@ import pytest
 import trimesh
 
 from deferred.interfaces import registry
-from deferred.interfaces.shading import split_surface_id
+from deferred.gbuffer.surface_id import split_surface_id
 from deferred.scene.model import scene_from_dict
 
 

@@ -409,7 +409,7 @@ def tangent_frames(mesh):
 def layer_positions(gl, shaders, mesh, h, wetness, curl_radius, curl_frequency, fur_length,
                     deflection=None, frames=None):
     """fur.vert's layer positions and strand tangents (object space: identity transforms)."""
-    from deferred.scene.meshes import GpuMesh
+    from deferred.gl.meshes import GpuMesh
 
     ctx = gl.ctx
     program = fur_vertex_program(ctx, shaders)

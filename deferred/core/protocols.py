@@ -1,0 +1,86 @@
+"""What the core asks of the layers above it: the shapes of a scene, its objects and their
+materials as passes see them, a resource that binds itself to every program, and the per-frame
+source of an object's inputs. The layers above implement them (``deferred.scene``,
+``deferred.interfaces``, ``deferred.lighting``, ``deferred.render``); the core names no class of
+theirs.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, Protocol
+
+import moderngl
+import numpy as np
+
+if TYPE_CHECKING:
+    from deferred.gl.meshes import MeshData
+    from deferred.gl.uniforms import ProgramUniforms
+
+
+class CameraLike(Protocol):
+    near: float
+    far: float
+
+    def view(self) -> np.ndarray: ...
+    def projection(self, aspect: float) -> np.ndarray: ...
+    def inverse_projection(self, aspect: float) -> np.ndarray: ...
+
+
+class SceneLike(Protocol):
+    """A frame's scene as the core reads it (:class:`deferred.scene.Scene`)."""
+
+    camera: CameraLike
+    objects: list
+
+
+class MaterialLike(Protocol):
+    """A material as the core reads it (:class:`deferred.interfaces.material.Material`)."""
+
+    name: str
+    params: Any
+
+    def defines(self, obj: Any) -> dict[str, str]: ...
+    def shader_folder(self) -> str: ...
+
+
+class SceneObjectLike(Protocol):
+    """An object as an object pass draws it (:class:`deferred.scene.SceneObject`)."""
+
+    label: str
+    mesh: MeshData
+    material: Any  # a MaterialLike
+
+
+class BindingSource(Protocol):
+    """A per-frame resource every program may read (the light buffer, the light lists, the
+    shading models' samplers): the frame offers it to each program it binds."""
+
+    def bind(self, uniforms: ProgramUniforms, texture_unit: int) -> int:
+        """Set this source's uniforms and samplers where the program has them, samplers from
+        ``texture_unit`` on; the next free unit."""
+        ...
+
+
+@dataclass(slots=True)
+class MaterialInputs:
+    """A material's uniforms and textures for one frame, and which of them its programs
+    declare (strict mode checks that each is declared by at least one)."""
+
+    material: Any  # a MaterialLike
+    uniforms: dict[str, Any]
+    textures: dict[str, moderngl.Texture]
+    params: Any = None  # the material's params they were made from
+    # kept across frames (deferred.render.caches.KeptMaterialInputs); its uniforms are then
+    # StableValues
+    kept: bool = False
+    declared: set[str] = field(default_factory=set)
+    programs: list[str] = field(default_factory=list)
+
+
+class ObjectInputs(Protocol):
+    """Where a frame finds an object's transforms and its material's inputs
+    (:class:`deferred.render.caches.FrameInputs`)."""
+
+    def object_uniforms(self, obj: Any) -> dict[str, Any]: ...
+    def material_inputs(self, material: Any) -> MaterialInputs: ...

@@ -1,0 +1,87 @@
+"""GPU objects that outlive a frame: meshes' buffers, textures loaded from files, helper
+geometry; a renderer holds one and releases it with itself."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import moderngl
+import numpy as np
+
+from deferred.gl.meshes import GpuMesh, MeshData
+from deferred.io.images import read_image
+
+
+class Resources:
+    """GPU objects that outlive one frame: meshes, textures loaded from files, helper geometry."""
+
+    def __init__(self, ctx: moderngl.Context):
+        self.ctx = ctx
+        self._meshes: dict[int, GpuMesh] = {}
+        self._mesh_refs: list[MeshData] = []  # keep ids stable while cached
+        self._cached: dict[Any, Any] = {}
+        self._fullscreen_vaos: dict[int, moderngl.VertexArray] = {}
+        # (pass, colours, depth) framebuffer requests already checked against the pass's
+        # declarations: declarations are fixed once the graph is compiled and targets are only
+        # ever added, so a request that passed once passes for the renderer's life
+        self.checked_framebuffers: dict[tuple, Any] = {}
+
+    def gpu_mesh(self, mesh: MeshData) -> GpuMesh:
+        gpu = self._meshes.get(id(mesh))
+        if gpu is None:
+            gpu = GpuMesh(self.ctx, mesh)
+            self._meshes[id(mesh)] = gpu
+            self._mesh_refs.append(mesh)
+        return gpu
+
+    def cached(self, key: Any, create: Callable[[moderngl.Context], Any]) -> Any:
+        """A GPU object kept for the renderer's life (anything with ``release()``);
+        ``create(ctx)`` makes it the first time ``key`` is asked for."""
+        made = self._cached.get(key)
+        if made is None:
+            made = create(self.ctx)
+            self._cached[key] = made
+        return made
+
+    def texture(self, key: Any, create: Callable[[moderngl.Context], moderngl.Texture]
+                ) -> moderngl.Texture:
+        """A cached texture (see :meth:`cached`)."""
+        return self.cached(key, create)
+
+    def image_texture(self, path: Path, srgb: bool = True,
+                      where: str | None = None) -> moderngl.Texture:
+        """The image at ``path`` as a mipmapped texture (cached); ``where`` (the scene key)
+        names it in a read error."""
+        def create(ctx: moderngl.Context) -> moderngl.Texture:
+            pixels = read_image(path, srgb_to_linear=srgb, where=where,
+                                max_size=ctx.info["GL_MAX_TEXTURE_SIZE"])
+            height, width, _ = pixels.shape
+            texture = ctx.texture((width, height), 4, np.ascontiguousarray(
+                pixels[::-1]).astype(np.float16).tobytes(), dtype="f2")
+            texture.build_mipmaps()
+            texture.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+            return texture
+
+        return self.texture(("image", str(path), srgb), create)
+
+    def fullscreen_vertex_array(self, program: moderngl.Program) -> moderngl.VertexArray:
+        # Full-screen triangles are generated from gl_VertexID; a VAO with no buffers draws them.
+        vao = self._fullscreen_vaos.get(program.glo)
+        if vao is None:
+            vao = self.ctx.vertex_array(program, [])
+            self._fullscreen_vaos[program.glo] = vao
+        return vao
+
+    def release(self) -> None:
+        for gpu in self._meshes.values():
+            gpu.release()
+        self._meshes.clear()
+        self._mesh_refs.clear()
+        for made in self._cached.values():
+            made.release()
+        self._cached.clear()
+        for vao in self._fullscreen_vaos.values():
+            vao.release()
+        self._fullscreen_vaos.clear()

@@ -1,0 +1,153 @@
+"""What a renderer keeps from frame to frame, and the per-frame source of an object's inputs.
+
+:class:`ObjectTransforms` holds every object's transform uniforms while the objects hold;
+:class:`KeptMaterialInputs` a material's uniforms and textures while its params hold;
+:class:`FrameInputs` gives a frame's passes both (:class:`deferred.core.protocols.ObjectInputs`)
+and, in strict mode, checks at the end of the frame that every uniform a material sets is
+declared by one of its programs.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from deferred.core.protocols import MaterialInputs
+from deferred.errors import RenderError
+from deferred.gl.uniforms import StableValues
+
+if TYPE_CHECKING:
+    from deferred.core.frame import Frame
+    from deferred.interfaces.material import Material
+    from deferred.scene import Scene, SceneObject
+
+
+class KeptMaterialInputs:
+    """Materials' inputs kept from one frame to the next while their params are the same
+    object (params are replaced whole, never changed in place), for materials whose inputs
+    are a function of the params (:meth:`Material.keeps_inputs`): a scene of 400 materials
+    made 400 uniform dicts a frame otherwise."""
+
+    def __init__(self) -> None:
+        self._kept: dict[int, MaterialInputs] = {}
+
+    def start_frame(self, scene: Scene) -> None:
+        """Drop the materials no object of ``scene`` has (replaced on their objects), once
+        they outnumber the objects: a scene that keeps its materials pays one comparison."""
+        if len(self._kept) > len(scene.objects):
+            present = {id(obj.material) for obj in scene.objects}
+            self._kept = {key: inputs for key, inputs in self._kept.items() if key in present}
+
+    def of(self, material: Material, frame: Frame) -> MaterialInputs:
+        key = id(material)
+        kept = self._kept.get(key)
+        if kept is not None and kept.material is material and kept.params is material.params:
+            return kept
+        keep = material.keeps_inputs()
+        uniforms = material.uniforms(frame)
+        inputs = MaterialInputs(material, StableValues(uniforms) if keep else uniforms,
+                                material.textures(frame), params=material.params, kept=keep)
+        if keep:
+            self._kept[key] = inputs
+        return inputs
+
+    def release(self) -> None:  # the textures are Resources', released there
+        self._kept.clear()
+
+
+class ObjectTransforms:
+    """Every object's transform uniforms (``u_model`` and ``u_model_normal_matrix``, the
+    inverse transpose of the model's 3x3, as GL bytes; ``u_surface_id``), made for all objects
+    at once and kept while the objects hold. The camera's view is apart (``u_view``,
+    ``shaders/common/object_transform.glsl``), so a camera that moves remakes none of them: the
+    batched inverse and the conversions cost about 3 us an object when they are remade."""
+
+    def __init__(self) -> None:
+        self._key: tuple | None = None
+        self._values: dict[int, dict[str, Any]] = {}
+
+    def of(self, objects: list[SceneObject]) -> dict[int, dict[str, Any]]:
+        """id(object) -> its uniforms."""
+        if not objects:
+            return {}
+        surface_ids = [float(obj.material.surface_id()) for obj in objects]
+        # what the values are made of (contents, not identities: a model may be written in
+        # place), and which object each belongs to
+        key = (b"".join([obj.model.tobytes() for obj in objects]), surface_ids,
+               [id(obj) for obj in objects])
+        if key != self._key:
+            models = np.stack([obj.model for obj in objects])
+            self._values = self._make(objects, models, surface_ids)
+            self._key = key
+        return self._values
+
+    @staticmethod
+    def _make(objects: list[SceneObject], models: np.ndarray,
+              surface_ids: list[float]) -> dict[int, dict[str, Any]]:
+        normals = np.transpose(np.linalg.inv(models[:, :3, :3]), (0, 2, 1))
+
+        def column_major(matrices: np.ndarray) -> bytes:  # GLSL's order, all at once
+            return np.ascontiguousarray(np.transpose(matrices, (0, 2, 1)),
+                                        dtype=np.float32).tobytes()
+
+        model_bytes, normal_bytes = column_major(models), column_major(normals)
+        values = {}
+        for index, (obj, surface_id) in enumerate(zip(objects, surface_ids, strict=True)):
+            values[id(obj)] = StableValues(  # replaced whole when they change
+                u_model=model_bytes[64 * index:64 * index + 64],
+                u_model_normal_matrix=normal_bytes[36 * index:36 * index + 36],
+                u_surface_id=surface_id)
+        return values
+
+
+class FrameInputs:
+    """One frame's objects' transforms and materials' inputs (each material's made once a
+    frame, or kept from the last), for the frame's passes."""
+
+    def __init__(self, scene: Scene, transforms: ObjectTransforms, kept: KeptMaterialInputs,
+                 strict: bool = False):
+        self.scene = scene
+        self.strict = strict
+        self.frame: Frame | None = None  # set by the frame it serves (Frame.__init__)
+        self._transforms = transforms
+        self._kept = kept
+        self._objects: dict[int, dict[str, Any]] | None = None
+        self._materials: dict[int, MaterialInputs] = {}
+
+    def object_uniforms(self, obj: SceneObject) -> dict[str, Any]:
+        """The object's transforms and id (for every object at once, kept across frames while
+        the objects hold: :class:`ObjectTransforms`)."""
+        if self._objects is None:
+            self._objects = self._transforms.of(self.scene.objects)
+        return self._objects[id(obj)]
+
+    def material_inputs(self, material: Material) -> MaterialInputs:
+        """``material``'s uniforms and textures, computed once per frame (or kept from the
+        last: :class:`KeptMaterialInputs`)."""
+        inputs = self._materials.get(id(material))
+        if inputs is None:
+            inputs = self._kept.of(material, self.frame)
+            if self.strict:  # what this frame's programs declare is the frame's own
+                inputs = MaterialInputs(material, inputs.uniforms, inputs.textures,
+                                        params=inputs.params, kept=inputs.kept)
+            self._materials[id(material)] = inputs
+        return inputs
+
+    def check_material_uniforms(self) -> None:
+        """Strict mode, at the end of a frame: every uniform a material sets is declared by at
+        least one of its programs."""
+        shaders = self.frame.shaders
+        for inputs in self._materials.values():
+            if not inputs.programs:
+                continue
+            # Passes switched off by a parameter (no shells) leave their uniforms unused in
+            # this frame: the material's shader folder still has to declare them.
+            declared = inputs.declared | shaders.declared_in_folder(
+                inputs.material.shader_folder())
+            unused = [n for n in [*inputs.uniforms, *inputs.textures] if n not in declared]
+            if unused:
+                raise RenderError(
+                    f"material {inputs.material.name}: no program of it declares uniform "
+                    f"{', '.join(repr(n) for n in unused)} (programs: "
+                    f"{', '.join(dict.fromkeys(inputs.programs))})")
