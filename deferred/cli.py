@@ -19,7 +19,8 @@ from rich.table import Table
 
 from deferred.errors import DeferredError, InputError, RenderError, ShaderError
 from deferred.interfaces import registry
-from deferred.io.images import check_output_path, write_image
+from deferred.io.images import write_image
+from deferred.io.paths import check_output_path
 from deferred.io.safety import interrupt_exit_code, termination_as_interrupt
 from deferred.render.pipeline import PIPELINES
 from deferred.scene.model import load_scene, parse_size
@@ -101,7 +102,8 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
         with_material_view,
         write_view,
     )
-    from deferred.io.video import check_video_size, frame_times, output_kind
+    from deferred.io.paths import output_kind
+    from deferred.io.video import check_video_size, frame_times
     from deferred.lighting.lists import resolve_light_path
     from deferred.render.renderer import FULL_FEATURES, Renderer
 
@@ -376,7 +378,7 @@ def _render_outputs(out: Path, kind: str, frames: int) -> list[Path]:
     """Every file ``render -o`` writes: a sequence's frames, or the one file."""
     if kind != "sequence":
         return [out]
-    from deferred.io.video import expand_pattern
+    from deferred.io.paths import expand_pattern
 
     return [expand_pattern(out, index) for index in range(frames)]
 

@@ -8,6 +8,7 @@ import numbers
 import stat
 import types
 import typing
+from enum import Enum
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
@@ -106,9 +107,10 @@ def lax_problem(value: Any, annotation: Any) -> str | None:
         return (shaped or problems)[0]
     if annotation is type(None):
         return None if value is None else f"expected nothing, not {value!r}"
-    if origin is Literal:
-        return None if value in typing.get_args(annotation) else \
-            f"expected one of {', '.join(map(repr, typing.get_args(annotation)))}"
+    if origin is Literal or isinstance(annotation, type) and issubclass(annotation, Enum):
+        choices = typing.get_args(annotation) if origin is Literal else \
+            tuple(member.value for member in annotation)
+        return None if value in choices else f"expected one of {', '.join(map(repr, choices))}"
     if annotation is bool:
         return None if isinstance(value, bool) else "expected true or false"
     if annotation in (int, float):

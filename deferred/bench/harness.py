@@ -52,7 +52,9 @@ from deferred.errors import InputError
 from deferred.gl.context import GLContext, create_context
 from deferred.interfaces import registry
 from deferred.interfaces.light import Light
-from deferred.io.images import check_output_path, write_image, write_text
+from deferred.io.images import write_image, write_text
+from deferred.io.paths import check_output_path
+from deferred.names import LIGHT_PATHS, LightPath, Pipeline
 from deferred.render.pipeline import PIPELINES
 from deferred.scene.model import Scene, SceneObject
 
@@ -93,12 +95,10 @@ def parse_counts(text: str, where: str) -> list[int]:
 
 def parse_light_paths(text: str, where: str = "--light-paths") -> list[str] | None:
     """``"all"`` (None: every path of each pipeline) or path names, checked."""
-    from deferred.lighting.lists import DEFERRED_PATHS, FORWARD_PATHS
-
     if text.strip() == "all":
         return None
     names = [p.strip() for p in text.split(",") if p.strip()]
-    known = dict.fromkeys(DEFERRED_PATHS + FORWARD_PATHS)
+    known = [path.value for path in LightPath]
     for name in names:
         if name not in known:
             raise InputError(f"unknown light path '{name}' (choose from all, "
@@ -111,9 +111,7 @@ def parse_light_paths(text: str, where: str = "--light-paths") -> list[str] | No
 def pipeline_paths(pipeline: str, light_paths: Sequence[str] | None) -> list[str]:
     """The light paths a sweep runs for ``pipeline``: every one of its own, or those named that
     it has."""
-    from deferred.lighting.lists import DEFERRED_PATHS, FORWARD_PATHS
-
-    own = DEFERRED_PATHS if pipeline == "deferred" else FORWARD_PATHS
+    own = LIGHT_PATHS[Pipeline(pipeline)]
     return list(own) if light_paths is None else [p for p in own if p in light_paths]
 
 

@@ -10,11 +10,17 @@ its material's inputs come from its ``inputs`` (:class:`deferred.core.protocols.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import moderngl
 
-from deferred.core.protocols import BindingSource, MaterialInputs, ObjectInputs, SceneLike
+from deferred.core.protocols import (
+    BindingSource,
+    MaterialInputs,
+    ObjectInputs,
+    PassLike,
+    SceneLike,
+)
 from deferred.errors import DeferredError, InputError, RenderError, gl_error
 from deferred.gl.context import GLContext
 from deferred.gl.device import Device
@@ -22,9 +28,6 @@ from deferred.gl.resources import Resources
 from deferred.gl.shaderlib import ShaderLibrary
 from deferred.gl.targets import FrameTargets
 from deferred.gl.uniforms import ProgramUniforms, gl_value
-
-if TYPE_CHECKING:
-    from deferred.core.passes import RenderPass
 
 
 class Frame:
@@ -77,10 +80,10 @@ class Frame:
         self.draw_fullscreen = device.draw_fullscreen
         self.gl_call = device.gl_call
         self.count_draw = device.count_draw
-        self.current_pass: RenderPass | None = None
+        self.current_pass: PassLike | None = None
 
     # -- passes --------------------------------------------------------------------------------
-    def run_pass(self, render_pass: RenderPass, check_errors: bool = True) -> None:
+    def run_pass(self, render_pass: PassLike, check_errors: bool = True) -> None:
         """Clear the targets ``render_pass`` creates, run it, and name it in any failure (a GL
         error too, unless ``check_errors`` is off: :meth:`check_errors` then does it for a run
         of passes)."""
@@ -107,7 +110,7 @@ class Frame:
             by_pass = self.stats.draws_by_pass
             by_pass[render_pass.name] = by_pass.get(render_pass.name, 0) + draws
 
-    def check_errors(self, passes: list[RenderPass]) -> None:
+    def check_errors(self, passes: list[PassLike]) -> None:
         """Raise the GL error, if any, that ``passes`` (run in order without checks) left,
         naming the pass: with more than one, they run again one by one, each checked, and the
         first to raise it is named (or all of them, where none does again). Reading the error

@@ -7,6 +7,7 @@ theirs.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Protocol
 
@@ -50,6 +51,17 @@ class SceneObjectLike(Protocol):
     label: str
     mesh: MeshData
     material: Any  # a MaterialLike
+
+
+class PassLike(Protocol):
+    """A pass as the frame runs it (:class:`deferred.core.passes.RenderPass`)."""
+
+    name: str
+    creates: Mapping[str, Any]
+    reads: tuple[str, ...]
+    writes: tuple[str, ...]
+
+    def execute(self, frame: Any) -> None: ...
 
 
 class BindingSource(Protocol):

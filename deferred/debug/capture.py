@@ -23,6 +23,7 @@ from deferred.gbuffer.layout import (
     decode,
 )
 from deferred.gl.target_spec import TargetSpec
+from deferred.names import LIST_PATHS
 from deferred.render.renderer import Renderer
 
 GBUFFER_CHANNELS = ("albedo.R", "albedo.G", "albedo.B", "specular.intensity",
@@ -217,7 +218,7 @@ def capture_frame(renderer: Renderer, passes: Sequence[str] | None = None,
     scene = renderer.scene
     ends = {name: targets.read_raw(name)[::-1] for name in targets.specs}  # top row first
     light_lists = None
-    if renderer.light_path in ("tiled", "clustered") and renderer.light_lists is not None:
+    if renderer.light_path in LIST_PATHS and renderer.light_lists is not None:
         depth = None  # deferred: only surfaces read a list (Forward+: every fragment drawn)
         if renderer.pipeline_name == "deferred":  # GL's bottom row first, as the lists count
             depth = to_float(ends[LINEAR_DEPTH])[::-1, :, 0]

@@ -30,7 +30,8 @@ from deferred.errors import InputError, RenderError
 from deferred.gbuffer.layout import GBUFFER_COLOR_TARGETS
 from deferred.gl.target_spec import TargetSpec
 from deferred.gl.targets import COMPOSITE, LIGHT_ACCUMULATION
-from deferred.io.images import NAME_MAX, write_image, write_text
+from deferred.io.images import write_image, write_text
+from deferred.io.paths import NAME_MAX
 from deferred.io.safety import signals_deferred
 from deferred.render.renderer import Renderer
 

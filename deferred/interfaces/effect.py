@@ -18,6 +18,7 @@ from importlib.resources.abc import Traversable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
 
+from deferred.names import Pipeline
 from deferred.params import Params, UniformOverrides, params_uniforms, validate_params
 
 if TYPE_CHECKING:
@@ -35,7 +36,7 @@ class EffectParams(Params):
 class Effect:
     name: ClassVar[str]
     Params: ClassVar[type[EffectParams]] = EffectParams
-    pipelines: ClassVar[tuple[str, ...]] = ("deferred", "forward")
+    pipelines: ClassVar[tuple[str, ...]] = tuple(Pipeline)
     shader_root: ClassVar[Traversable | Path | None] = None
     uniform_overrides: ClassVar[UniformOverrides] = {}
     type_id: ClassVar[int] = 0  # set by the registry

@@ -15,11 +15,12 @@ from __future__ import annotations
 
 from importlib.resources.abc import Traversable
 from pathlib import Path
-from typing import Any, ClassVar, Literal
+from typing import Any, ClassVar
 
 import numpy as np
 from pydantic import Field
 
+from deferred.names import LightVolume
 from deferred.params import Params, validate_params
 from deferred.validation import Radiance
 
@@ -35,7 +36,7 @@ class Light:
     Params: ClassVar[type[LightParams]] = LightParams
     glsl_file: ClassVar[str] = ""
     glsl_function: ClassVar[str] = ""
-    volume: ClassVar[Literal["fullscreen", "sphere"]] = "fullscreen"
+    volume: ClassVar[LightVolume] = LightVolume.FULLSCREEN
     shader_root: ClassVar[Traversable | Path | None] = None
     type_id: ClassVar[int] = 0  # set by the registry
 

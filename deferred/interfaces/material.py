@@ -15,6 +15,7 @@ file, a define) or to a function giving the uniforms it becomes.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from importlib.resources.abc import Traversable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
@@ -23,10 +24,17 @@ import moderngl
 from pydantic import BaseModel, Field
 
 from deferred.core.passes import ObjectPass, Phase, RenderPass
-from deferred.gbuffer.layout import DEPTH, GBUFFER_COLOR_TARGETS, GBufferData, data_write_file
+from deferred.errors import InputError
+from deferred.gbuffer.layout import (
+    DEPTH,
+    GBUFFER_COLOR_TARGETS,
+    GBufferData,
+    GBufferLayout,
+    data_write_file,
+)
 from deferred.gbuffer.surface_id import surface_id
 from deferred.gl.targets import COMPOSITE
-from deferred.interfaces.shading import material_data
+from deferred.interfaces import registry
 from deferred.params import Params, UniformOverrides, params_uniforms, validate_params
 
 if TYPE_CHECKING:
@@ -100,8 +108,6 @@ class Material:
                   where: str | None = None) -> Material:
         """Validate ``values`` against ``Params``; errors name the offending key."""
         material = cls(validate_params(cls.Params, values, where), base_dir)
-        from deferred.interfaces import registry
-
         registry.shading_models.get(material.shading_model,
                                     f"{where}: shading model" if where else "shading model")
         material.check_files(where)
@@ -146,8 +152,6 @@ class Material:
         key = (self.type_id, self.shading_model)
         cached = self.__dict__.get("_surface_id")  # asked for by every object, every frame
         if cached is None or cached[0] != key:
-            from deferred.interfaces import registry
-
             model_id = registry.shading_models.get(self.shading_model).type_id
             cached = self.__dict__["_surface_id"] = (key, surface_id(self.type_id, model_id))
         return cached[1]
@@ -233,3 +237,39 @@ def describe_model(model: type[BaseModel]) -> list[dict[str, Any]]:
         rows.append({"name": name, "type": type_name, "default": field.default,
                      "range": ", ".join(bounds), "doc": field.description or ""})
     return rows
+
+
+def material_data(material: Material) -> tuple[GBufferData, ...]:
+    """The data ``material``'s objects write: its own and its shading model's, by name
+    (kept on the material: its class, model and parameters never change)."""
+    cached = material.__dict__.get("_gbuffer_data")
+    if cached is None:
+        cached = material.__dict__["_gbuffer_data"] = _material_data(material)
+    return cached
+
+
+def _material_data(material: Material) -> tuple[GBufferData, ...]:
+    model = registry.shading_models.get(material.shading_model)
+    merged: dict[str, GBufferData] = {}
+    for data in (*model.gbuffer_data, *material.gbuffer_data):
+        if data.name in merged and merged[data.name] != data:
+            raise InputError(f"material {material.name}: G-buffer data '{data.name}' is declared "
+                             f"twice with different formats")
+        merged[data.name] = data
+    return tuple(merged.values())
+
+
+def compose_layout(materials: Iterable[Material]) -> GBufferLayout:
+    """The layout for a scene's materials; one name declared two ways is an error."""
+    data: dict[str, GBufferData] = {}
+    owners: dict[str, str] = {}
+    for material in materials:
+        for entry in material_data(material):
+            if entry.name in data and data[entry.name] != entry:
+                raise InputError(f"G-buffer data '{entry.name}' is declared as {entry.format} "
+                                 f"{entry.channels} by {material.name} and as "
+                                 f"{data[entry.name].format} {data[entry.name].channels} by "
+                                 f"{owners[entry.name]}")
+            data.setdefault(entry.name, entry)
+            owners.setdefault(entry.name, material.name)
+    return GBufferLayout(data)

@@ -29,13 +29,11 @@ from typing import TYPE_CHECKING, ClassVar
 import moderngl
 
 from deferred.core.frame import bind_samplers
-from deferred.errors import InputError
-from deferred.gbuffer.layout import GBufferData, GBufferLayout
+from deferred.gbuffer.layout import GBufferData
 
 if TYPE_CHECKING:
     from deferred.core.frame import Frame
     from deferred.gl.uniforms import ProgramUniforms
-    from deferred.interfaces.material import Material
 
 class ShadingModel:
     """A BRDF the lights call (see the module documentation)."""
@@ -71,44 +69,6 @@ class ShadingTextures:
             for model in self.models:
                 textures.update(model.textures(self.frame))
         return bind_samplers(uniforms, textures, texture_unit) if textures else texture_unit
-
-
-def material_data(material: Material) -> tuple[GBufferData, ...]:
-    """The data ``material``'s objects write: its own and its shading model's, by name
-    (kept on the material: its class, model and parameters never change)."""
-    cached = material.__dict__.get("_gbuffer_data")
-    if cached is None:
-        cached = material.__dict__["_gbuffer_data"] = _material_data(material)
-    return cached
-
-
-def _material_data(material: Material) -> tuple[GBufferData, ...]:
-    from deferred.interfaces import registry
-
-    model = registry.shading_models.get(material.shading_model)
-    merged: dict[str, GBufferData] = {}
-    for data in (*model.gbuffer_data, *material.gbuffer_data):
-        if data.name in merged and merged[data.name] != data:
-            raise InputError(f"material {material.name}: G-buffer data '{data.name}' is declared "
-                             f"twice with different formats")
-        merged[data.name] = data
-    return tuple(merged.values())
-
-
-def compose_layout(materials: Iterable[Material]) -> GBufferLayout:
-    """The layout for a scene's materials; one name declared two ways is an error."""
-    data: dict[str, GBufferData] = {}
-    owners: dict[str, str] = {}
-    for material in materials:
-        for entry in material_data(material):
-            if entry.name in data and data[entry.name] != entry:
-                raise InputError(f"G-buffer data '{entry.name}' is declared as {entry.format} "
-                                 f"{entry.channels} by {material.name} and as "
-                                 f"{data[entry.name].format} {data[entry.name].channels} by "
-                                 f"{owners[entry.name]}")
-            data.setdefault(entry.name, entry)
-            owners.setdefault(entry.name, material.name)
-    return GBufferLayout(data)
 
 
 def shading_dispatch_glsl(models: list[type[ShadingModel]]) -> str:

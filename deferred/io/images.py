@@ -1,13 +1,12 @@
 """Image files through OpenImageIO: PNG/EXR out (atomically), any OIIO format in.
 
-``deferred render`` also writes numbered sequences (``out_####.png``) and videos (``.mp4``,
-``.gif``): :mod:`deferred.io.video`.
+Output names are checked in :mod:`deferred.io.paths`; ``deferred render`` also writes numbered
+sequences (``out_####.png``) and videos (``.mp4``, ``.gif``): :mod:`deferred.io.video`.
 """
 
 from __future__ import annotations
 
 import os
-import secrets
 import stat
 import sys
 import tempfile
@@ -18,10 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from deferred.errors import InputError, RenderError
-
-IMAGE_SUFFIXES = (".png", ".exr")
-VIDEO_SUFFIXES = (".mp4", ".gif")
-OUTPUT_SUFFIXES = (*IMAGE_SUFFIXES, *VIDEO_SUFFIXES)  # what ``deferred render -o`` writes
+from deferred.io.paths import temporary_path
 
 
 def srgb_encode(linear: np.ndarray) -> np.ndarray:
@@ -35,43 +31,6 @@ def srgb_decode(encoded: np.ndarray) -> np.ndarray:
     return np.where(encoded <= 0.04045, encoded / 12.92, np.power((encoded + 0.055) / 1.055, 2.4))
 
 
-def check_output_path(path: str | Path, where: str = "-o",
-                      suffixes: tuple[str, ...] = OUTPUT_SUFFIXES,
-                      patterns: bool = True) -> Path:
-    """An output file named by option ``where``: one of ``suffixes``, in an existing folder,
-    not itself a folder. With ``patterns``, a name with a run of ``#`` is a numbered image
-    sequence (:func:`deferred.io.video.expand_pattern`), checked as its first file."""
-    path = Path(path)
-    shown = str(path) if len(str(path)) <= 120 else f"{str(path)[:60]}...{str(path)[-40:]}"
-    if path.suffix.lower() not in suffixes:
-        raise InputError(f"output must end in {_either(suffixes)}: {shown}", where)
-    if any(len(part.encode()) > NAME_MAX for part in path.parent.parts):
-        raise InputError(f"folder name longer than {NAME_MAX} bytes: {shown}", where)
-    if len(path.name.encode()) > NAME_MAX:
-        raise InputError(f"file name longer than {NAME_MAX} bytes: {path.name[:40]}...", where)
-    if len(str(path.absolute()).encode()) >= PATH_MAX:
-        raise InputError(f"path longer than {PATH_MAX} bytes: {shown}", where)
-    if not path.parent.is_dir():
-        raise InputError(f"output folder does not exist: {path.parent}", where)
-    first = path
-    if patterns and "#" in path.name:
-        from deferred.io.video import expand_pattern
-
-        first = expand_pattern(path, 0, where)
-    if len(first.name.encode()) > NAME_MAX:
-        # caught here, not after the frame is rendered and written to a temporary name
-        raise InputError(f"file name longer than {NAME_MAX} bytes: {first.name[:40]}...", where)
-    if first.is_dir():
-        raise InputError(f"output is a folder, not a file: {first}", where)
-    return path
-
-
-def _either(suffixes: Sequence[str]) -> str:
-    return suffixes[0] if len(suffixes) == 1 else \
-        f"{', '.join(suffixes[:-1])} or {suffixes[-1]}"
-
-
-# OpenEXR stores channels sorted by name; this attribute keeps the order they were written in.
 CHANNEL_ORDER_ATTRIBUTE = "deferred:channels"
 
 
@@ -196,29 +155,7 @@ def write_text(path: str | Path, text: str) -> Path:
     return path
 
 
-# A file name may hold 255 bytes on the common file systems (ext4, XFS, btrfs, APFS, NTFS).
-NAME_MAX = 255
-PATH_MAX = 4096  # bytes of a whole path (Linux)
 NEGATIVE_TOLERANCE = 1e-3  # image values this far below 0 read as 0 (HDR filter ringing)
-# What temporary_path adds to a name: ".", ".", 12 hex digits, ".tmp".
-_TEMPORARY_EXTRA = 18
-
-
-def temporary_path(path: str | Path) -> Path:
-    """A hidden name next to ``path`` to write to before renaming over it; the suffix stays
-    last so writers pick the format from it. The stem is shortened where the extra characters
-    would take the name past ``NAME_MAX`` bytes (the random part keeps it unique)."""
-    path = Path(path)
-    directory = path.parent if str(path.parent) else Path(".")
-    stem = path.stem
-    room = NAME_MAX - _TEMPORARY_EXTRA - len(path.suffix.encode())
-    if len(stem.encode()) > room:
-        stem = stem.encode()[:max(room, 1)].decode(errors="ignore")
-    # Not mkstemp: its 0600 mode would survive the rename; the writer creates the file under
-    # the umask like any other output.
-    return directory / f".{stem}.{secrets.token_hex(6)}.tmp{path.suffix}"
-
-
 def _write_atomically(path: Path, write: Callable[[str], None]) -> None:
     """``write(temporary)`` next to ``path``, then rename over it: readers never see half a file,
     and a failure (an error, Ctrl-C) leaves the old file as it was and no temporary.

@@ -17,18 +17,15 @@ from __future__ import annotations
 
 import math
 import os
-import re
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Literal
 
 import numpy as np
 
 from deferred.errors import InputError, RenderError
-from deferred.io.images import IMAGE_SUFFIXES, VIDEO_SUFFIXES, temporary_path, write_image
+from deferred.io.images import write_image
+from deferred.io.paths import expand_pattern, output_kind, temporary_path
 
-OutputKind = Literal["image", "sequence", "video"]
-FRAME_RUN = re.compile(r"#+")
 GIF_TICK_MS = 10  # GIF frame delays are whole hundredths of a second
 MP4_QUALITY = 7  # imageio's 0..10 scale: libx264 CRF 15
 
@@ -42,35 +39,6 @@ def frame_times(frames: int, fps: float, start: float = 0.0) -> list[float]:
     if not (math.isfinite(start) and start >= 0.0):
         raise InputError(f"must be a finite number of seconds >= 0, got {start!r}", "--time")
     return [start + index / fps for index in range(frames)]
-
-
-def is_pattern(path: str | Path) -> bool:
-    """Whether ``path``'s file name has a run of ``#`` (a numbered sequence)."""
-    return "#" in Path(path).name
-
-
-def expand_pattern(path: str | Path, index: int, where: str = "-o") -> Path:
-    """``out_####.png``, 7 -> ``out_0007.png``: the file name's run of ``#`` becomes ``index``
-    zero-padded to the run's length. A name must have exactly one run."""
-    path = Path(path)
-    runs = FRAME_RUN.findall(path.name)
-    if len(runs) != 1:
-        raise InputError(f"a frame pattern has one run of '#' (out_####.png), got {path.name}",
-                         where)
-    if path.suffix.lower() not in IMAGE_SUFFIXES:
-        raise InputError(f"a frame pattern must end in {' or '.join(IMAGE_SUFFIXES)}: {path}",
-                         where)
-    if index < 0:
-        raise ValueError(f"frame number {index} < 0")
-    width = len(runs[0])
-    return path.with_name(FRAME_RUN.sub(f"{index:0{width}d}", path.name))
-
-
-def output_kind(path: str | Path) -> OutputKind:
-    """``"sequence"`` (a ``#`` pattern), ``"video"`` (.mp4, .gif) or ``"image"``."""
-    if is_pattern(path):
-        return "sequence"
-    return "video" if Path(path).suffix.lower() in VIDEO_SUFFIXES else "image"
 
 
 def check_video_size(path: str | Path, size: tuple[int, int], where: str = "-o") -> None:

@@ -27,6 +27,7 @@ from deferred.lighting.dispatch import (
     FULLSCREEN_UNIFORM,
     light_range_uniform,
 )
+from deferred.names import LightVolume
 
 if TYPE_CHECKING:
     from deferred.gl.uniforms import ProgramUniforms
@@ -74,7 +75,7 @@ class LightBuffer:
              ) -> tuple[np.ndarray, dict, int]:
         """(records, type -> (offset, count), full-screen light count): full-screen lights
         first, then volume lights inside the frustum of ``projection`` (all when None)."""
-        ordered = sorted(lights, key=lambda light: (light.volume != "fullscreen",
+        ordered = sorted(lights, key=lambda light: (light.volume != LightVolume.FULLSCREEN,
                                                     light.type_id))  # stable: scene order kept
         records = np.zeros((len(ordered), RECORD_VEC4S, 4), dtype=np.float32)
         start = 0
@@ -84,7 +85,7 @@ class LightBuffer:
             records[start:start + len(run), 0, 3] = float(light_type.type_id)
             start += len(run)
         keep = np.ones(len(ordered), bool)
-        volumes = np.array([light.volume != "fullscreen" for light in ordered], bool)
+        volumes = np.array([light.volume != LightVolume.FULLSCREEN for light in ordered], bool)
         if projection is not None and volumes.any():
             keep[volumes] = visible_spheres(records[volumes], projection)
         ordered = [light for light, kept in zip(ordered, keep, strict=True) if kept]
@@ -93,7 +94,7 @@ class LightBuffer:
         for index, light in enumerate(ordered):
             start, count = ranges.get(type(light), (index, 0))
             ranges[type(light)] = (start, count + 1)
-        global_count = sum(1 for light in ordered if light.volume == "fullscreen")
+        global_count = sum(1 for light in ordered if light.volume == LightVolume.FULLSCREEN)
         return records, ranges, global_count
 
     def upload(self, lights: list[Light], view: np.ndarray,

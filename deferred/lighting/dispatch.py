@@ -4,6 +4,7 @@ each type's range of the light buffer, and the loops over one light list's entri
 from __future__ import annotations
 
 from deferred.interfaces.light import Light
+from deferred.names import LightVolume
 
 DISPATCH_FILE = "generated/lights.glsl"
 LISTED_DISPATCH_FILE = "generated/listed_lights.glsl"  # after lights/light_lists.glsl only
@@ -67,8 +68,8 @@ def light_dispatch_glsl(light_types: list[type[Light]]) -> str:
                      "    }"]
         return [*body, "    return total;", "}"]
 
-    fullscreen = [cls for cls in light_types if cls.volume == "fullscreen"]
-    volumes = [cls for cls in light_types if cls.volume != "fullscreen"]
+    fullscreen = [cls for cls in light_types if cls.volume == LightVolume.FULLSCREEN]
+    volumes = [cls for cls in light_types if cls.volume != LightVolume.FULLSCREEN]
     lines += switch("evaluate_light", light_types)
     lines += switch("evaluate_volume_light", volumes)
     lines += loops("evaluate_fullscreen_lights", fullscreen, "fullscreen_light")
@@ -87,7 +88,7 @@ def listed_dispatch_glsl(light_types: list[type[Light]]) -> str:
     there; lights.toml at 640x360, half the lights spots: the tiled shading 35.9 -> 50.8 ms at
     1024 lights). A loop but the last stops at the first entry past its type's range, whose
     evaluation runs masked once on llvmpipe."""
-    volumes = sorted((cls for cls in light_types if cls.volume != "fullscreen"),
+    volumes = sorted((cls for cls in light_types if cls.volume != LightVolume.FULLSCREEN),
                      key=lambda cls: cls.type_id)
     lines = ["vec3 evaluate_listed_slots(int first, int length, Surface s, vec3 P, vec3 V) {",
              "    vec3 total = vec3(0.0);",

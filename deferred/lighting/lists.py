@@ -47,6 +47,7 @@ from deferred.gbuffer.layout import LINEAR_DEPTH
 from deferred.lighting.buffer import LIGHT_BUFFER, fullscreen_overflow
 from deferred.lighting.dispatch import FULLSCREEN_LIGHT_CAPACITY
 from deferred.lighting.volumes import surface_pass
+from deferred.names import EQUIVALENT_PATHS, LIST_PATHS, LightPath, Pipeline
 
 if TYPE_CHECKING:
     from deferred.core.frame import Frame
@@ -54,11 +55,7 @@ if TYPE_CHECKING:
     from deferred.gl.uniforms import ProgramUniforms
 
 LIGHT_LISTS = "light_lists"  # its name on a frame's blackboard
-DEFERRED_PATHS = ("volumes", "tiled", "clustered")
-FORWARD_PATHS = ("naive", "tiled")
 # A path named for one pipeline, in the other: forward has no volumes or clusters.
-FORWARD_EQUIVALENT = {"volumes": "naive", "clustered": "tiled"}
-DEFERRED_EQUIVALENT = {"naive": "volumes"}
 TILE = 16  # pixels per culling tile side (tiled, Forward+): an invocation of the culling each
 # The tiled lists are those of LIST_SPLIT x LIST_SPLIT sub-tiles of a culling tile (8x8 pixels):
 # the culling tests a light against a sub-tile only where it touches the tile.
@@ -90,15 +87,14 @@ def resolve_light_path(pipeline: str, requested: str | None, features: Features,
     fastest this context allows (tiled when compute shaders exist; volumes and naive on GL 3.3,
     where they are the only ones)."""
     if requested is None:
-        return "tiled" if features.compute_shaders else \
-            ("volumes" if pipeline == "deferred" else "naive")
-    names = DEFERRED_PATHS + FORWARD_PATHS
-    if requested not in names:
+        return LightPath.TILED if features.compute_shaders else \
+            (LightPath.VOLUMES if pipeline == Pipeline.DEFERRED else LightPath.NAIVE)
+    if requested not in set(LightPath):
         raise InputError(f"unknown light path '{requested}' (choose from "
-                         f"{', '.join(dict.fromkeys(names))})", where)
-    path = FORWARD_EQUIVALENT.get(requested, requested) if pipeline == "forward" else \
-        DEFERRED_EQUIVALENT.get(requested, requested)
-    if path in ("tiled", "clustered") and not features.compute_shaders:
+                         f"{', '.join(LightPath)})", where)
+    requested = LightPath(requested)
+    path = EQUIVALENT_PATHS[Pipeline(pipeline)].get(requested, requested)
+    if path in LIST_PATHS and not features.compute_shaders:
         raise InputError(f"light path '{requested}' needs compute shaders (GL 4.3); this context "
                          "has the GL 3.3 paths only (volumes, naive)", where)
     return path
@@ -183,8 +179,8 @@ def check_light_limits(light_path: str, size: tuple[int, int], volume_lights: in
     reads it)."""
     if lights - volume_lights > FULLSCREEN_LIGHT_CAPACITY:
         raise InputError(fullscreen_overflow(lights - volume_lights), "light")
-    if light_path in ("tiled", "clustered"):
-        grid = list_grid(*size, light_path == "clustered")
+    if light_path in LIST_PATHS:
+        grid = list_grid(*size, light_path == LightPath.CLUSTERED)
         overflow = list_overflow(grid, volume_lights)  # every light in one list: the most
         if overflow is not None:
             raise InputError(_lists_too_big(f"{volume_lights} lights", grid, *overflow),

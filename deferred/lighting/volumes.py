@@ -18,6 +18,7 @@ from deferred.gl.target_spec import TargetSpec
 from deferred.gl.targets import LIGHT_ACCUMULATION
 from deferred.interfaces.light import Light
 from deferred.lighting.buffer import LIGHT_BUFFER
+from deferred.names import LightVolume
 from deferred.scene.meshes import build_mesh
 
 if TYPE_CHECKING:
@@ -81,7 +82,7 @@ class LightTypePass(RenderPass):
         offset, count = frame.blackboard[LIGHT_BUFFER].range(self.light_type)
         if count == 0:
             return
-        sphere = self.light_type.volume == "sphere"
+        sphere = self.light_type.volume == LightVolume.SPHERE
         vertex = "lights/volume.vert" if sphere else "lights/fullscreen.vert"
         defines = {"LIGHT_FUNCTION": self.light_type.glsl_function}
         if self.occlusion:

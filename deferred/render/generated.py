@@ -9,6 +9,7 @@ from collections.abc import Iterable
 from deferred.gbuffer.layout import (
     DATA_FETCH_FILE,
     DATA_STRUCT_FILE,
+    GBufferLayout,
     data_fetch_glsl,
     data_struct_glsl,
     data_write_file,
@@ -16,13 +17,8 @@ from deferred.gbuffer.layout import (
 )
 from deferred.gbuffer.surface_id import SURFACE_ID_FILE, surface_id_glsl
 from deferred.interfaces.light import Light
-from deferred.interfaces.material import Material
-from deferred.interfaces.shading import (
-    GBufferLayout,
-    ShadingModel,
-    material_data,
-    shading_dispatch_glsl,
-)
+from deferred.interfaces.material import Material, material_data
+from deferred.interfaces.shading import ShadingModel, shading_dispatch_glsl
 from deferred.lighting.dispatch import (
     DISPATCH_FILE,
     LISTED_DISPATCH_FILE,

@@ -19,6 +19,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from deferred import names
 from deferred.core.graph import PassGraph, compile_graph
 from deferred.core.passes import (
     ClearPass,
@@ -89,7 +90,7 @@ def scene_passes(scene: Scene, pipeline: str) -> list[RenderPass]:
     by_class: dict[type, list] = {}
     for obj in scene.objects:
         by_class.setdefault(type(obj.material), []).append(obj)
-    phases = [Phase.FORWARD] if pipeline == "forward" else \
+    phases = [Phase.FORWARD] if pipeline == names.Pipeline.FORWARD else \
         [Phase.GEOMETRY, Phase.SCREEN, Phase.STIPPLE, Phase.LIGHTING, Phase.MATERIAL]
     shared: dict[str, RenderPass] = {}
     for cls, objects in by_class.items():
@@ -132,7 +133,7 @@ class Pipeline:
     light_paths: tuple[str, ...] = ()
 
     def __init__(self, light_path: str | None = None):
-        self.light_path = light_path or self.light_paths[0]
+        self.light_path = light_path or names.LightPath.TILED
         if self.light_path not in self.light_paths:
             raise InputError(f"the {self.name} pipeline has no light path '{self.light_path}' "
                              f"(choose from {', '.join(self.light_paths)})", "--light-path")
@@ -150,8 +151,8 @@ class Pipeline:
 
 
 class DeferredPipeline(Pipeline):
-    name = "deferred"
-    light_paths = ("tiled", "clustered", "volumes")
+    name = names.Pipeline.DEFERRED
+    light_paths = names.LIGHT_PATHS[names.Pipeline.DEFERRED]
 
     def build(self, scene: Scene) -> list[RenderPass]:
         layout = scene.gbuffer_layout()
@@ -163,7 +164,7 @@ class DeferredPipeline(Pipeline):
         occlusion = AMBIENT_OCCLUSION if any(AMBIENT_OCCLUSION in p.creates for p in passes) \
             else None
         folded = False  # the composition made by the lighting pass (below)
-        if self.light_path == "volumes":
+        if self.light_path == names.LightPath.VOLUMES:
             # the light accumulation starts as 0 on surfaces and the background elsewhere
             # (its clear); each light type's pass adds into it
             background = surface_pass("lighting.background", "lights/background.frag",
@@ -177,7 +178,7 @@ class DeferredPipeline(Pipeline):
             # Where no other pass writes the light accumulation and the material phase has no
             # pass, the composition is the light accumulation: the same pass writes both, and
             # there is nothing to copy.
-            clustered = self.light_path == "clustered"
+            clustered = self.light_path == names.LightPath.CLUSTERED
             folded = not phase_passes(scene, Phase.MATERIAL, [], wide) and not any(
                 LIGHT_ACCUMULATION in p.writes
                 for p in phase_passes(scene, Phase.LIGHTING, [], wide))
@@ -197,15 +198,15 @@ class DeferredPipeline(Pipeline):
 
 
 class ForwardPipeline(Pipeline):
-    name = "forward"
-    light_paths = ("tiled", "naive")
+    name = names.Pipeline.FORWARD
+    light_paths = names.LIGHT_PATHS[names.Pipeline.FORWARD]
 
     def build(self, scene: Scene) -> list[RenderPass]:
         wide = scene_passes(scene, self.name)
         creates = {COMPOSITE: replace(COMPOSITE_SPEC, clear=(*scene.background, 0.0)),
                    DEPTH: GBUFFER_TARGETS[DEPTH]}
         fixed: list[RenderPass] = []
-        if self.light_path == "tiled":  # Forward+: depth pre-pass, tiled culling
+        if self.light_path == names.LightPath.TILED:  # Forward+: depth pre-pass, tiled culling
             creates[LINEAR_DEPTH] = GBUFFER_TARGETS[LINEAR_DEPTH]
             fixed += [depth_prepass(p) for obj in scene.objects
                       for p in obj.material.passes(Phase.FORWARD, obj)
@@ -218,7 +219,7 @@ class ForwardPipeline(Pipeline):
         return passes
 
     def shader_defines(self) -> dict[str, str]:
-        return {"FORWARD_PLUS": "1"} if self.light_path == "tiled" else {}
+        return {"FORWARD_PLUS": "1"} if self.light_path == names.LightPath.TILED else {}
 
 
 def depth_prepass(lit: ForwardLitPass) -> RenderPass:
@@ -229,5 +230,5 @@ def depth_prepass(lit: ForwardLitPass) -> RenderPass:
                       colors=(LINEAR_DEPTH,), constants=lit.constants, order=Order.FIRST)
 
 
-PIPELINES: dict[str, type[Pipeline]] = {"deferred": DeferredPipeline,
-                                        "forward": ForwardPipeline}
+PIPELINES: dict[str, type[Pipeline]] = {names.Pipeline.DEFERRED.value: DeferredPipeline,
+                                        names.Pipeline.FORWARD.value: ForwardPipeline}

@@ -23,6 +23,7 @@ from deferred.interfaces.material import Material
 from deferred.interfaces.shading import ShadingTextures
 from deferred.lighting.buffer import LIGHT_BUFFER, LightBuffer
 from deferred.lighting.lists import LIGHT_LISTS, LightLists, check_light_limits, resolve_light_path
+from deferred.names import LightVolume
 from deferred.render.caches import FrameInputs, KeptMaterialInputs, ObjectTransforms
 from deferred.render.generated import generated_glsl
 from deferred.render.pipeline import PIPELINES, check_passes
@@ -132,7 +133,7 @@ class Renderer:
         ctx = self.gl.ctx
         features = self.gl.features
         self.light_path = resolve_light_path(pipeline, requested, features)
-        volume_lights = sum(1 for light in scene.lights if light.volume != "fullscreen")
+        volume_lights = sum(1 for light in scene.lights if light.volume != LightVolume.FULLSCREEN)
         check_light_limits(self.light_path, self.size, volume_lights, len(scene.lights),
                            self.gl.max_texture_size)
         self.pipeline = PIPELINES[pipeline](self.light_path)

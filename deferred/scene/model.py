@@ -38,8 +38,9 @@ from deferred.gl.meshes import MeshData
 from deferred.interfaces import registry
 from deferred.interfaces.effect import Effect
 from deferred.interfaces.light import Light
-from deferred.interfaces.material import Material, MaterialParams
-from deferred.interfaces.shading import ShadingModel, compose_layout
+from deferred.interfaces.material import Material, MaterialParams, compose_layout
+from deferred.interfaces.shading import ShadingModel
+from deferred.names import LightPath
 from deferred.params import validate_params
 from deferred.scene.camera import Camera, model_matrix
 from deferred.scene.meshes import load_mesh
@@ -140,7 +141,7 @@ class SceneModel(_Strict):
                                  description="linear RGB behind everything, each >= 0")
     exposure: float = Field(1.0, gt=0.0)
     tonemap: Literal["reinhard", "aces", "none"] = "aces"
-    light_path: Literal["volumes", "tiled", "clustered", "naive"] | None = Field(
+    light_path: LightPath | None = Field(
         None, description="how lights reach the pixels (deferred.lighting.lists); default the "
                           "fastest the context allows")
     camera: CameraModel = Field(default_factory=CameraModel)

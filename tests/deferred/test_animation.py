@@ -6,7 +6,8 @@ import pytest
 from deferred.cli import main
 from deferred.errors import InputError
 from deferred.io.images import read_image
-from deferred.io.video import expand_pattern, frame_times, gif_durations, output_kind
+from deferred.io.paths import expand_pattern, output_kind
+from deferred.io.video import frame_times, gif_durations
 from deferred.scene.model import scene_from_toml
 
 SCENE = """

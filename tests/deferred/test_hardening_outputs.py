@@ -24,7 +24,8 @@ from deferred.cli import main
 from deferred.debug.capture import capture_frame
 from deferred.debug.dump import is_dump_folder, safe_name, write_dump
 from deferred.errors import InputError, RenderError
-from deferred.io.images import NAME_MAX, temporary_path, write_image, write_text
+from deferred.io.images import write_image, write_text
+from deferred.io.paths import NAME_MAX, temporary_path
 from deferred.render.renderer import Renderer
 from deferred.scene.model import scene_from_dict
 

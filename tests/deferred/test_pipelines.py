@@ -7,9 +7,9 @@ from conftest import psnr
 
 from deferred.core.passes import Phase
 from deferred.gbuffer.layout import decode
+from deferred.gbuffer.surface_id import surface_id
 from deferred.gl.context import Features, GLContext
 from deferred.interfaces import registry
-from deferred.gbuffer.surface_id import surface_id
 from deferred.render.renderer import Renderer
 from deferred.scene.model import load_scene, scene_from_dict
 

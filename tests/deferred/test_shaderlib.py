@@ -91,8 +91,8 @@ def test_every_packaged_shader_program_compiles(gl):
     """The built-in programs compile on this driver (both light-buffer variants), with every
     built-in light type and shading model and their G-buffer data; installed plugins play no
     part."""
-    from deferred.interfaces import registry
     from deferred.gbuffer.layout import GBufferLayout
+    from deferred.interfaces import registry
     from deferred.materials.standard import StandardMaterial
     from deferred.render.generated import generated_glsl
 

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 import trimesh
 
-from deferred.interfaces import registry
 from deferred.gbuffer.surface_id import split_surface_id
+from deferred.interfaces import registry
 from deferred.scene.model import scene_from_dict
 
 

@@ -1,0 +1,54 @@
+"""Names that several layers use, defined once: the pipelines, the light paths each runs, and
+how a light type is bounded. Each is a string enum: a member equals its name as a string (what a
+user types, what a scene file holds) and prints as it (in messages, JSON and f-strings).
+(The phases of a frame are :class:`deferred.core.passes.Phase`.)
+"""
+
+from __future__ import annotations
+
+from enum import Enum
+
+
+class NameEnum(str, Enum):
+    """A string enum whose members print as their value."""
+
+    def __str__(self) -> str:
+        return self.value
+
+    def __format__(self, spec: str) -> str:
+        return format(self.value, spec)
+
+
+class Pipeline(NameEnum):
+    DEFERRED = "deferred"
+    FORWARD = "forward"
+
+
+class LightPath(NameEnum):
+    """How lights reach the pixels (``--light-path``; ``deferred.lighting``)."""
+
+    VOLUMES = "volumes"  # deferred: an instanced pass per light type, spheres for local lights
+    TILED = "tiled"  # deferred tiled shading / Forward+: lists per screen tile (compute)
+    CLUSTERED = "clustered"  # deferred: lists per tile and depth slice (compute)
+    NAIVE = "naive"  # forward: every light looped per fragment
+
+
+# each pipeline's light paths, in the order the bench runs them
+LIGHT_PATHS: dict[Pipeline, tuple[LightPath, ...]] = {
+    Pipeline.DEFERRED: (LightPath.VOLUMES, LightPath.TILED, LightPath.CLUSTERED),
+    Pipeline.FORWARD: (LightPath.NAIVE, LightPath.TILED),
+}
+# the paths that cull lights into lists with compute shaders (GL 4.3)
+LIST_PATHS = (LightPath.TILED, LightPath.CLUSTERED)
+# a path named for one pipeline, asked of the other: what that one runs instead
+EQUIVALENT_PATHS: dict[Pipeline, dict[LightPath, LightPath]] = {
+    Pipeline.DEFERRED: {LightPath.NAIVE: LightPath.VOLUMES},
+    Pipeline.FORWARD: {LightPath.VOLUMES: LightPath.NAIVE, LightPath.CLUSTERED: LightPath.TILED},
+}
+
+
+class LightVolume(NameEnum):
+    """How the deferred lighting bounds a light type (``Light.volume``)."""
+
+    FULLSCREEN = "fullscreen"  # every pixel (directional, ambient)
+    SPHERE = "sphere"  # the record's position.xyz and radius position.w (point, spot)
