@@ -5,9 +5,7 @@ from __future__ import annotations
 import numpy as np
 from pydantic import Field
 
-from deferred.interfaces.light import Light, LightParams, view_direction
-from deferred.interfaces.registry import lights
-from deferred.validation import NonZeroVec3, Radiance
+from deferred.api import Light, LightParams, NonZeroVec3, Radiance, lights, view_direction
 
 
 class AmbientParams(LightParams):

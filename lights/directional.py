@@ -5,9 +5,7 @@ from __future__ import annotations
 import numpy as np
 from pydantic import Field
 
-from deferred.interfaces.light import Light, LightParams, view_direction
-from deferred.interfaces.registry import lights
-from deferred.validation import NonZeroVec3
+from deferred.api import Light, LightParams, NonZeroVec3, lights, view_direction
 
 
 class DirectionalParams(LightParams):

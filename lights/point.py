@@ -5,8 +5,7 @@ from __future__ import annotations
 import numpy as np
 from pydantic import Field
 
-from deferred.interfaces.light import Light, LightParams, radiances, view_points
-from deferred.interfaces.registry import lights
+from deferred.api import Light, LightParams, lights, radiances, view_points
 
 
 class PointParams(LightParams):

@@ -5,9 +5,7 @@ from __future__ import annotations
 import numpy as np
 from pydantic import Field, model_validator
 
-from deferred.interfaces.light import Light, radiances, view_directions, view_points
-from deferred.interfaces.registry import lights
-from deferred.validation import NonZeroVec3
+from deferred.api import Light, NonZeroVec3, lights, radiances, view_directions, view_points
 
 from .point import PointParams
 

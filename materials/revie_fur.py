@@ -20,12 +20,22 @@ from typing import TYPE_CHECKING, Any
 import moderngl
 from pydantic import Field
 
-from deferred.core.passes import Phase, RenderPass
-from deferred.gbuffer.layout import ALBEDO_SPECULAR, LINEAR_DEPTH, NORMAL_EXPONENT_ID
-from deferred.gl.targets import COMPOSITE, LIGHT_ACCUMULATION
-from deferred.interfaces.material import BlinnPhongParams, ForwardLitPass, GBufferPass, Material
-from deferred.interfaces.registry import materials
-from deferred.validation import Albedo, NonZeroVec3
+from deferred.api import (
+    ALBEDO_SPECULAR,
+    COMPOSITE,
+    LIGHT_ACCUMULATION,
+    LINEAR_DEPTH,
+    NORMAL_EXPONENT_ID,
+    Albedo,
+    BlinnPhongParams,
+    ForwardLitPass,
+    GBufferPass,
+    Material,
+    NonZeroVec3,
+    Phase,
+    RenderPass,
+    materials,
+)
 
 from .techniques.fins import FinPass
 from .techniques.fur import (
@@ -47,8 +57,7 @@ from .techniques.stipple import (
 )
 
 if TYPE_CHECKING:
-    from deferred.core.frame import Frame
-    from deferred.scene.model import SceneObject
+    from deferred.api import Frame, SceneObject
 
 Vec3 = tuple[float, float, float]
 FUR_VERTEX = "materials/revie_fur/fur.vert"

@@ -14,11 +14,10 @@ from typing import TYPE_CHECKING
 import moderngl
 import numpy as np
 
-from deferred.interfaces.registry import shading_models
-from deferred.interfaces.shading import GBufferData, ShadingModel
+from deferred.api import GBufferData, ShadingModel, shading_models
 
 if TYPE_CHECKING:
-    from deferred.core.frame import Frame
+    from deferred.api import Frame
 
 STRAND_TANGENT = GBufferData(
     "strand_tangent", "RG16F", ("u", "v"),

@@ -28,13 +28,19 @@ import moderngl
 import numpy as np
 from pydantic import Field, model_validator
 
-from deferred.core.passes import Phase, RenderPass
-from deferred.errors import InputError
-from deferred.gl.targets import COMPOSITE
-from deferred.interfaces.material import BlinnPhongParams, ForwardLitPass, GBufferPass, Material
-from deferred.interfaces.registry import materials
-from deferred.io.images import read_image
-from deferred.validation import Albedo
+from deferred.api import (
+    COMPOSITE,
+    Albedo,
+    BlinnPhongParams,
+    ForwardLitPass,
+    GBufferPass,
+    InputError,
+    Material,
+    Phase,
+    RenderPass,
+    materials,
+    read_image,
+)
 
 from .techniques.fins import FinPass
 from .techniques.fur import (
@@ -70,8 +76,7 @@ from .techniques.wetness import (
 )
 
 if TYPE_CHECKING:
-    from deferred.core.frame import Frame
-    from deferred.scene.model import SceneObject
+    from deferred.api import Frame, SceneObject
 
 Vec3 = tuple[float, float, float]
 FUR_VERTEX = "materials/shell_fur/fur.vert"

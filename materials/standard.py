@@ -7,13 +7,17 @@ from typing import TYPE_CHECKING
 import moderngl
 from pydantic import Field
 
-from deferred.interfaces.material import BlinnPhongParams, Material
-from deferred.interfaces.registry import materials
-from deferred.io.images import check_image
-from deferred.validation import Albedo, require_regular_file
+from deferred.api import (
+    Albedo,
+    BlinnPhongParams,
+    Material,
+    check_image,
+    materials,
+    require_regular_file,
+)
 
 if TYPE_CHECKING:
-    from deferred.core.frame import Frame
+    from deferred.api import Frame
 
 
 class StandardParams(BlinnPhongParams):

@@ -14,12 +14,20 @@ from typing import TYPE_CHECKING, Literal
 
 from pydantic import Field
 
-from deferred.core.passes import ObjectPass, Order, Phase, RenderPass
-from deferred.gbuffer.layout import LINEAR_DEPTH, NORMAL_EXPONENT_ID
-from deferred.gl.targets import COMPOSITE, LIGHT_ACCUMULATION
-from deferred.interfaces.material import BlinnPhongParams, Material
-from deferred.interfaces.registry import materials
-from deferred.validation import Albedo
+from deferred.api import (
+    COMPOSITE,
+    LIGHT_ACCUMULATION,
+    LINEAR_DEPTH,
+    NORMAL_EXPONENT_ID,
+    Albedo,
+    BlinnPhongParams,
+    Material,
+    ObjectPass,
+    Order,
+    Phase,
+    RenderPass,
+    materials,
+)
 
 from .techniques.stipple import (
     StippleObliterationPass,
@@ -29,7 +37,7 @@ from .techniques.stipple import (
 )
 
 if TYPE_CHECKING:
-    from deferred.scene.model import SceneObject
+    from deferred.api import SceneObject
 
 
 class StippleGlassParams(BlinnPhongParams):

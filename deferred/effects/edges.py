@@ -6,13 +6,20 @@ from __future__ import annotations
 
 from pydantic import Field
 
-from deferred.core.passes import FullscreenPass, Order, Phase, RenderPass
-from deferred.gbuffer.layout import LINEAR_DEPTH, NORMAL_EXPONENT_ID
-from deferred.gl.target_spec import TargetSpec
-from deferred.gl.targets import FINAL
-from deferred.interfaces.effect import Effect, EffectParams
-from deferred.interfaces.registry import effects
-from deferred.validation import Albedo
+from deferred.api import (
+    FINAL,
+    LINEAR_DEPTH,
+    NORMAL_EXPONENT_ID,
+    Albedo,
+    Effect,
+    EffectParams,
+    FullscreenPass,
+    Order,
+    Phase,
+    RenderPass,
+    TargetSpec,
+    effects,
+)
 
 EDGES_RAW = "edges_raw"
 EDGES = "edges"

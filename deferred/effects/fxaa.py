@@ -6,10 +6,18 @@ from __future__ import annotations
 
 from pydantic import Field
 
-from deferred.core.passes import FullscreenPass, Order, Phase, RenderPass, copy_pass
-from deferred.gl.targets import FINAL, FINAL_SPEC
-from deferred.interfaces.effect import Effect, EffectParams
-from deferred.interfaces.registry import effects
+from deferred.api import (
+    FINAL,
+    FINAL_SPEC,
+    Effect,
+    EffectParams,
+    FullscreenPass,
+    Order,
+    Phase,
+    RenderPass,
+    copy_pass,
+    effects,
+)
 
 FXAA_SOURCE = "fxaa_source"
 

@@ -9,11 +9,18 @@ from __future__ import annotations
 
 from pydantic import Field
 
-from deferred.core.passes import FullscreenPass, Phase, RenderPass
-from deferred.gbuffer.layout import LINEAR_DEPTH, NORMAL_EXPONENT_ID
-from deferred.gl.target_spec import TargetSpec
-from deferred.interfaces.effect import AMBIENT_OCCLUSION, Effect, EffectParams
-from deferred.interfaces.registry import effects
+from deferred.api import (
+    AMBIENT_OCCLUSION,
+    LINEAR_DEPTH,
+    NORMAL_EXPONENT_ID,
+    Effect,
+    EffectParams,
+    FullscreenPass,
+    Phase,
+    RenderPass,
+    TargetSpec,
+    effects,
+)
 
 SSAO_RAW = "ssao_raw"
 SSAO_SPEC = TargetSpec(1, "f1", "ambient occlusion (1 = open)")

@@ -1,0 +1,15 @@
+"""The scene: its model (objects, lights, camera, timeline), the loader of scene files, the
+camera and the meshes' loaders."""
+
+from deferred.scene.camera import Camera
+from deferred.scene.model import (
+    Scene,
+    SceneObject,
+    TimelineEvent,
+    load_scene,
+    scene_from_dict,
+    scene_from_toml,
+)
+
+__all__ = ["Camera", "Scene", "SceneObject", "TimelineEvent", "load_scene", "scene_from_dict",
+           "scene_from_toml"]

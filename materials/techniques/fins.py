@@ -11,9 +11,7 @@ from typing import Any
 import moderngl
 import numpy as np
 
-from deferred.core.passes import ObjectPass, Order
-from deferred.gbuffer.layout import DEPTH
-from deferred.gl.meshes import GpuMesh, MeshData
+from deferred.api import DEPTH, GpuMesh, MeshData, ObjectPass, Order
 
 
 def edge_adjacency(mesh: MeshData, tolerance: float = 1e-6) -> np.ndarray:

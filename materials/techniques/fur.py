@@ -25,15 +25,13 @@ import moderngl
 import numpy as np
 from pydantic import Field, model_validator
 
-from deferred.errors import InputError
-from deferred.interfaces.material import MaterialParams
+from deferred.api import InputError, MaterialParams
 
 from .fur_volume import FurPattern, pattern, strand_volume, volume_texture
 from .heightfield import heightfield_volume, load_heightfield
 
 if TYPE_CHECKING:
-    from deferred.core.frame import Frame
-    from deferred.scene.model import SceneObject
+    from deferred.api import Frame, SceneObject
 
 # A heightfield image tile counts as this many strands when density converts to tiles per unit.
 IMAGE_TILE_STRANDS = 1024

@@ -28,13 +28,19 @@ from typing import TYPE_CHECKING
 
 import moderngl
 
-from deferred.core.passes import FullscreenPass, Order, Phase
-from deferred.gbuffer.layout import ALBEDO_SPECULAR, LINEAR_DEPTH, NORMAL_EXPONENT_ID
-from deferred.gl.target_spec import TargetSpec
-from deferred.gl.targets import LIGHT_ACCUMULATION
+from deferred.api import (
+    ALBEDO_SPECULAR,
+    LIGHT_ACCUMULATION,
+    LINEAR_DEPTH,
+    NORMAL_EXPONENT_ID,
+    FullscreenPass,
+    Order,
+    Phase,
+    TargetSpec,
+)
 
 if TYPE_CHECKING:
-    from deferred.core.frame import Frame
+    from deferred.api import Frame
 
 FUR_LIGHT_FRAGMENT = "techniques/fur_light.frag"
 

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from deferred.io.images import read_image
+from deferred.api import read_image
 
 from .fur_volume import VOLUME_LAYERS
 

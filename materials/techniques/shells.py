@@ -9,8 +9,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from deferred.core.passes import ObjectPass, Order
-from deferred.gbuffer.layout import DEPTH
+from deferred.api import DEPTH, ObjectPass, Order
 
 from .fur import shell_count, shell_layout
 from .fur_volume import VOLUME_LAYERS

@@ -14,10 +14,19 @@ under another's stipple samples.
 
 from __future__ import annotations
 
-from deferred.core.passes import ObjectPass, Order, Phase, RenderPass, copy_pass
-from deferred.gbuffer.layout import DEPTH, LINEAR_DEPTH, NORMAL_EXPONENT_ID
-from deferred.gl.targets import COMPOSITE, COMPOSITE_SPEC
-from deferred.interfaces.material import GBufferPass
+from deferred.api import (
+    COMPOSITE,
+    COMPOSITE_SPEC,
+    DEPTH,
+    LINEAR_DEPTH,
+    NORMAL_EXPONENT_ID,
+    GBufferPass,
+    ObjectPass,
+    Order,
+    Phase,
+    RenderPass,
+    copy_pass,
+)
 
 PATTERNS = (2, 4)
 COMPOSITE_SNAPSHOT = "composite_snapshot"

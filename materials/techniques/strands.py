@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from deferred.gl.meshes import MeshData
+from deferred.api import MeshData
 
 
 @dataclass(frozen=True)

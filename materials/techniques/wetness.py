@@ -23,9 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from deferred.errors import InputError
-from deferred.gl.meshes import MeshData
-from deferred.io.images import read_channels, read_image
+from deferred.api import InputError, MeshData, read_channels, read_image
 
 DRY_CENTRE = -8.0  # the (R, G) of a dry texel: no clump centre is ever within reach of it
 

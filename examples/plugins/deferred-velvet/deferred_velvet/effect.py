@@ -2,9 +2,7 @@
 
 from pydantic import Field
 
-from deferred.core.passes import FullscreenPass, Order, Phase
-from deferred.gl.targets import FINAL
-from deferred.interfaces.effect import Effect, EffectParams
+from deferred.api import FINAL, Effect, EffectParams, FullscreenPass, Order, Phase
 
 from . import SHADERS
 

@@ -3,8 +3,7 @@
 import numpy as np
 from pydantic import Field
 
-from deferred.interfaces.light import Light, LightParams, view_direction
-from deferred.validation import NonZeroVec3
+from deferred.api import Light, LightParams, NonZeroVec3, view_direction
 
 from . import SHADERS
 

@@ -2,7 +2,7 @@
 
 from pydantic import Field
 
-from deferred.interfaces.material import Material, MaterialParams
+from deferred.api import Material, MaterialParams
 
 from . import SHADERS
 

@@ -1,6 +1,6 @@
 """The velvet shading model and the G-buffer channel it reads."""
 
-from deferred.interfaces.shading import GBufferData, ShadingModel
+from deferred.api import GBufferData, ShadingModel
 
 from . import SHADERS
 

@@ -1,0 +1,122 @@
+"""The plugin API: everything a material, light, shading model or effect imports, in one module.
+
+A plugin (the built-in materials, lights and effects, and the example package in
+``examples/plugins``) imports from here and nowhere else in ``deferred``;
+``docs/writing-a-material.md`` walks through it. The names, by what they are for:
+
+- **interfaces**: :class:`Material` (with :class:`MaterialParams`, :class:`BlinnPhongParams`,
+  the passes it gets by default, :class:`GBufferPass` and :class:`ForwardLitPass`),
+  :class:`ShadingModel`, :class:`GBufferData`, :class:`Light` (:class:`LightParams`),
+  :class:`Effect` (:class:`EffectParams`), and the registries to register them with:
+  ``materials``, ``lights``, ``shading_models``, ``effects``.
+- **passes**: :class:`RenderPass`, :class:`ObjectPass`, :class:`FullscreenPass`,
+  :class:`ClearPass`, :func:`copy_pass`, :class:`Phase` and :class:`Order`; the
+  :class:`Frame` a pass runs against; :class:`TargetSpec` for the targets a pass creates.
+- **targets by name**: the G-buffer's (``ALBEDO_SPECULAR``, ``NORMAL_EXPONENT_ID``,
+  ``LINEAR_DEPTH``, ``DEPTH``, ``GBUFFER_COLOR_TARGETS``) and the frame's
+  (``LIGHT_ACCUMULATION``, ``COMPOSITE``, ``FINAL`` and their specs).
+- **parameters**: the validated types (:data:`Albedo`, :data:`Radiance`, :data:`NonZeroVec3`),
+  :class:`Params` and ``UniformOverrides``; ``require_regular_file`` for file parameters.
+- **data**: :class:`MeshData` and :class:`GpuMesh` (the vertex format), :class:`SceneObject`
+  and :class:`Scene` (what passes are made for), images (:func:`read_image`,
+  :func:`read_channels`, :func:`check_image`), the light helpers (``view_point(s)``,
+  ``view_direction(s)``, ``radiances``), the names (:class:`LightVolume`, :class:`Pipeline`,
+  :class:`LightPath`) and the errors (:class:`InputError`, :class:`RenderError`).
+- **GLSL**: :data:`GLSL_INCLUDES`, the framework's shader files a plugin's GLSL may include,
+  each with what it gives.
+"""
+
+from __future__ import annotations
+
+from deferred.core.frame import Frame
+from deferred.core.passes import (
+    ClearPass,
+    FullscreenPass,
+    ObjectPass,
+    Order,
+    Phase,
+    RenderPass,
+    copy_pass,
+)
+from deferred.errors import InputError, RenderError
+from deferred.gbuffer import (
+    ALBEDO_SPECULAR,
+    DEPTH,
+    GBUFFER_COLOR_TARGETS,
+    LINEAR_DEPTH,
+    NORMAL_EXPONENT_ID,
+    GBufferData,
+)
+from deferred.gl.meshes import GpuMesh, MeshData
+from deferred.gl.target_spec import TargetSpec
+from deferred.gl.targets import (
+    COMPOSITE,
+    COMPOSITE_SPEC,
+    FINAL,
+    FINAL_SPEC,
+    LIGHT_ACCUMULATION,
+    LIGHT_ACCUMULATION_SPEC,
+)
+from deferred.interfaces.effect import AMBIENT_OCCLUSION, Effect, EffectParams
+from deferred.interfaces.light import (
+    Light,
+    LightParams,
+    radiances,
+    view_direction,
+    view_directions,
+    view_point,
+    view_points,
+)
+from deferred.interfaces.material import (
+    BlinnPhongParams,
+    ForwardLitPass,
+    GBufferPass,
+    Material,
+    MaterialParams,
+)
+from deferred.interfaces.registry import effects, lights, materials, shading_models
+from deferred.interfaces.shading import ShadingModel
+from deferred.io.images import check_image, read_channels, read_image
+from deferred.names import LightPath, LightVolume, Pipeline
+from deferred.params import Params, UniformOverrides
+from deferred.scene import Scene, SceneObject
+from deferred.validation import Albedo, NonZeroVec3, Radiance, require_regular_file
+
+# The framework's GLSL a plugin may include (``#include "<file>"``), and what each gives.
+GLSL_INCLUDES: dict[str, str] = {
+    "common/surface.glsl": "struct Surface (what a material's surface function returns) and "
+                           "the surface-id helpers",
+    "common/surface_input.glsl": "struct SurfaceInput (the fragment's interpolated inputs) "
+                                 "and the framework's completion of a Surface",
+    "common/object_transform.glsl": "the object's model and normal matrices and the camera's "
+                                    "view (vertex shaders)",
+    "common/lighting.glsl": "struct LightRecord and the shading-model interface (a light's "
+                            "GLSL function)",
+    "common/forward_lighting.glsl": "every light of the frame at one surface point (forward "
+                                    "passes)",
+    "gbuffer/layout.glsl": "the G-buffer's encoding and decoding",
+    "gbuffer/write.glsl": "the G-buffer's outputs and gbuffer_write (G-buffer passes)",
+    "techniques/stipple.glsl": "stipple patterns (Revie 2.3.4, Listing 2.6)",
+    "techniques/rim.glsl": "rim scattering by bent normals (Revie 2.3.2, Listing 2.3)",
+    "techniques/grain_normal.glsl": "the anisotropic grain normal (Revie 2.3.3, Listing 2.5)",
+    "techniques/shells.glsl": "concentric shell offsets (Revie 2.3.1, Listing 2.1)",
+    "techniques/fur.glsl": "the fur volume's coverage and brightness lookups",
+    "techniques/accumulated_light.glsl": "a fur layer's light from the light accumulation "
+                                         "(Revie 2.4.4, Listing 2.2)",
+    "techniques/fur_light.glsl": "a fur layer's light from a fur_light gather",
+    "techniques/strand_tangent.glsl": "a strand tangent as G-buffer data (Kajiya-Kay)",
+}
+
+__all__ = [
+    "ALBEDO_SPECULAR", "AMBIENT_OCCLUSION", "COMPOSITE", "COMPOSITE_SPEC", "DEPTH", "FINAL",
+    "FINAL_SPEC", "GBUFFER_COLOR_TARGETS", "GLSL_INCLUDES", "LIGHT_ACCUMULATION",
+    "LIGHT_ACCUMULATION_SPEC", "LINEAR_DEPTH", "NORMAL_EXPONENT_ID", "Albedo",
+    "BlinnPhongParams", "ClearPass", "Effect", "EffectParams", "ForwardLitPass", "Frame",
+    "FullscreenPass", "GBufferData", "GBufferPass", "GpuMesh", "InputError", "Light",
+    "LightParams", "LightPath", "LightVolume", "Material", "MaterialParams", "MeshData",
+    "NonZeroVec3", "ObjectPass", "Order", "Params", "Phase", "Pipeline", "Radiance",
+    "RenderError", "RenderPass", "Scene", "SceneObject", "ShadingModel", "TargetSpec",
+    "UniformOverrides", "check_image", "copy_pass", "effects", "lights", "materials",
+    "radiances", "read_channels", "read_image", "require_regular_file", "shading_models",
+    "view_direction", "view_directions", "view_point", "view_points",
+]
