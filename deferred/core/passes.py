@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 import moderngl
 
 from deferred.gl.target_spec import TargetSpec
+from deferred.memo import overrides
 
 if TYPE_CHECKING:
     from deferred.core.frame import Frame
@@ -85,6 +86,20 @@ class RenderPass(ABC):
         return f"<{type(self).__name__} {self.name} ({self.phase.value})>"
 
 
+def drawn_targets(samples: tuple[str, ...], colors: tuple[str, ...] | list[str],
+                  blend: str | None, depth: str | None, depth_test: bool,
+                  depth_write: bool) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """(reads, writes) of a pass drawing into ``colors`` and ``depth`` with this state: it reads
+    what it samples, the colours it blends over, and the depth it tests against or has bound
+    without writing it (the depth of earlier passes, kept); it writes its colours and, with
+    depth writes, the depth."""
+    reads = tuple(dict.fromkeys(
+        [*samples, *(colors if blend else ()),
+         *((depth,) if depth and (depth_test or not depth_write) else ())]))
+    writes = tuple(colors) + ((depth,) if depth and depth_write else ())
+    return reads, writes
+
+
 class ClearPass(RenderPass):
     """Create targets and nothing else: the renderer clears each to its declared value when this
     pass runs (the G-buffer's ``gbuffer.clear``)."""
@@ -132,10 +147,8 @@ class FullscreenPass(RenderPass):
         self.depth_write = depth_write
         self.instances = instances
         self.samples = tuple(dict.fromkeys(inputs.values()))
-        self.reads = tuple(dict.fromkeys(
-            [*inputs.values(), *(outputs if blend else ()),
-             *((depth,) if depth and (depth_test or not depth_write) else ())]))
-        self.writes = outputs + ((depth,) if depth and depth_write else ())
+        self.reads, self.writes = drawn_targets(self.samples, outputs, blend, depth, depth_test,
+                                                depth_write)
 
     def execute(self, frame: Frame) -> None:
         program = frame.shaders.program(self.vertex, self.fragment, defines=self.defines)
@@ -185,14 +198,16 @@ class ObjectPass(RenderPass):
     extra_defines: dict[str, str] | None = None
     # the last program lookup: (shaders, generation, material, params, mesh, defines, program)
     _program_memo: tuple | None = None
-    # whether uniforms, textures, draws and draw_uniforms are ObjectPass's own (set for each
-    # subclass as it is made)
+    # whether uniforms, textures, draws and draw_uniforms are ObjectPass's own, and whether
+    # defines is the class's own (set for each subclass as it is made: deferred.memo.overrides)
     _hooks_unchanged: ClassVar[bool] = True
+    _own_defines: ClassVar[bool] = False
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
-        cls._hooks_unchanged = all(getattr(cls, hook) is getattr(ObjectPass, hook) for hook in
-                                   ("uniforms", "textures", "draws", "draw_uniforms"))
+        cls._hooks_unchanged = not overrides(cls, ObjectPass, "uniforms", "textures", "draws",
+                                             "draw_uniforms")
+        cls._own_defines = overrides(cls, ObjectPass, "defines")
 
     def __init__(self, name: str, phase: Phase, obj: SceneObjectLike, **options: Any):
         self.name = name
@@ -204,12 +219,8 @@ class ObjectPass(RenderPass):
                 raise TypeError(f"{type(self).__name__} has no option '{key}'")
             setattr(self, key, value)
         self.samples = tuple(self.extra_reads)
-        self.reads = tuple(dict.fromkeys(
-            [*self.extra_reads, *(self.colors if self.blend else ()),
-             *((self.depth,) if self.depth and (self.depth_test or not self.depth_write)
-               else ())]))
-        self.writes = tuple(self.colors) + ((self.depth,) if self.depth and self.depth_write
-                                            else ())
+        self.reads, self.writes = drawn_targets(self.samples, self.colors, self.blend,
+                                                self.depth, self.depth_test, self.depth_write)
 
     def defines(self, frame: Frame) -> dict[str, str]:
         defines = self.obj.material.defines(self.obj)
@@ -243,7 +254,7 @@ class ObjectPass(RenderPass):
         # those are the same objects, so is the program (building and comparing the defines
         # cost 2 us of a 12 us draw).
         if fresh and memo[2] is material and memo[3] is material.params and \
-                memo[4] is self.obj.mesh and type(self).defines is ObjectPass.defines:
+                memo[4] is self.obj.mesh and not self._own_defines:
             return memo[6]
         defines = self.defines(frame)
         program = memo[6] if fresh and memo[5] == defines else \

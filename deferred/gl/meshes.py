@@ -13,6 +13,8 @@ from dataclasses import dataclass, field
 import moderngl
 import numpy as np
 
+from deferred.memo import kept_while
+
 # (name, components) in buffer order; the GLSL attribute is ``in_<name>``.
 VERTEX_ATTRIBUTES = (("position", 3), ("normal", 3), ("uv", 2), ("tangent", 3),
                      ("binormal", 3), ("comb", 4))
@@ -42,15 +44,12 @@ class MeshData:
         parts = [self.positions, self.normals, self.uvs, self.tangents, self.binormals, self.comb]
         return np.ascontiguousarray(np.hstack(parts).astype(np.float32))
 
+    @kept_while("positions")
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
         """(least, greatest) position per axis; made once per positions array (the GPU copy
         assumes the arrays do not change either), as the fur's level of detail asks for it
         every frame."""
-        cached = self.__dict__.get("_bounds")
-        if cached is None or cached[0] is not self.positions:
-            cached = self.__dict__["_bounds"] = (
-                self.positions, (self.positions.min(axis=0), self.positions.max(axis=0)))
-        return cached[1]
+        return self.positions.min(axis=0), self.positions.max(axis=0)
 
 
 @dataclass

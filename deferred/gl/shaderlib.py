@@ -209,10 +209,6 @@ class ShaderLibrary:
                     pending.append(match.group(1) or match.group(2))
         return frozenset(names)
 
-    def members(self, program) -> frozenset[str]:
-        """The program's active uniforms and blocks (``name in program`` walks them all)."""
-        return self.uniforms(program).members
-
     def uniforms(self, program) -> ProgramUniforms:
         """The program's uniforms, written only when their values change."""
         uniforms = self._uniforms.get(program.glo)

@@ -35,6 +35,7 @@ from deferred.gbuffer.layout import (
 from deferred.gbuffer.surface_id import surface_id
 from deferred.gl.targets import COMPOSITE
 from deferred.interfaces import registry
+from deferred.memo import kept_while
 from deferred.params import Params, UniformOverrides, params_uniforms, validate_params
 
 if TYPE_CHECKING:
@@ -132,38 +133,38 @@ class Material:
         """Preprocessor defines of this material's programs for ``obj``: a function of the
         params and ``obj.mesh`` only (an object pass keeps its program while those are the
         same objects; params are replaced whole, never changed in place)."""
-        # every pass of every object asks, every frame: made once (the class, its shading
-        # model and so its data never change), copied for the caller to extend
-        base = self.__dict__.get("_base_defines")
-        if base is None:
-            names = [data.name for data in material_data(self)]
-            base = self.__dict__["_base_defines"] = {
-                "SURFACE_FILE": f'"{self.surface_shader}"',
+        return dict(self._base_defines())  # a copy for the caller to extend
+
+    @kept_while()  # the class, its shading model and so its data never change
+    def _base_defines(self) -> dict[str, str]:
+        names = [data.name for data in material_data(self)]
+        return {"SURFACE_FILE": f'"{self.surface_shader}"',
                 "GBUFFER_DATA_WRITE": f'"{data_write_file(names)}"'}
-        return dict(base)
+
+    @kept_while()
+    def written_data(self) -> tuple[GBufferData, ...]:
+        """The G-buffer data this material's objects write: its own and its shading
+        model's, by name (:func:`material_data`)."""
+        return _material_data(self)
 
     def gbuffer_targets(self) -> tuple[str, ...]:
         """The targets this material's G-buffer passes write: the core G-buffer, then its data
         (its own and its shading model's), in the order of ``gbuffer/write.glsl``'s outputs."""
         return (*GBUFFER_COLOR_TARGETS, *(data.name for data in material_data(self)))
 
+    @kept_while("type_id", "shading_model")  # asked for by every object, every frame
     def surface_id(self) -> int:
         """The G-buffer id of this material's pixels: its shading model and its type id."""
-        key = (self.type_id, self.shading_model)
-        cached = self.__dict__.get("_surface_id")  # asked for by every object, every frame
-        if cached is None or cached[0] != key:
-            model_id = registry.shading_models.get(self.shading_model).type_id
-            cached = self.__dict__["_surface_id"] = (key, surface_id(self.type_id, model_id))
-        return cached[1]
+        model_id = registry.shading_models.get(self.shading_model).type_id
+        return surface_id(self.type_id, model_id)
 
     def uniforms(self, frame: Frame) -> dict[str, Any]:
         """``u_<field>`` for every parameter that is a uniform (``uniform_overrides``)."""
-        # params are frozen and replaced whole (a timeline event): made once per params
-        cached = self.__dict__.get("_params_uniforms")
-        if cached is None or cached[0] is not self.params:
-            cached = self.__dict__["_params_uniforms"] = (
-                self.params, params_uniforms(self.params, self.uniform_overrides))
-        return dict(cached[1])
+        return dict(self._params_uniforms())
+
+    @kept_while("params")  # params are frozen and replaced whole (a timeline event)
+    def _params_uniforms(self) -> dict[str, Any]:
+        return params_uniforms(self.params, self.uniform_overrides)
 
     def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
         return {}
@@ -242,10 +243,7 @@ def describe_model(model: type[BaseModel]) -> list[dict[str, Any]]:
 def material_data(material: Material) -> tuple[GBufferData, ...]:
     """The data ``material``'s objects write: its own and its shading model's, by name
     (kept on the material: its class, model and parameters never change)."""
-    cached = material.__dict__.get("_gbuffer_data")
-    if cached is None:
-        cached = material.__dict__["_gbuffer_data"] = _material_data(material)
-    return cached
+    return material.written_data()
 
 
 def _material_data(material: Material) -> tuple[GBufferData, ...]:

@@ -20,7 +20,6 @@ import moderngl
 import numpy as np
 
 from deferred.errors import InputError
-from deferred.gl.context import Features
 from deferred.interfaces.light import Light
 from deferred.lighting.dispatch import (
     FULLSCREEN_LIGHT_CAPACITY,
@@ -56,7 +55,7 @@ def fullscreen_overflow(count: int) -> str:
 
 
 class LightBuffer:
-    def __init__(self, ctx: moderngl.Context, features: Features | None = None):
+    def __init__(self, ctx: moderngl.Context):
         self.ctx = ctx
         self.count = 0
         self.global_count = 0  # full-screen lights, first in the buffer

@@ -23,6 +23,7 @@ from deferred.interfaces.material import Material
 from deferred.interfaces.shading import ShadingTextures
 from deferred.lighting.buffer import LIGHT_BUFFER, LightBuffer
 from deferred.lighting.lists import LIGHT_LISTS, LightLists, check_light_limits, resolve_light_path
+from deferred.memo import overrides
 from deferred.names import LightVolume
 from deferred.render.caches import FrameInputs, KeptMaterialInputs, ObjectTransforms
 from deferred.render.generated import generated_glsl
@@ -148,7 +149,7 @@ class Renderer:
         self.targets = FrameTargets(ctx, *self.size)
         self._declare_targets()
         self.resources = Resources(ctx)
-        self.light_buffer = LightBuffer(ctx, features)
+        self.light_buffer = LightBuffer(ctx)
         self.light_lists = LightLists(ctx) if features.compute_shaders else None
         self.last_frame: Frame | None = None
         error = ctx.error
@@ -218,7 +219,7 @@ class Renderer:
         self.light_buffer.upload(self.scene.lights, frame.view, frame.projection)
         self._check_gl("uploading the lights")
         for render_pass in self.passes:
-            if type(render_pass).prepare is RenderPass.prepare:
+            if not overrides(type(render_pass), RenderPass, "prepare"):
                 continue  # nothing to prepare (most passes: skipping them saves a GL error read)
             try:
                 render_pass.prepare(frame)

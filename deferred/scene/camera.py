@@ -11,6 +11,8 @@ from dataclasses import dataclass
 import numpy as np
 import pyrr
 
+from deferred.memo import kept_while
+
 
 def gl_bytes(matrix: np.ndarray) -> bytes:
     """Bytes of a column-vector matrix in the column-major order GLSL expects."""
@@ -39,31 +41,20 @@ class Camera:
 
     # The camera is frozen, so its matrices are made once (pyrr's look-at alone was 8% of a
     # frame's Python time on a small scene) and handed out read-only.
+    @kept_while()
     def view(self) -> np.ndarray:
-        cached = self.__dict__.get("_view")
-        if cached is None:
-            cached = _read_only(pyrr.matrix44.create_look_at(
-                np.array(self.position, dtype=np.float64),
-                np.array(self.target, dtype=np.float64),
-                np.array(self.up, dtype=np.float64)).T)
-            self.__dict__["_view"] = cached
-        return cached
+        return _read_only(pyrr.matrix44.create_look_at(
+            np.array(self.position, dtype=np.float64), np.array(self.target, dtype=np.float64),
+            np.array(self.up, dtype=np.float64)).T)
 
+    @kept_while()
     def projection(self, aspect: float) -> np.ndarray:
-        return self._per_aspect("_projections", aspect, lambda: (
-            pyrr.matrix44.create_perspective_projection(
-                self.fov, aspect, self.near, self.far, dtype=np.float64).T))
+        return _read_only(pyrr.matrix44.create_perspective_projection(
+            self.fov, aspect, self.near, self.far, dtype=np.float64).T)
 
+    @kept_while()
     def inverse_projection(self, aspect: float) -> np.ndarray:
-        return self._per_aspect("_inverse_projections", aspect,
-                                lambda: np.linalg.inv(self.projection(aspect)))
-
-    def _per_aspect(self, name: str, aspect: float, make) -> np.ndarray:
-        cached = self.__dict__.setdefault(name, {})
-        matrix = cached.get(aspect)
-        if matrix is None:
-            matrix = cached[aspect] = _read_only(make())
-        return matrix
+        return _read_only(np.linalg.inv(self.projection(aspect)))
 
 
 def _read_only(matrix: np.ndarray) -> np.ndarray:

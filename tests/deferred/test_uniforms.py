@@ -210,3 +210,25 @@ def test_the_uniform_writer_leaves_what_moderngls_own_setter_does(gl):
     finally:
         ours.release()
         theirs.release()
+
+
+def test_the_private_moderngl_writer_is_pinned(gl):
+    """uniform_writer writes past moderngl's Python layers through the private
+    ``Context._write_uniform`` (moderngl 5.12 and later); where moderngl drops or renames it
+    the writer falls back to the handle's own setter, correct but slower. This pins it: a
+    moderngl without it fails here, by name, instead of slowing every draw unseen (the
+    equivalence test above catches a changed signature)."""
+    import moderngl
+
+    from deferred.gl.uniforms import uniform_writer
+
+    program = gl.ctx.program(vertex_shader=WRITER_VERTEX, fragment_shader=FRAGMENT)
+    try:
+        handle = program["u_vec3"]
+        assert callable(getattr(handle.ctx, "_write_uniform", None)), (
+            f"moderngl {moderngl.__version__} has no Context._write_uniform: "
+            "deferred.gl.uniforms.uniform_writer needs a look")
+        assert uniform_writer(handle).__name__ == "write"  # the direct path, not the fallback
+        assert uniform_writer(program["u_array"]).__name__ == "write_by_handle"
+    finally:
+        program.release()

@@ -1,0 +1,58 @@
+"""Memos: the framework's one way of keeping a value that is asked for often and changes rarely.
+
+- :func:`kept_while` keeps a method's result on its object while the attributes it is made from
+  are the same objects (identity, not equality: parameters, meshes and cameras are replaced
+  whole, never changed in place), one result per argument tuple. A material's uniforms are kept
+  while its ``params`` are the same object, a mesh's bounds while its positions are, a frozen
+  camera's matrices for its life.
+- :func:`overrides` answers whether a class overrides a hook of a base class, so the framework
+  can skip a hook no class changed (a pass with no ``prepare``) without calling it. Where the
+  answer is wanted a draw, a class keeps it as a class attribute made when the class is
+  (``ObjectPass.__init_subclass__``).
+
+Both keep plain values: nothing is released through them (GPU objects are kept by
+:class:`deferred.gl.resources.Resources`).
+"""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Callable
+from typing import Any, TypeVar
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+
+def kept_while(*sources: str) -> Callable[[F], F]:
+    """Decorate a method so its result, for each argument tuple, is kept on the instance (in its
+    ``__dict__``, so frozen dataclasses take it too) while the attributes named ``sources``
+    are the same objects as when it was made; with no ``sources``, for the instance's life.
+
+    The kept value is returned itself, not a copy: a method whose callers may change what it
+    returns hands out copies of a kept one."""
+
+    def decorate(method: F) -> F:
+        slot = f"_kept_{method.__name__}"
+
+        @functools.wraps(method)
+        def kept(self, *args):
+            made_from = tuple([getattr(self, name) for name in sources])
+            held = self.__dict__.get(slot)
+            if held is None or len(held[0]) != len(made_from) or \
+                    any(a is not b for a, b in zip(held[0], made_from, strict=True)):
+                held = self.__dict__[slot] = (made_from, {})
+            values = held[1]
+            value = values.get(args, values)  # the dict itself: "not made yet"
+            if value is values:
+                value = values[args] = method(self, *args)
+            return value
+
+        return kept  # type: ignore[return-value]
+
+    return decorate
+
+
+def overrides(cls: type, base: type, *hooks: str) -> bool:
+    """Whether ``cls`` (a subclass of ``base``) has its own version of any of ``hooks``: an
+    attribute other than ``base``'s."""
+    return any(getattr(cls, hook) is not getattr(base, hook) for hook in hooks)
