@@ -17,10 +17,10 @@ import time
 
 import numpy as np
 
-from deferred.bench.harness import with_extra_lights
+from deferred.bench.scenes import with_extra_lights
 from deferred.gl.context import create_context
 from deferred.render.renderer import Renderer
-from deferred.scene.model import load_scene
+from deferred.scene.loader import load_scene
 
 SIZE = (640, 360)
 

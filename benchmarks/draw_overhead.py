@@ -1,7 +1,7 @@
 """The framework's CPU time per draw call: the marginal cost of one more object's draw.
 
 The bench's ``cpu_ms`` is the rendering thread's CPU time over ``render()`` less its time
-inside the GL calls that draw (``deferred.bench.harness.time_cpu``); ``cpu_us_per_draw`` divides that
+inside the GL calls that draw (``deferred.bench.timing.time_cpu``); ``cpu_us_per_draw`` divides that
 by the frame's draws, so on a scene of few objects it is mostly the frame's fixed work (the
 light records, the camera, one-draw passes) spread over them. This script separates the two:
 it renders scenes of N standard-material cubes (N = 25, 100, 400 by default, every cube its own
@@ -23,7 +23,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from deferred.bench.harness import cpu_frame, time_cpu
+from deferred.bench.timing import cpu_frame, time_cpu
 from deferred.gl.context import create_context
 from deferred.lights.ambient import AmbientLight
 from deferred.lights.directional import DirectionalLight

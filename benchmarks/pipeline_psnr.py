@@ -16,7 +16,8 @@ import math
 import numpy as np
 
 from deferred.render.renderer import Renderer
-from deferred.scene.model import load_scene, parse_size
+from deferred.scene.loader import load_scene
+from deferred.scene.model import parse_size
 
 
 def psnr(a: np.ndarray, b: np.ndarray) -> float:

@@ -5,7 +5,7 @@ Each VARIANT is a folder laid out like ``deferred/shaders`` holding only the fil
 (``lights/listed_lights.glsl``, say); ``-`` is the shaders as they are. One renderer is built
 per variant on one GL context, and every round renders, for each variant in turn, one frame
 timed by wall clock around ``render()`` and ``finish()`` and one with every pass fenced
-(``deferred.bench.harness.time_passes``); each round starts from the next variant. Printed: each
+(``deferred.bench.timing.time_passes``); each round starts from the next variant. Printed: each
 variant's median and minimum frame time and its passes' medians. Run from the repository root:
 
     python benchmarks/shader_ab.py [--scene FILE] [--size WxH] [--lights N] [--rounds N]
@@ -24,11 +24,12 @@ import sys
 import time
 from pathlib import Path
 
-from deferred.bench.harness import time_passes, with_extra_lights
+from deferred.bench.scenes import with_extra_lights
+from deferred.bench.timing import time_passes
 from deferred.errors import DeferredError
 from deferred.gl.context import create_context
 from deferred.render.renderer import Renderer
-from deferred.scene.model import load_scene
+from deferred.scene.loader import load_scene
 
 
 def parse_size(text: str) -> tuple[int, int]:

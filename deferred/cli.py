@@ -23,7 +23,8 @@ from deferred.io.images import write_image
 from deferred.io.paths import check_output_path
 from deferred.io.safety import interrupt_exit_code, termination_as_interrupt
 from deferred.render.pipeline import PIPELINES
-from deferred.scene.model import load_scene, parse_size
+from deferred.scene.loader import load_scene
+from deferred.scene.model import parse_size
 
 stderr = Console(stderr=True, soft_wrap=True)  # status lines never wrap on pipes
 
@@ -104,7 +105,7 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
     )
     from deferred.io.paths import output_kind
     from deferred.io.video import check_video_size, frame_times
-    from deferred.lighting.lists import resolve_light_path
+    from deferred.lighting.paths import resolve_light_path
     from deferred.render.renderer import FULL_FEATURES, Renderer
 
     if view_name == "help":
@@ -321,7 +322,7 @@ def bench(scene: str | None, lights: str, shells: str, size: str | None, runs: i
     shell counts (DESIGN.md, "Benchmarks")."""
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
 
-    from deferred.bench import harness as benchmark
+    from deferred import bench as benchmark
 
     # Every option is checked before the first frame: bad input never costs a sweep.
     sweep = benchmark.Sweep(lights=benchmark.parse_counts(lights, "--lights"),

@@ -15,7 +15,7 @@ import numpy as np  # noqa: E402
 from deferred.debug.views import with_material_view  # noqa: E402
 from deferred.io.images import read_image  # noqa: E402
 from deferred.render.renderer import Renderer  # noqa: E402
-from deferred.scene.model import load_scene, scene_from_dict  # noqa: E402
+from deferred.scene.loader import load_scene, scene_from_dict  # noqa: E402
 
 ROOT = Path(__file__).parents[1]
 FIGURES = ROOT / "docs" / "figures"

@@ -1,26 +1,6 @@
-"""Light paths: how lights reach the pixels (Olsson and Assarsson 2011, "Tiled Shading";
-Olsson, Billeter and Assarsson 2012, "Clustered Deferred and Forward Shading").
-
-Deferred:
-
-- ``volumes``: one instanced pass per light type, each light drawn as its bounding sphere (or a
-  full-screen triangle), re-reading the G-buffer and blending into the light accumulation for
-  every pixel it covers. Needs GL 3.3 only.
-- ``tiled``: a compute pass culls the volume lights per 16x16 tile against the tile's frustum,
-  depth bounds and the view-space box of its points (``lights/cull_tiles.comp``), in two
-  dispatches: coarse tiles of 4x4 tiles against every light, then each tile against its
-  coarse tile's lights, and the lights that touch the tile against each of its 8x8 quadrants,
-  which have the lists; one full-screen pass then reads the G-buffer once per pixel and loops
-  the full-screen lights and its quadrant's list (``lights/list_shading.frag``).
-- ``clustered``: the same shading, from lists of view-space clusters (32x32 tiles x 16
-  exponential depth slices) filled tile by tile (``lights/cull_clusters.comp``).
-
-Forward:
-
-- ``naive``: every fragment loops every light.
-- ``tiled`` (Forward+): a depth pre-pass, the tiled culling (depth bounds from the near plane, so
-  blended surfaces in front of the opaque ones are covered), and the lit passes loop their
-  quadrant's list (``common/forward_lighting.glsl``).
+"""The light lists of the tiled and clustered paths (:mod:`deferred.lighting.paths`): their grid
+of tiles (and depth slices), their GPU storage and its limits, and how many lights a list can
+hold.
 
 The culling shaders write the lists for the shading in an RGBA32UI texture of a texel a slot,
 the light's sphere (its radius a half float) and index (:meth:`LightLists.entries`); the list
@@ -41,17 +21,12 @@ from typing import TYPE_CHECKING, Any
 import moderngl
 import numpy as np
 
-from deferred.core.passes import FullscreenPass, Order, Phase, RenderPass
 from deferred.errors import InputError, RenderError
-from deferred.gbuffer.layout import LINEAR_DEPTH
-from deferred.lighting.buffer import LIGHT_BUFFER, fullscreen_overflow
+from deferred.lighting.buffer import fullscreen_overflow
 from deferred.lighting.dispatch import FULLSCREEN_LIGHT_CAPACITY
-from deferred.lighting.volumes import surface_pass
-from deferred.names import EQUIVALENT_PATHS, LIST_PATHS, LightPath, Pipeline
+from deferred.names import LIST_PATHS, LightPath
 
 if TYPE_CHECKING:
-    from deferred.core.frame import Frame
-    from deferred.gl.context import Features
     from deferred.gl.uniforms import ProgramUniforms
 
 LIGHT_LISTS = "light_lists"  # its name on a frame's blackboard
@@ -79,25 +54,6 @@ LIST_IMAGE_UNIT = 2  # the culling writes the shading's lists texture through th
 # A listed light's texel holds its index (in the light buffer, full-screen lights first) in 16
 # bits, beside its radius as a half float.
 MAX_LISTED_LIGHTS = 1 << 16
-
-
-def resolve_light_path(pipeline: str, requested: str | None, features: Features,
-                       where: str = "--light-path") -> str:
-    """The light path a pipeline runs: ``requested`` (either pipeline's name of it), or the
-    fastest this context allows (tiled when compute shaders exist; volumes and naive on GL 3.3,
-    where they are the only ones)."""
-    if requested is None:
-        return LightPath.TILED if features.compute_shaders else \
-            (LightPath.VOLUMES if pipeline == Pipeline.DEFERRED else LightPath.NAIVE)
-    if requested not in set(LightPath):
-        raise InputError(f"unknown light path '{requested}' (choose from "
-                         f"{', '.join(LightPath)})", where)
-    requested = LightPath(requested)
-    path = EQUIVALENT_PATHS[Pipeline(pipeline)].get(requested, requested)
-    if path in LIST_PATHS and not features.compute_shaders:
-        raise InputError(f"light path '{requested}' needs compute shaders (GL 4.3); this context "
-                         "has the GL 3.3 paths only (volumes, naive)", where)
-    return path
 
 
 @dataclass(frozen=True)
@@ -453,116 +409,3 @@ def list_capacity(spheres: np.ndarray, inverse_projection: np.ndarray, width: in
         return max(int(most), 1)
     per_tile = columns.T @ rows  # (columns, rows)
     return max(int(per_tile.max()), 1)
-
-
-class LightCullPass(RenderPass):
-    """Fill the light lists with a compute shader (tiles or clusters)."""
-
-    def __init__(self, name: str, phase: Phase, clustered: bool, from_near: bool = False):
-        self.name = name
-        self.phase = phase
-        self.clustered = clustered
-        self.from_near = from_near
-        self.order = Order.FIRST
-        # tiles read the depth bounds; clusters need no depth
-        self.reads = () if clustered else (LINEAR_DEPTH,)
-        self.samples = self.reads
-
-    def execute(self, frame: Frame) -> None:
-        if LIST_SPLIT not in (1, 2):  # the culling writes 16x16 lists or their quadrants
-            raise RenderError(f"LIST_SPLIT is {LIST_SPLIT}; the tiled culling splits a tile "
-                              "into 1 or 2 lists a side")
-        lights = frame.blackboard[LIGHT_BUFFER]
-        light_lists = frame.blackboard[LIGHT_LISTS]
-        grid = list_grid(frame.width, frame.height, self.clustered)
-        camera = frame.scene.camera
-        # every list is a subset of its tile's side-plane set (and slice), every coarse list
-        # of its coarse tile's
-        slices = (camera.near, camera.far, grid.slices) if self.clustered else None
-
-        def capacity(tile: int, slices: tuple | None = None) -> int:
-            return light_lists.capacity_for(lights.volume_spheres, frame.inverse_projection,
-                                            frame.width, frame.height, tile, slices)
-
-        coarse_capacity = 1 if self.clustered else capacity(coarse_grid(grid).tile)
-        light_lists.prepare(grid, capacity(grid.tile, slices), camera.near, camera.far,
-                            coarse_capacity)
-        defines = {"CULL_GROUP_SIZE": str(CULL_GROUP_SIZE), "LIST_IMAGE_UNIT": str(LIST_IMAGE_UNIT)}
-        if self.from_near:
-            defines["CULL_FROM_NEAR"] = "1"
-        if self.clustered:
-            defines["LIGHT_LISTS_CLUSTERED"] = "1"
-            defines["LIST_SLICES"] = str(grid.slices)
-            shader = frame.shaders.compute("lights/cull_clusters.comp", defines)
-        else:
-            shader = frame.shaders.compute("lights/cull_tiles.comp",
-                                           {**defines, "CULL_CANDIDATES": "1",
-                                            **({"LIST_QUADRANTS": "1"} if LIST_SPLIT == 2
-                                               else {})})
-        counts = {"u_light_count": lights.count, "u_global_light_count": lights.global_count}
-        textures = {"u_lights": lights.texture}
-        if self.clustered:
-            dispatches = [(shader, {**light_lists.uniforms(), **counts},
-                           grid.count // grid.slices)]
-        else:
-            textures["u_linear_depth"] = frame.target(LINEAR_DEPTH)
-            counts["u_pixel_to_view"] = pixel_to_view(frame.projection, frame.width,
-                                                      frame.height)
-            # coarse tiles against every light, then the tiles against their coarse tile's
-            coarse = light_lists.coarse_uniforms()
-            first = frame.shaders.compute("lights/cull_tiles.comp",
-                                          {**defines, "CULL_COARSE": "1"})
-            dispatches = [(first, {**coarse["first"], **counts}, coarse_grid(grid).count),
-                          (shader, {**coarse["second"], **counts}, culling_tiles(grid))]
-        for index, (program, uniforms, tiles) in enumerate(dispatches):
-            if index:
-                frame.ctx.memory_barrier()
-            frame.bind_compute(program, uniforms, textures)
-            light_lists.bind_image(frame.shaders.uniforms(program))
-            groups = math.ceil(tiles / CULL_GROUP_SIZE)  # an invocation a tile
-            frame.gl_call(lambda program=program, groups=groups: program.run(groups, 1, 1))
-        frame.ctx.memory_barrier()
-        frame.count_draw()
-
-
-def pixel_to_view(projection: np.ndarray, width: int, height: int) -> tuple[float, ...]:
-    """(scale.xy, offset.xy) with view-space xy / linear depth = pixel * scale + offset for a
-    perspective ``projection`` (math order, column vectors): the culling's view positions of
-    pixels, one multiply-add where the inverse projection takes a matrix product."""
-    p = projection
-    scale = (2.0 / (width * p[0, 0]), 2.0 / (height * p[1, 1]))
-    offset = ((p[0, 2] - 1.0) / p[0, 0], (p[1, 2] - 1.0) / p[1, 1])
-    return (*(float(v) for v in scale), *(float(v) for v in offset))
-
-
-def list_shading_pass(name: str, clustered: bool, gbuffer: tuple[str, ...],
-                      occlusion: str | None, background: tuple[float, float, float],
-                      composite: bool = False) -> FullscreenPass:
-    """The deferred lighting of every light from the lists: one full-screen pass, which creates
-    the light accumulation (the scene's background where the G-buffer holds no surface, alpha
-    0; the lights' sum on surfaces, alpha 1), so no pass has to lay the background down first.
-    With ``composite`` it creates the composition buffer too, the same values (a frame with
-    no material pass: the copy between them would be all the material phase did).
-
-    It runs on surfaces only (:func:`deferred.lighting.volumes.surface_pass`: lights.toml, 640x360, about
-    a third background: the pass 14.2 -> 11.3 ms at 1 light, 20.7 -> 16.3 at 256, 40.0 -> 35.7
-    at 1024)."""
-    from deferred.gl.targets import (
-        COMPOSITE,
-        COMPOSITE_SPEC,
-        LIGHT_ACCUMULATION,
-        LIGHT_ACCUMULATION_SPEC,
-    )
-
-    inputs = {f"u_{target}": target for target in gbuffer}
-    defines = {}
-    if occlusion:
-        inputs["u_ssao"] = occlusion
-        defines["HAS_SSAO"] = "1"
-    if clustered:
-        defines["LIGHT_LISTS_CLUSTERED"] = "1"
-    creates = {LIGHT_ACCUMULATION: LIGHT_ACCUMULATION_SPEC}
-    if composite:
-        creates[COMPOSITE] = COMPOSITE_SPEC
-        defines["WRITE_COMPOSITE"] = "1"
-    return surface_pass(name, "lights/list_shading.frag", inputs, creates, background, defines)

@@ -19,7 +19,7 @@ from deferred.gl.targets import LIGHT_ACCUMULATION
 from deferred.interfaces.light import Light
 from deferred.lighting.buffer import LIGHT_BUFFER
 from deferred.names import LightVolume
-from deferred.scene.meshes import build_mesh
+from deferred.scene.geometry import build_mesh
 
 if TYPE_CHECKING:
     from deferred.core.frame import Frame
@@ -48,7 +48,7 @@ def surface_pass(name: str, fragment: str, inputs: dict[str, str],
     pixels with depth but no surface), and draws its triangle on the far plane with the depth
     test "greater" against the G-buffer's depth (``common/fullscreen_triangle.glsl``). On
     llvmpipe a block of pixels failing that test is skipped, where an ``if`` in the shader
-    skips nothing: the list shading (``deferred.lighting.lists.list_shading_pass``) and the
+    skips nothing: the list shading (``deferred.lighting.culling.list_shading_pass``) and the
     volumes path's background pass."""
     cleared = (*background, 0.0)
     return FullscreenPass(name, Phase.LIGHTING, fragment, inputs, tuple(creates),

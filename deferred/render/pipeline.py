@@ -48,7 +48,7 @@ from deferred.gl.targets import (
 )
 from deferred.interfaces.effect import AMBIENT_OCCLUSION
 from deferred.interfaces.material import ForwardLitPass
-from deferred.lighting.lists import LightCullPass, list_shading_pass
+from deferred.lighting.culling import LightCullPass, list_shading_pass
 from deferred.lighting.volumes import LightTypePass, surface_pass
 from deferred.scene.model import Scene
 

@@ -22,7 +22,8 @@ from deferred.gl.targets import COMPOSITE, FINAL, FrameTargets
 from deferred.interfaces.material import Material
 from deferred.interfaces.shading import ShadingTextures
 from deferred.lighting.buffer import LIGHT_BUFFER, LightBuffer
-from deferred.lighting.lists import LIGHT_LISTS, LightLists, check_light_limits, resolve_light_path
+from deferred.lighting.lists import LIGHT_LISTS, LightLists, check_light_limits
+from deferred.lighting.paths import resolve_light_path
 from deferred.memo import overrides
 from deferred.names import LightVolume
 from deferred.render.caches import FrameInputs, KeptMaterialInputs, ObjectTransforms

@@ -36,7 +36,7 @@ from deferred.materials.techniques.wetness import (  # noqa: E402
     random_droplets,
 )
 from deferred.render.renderer import Renderer  # noqa: E402
-from deferred.scene.model import scene_from_dict  # noqa: E402
+from deferred.scene.loader import scene_from_dict  # noqa: E402
 
 try:
     import tomllib

@@ -8,7 +8,7 @@ from deferred.errors import InputError
 from deferred.io.images import read_image
 from deferred.io.paths import expand_pattern, output_kind
 from deferred.io.video import frame_times, gif_durations
-from deferred.scene.model import scene_from_toml
+from deferred.scene.loader import scene_from_toml
 
 SCENE = """
 size = [64, 48]
@@ -146,7 +146,7 @@ def test_timeline_errors_exit_2_with_one_line(tmp_path, capsys, event, expected)
 
 def test_same_time_same_image_and_frame_time(gl, scene_file):
     from deferred.render.renderer import Renderer
-    from deferred.scene.model import load_scene
+    from deferred.scene.loader import load_scene
 
     seen = []
     with Renderer(load_scene(scene_file), gl=gl) as renderer:
@@ -274,7 +274,7 @@ def test_bad_animation_options_exit_2(tmp_path, capsys, monkeypatch, scene_file,
 
 
 def test_bench_shell_sweep_holds_over_a_timeline():
-    from deferred.bench.harness import with_shells
+    from deferred.bench.scenes import with_shells
 
     text = SCENE.replace('name = "ball"', 'name = "ball"\nmaterial = "revie_fur"').replace(
         "color = [0.8, 0.1, 0.1]", "shells = 8") + """

@@ -8,20 +8,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from deferred.bench.harness import (
-    COLUMNS,
-    Sweep,
-    extra_point_lights,
-    run_bench,
-    shell_objects,
-    with_extra_lights,
-    with_shells,
-)
+from deferred.bench.harness import Sweep, run_bench
+from deferred.bench.report import COLUMNS
+from deferred.bench.scenes import extra_point_lights, shell_objects, with_extra_lights, with_shells
 from deferred.cli import main
 from deferred.errors import InputError
 from deferred.io.images import read_image
 from deferred.render.pipeline import PIPELINES
-from deferred.scene.model import load_scene, scene_from_dict
+from deferred.scene.loader import load_scene, scene_from_dict
 
 LIGHTS_SCENE = Path(__file__).parents[2] / "benchmarks" / "lights.toml"
 FAST = ["--size", "64x36", "--runs", "2", "--warmup", "1"]
@@ -240,7 +234,7 @@ def test_builtin_overdraw_scene_has_objects_at_several_depths(render):
 
 
 def test_speedups_compare_the_fastest_deferred_path_at_the_most_lights():
-    from deferred.bench.harness import BenchReport, BenchResult, speedups
+    from deferred.bench.report import BenchReport, BenchResult, speedups
 
     def row(pipeline, path, lights, ms, shells=0):
         return BenchResult(pipeline, lights, shells, 64, 36, [ms], light_path=path)
@@ -260,7 +254,7 @@ def test_speedups_compare_the_fastest_deferred_path_at_the_most_lights():
 
 
 def test_growth_compares_the_best_deferred_path_with_its_own_frame_at_the_fewest_lights():
-    from deferred.bench.harness import BenchReport, BenchResult, growth
+    from deferred.bench.report import BenchReport, BenchResult, growth
 
     def row(pipeline, path, lights, ms, shells=0):
         return BenchResult(pipeline, lights, shells, 64, 36, [ms], light_path=path)

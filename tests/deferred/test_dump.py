@@ -18,7 +18,7 @@ from deferred.gbuffer.layout import decode
 from deferred.interfaces import registry
 from deferred.io.images import read_channels, read_image, write_image
 from deferred.render.renderer import Renderer
-from deferred.scene.model import scene_from_dict
+from deferred.scene.loader import scene_from_dict
 
 SIZE = (160, 120)
 
@@ -619,7 +619,7 @@ def test_a_dump_of_a_list_path_holds_the_light_lists(tmp_path, renderer, gl):
         pytest.skip("the driver has no compute shaders")
     from dataclasses import replace
 
-    from deferred.bench.harness import with_extra_lights
+    from deferred.bench.scenes import with_extra_lights
 
     scene = with_extra_lights(replace(small_scene(), light_path="tiled"), 40, SIZE[0] / SIZE[1])
     capture = capture_frame(renderer(scene))

@@ -9,7 +9,7 @@ from model_materials import InvertEffect, TintMaterial
 from deferred.errors import InputError
 from deferred.interfaces import registry
 from deferred.render.renderer import Renderer
-from deferred.scene.model import scene_from_dict
+from deferred.scene.loader import scene_from_dict
 
 OBJECTS = [
     {"mesh": "builtin:plane", "scale": 6.0, "params": {"color": [0.6, 0.6, 0.6]}},

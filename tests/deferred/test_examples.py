@@ -7,7 +7,7 @@ import pytest
 
 from deferred.gl.context import Features, GLContext
 from deferred.render.renderer import Renderer
-from deferred.scene.model import load_scene
+from deferred.scene.loader import load_scene
 
 EXAMPLES = sorted((Path(__file__).parents[2] / "examples").glob("*.toml"))
 

@@ -12,7 +12,7 @@ from deferred.gl.target_spec import TargetSpec
 from deferred.gl.targets import COMPOSITE, FINAL
 from deferred.interfaces.material import Material
 from deferred.render.renderer import Renderer
-from deferred.scene.model import scene_from_dict
+from deferred.scene.loader import scene_from_dict
 
 SCENE = {
     "size": [48, 32],

@@ -13,7 +13,9 @@ import OpenImageIO as oiio
 import pytest
 
 import deferred.io.images
+import deferred.scene.geometry
 import deferred.scene.meshes
+import deferred.scene.unwrap
 from deferred.cli import main
 from deferred.errors import InputError
 from deferred.io.images import check_image, read_channels, read_image, write_image
@@ -145,7 +147,8 @@ def test_bad_mesh_is_a_one_line_error(tmp_path, capfd, name):
                                           ("MAX_MESH_FILE_BYTES", 16)])
 def test_mesh_size_limits(tmp_path, capfd, monkeypatch, limit, value):
     (tmp_path / "tet.obj").write_text(TETRAHEDRON)
-    monkeypatch.setattr(deferred.scene.meshes, limit, value)
+    module = deferred.scene.meshes if limit == "MAX_MESH_FILE_BYTES" else deferred.scene.geometry
+    monkeypatch.setattr(module, limit, value)
     code, err, out = render_scene(tmp_path, capfd, {"mesh": "tet.obj", "material": "standard"})
     assert_one_line_error(code, err, "object[0].mesh", "tet.obj", "more than the")
     assert not out.exists()
@@ -161,7 +164,7 @@ def test_latin1_obj_loads(tmp_path):
 
 def test_far_but_sound_mesh_still_loads():
     """The span criterion is relative: a vertex 1e5 out on a mesh of 0.2 edges is accepted."""
-    from deferred.scene.meshes import build_mesh
+    from deferred.scene.geometry import build_mesh
 
     positions = np.array([[0, 0, 0], [0.2, 0, 0], [0, 0.2, 0], [1e5, 0.2, 0]], float)
     mesh = build_mesh("far", positions, np.array([[0, 1, 2], [1, 3, 2]]))
@@ -184,7 +187,7 @@ def _raise(positions, indices):
 
 def test_unwrap_time_limit(tmp_path, capfd, monkeypatch):
     (tmp_path / "tet.obj").write_text(TETRAHEDRON)
-    monkeypatch.setattr(deferred.scene.meshes, "_xatlas_parametrize", _sleep_for_ever)  # fork copies it
+    monkeypatch.setattr(deferred.scene.unwrap, "_xatlas_parametrize", _sleep_for_ever)  # fork copies it
     monkeypatch.setenv("DEFERRED_UNWRAP_TIMEOUT", "0.3")
     start = time.monotonic()
     code, err, out = render_scene(tmp_path, capfd, {"mesh": "tet.obj", "material": "standard"})
@@ -197,7 +200,7 @@ def test_unwrap_time_limit(tmp_path, capfd, monkeypatch):
 
 def test_ctrl_c_ends_the_unwrap(tmp_path, monkeypatch):
     (tmp_path / "tet.obj").write_text(TETRAHEDRON)
-    monkeypatch.setattr(deferred.scene.meshes, "_xatlas_parametrize", _sleep_for_ever)
+    monkeypatch.setattr(deferred.scene.unwrap, "_xatlas_parametrize", _sleep_for_ever)
     main_thread = threading.main_thread().ident
     timer = threading.Timer(0.3, signal.pthread_kill, (main_thread, signal.SIGINT))
     start = time.monotonic()
@@ -215,7 +218,7 @@ def test_ctrl_c_ends_the_unwrap(tmp_path, monkeypatch):
                                              (_raise, "ValueError: xatlas said no")])
 def test_unwrap_failures_name_the_mesh(tmp_path, monkeypatch, child, fragment):
     (tmp_path / "tet.obj").write_text(TETRAHEDRON)
-    monkeypatch.setattr(deferred.scene.meshes, "_xatlas_parametrize", child)
+    monkeypatch.setattr(deferred.scene.unwrap, "_xatlas_parametrize", child)
     with pytest.raises(InputError, match="UV unwrap failed") as caught:
         load_mesh("tet.obj", tmp_path)
     assert fragment in str(caught.value) and "tet.obj" in str(caught.value)

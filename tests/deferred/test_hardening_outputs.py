@@ -27,7 +27,7 @@ from deferred.errors import InputError, RenderError
 from deferred.io.images import write_image, write_text
 from deferred.io.paths import NAME_MAX, temporary_path
 from deferred.render.renderer import Renderer
-from deferred.scene.model import scene_from_dict
+from deferred.scene.loader import scene_from_dict
 
 REPO = Path(__file__).parents[2]
 

@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from deferred.errors import InputError
 from deferred.render.renderer import Renderer
-from deferred.scene.model import scene_from_dict
+from deferred.scene.loader import scene_from_dict
 
 # Values of every kind a TOML document can hold, weighted to the troublesome ones.
 scalars = st.one_of(

@@ -200,7 +200,7 @@ def test_the_python_api_takes_numpy_values_and_a_fields_own_conversion():
     from deferred.errors import InputError
     from deferred.interfaces import registry
     from deferred.params import Params, validate_params
-    from deferred.scene.model import scene_from_dict
+    from deferred.scene.loader import scene_from_dict
 
     point = registry.lights.get("point").from_dict(
         {"intensity": np.float32(2.0), "radius": np.int64(3), "position": np.array([0., 1., 2.])})

@@ -10,7 +10,7 @@ from deferred.interfaces.material import GBufferPass
 from deferred.io.images import write_image
 from deferred.materials.standard import StandardMaterial
 from deferred.render.renderer import Renderer
-from deferred.scene.model import scene_from_dict
+from deferred.scene.loader import scene_from_dict
 
 
 def sphere_scene():

@@ -3,7 +3,9 @@ import pytest
 import trimesh
 
 from deferred.errors import InputError
-from deferred.scene.meshes import BUILTIN_MESHES, comb_to_tangent_space, load_mesh
+from deferred.scene.builtin_meshes import BUILTIN_MESHES
+from deferred.scene.geometry import comb_to_tangent_space
+from deferred.scene.meshes import load_mesh
 
 
 def listing_2_7_reference(color, normal, tangent, binormal):

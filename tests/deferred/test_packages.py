@@ -13,7 +13,7 @@ from deferred.cli import main
 from deferred.interfaces import registry
 from deferred.io.images import read_image
 from deferred.render.renderer import Renderer
-from deferred.scene.model import load_scene
+from deferred.scene.loader import load_scene
 
 
 def test_nothing_is_importable_as_a_top_level_materials_lights_or_shaders(tmp_path):

@@ -11,7 +11,7 @@ from deferred.gbuffer.surface_id import surface_id
 from deferred.gl.context import Features, GLContext
 from deferred.interfaces import registry
 from deferred.render.renderer import Renderer
-from deferred.scene.model import load_scene, scene_from_dict
+from deferred.scene.loader import load_scene, scene_from_dict
 
 ALL_LIGHTS = [
     {"type": "ambient", "color": [0.2, 0.22, 0.3], "ground": [0.1, 0.05, 0.02]},
@@ -213,7 +213,7 @@ def test_a_gl_error_while_preparing_a_pass_names_the_pass_not_outside_code(gl, m
     import warnings
 
     from deferred.errors import RenderError, gl_error
-    from deferred.scene.model import scene_from_dict
+    from deferred.scene.loader import scene_from_dict
 
     scene = scene_from_dict({"size": [32, 24], "object": [{"mesh": "builtin:sphere"}],
                              "light": [{"type": "directional"}]})
@@ -237,7 +237,7 @@ def test_a_gl_error_in_one_of_a_run_of_object_passes_names_that_pass(gl, monkeyp
     # the error flag is read once a run of passes of one kind (Frame.check_errors): the
     # passes of the run are then run again one by one to name the one that raises it
     from deferred.errors import RenderError
-    from deferred.scene.model import scene_from_dict
+    from deferred.scene.loader import scene_from_dict
 
     scene = scene_from_dict({"size": [32, 24], "light": [{"type": "directional"}],
                              "object": [{"name": f"ball{i}", "mesh": "builtin:sphere",
@@ -273,7 +273,7 @@ def test_a_pass_failing_after_an_unchecked_gl_error_leaves_no_error_to_the_next_
     import warnings
 
     from deferred.errors import RenderError
-    from deferred.scene.model import scene_from_dict
+    from deferred.scene.loader import scene_from_dict
 
     scene = scene_from_dict({"size": [32, 24], "light": [{"type": "directional"}],
                              "object": [{"name": f"ball{i}", "mesh": "builtin:sphere",
@@ -368,7 +368,7 @@ def test_tonemap_operator_matches_a_numpy_reference(gl, tonemap):
     """The final image is the composition times the exposure, through the scene's operator
     (a define of the pass), sRGB encoded: checked against numpy for each operator."""
     from deferred.debug.capture import capture_frame
-    from deferred.scene.model import load_scene
+    from deferred.scene.loader import load_scene
 
     scene = load_scene(None)
     scene.tonemap = tonemap

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from deferred.io.images import read_image, write_image
-from deferred.scene.model import load_scene
+from deferred.scene.loader import load_scene
 
 ROOT = Path(__file__).parents[2]
 REFERENCES = ROOT / "tests" / "reference"

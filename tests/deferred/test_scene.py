@@ -1,7 +1,8 @@
 import pytest
 
 from deferred.errors import InputError
-from deferred.scene.model import load_scene, parse_size, scene_from_toml
+from deferred.scene.loader import load_scene, scene_from_toml
+from deferred.scene.model import parse_size
 
 GOOD = """
 size = [320, 200]

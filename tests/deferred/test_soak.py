@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from deferred.render.renderer import Renderer
-from deferred.scene.model import scene_from_dict
+from deferred.scene.loader import scene_from_dict
 
 FRAMES = 1000
 GL_CLASSES = tuple(getattr(moderngl, name) for name in (

@@ -132,7 +132,7 @@ def test_forgotten_values_are_written_again(program):
 def test_the_state_memo_sets_what_a_pass_states(render):
     # A pass stating the last pass's state sets nothing; one changing only the depth offset
     # between draws (the root shell) must not leave the next pass with its offset.
-    from deferred.scene.model import load_scene
+    from deferred.scene.loader import load_scene
 
     _, renderer = render(load_scene("builtin:demo"), size=(32, 18))
     frame = renderer.last_frame
@@ -148,7 +148,7 @@ def test_the_state_memo_sets_what_a_pass_states(render):
 
 
 def test_gl_call_times_are_measured_only_when_asked(render):
-    from deferred.scene.model import load_scene
+    from deferred.scene.loader import load_scene
 
     result, renderer = render(load_scene("builtin:overdraw"), size=(64, 36))
     assert result.gl_call_seconds == 0.0

@@ -10,7 +10,7 @@ from deferred.gl.context import Features, GLContext
 from deferred.lights.point import distance_falloff
 from deferred.lights.spot import cone_falloff
 from deferred.render.renderer import Renderer
-from deferred.scene.model import scene_from_dict
+from deferred.scene.loader import scene_from_dict
 
 SIZE = (96, 72)
 CAMERA = {"position": [0.0, 4.0, 0.0], "target": [0.0, 0.0, 0.0], "up": [0.0, 0.0, -1.0],

@@ -7,12 +7,12 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from deferred.bench.harness import with_extra_lights
+from deferred.bench.scenes import with_extra_lights
 from deferred.errors import InputError
 from deferred.gl.context import Features, GLContext
 from deferred.lighting.buffer import visible_spheres
 from deferred.render.renderer import Renderer
-from deferred.scene.model import load_scene, scene_from_dict
+from deferred.scene.loader import load_scene, scene_from_dict
 
 ALL_TYPES = [
     {"type": "ambient", "color": [0.2, 0.22, 0.25], "ground": [0.1, 0.08, 0.06]},
@@ -334,7 +334,7 @@ def test_a_renderer_reused_with_other_light_counts_draws_what_a_fresh_one_does(g
 def test_pixel_to_view_is_the_inverse_projection_at_pixel_centres():
     """The culling's view positions of pixels (one multiply-add) against the lighting's (the
     inverse projection), for a wide and a tall frame."""
-    from deferred.lighting.lists import pixel_to_view
+    from deferred.lighting.culling import pixel_to_view
     from deferred.scene.camera import Camera
 
     for width, height, fov in ((640, 360, 50.0), (200, 500, 90.0)):
@@ -515,7 +515,7 @@ def test_the_shading_copy_of_the_lists_holds_each_listed_lights_sphere_and_index
 
 
 def test_a_radius_past_a_half_float_is_refused_on_the_list_paths(gl):
-    from deferred.scene.model import scene_from_dict
+    from deferred.scene.loader import scene_from_dict
 
     if not gl.features.compute_shaders:
         pytest.skip("the driver has no compute shaders")

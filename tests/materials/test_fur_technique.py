@@ -23,8 +23,8 @@ from deferred.materials.techniques.fur_volume import (
 )
 from deferred.materials.techniques.heightfield import heightfield_volume
 from deferred.render.renderer import Renderer
+from deferred.scene.loader import scene_from_dict
 from deferred.scene.meshes import load_mesh
-from deferred.scene.model import scene_from_dict
 
 LIGHTS = [{"type": "ambient", "color": [0.2, 0.2, 0.25]},
           {"type": "directional", "direction": [-0.5, -0.7, -0.6], "intensity": 1.5}]

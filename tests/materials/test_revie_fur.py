@@ -6,7 +6,7 @@ import trimesh
 
 from deferred.gbuffer.surface_id import split_surface_id
 from deferred.interfaces import registry
-from deferred.scene.model import scene_from_dict
+from deferred.scene.loader import scene_from_dict
 
 
 def fur_scene(params=None, size=(160, 120), lights=None, objects=(), camera=None, mesh=None,
@@ -236,7 +236,7 @@ def test_vertex_colour_comb_and_length_are_used(render, tmp_path):
     A plane seen from above, combed along +X or -X by its vertex colours: the stippled outer
     shell slides off the plane's edge on the combed side only, by less when A is smaller.
     """
-    from deferred.scene.meshes import builtin_plane
+    from deferred.scene.builtin_meshes import builtin_plane
 
     plane = builtin_plane(divisions=8)
     overhang = {}

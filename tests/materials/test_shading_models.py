@@ -12,7 +12,7 @@ from deferred.gbuffer.layout import octahedral_decode
 from deferred.interfaces import registry
 from deferred.materials.shading_models import toon_ramps
 from deferred.render.renderer import Renderer
-from deferred.scene.model import scene_from_dict
+from deferred.scene.loader import scene_from_dict
 
 SIZE = (96, 72)
 CAMERA = {"position": [0.0, 4.0, 0.0], "target": [0.0, 0.0, 0.0], "up": [0.0, 0.0, -1.0],

@@ -23,8 +23,8 @@ from deferred.materials.techniques.wetness import (
     load_wetness_mask,
     mask_image,
 )
-from deferred.scene.meshes import builtin_plane, builtin_sphere
-from deferred.scene.model import scene_from_dict
+from deferred.scene.builtin_meshes import builtin_plane, builtin_sphere
+from deferred.scene.loader import scene_from_dict
 
 HARNESS = Path(__file__).parents[1] / "fixtures" / "shell_fur_harness"
 
@@ -855,7 +855,7 @@ def test_fur_over_the_screen_border_is_lit_as_inside(render):
     """Fur whose root lies just off the screen takes the light of the pixels inside, as the
     search did: the deferred image does not differ from the forward one more along the border
     than inside (``fig12_word``: a furry square filling the frame)."""
-    from deferred.scene.model import load_scene
+    from deferred.scene.loader import load_scene
 
     scene = load_scene(Path(__file__).parents[2] / "examples" / "shell_fur" / "fig12_word.toml")
     deferred, _ = render(scene, size=(320, 240))  # roots 1 pixel off the screen

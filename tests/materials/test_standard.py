@@ -4,7 +4,7 @@ import numpy as np
 
 from deferred.gbuffer.layout import decode
 from deferred.io.images import write_image
-from deferred.scene.model import load_scene
+from deferred.scene.loader import load_scene
 
 
 def test_texture_and_specular_land_in_the_gbuffer(render, tmp_path):

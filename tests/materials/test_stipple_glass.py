@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from deferred.scene.model import scene_from_dict
+from deferred.scene.loader import scene_from_dict
 
 
 def glass_scene(pattern, opacity=0.4):
