@@ -231,7 +231,8 @@ def dump(scene: str | None, output: str | None, pipeline: str, size: str | None,
     from rich.progress import Progress, SpinnerColumn, TextColumn
 
     from deferred.debug.capture import select_passes
-    from deferred.debug.dump import check_dump_folder, check_dump_inputs, dump_scene
+    from deferred.debug.dump import dump_scene
+    from deferred.debug.dump_folder import check_dump_folder, check_dump_inputs
     from deferred.debug.pixel_history import format_history, parse_pixel
     from deferred.io.safety import scene_inputs
     from deferred.render.renderer import Renderer

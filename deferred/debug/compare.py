@@ -14,7 +14,8 @@ from typing import Any
 
 import numpy as np
 
-from deferred.debug.dump import safe_name, swap_in_folder
+from deferred.debug.dump import safe_name
+from deferred.debug.dump_folder import swap_in_folder
 from deferred.debug.preview import heat_colors, to_uint8
 from deferred.errors import InputError, RenderError
 from deferred.io.images import read_channels, write_image, write_text

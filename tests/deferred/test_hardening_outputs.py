@@ -22,7 +22,8 @@ import pytest
 import deferred.debug.dump as dump_module
 from deferred.cli import main
 from deferred.debug.capture import capture_frame
-from deferred.debug.dump import is_dump_folder, safe_name, write_dump
+from deferred.debug.dump import safe_name, write_dump
+from deferred.debug.dump_folder import is_dump_folder
 from deferred.errors import InputError, RenderError
 from deferred.io.images import write_image, write_text
 from deferred.io.paths import NAME_MAX, temporary_path
