@@ -20,6 +20,7 @@ import OpenImageIO as oiio
 import pytest
 
 import deferred.debug.dump as dump_module
+import deferred.debug.dump_folder as dump_folder
 from deferred.cli import main
 from deferred.debug.capture import capture_frame
 from deferred.debug.dump import safe_name, write_dump
@@ -395,7 +396,7 @@ def test_interrupted_between_the_renames_keeps_the_old_dump(tmp_path, capture, m
             raise KeyboardInterrupt
         return real(source, target)
 
-    monkeypatch.setattr(dump_module.os, "rename", interrupted)
+    monkeypatch.setattr(dump_folder.os, "rename", interrupted)
     with pytest.raises(KeyboardInterrupt):
         write_dump(frame, out)
     monkeypatch.undo()
