@@ -23,7 +23,8 @@ A plugin (the built-in materials, lights and effects, and the example package in
   ``view_direction(s)``, ``radiances``), the names (:class:`LightVolume`, :class:`Pipeline`,
   :class:`LightPath`) and the errors (:class:`InputError`, :class:`RenderError`).
 - **GLSL**: :data:`GLSL_INCLUDES`, the framework's shader files a plugin's GLSL may include,
-  each with what it gives.
+  each with what it gives; :func:`register_shader_root` for a folder of GLSL every scene
+  searches (a class's own is its ``shader_root``).
 """
 
 from __future__ import annotations
@@ -48,6 +49,7 @@ from deferred.gbuffer import (
     GBufferData,
 )
 from deferred.gl.meshes import GpuMesh, MeshData
+from deferred.gl.shaderlib import register_shader_root
 from deferred.gl.target_spec import TargetSpec
 from deferred.gl.targets import (
     COMPOSITE,
@@ -117,6 +119,7 @@ __all__ = [
     "NonZeroVec3", "ObjectPass", "Order", "Params", "Phase", "Pipeline", "Radiance",
     "RenderError", "RenderPass", "Scene", "SceneObject", "ShadingModel", "TargetSpec",
     "UniformOverrides", "check_image", "copy_pass", "effects", "lights", "materials",
-    "radiances", "read_channels", "read_image", "require_regular_file", "shading_models",
+    "radiances", "read_channels", "read_image", "register_shader_root", "require_regular_file",
+    "shading_models",
     "view_direction", "view_directions", "view_point", "view_points",
 ]

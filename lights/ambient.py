@@ -5,7 +5,15 @@ from __future__ import annotations
 import numpy as np
 from pydantic import Field
 
-from deferred.api import Light, LightParams, NonZeroVec3, Radiance, lights, view_direction
+from deferred.api import (
+    Light,
+    LightParams,
+    LightVolume,
+    NonZeroVec3,
+    Radiance,
+    lights,
+    view_direction,
+)
 
 
 class AmbientParams(LightParams):
@@ -20,7 +28,7 @@ class AmbientLight(Light):
     Params = AmbientParams
     glsl_file = "lights/ambient.glsl"
     glsl_function = "ambient_light"
-    volume = "fullscreen"
+    volume = LightVolume.FULLSCREEN
 
     def record(self, view: np.ndarray) -> np.ndarray:
         record = np.zeros((4, 4), dtype=np.float32)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from pydantic import Field
 
-from deferred.api import Light, LightParams, NonZeroVec3, lights, view_direction
+from deferred.api import Light, LightParams, LightVolume, NonZeroVec3, lights, view_direction
 
 
 class DirectionalParams(LightParams):
@@ -18,7 +18,7 @@ class DirectionalLight(Light):
     Params = DirectionalParams
     glsl_file = "lights/directional.glsl"
     glsl_function = "directional_light"
-    volume = "fullscreen"
+    volume = LightVolume.FULLSCREEN
 
     def record(self, view: np.ndarray) -> np.ndarray:
         record = np.zeros((4, 4), dtype=np.float32)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from pydantic import Field
 
-from deferred.api import Light, LightParams, lights, radiances, view_points
+from deferred.api import Light, LightParams, LightVolume, lights, radiances, view_points
 
 
 class PointParams(LightParams):
@@ -25,7 +25,7 @@ class PointLight(Light):
     Params = PointParams
     glsl_file = "lights/point.glsl"
     glsl_function = "point_light"
-    volume = "sphere"
+    volume = LightVolume.SPHERE
 
     def record(self, view: np.ndarray) -> np.ndarray:
         return self.records([self], view)[0]

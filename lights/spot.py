@@ -5,7 +5,15 @@ from __future__ import annotations
 import numpy as np
 from pydantic import Field, model_validator
 
-from deferred.api import Light, NonZeroVec3, lights, radiances, view_directions, view_points
+from deferred.api import (
+    Light,
+    LightVolume,
+    NonZeroVec3,
+    lights,
+    radiances,
+    view_directions,
+    view_points,
+)
 
 from .point import PointParams
 
@@ -34,7 +42,7 @@ class SpotLight(Light):
     Params = SpotParams
     glsl_file = "lights/spot.glsl"
     glsl_function = "spot_light"
-    volume = "sphere"
+    volume = LightVolume.SPHERE
 
     def record(self, view: np.ndarray) -> np.ndarray:
         return self.records([self], view)[0]

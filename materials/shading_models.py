@@ -1,4 +1,5 @@
-"""Built-in shading models (see :mod:`deferred.interfaces.shading`); importing this module registers them.
+"""Built-in shading models (see :mod:`deferred.interfaces.shading`); importing this module
+registers them.
 
 - ``blinn_phong``: the standard model (albedo, specular intensity and exponent).
 - ``kajiya_kay``: strands (Silva et al. Eq. 6; Kajiya and Kay 1989): diffuse |T x L|, specular

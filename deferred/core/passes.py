@@ -1,9 +1,10 @@
 """Passes: the pipeline is an ordered list of these (Revie section 2.1, Figure 2.3).
 
 Each pass has a unique name, the phase it belongs to, and the targets it creates (with their
-format and clear value), reads and writes; :mod:`deferred.core.graph` checks these declarations before
-any GL work, dumps capture a pass's ``writes`` after it runs and benchmarks time it. Passes set all
-the GL state they need (``Frame.set_state``), so their order is the only coupling between them.
+format and clear value), reads and writes; :mod:`deferred.core.graph` checks these declarations
+before any GL work, dumps capture a pass's ``writes`` after it runs and benchmarks time it. Passes
+set all the GL state they need (``Frame.set_state``), so their order is the only coupling between
+them.
 """
 
 from __future__ import annotations

@@ -1,9 +1,9 @@
 """Looking at buffers: display colours for any target, false colour, labelled contact sheets.
 
 Everything here turns float buffers (top row first) into RGB in [0, 1] for PNG previews; the
-values themselves go to EXR unchanged (:mod:`deferred.debug.dump`). Normals show as ``N * 0.5 + 0.5``,
-depths through the ``turbo`` colour map over the covered range, material ids as categorical
-colours (0, the background, is black).
+values themselves go to EXR unchanged (:mod:`deferred.debug.dump`). Normals show as
+``N * 0.5 + 0.5``, depths through the ``turbo`` colour map over the covered range, material ids
+as categorical colours (0, the background, is black).
 """
 
 from __future__ import annotations

@@ -1,4 +1,5 @@
 """Built-in scene effects (``[[effect]]`` in scene files: ssao, fxaa, edges); importing this
-package registers them (see :mod:`deferred.interfaces.effect` and :mod:`deferred.interfaces.registry`)."""
+package registers them (see :mod:`deferred.interfaces.effect` and
+:mod:`deferred.interfaces.registry`)."""
 
 from deferred.effects import edges, fxaa, ssao  # noqa: F401

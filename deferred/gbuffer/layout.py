@@ -13,7 +13,7 @@ is reconstructed from the linear depth and the pixel's view ray (``gbuffer/layou
 
 Normals are octahedral-encoded [Cigolle et al. 2014] so a view-space unit vector fits two half
 floats. The id channel packs the registry ``type_id`` of the material that wrote the pixel and of
-its shading model (:func:`deferred.interfaces.shading.surface_id`), exact in a half float.
+its shading model (:func:`deferred.gbuffer.surface_id.surface_id`), exact in a half float.
 
 Materials may add targets of their own (:class:`deferred.gbuffer.GBufferData`); the GLSL that
 declares, writes and fetches them is generated per scene (:func:`data_struct_glsl`,

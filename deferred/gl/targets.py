@@ -2,8 +2,8 @@
 
 Passes declare what they create, read and write by target name (:mod:`deferred.core.graph` checks
 it); the dump and the benchmark use the same names. Core targets are the G-buffer (see
-:mod:`deferred.gbuffer.layout`), the light accumulation, the composition buffer and the final image; a
-material or effect pass may create more.
+:mod:`deferred.gbuffer.layout`), the light accumulation, the composition buffer and the final
+image; a material or effect pass may create more.
 """
 
 from __future__ import annotations

@@ -6,7 +6,7 @@ An effect is a class with a unique ``name`` (the scene file's ``[[effect]] type`
 ranked by ``Order`` within the phase. Parameters become ``u_<field>`` uniforms
 (:mod:`deferred.params`). ``pipelines`` names the pipelines it applies to (an effect reading the
 G-buffer has nothing to read in the forward pipeline). Register with
-``@deferred.interfaces.registry.effects.register`` or the entry-point group ``deferred.effects``.
+``@deferred.api.effects.register`` or the entry-point group ``deferred.effects``.
 
 A screen effect that creates the target ``ssao`` (:data:`AMBIENT_OCCLUSION`) feeds the
 ambient light, whichever effect it is.

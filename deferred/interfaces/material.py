@@ -6,7 +6,7 @@ one-line description per field) and a ``surface_shader``: a GLSL file defining
 class gives it a G-buffer pass (geometry phase) and a forward lit pass (forward pipeline). Materials
 that need more (stipple, shells, composition) override the ``*_passes`` hooks, and may add passes
 once per scene (``scene_passes``); they never edit the pipeline. Register with
-``@deferred.interfaces.registry.materials.register`` or the entry-point group ``deferred.materials``.
+``@deferred.api.materials.register`` or the entry-point group ``deferred.materials``.
 
 Parameters become uniforms by name (:mod:`deferred.params`): field ``fur_length`` is
 ``u_fur_length``; ``uniform_overrides`` maps a field to ``None`` (not a uniform: a pass count, a

@@ -7,7 +7,7 @@ A **shading model** is a BRDF in one GLSL file, defining
 Both pipelines call it: the deferred lights through a generated dispatch on the G-buffer's
 shading-model id, the forward pass in its loop over the lights. An optional
 ``vec3 <ambient_function>(Surface s, vec3 irradiance)`` answers the ambient light (default:
-``albedo * irradiance``). Register with ``@deferred.interfaces.registry.shading_models.register`` or the
+``albedo * irradiance``). Register with ``@deferred.api.shading_models.register`` or the
 entry-point group ``deferred.shading_models``; only the models a scene uses are compiled.
 
 **G-buffer data** is extra per-pixel data (a strand tangent, a toon ramp row) in a render target

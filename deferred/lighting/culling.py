@@ -117,9 +117,8 @@ def list_shading_pass(name: str, clustered: bool, gbuffer: tuple[str, ...],
     With ``composite`` it creates the composition buffer too, the same values (a frame with
     no material pass: the copy between them would be all the material phase did).
 
-    It runs on surfaces only (:func:`deferred.lighting.volumes.surface_pass`: lights.toml, 640x360, about
-    a third background: the pass 14.2 -> 11.3 ms at 1 light, 20.7 -> 16.3 at 256, 40.0 -> 35.7
-    at 1024)."""
+    It runs on surfaces only (:func:`deferred.lighting.volumes.surface_pass`; measured in
+    benchmarks/README.md)."""
     from deferred.gl.targets import (
         COMPOSITE,
         COMPOSITE_SPEC,

@@ -264,8 +264,8 @@ class Renderer:
                             frame.stats.gl_call_seconds)
 
     def check_times(self, times: list[float], where: str = "--time") -> None:
-        """Every material's :meth:`~deferred.interfaces.material.Material.check_time` for the latest of
-        ``times``: an animation is refused before its first frame, not part way."""
+        """Every material's :meth:`~deferred.interfaces.material.Material.check_time` for the
+        latest of ``times``: an animation is refused before its first frame, not part way."""
         if times:
             latest = max(times)
             for obj in self.scene.objects:

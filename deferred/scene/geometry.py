@@ -114,8 +114,8 @@ def build_mesh(name: str, positions: np.ndarray, indices: np.ndarray,
     if uvs is not None and len(uvs) == len(positions) and not np.isfinite(uvs).all():
         raise InputError("mesh has non-finite UVs (NaN or infinity)", name)
     if uvs is None or len(uvs) != len(positions):
-        positions, normals, colors, indices, uvs = unwrap_vertices(positions, normals, colors, indices,
-                                                           name)
+        positions, normals, colors, indices, uvs = unwrap_vertices(positions, normals, colors,
+                                                                   indices, name)
         generated = True
     uvs = np.asarray(uvs, dtype=np.float64)
     tangents, binormals = tangent_frames(positions, normals, uvs, indices)

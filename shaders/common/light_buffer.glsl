@@ -1,4 +1,4 @@
-// All lights of the frame (deferred.lightbuffer): an RGBA32F texture, four texels per row, one
+// All lights of the frame (deferred.lighting.buffer): an RGBA32F texture, four texels per row, one
 // row per light. A texture on every GL level, not a storage buffer where there is one: llvmpipe
 // reads a texel about 3.4 times as fast as a storage buffer's vec4 (brute-force light loop,
 // benchmarks/brute_force.py), and the light loops read little else.

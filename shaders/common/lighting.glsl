@@ -1,7 +1,7 @@
 // Light records and the shading-model interface shared by the deferred and forward pipelines.
 #include "common/surface.glsl"
 
-// One light, four vec4s in view space (deferred.light.Light.record):
+// One light, four vec4s in view space (deferred.interfaces.light.Light.record):
 //   color     rgb = colour * intensity, w = light type id
 //   position  xyz = position, w = radius (volume lights)
 //   direction xyz = direction the light travels, w = type-specific (spot: cos outer angle)
@@ -13,7 +13,7 @@ struct LightRecord {
     vec4 extra;
 };
 
-// The surface's shading model answers a light (generated dispatch, deferred.shading): L unit
+// The surface's shading model answers a light (generated dispatch, deferred.interfaces.shading): L unit
 // toward the light, V unit toward the viewer, radiance arriving at the point.
 vec3 shade_light(Surface s, vec3 L, vec3 V, vec3 radiance);
 // ... and ambient irradiance (default: albedo * irradiance).

@@ -1,4 +1,4 @@
-// An object's transform (deferred.frame.ObjectTransforms): its model matrix and the inverse
+// An object's transform (deferred.render.caches.ObjectTransforms): its model matrix and the inverse
 // transpose of the model's 3x3 (normals), and the camera's view, kept apart. A camera that
 // moves changes one uniform a frame, not every object's: the view is a rigid motion (a
 // look-at), so the normal matrix of view x model is mat3(view) x the model's.

@@ -1,4 +1,4 @@
-// G-buffer encoding and decoding; the format is documented in deferred/gbuffer.py.
+// G-buffer encoding and decoding; the format is documented in deferred/gbuffer/layout.py.
 #include "common/surface.glsl"
 #include "gbuffer/octahedral.glsl"
 

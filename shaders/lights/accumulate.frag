@@ -21,7 +21,7 @@ void main() {
     vec3 P = view_position(gl_FragCoord.xy, g.linear_depth, u_resolution, u_inverse_projection);
     vec3 V = normalize(-P);
 #ifdef LIGHT_FUNCTION
-    // the pass's one type (deferred.light.LightTypePass): the switch of evaluate_light would run
+    // the pass's one type (deferred.lighting.volumes.LightTypePass): the switch of evaluate_light would run
     // every type's evaluation on llvmpipe, where an `if` skips nothing
     out_light = vec4(LIGHT_FUNCTION(fetch_light(v_light_index), g.surface, P, V), 0.0);
 #else

@@ -1,7 +1,7 @@
 // Deferred lighting from light lists (the tiled and clustered paths): each pixel reads the
 // G-buffer once and loops over the full-screen lights and the volume lights of its tile or
 // cluster - one pass for every light. It runs on surface pixels only (its triangle on the far
-// plane, the depth test "greater": deferred.light.surface_pass); its targets are
+// plane, the depth test "greater": deferred.lighting.volumes.surface_pass); its targets are
 // cleared to the background first, so it writes the light accumulation whole.
 #include "gbuffer/fetch.glsl"
 #include "common/light_buffer.glsl"
@@ -17,7 +17,7 @@ uniform vec3 u_background;  // where the G-buffer holds no surface (alpha 0: cov
 
 layout(location = 0) out vec4 out_light;
 #ifdef WRITE_COMPOSITE
-// the composition buffer, where the frame has no material pass (deferred.light_lists)
+// the composition buffer, where the frame has no material pass (deferred.lighting)
 layout(location = 1) out vec4 out_composite;
 #endif
 

@@ -1,5 +1,5 @@
 // The volume lights of one light list at a surface point: the deferred tiled and clustered
-// shading and Forward+ (deferred.light_lists).
+// shading and Forward+ (deferred.lighting).
 //
 // A list holds the lights that touch its tile or cluster; many miss any one point of it
 // (lights.toml at 1024 lights, 640x360: 21.6 entries a pixel in the 8x8 tiled lists, 31.5 in
@@ -25,6 +25,6 @@
 #include "generated/listed_lights.glsl"
 
 vec3 evaluate_listed_lights(int list, Surface s, vec3 P, vec3 V) {
-    // the loops, a do-while per volume light type: deferred.light.listed_dispatch_glsl
+    // the loops, a do-while per volume light type: deferred.lighting.dispatch.listed_dispatch_glsl
     return evaluate_listed_slots(light_list_first_slot(list), light_list_length(list), s, P, V);
 }

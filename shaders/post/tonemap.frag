@@ -3,7 +3,7 @@
 
 uniform sampler2D u_source;
 uniform float u_exposure;
-// TONEMAP (deferred.pipeline.TONEMAPS): 0 none (clamp), 1 Reinhard, 2 ACES (Narkowicz 2015
+// TONEMAP (deferred.render.pipeline.TONEMAPS): 0 none (clamp), 1 Reinhard, 2 ACES (Narkowicz 2015
 // fit). A define, not a uniform: on llvmpipe an `if` runs both operators (8% of the pass).
 #ifndef TONEMAP
 #define TONEMAP 2  // the scenes' default

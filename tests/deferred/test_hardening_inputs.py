@@ -187,7 +187,8 @@ def _raise(positions, indices):
 
 def test_unwrap_time_limit(tmp_path, capfd, monkeypatch):
     (tmp_path / "tet.obj").write_text(TETRAHEDRON)
-    monkeypatch.setattr(deferred.scene.unwrap, "_xatlas_parametrize", _sleep_for_ever)  # fork copies it
+    # the fork copies the patched module
+    monkeypatch.setattr(deferred.scene.unwrap, "_xatlas_parametrize", _sleep_for_ever)
     monkeypatch.setenv("DEFERRED_UNWRAP_TIMEOUT", "0.3")
     start = time.monotonic()
     code, err, out = render_scene(tmp_path, capfd, {"mesh": "tet.obj", "material": "standard"})

@@ -3,7 +3,7 @@
 import numpy as np
 from pydantic import Field
 
-from deferred.api import Light, LightParams, NonZeroVec3, view_direction
+from deferred.api import Light, LightParams, LightVolume, NonZeroVec3, view_direction
 
 from . import SHADERS
 
@@ -18,7 +18,7 @@ class RimLight(Light):
     Params = RimParams
     glsl_file = "velvet/rim_light.glsl"
     glsl_function = "rim_light"
-    volume = "fullscreen"
+    volume = LightVolume.FULLSCREEN
     shader_root = SHADERS
 
     def record(self, view: np.ndarray) -> np.ndarray:
