@@ -17,6 +17,7 @@ Both keep plain values: nothing is released through them (GPU objects are kept b
 from __future__ import annotations
 
 import functools
+import inspect
 from collections.abc import Callable
 from typing import Any, TypeVar
 
@@ -29,25 +30,61 @@ def kept_while(*sources: str) -> Callable[[F], F]:
     are the same objects as when it was made; with no ``sources``, for the instance's life.
 
     The kept value is returned itself, not a copy: a method whose callers may change what it
-    returns hands out copies of a kept one."""
+    returns hands out copies of a kept one. (Some of these are asked for by every object every
+    frame: the wrapper is specialised to do no more than it must.)"""
 
     def decorate(method: F) -> F:
         slot = f"_kept_{method.__name__}"
+        with_arguments = len(inspect.signature(method).parameters) > 1
+        names = tuple(sources)
 
-        @functools.wraps(method)
-        def kept(self, *args):
-            made_from = tuple([getattr(self, name) for name in sources])
-            held = self.__dict__.get(slot)
-            if held is None or len(held[0]) != len(made_from) or \
-                    any(a is not b for a, b in zip(held[0], made_from, strict=True)):
-                held = self.__dict__[slot] = (made_from, {})
-            values = held[1]
-            value = values.get(args, values)  # the dict itself: "not made yet"
-            if value is values:
-                value = values[args] = method(self, *args)
-            return value
+        def made_from(self) -> tuple:
+            return tuple([getattr(self, name) for name in names])
 
-        return kept  # type: ignore[return-value]
+        def fresh(held: tuple | None, current: tuple) -> bool:
+            return held is not None and len(held[0]) == len(current) and \
+                all(a is b for a, b in zip(held[0], current, strict=True))
+
+        if not with_arguments and not names:
+            def kept(self):
+                try:
+                    return self.__dict__[slot]
+                except KeyError:
+                    value = self.__dict__[slot] = method(self)
+                    return value
+        elif not with_arguments and len(names) == 1:
+            (name,) = names
+
+            def kept(self):
+                source = getattr(self, name)
+                held = self.__dict__.get(slot)
+                if held is not None and held[0] is source:
+                    return held[1]
+                value = method(self)
+                self.__dict__[slot] = (source, value)
+                return value
+        elif not with_arguments:
+            def kept(self):
+                current = made_from(self)
+                held = self.__dict__.get(slot)
+                if fresh(held, current):
+                    return held[1]
+                value = method(self)
+                self.__dict__[slot] = (current, value)
+                return value
+        else:
+            def kept(self, *args):
+                current = made_from(self)
+                held = self.__dict__.get(slot)
+                if not fresh(held, current):
+                    held = self.__dict__[slot] = (current, {})
+                values = held[1]
+                value = values.get(args, values)  # the dict itself: "not made yet"
+                if value is values:
+                    value = values[args] = method(self, *args)
+                return value
+
+        return functools.wraps(method)(kept)  # type: ignore[return-value]
 
     return decorate
 

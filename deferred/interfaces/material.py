@@ -152,7 +152,9 @@ class Material:
         (its own and its shading model's), in the order of ``gbuffer/write.glsl``'s outputs."""
         return (*GBUFFER_COLOR_TARGETS, *(data.name for data in material_data(self)))
 
-    @kept_while("type_id", "shading_model")  # asked for by every object, every frame
+    # asked for by every object, every frame; the type id is the class's from its registration
+    # on, and an unregistered class's (0) is refused, never kept
+    @kept_while("shading_model")
     def surface_id(self) -> int:
         """The G-buffer id of this material's pixels: its shading model and its type id."""
         model_id = registry.shading_models.get(self.shading_model).type_id

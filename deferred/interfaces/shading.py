@@ -54,21 +54,22 @@ class ShadingModel:
 
 class ShadingTextures:
     """The samplers of a scene's shading models (ramps...), offered to every program a frame
-    binds (a binding source of the frame: wherever lights run); asked of the models once a
-    frame, at the first program bound."""
+    binds (a binding source of the frame: wherever lights run)."""
 
-    def __init__(self, models: Iterable[type[ShadingModel]], frame: Frame):
-        self.models = list(models)
-        self.frame = frame
-        self._textures: dict[str, moderngl.Texture] | None = None
+    def __init__(self, textures: dict[str, moderngl.Texture]):
+        self.textures = textures
+
+    @classmethod
+    def of(cls, models: Iterable[type[ShadingModel]], frame: Frame) -> ShadingTextures | None:
+        """The models' samplers this frame; ``None`` where they have none (most scenes: the
+        frame then has no source to ask at every draw)."""
+        textures: dict[str, moderngl.Texture] = {}
+        for model in models:
+            textures.update(model.textures(frame))
+        return cls(textures) if textures else None
 
     def bind(self, uniforms: ProgramUniforms, texture_unit: int) -> int:
-        textures = self._textures
-        if textures is None:
-            textures = self._textures = {}
-            for model in self.models:
-                textures.update(model.textures(self.frame))
-        return bind_samplers(uniforms, textures, texture_unit) if textures else texture_unit
+        return bind_samplers(uniforms, self.textures, texture_unit)
 
 
 def shading_dispatch_glsl(models: list[type[ShadingModel]]) -> str:

@@ -215,8 +215,9 @@ class Renderer:
         inputs.frame = frame
         # what every program the frame binds may read: the scene's shading models' samplers,
         # the lights' records and, on the list paths, the lists
-        frame.binding_sources = [ShadingTextures(self.shading_models, frame), self.light_buffer,
-                                 *([self.light_lists] if self.light_lists is not None else [])]
+        shading = ShadingTextures.of(self.shading_models, frame)
+        frame.binding_sources = [source for source in (shading, self.light_buffer,
+                                                       self.light_lists) if source is not None]
         self.light_buffer.upload(self.scene.lights, frame.view, frame.projection)
         self._check_gl("uploading the lights")
         for render_pass in self.passes:
