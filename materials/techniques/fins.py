@@ -13,6 +13,8 @@ import numpy as np
 
 from deferred.api import DEPTH, GpuMesh, MeshData, ObjectPass, Order
 
+from .topology import weld
+
 
 def edge_adjacency(mesh: MeshData, tolerance: float = 1e-6) -> np.ndarray:
     """(E, 4) uint32 ``[c1, a, b, c2]`` per interior edge: its endpoints as triangle 1 winds
@@ -20,9 +22,7 @@ def edge_adjacency(mesh: MeshData, tolerance: float = 1e-6) -> np.ndarray:
     Vertices split at UV seams are welded by position, so seams are interior edges too; edges
     with one face, or more than two, get no fin; zero-area faces are left out."""
     positions = np.asarray(mesh.positions, dtype=np.float64)
-    keys = np.round(positions / tolerance).astype(np.int64)
-    _, welded = np.unique(keys, axis=0, return_inverse=True)
-    welded = welded.reshape(-1)
+    welded = weld(positions, tolerance)
     faces = np.asarray(mesh.indices, dtype=np.int64).reshape(-1, 3)
     # zero-area triangles (the poles of a UV sphere) border nothing: they would make their
     # edges look shared by three faces

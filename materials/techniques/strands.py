@@ -28,6 +28,8 @@ import numpy as np
 
 from deferred.api import MeshData
 
+from .topology import weld
+
 
 @dataclass(frozen=True)
 class StrandForces:
@@ -109,13 +111,6 @@ def triangle_strands(mesh: MeshData, model: np.ndarray,
     scale = np.asarray(mesh.comb, np.float64)[faces][..., 3].mean(axis=1)
     lengths = np.where(norm > 1e-20, fur_length * scale * world_per_object, 0.0)
     return p.mean(axis=1), normals, lengths
-
-
-def weld(positions: np.ndarray, tolerance: float = 1e-6) -> np.ndarray:
-    """Index of each vertex's position group (vertices split at UV seams share one)."""
-    keys = np.round(np.asarray(positions, np.float64) / tolerance).astype(np.int64)
-    _, welded = np.unique(keys, axis=0, return_inverse=True)
-    return welded.reshape(-1)
 
 
 def curl_frames(mesh: MeshData, welded: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -25,6 +25,8 @@ import numpy as np
 
 from deferred.api import InputError, MeshData, read_channels, read_image
 
+from .topology import weld
+
 DRY_CENTRE = -8.0  # the (R, G) of a dry texel: no clump centre is ever within reach of it
 
 
@@ -136,8 +138,6 @@ def dry_out(mask: np.ndarray, amount: float) -> None:
 def uv_wrap(mesh: MeshData, tolerance: float = 1e-3) -> tuple[bool, bool]:
     """Whether the mesh's UVs wrap around in u and in v: a vertex split at a seam has copies
     whose u (v) differ by 1 (a cylindrical unwrap, as the built-in sphere and torus have)."""
-    from .strands import weld
-
     welded = weld(mesh.positions)
     uvs = np.asarray(mesh.uvs, np.float64)
     order = np.argsort(welded, kind="stable")

@@ -255,7 +255,8 @@ def test_triangle_strands_point_outward_and_scale_to_world():
 
 
 def test_curl_frames_are_orthonormal_and_shared_across_seams():
-    from deferred.materials.techniques.strands import curl_frames, weld
+    from deferred.materials.techniques.strands import curl_frames
+    from deferred.materials.techniques.topology import weld
 
     mesh = builtin_sphere(16, 8)  # its u seam splits a column of vertices
     welded = weld(mesh.positions)
