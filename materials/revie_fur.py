@@ -15,9 +15,8 @@ The shells, their fur volume, level of detail and fins are the shared fur techni
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
-import moderngl
 from pydantic import Field
 
 from deferred.api import (
@@ -30,7 +29,6 @@ from deferred.api import (
     BlinnPhongParams,
     ForwardLitPass,
     GBufferPass,
-    Material,
     NonZeroVec3,
     Phase,
     RenderPass,
@@ -41,12 +39,9 @@ from .techniques.fins import FinPass
 from .techniques.fur import (
     FUR_DEBUG_VIEWS,
     FUR_UNIFORM_OVERRIDES,
+    FurMaterial,
     FurParams,
-    check_heightfield,
     debug_defines,
-    fur_scale,
-    fur_volume_texture,
-    tiles_per_unit,
 )
 from .techniques.shells import ShellPass
 from .techniques.stipple import (
@@ -57,7 +52,7 @@ from .techniques.stipple import (
 )
 
 if TYPE_CHECKING:
-    from deferred.api import Frame, SceneObject
+    from deferred.api import SceneObject
 
 Vec3 = tuple[float, float, float]
 FUR_VERTEX = "materials/revie_fur/fur.vert"
@@ -102,7 +97,7 @@ class FurFinPass(FinPass):
 
 
 @materials.register
-class RevieFurMaterial(Material):
+class RevieFurMaterial(FurMaterial):
     name = "revie_fur"
     Params = RevieFurParams
     surface_shader = "materials/revie_fur/surface.glsl"
@@ -110,13 +105,6 @@ class RevieFurMaterial(Material):
     # pass counts and switches compiled as defines are not uniforms; density becomes tiles
     uniform_overrides = {**FUR_UNIFORM_OVERRIDES, "stipple": None, "occlusion_test": None}
     debug_views = FUR_DEBUG_VIEWS
-
-    def check_files(self, where: str | None) -> None:
-        check_heightfield(self.heightfield_path(), where)
-
-    def heightfield_path(self):
-        return None if self.params.heightfield is None else \
-            self.resolve_path(self.params.heightfield)
 
     def defines(self, obj: SceneObject) -> dict[str, str]:
         defines = {**super().defines(obj), **pattern_defines(4, STIPPLE_PARITY)}
@@ -127,21 +115,6 @@ class RevieFurMaterial(Material):
         if self.params.occlusion_test:
             defines["FUR_OCCLUSION_TEST"] = "1"
         return {**defines, **debug_defines(self.params)}
-
-    def uniforms(self, frame: Frame) -> dict[str, Any]:
-        return {**super().uniforms(frame), "u_fur_tiles": tiles_per_unit(self.params)}
-
-    def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
-        return {"u_fur_volume": fur_volume_texture(frame, self.params,
-                                                   self.heightfield_path())}
-
-    @staticmethod
-    def vertex_constants(obj: SceneObject, shell_depth: float | None = None) -> dict[str, Any]:
-        """Uniforms of the fur vertex shader fixed for the object (and the shell depth)."""
-        constants = {"u_fur_scale": fur_scale(obj)}
-        if shell_depth is not None:
-            constants["u_shell_depth"] = shell_depth
-        return constants
 
     # -- passes ------------------------------------------------------------------------------
     @classmethod

@@ -35,7 +35,6 @@ from deferred.api import (
     ForwardLitPass,
     GBufferPass,
     InputError,
-    Material,
     Phase,
     RenderPass,
     materials,
@@ -46,11 +45,9 @@ from .techniques.fins import FinPass
 from .techniques.fur import (
     FUR_DEBUG_VIEWS,
     FUR_UNIFORM_OVERRIDES,
+    FurMaterial,
     FurParams,
-    check_heightfield,
     debug_defines,
-    fur_scale,
-    fur_volume_texture,
     shell_count,
     tiles_per_unit,
 )
@@ -424,7 +421,7 @@ CHORD = {"STRAND_CHORD": "1"}
 
 
 @materials.register
-class ShellFurMaterial(Material):
+class ShellFurMaterial(FurMaterial):
     name = "shell_fur"
     Params = ShellFurParams
     surface_shader = "materials/shell_fur/surface.glsl"
@@ -454,7 +451,7 @@ class ShellFurMaterial(Material):
     }
 
     def check_files(self, where: str | None) -> None:
-        check_heightfield(self.heightfield_path(), where)
+        super().check_files(where)
         for key in ("color_texture", "wetness_mask"):
             value = getattr(self.params, key)
             if value is None:
@@ -467,10 +464,6 @@ class ShellFurMaterial(Material):
                 read_mask_image(path) if key == "wetness_mask" else read_image(path)
             except InputError as exc:
                 raise InputError(exc.message, name) from None
-
-    def heightfield_path(self) -> Path | None:
-        return None if self.params.heightfield is None else \
-            self.resolve_path(self.params.heightfield)
 
     def wetness_mask_path(self, params: ShellFurParams | None = None) -> Path | None:
         params = params or self.params
@@ -490,12 +483,9 @@ class ShellFurMaterial(Material):
         """Whether the colour varies over the UVs (a texture or a pattern), else the tint."""
         return self.params.color_texture is not None or self.params.color_pattern != "none"
 
-    def uniforms(self, frame: Frame) -> dict[str, Any]:
-        return {**super().uniforms(frame), "u_fur_tiles": tiles_per_unit(self.params)}
-
     def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
         params = self.params
-        textures = {"u_fur_volume": fur_volume_texture(frame, params, self.heightfield_path())}
+        textures = super().textures(frame)
         if params.color_texture is not None:
             textures["u_color_map"] = frame.resources.image_texture(
                 self.resolve_path(params.color_texture))
@@ -511,13 +501,6 @@ class ShellFurMaterial(Material):
                                        lambda ctx: ShellFurState(ctx, obj, self))
         state.advance(float(getattr(frame, "time", 0.0)))
         return state
-
-    @staticmethod
-    def vertex_constants(obj: SceneObject, shell_depth: float | None = None) -> dict[str, Any]:
-        constants = {"u_fur_scale": fur_scale(obj)}
-        if shell_depth is not None:
-            constants["u_shell_depth"] = shell_depth
-        return constants
 
     # -- passes ------------------------------------------------------------------------------
     @classmethod

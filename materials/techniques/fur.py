@@ -1,7 +1,7 @@
 """The shared fur technique: the parameters every shell fur has, the mip-mapped fur volume its
 shells and fins sample (``fur_volume.py``, ``shaders/techniques/fur.glsl``), density in world
-units, level of detail and self-shadowing. ``revie_fur`` builds on it, and the curling and
-clumping shell fur will: they differ in how fur is lit and shaped, not in how shells are drawn.
+units, level of detail and self-shadowing. ``revie_fur`` and ``shell_fur`` build on it
+(:class:`FurMaterial`): they differ in how fur is lit and shaped, not in how shells are drawn.
 
 - **Density** is strands per square world unit: the volume tiles ``sqrt(density / strands per
   tile)`` times per world unit along the surface, looked up triplanar in the object's axes scaled
@@ -25,7 +25,7 @@ import moderngl
 import numpy as np
 from pydantic import Field, model_validator
 
-from deferred.api import InputError, MaterialParams
+from deferred.api import InputError, Material, MaterialParams
 
 from .fur_volume import FurPattern, pattern, strand_volume, volume_texture
 from .heightfield import heightfield_volume, load_heightfield
@@ -160,6 +160,36 @@ def object_scale(obj: SceneObject) -> np.ndarray:
 def fur_scale(obj: SceneObject) -> tuple[float, float, float]:
     """``u_fur_scale``: the object's axes to world units, for the volume lookups."""
     return tuple(float(s) for s in object_scale(obj))
+
+
+class FurMaterial(Material):
+    """What every fur material has (its ``params`` are a :class:`FurParams`): the heightfield
+    image checked and resolved, the fur volume and its tiling as inputs, and the constants of
+    the fur vertex shader for an object."""
+
+    params: FurParams
+
+    def check_files(self, where: str | None) -> None:
+        check_heightfield(self.heightfield_path(), where)
+
+    def heightfield_path(self) -> Path | None:
+        return None if self.params.heightfield is None else \
+            self.resolve_path(self.params.heightfield)
+
+    def uniforms(self, frame: Frame) -> dict[str, Any]:
+        return {**super().uniforms(frame), "u_fur_tiles": tiles_per_unit(self.params)}
+
+    def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
+        return {**super().textures(frame),
+                "u_fur_volume": fur_volume_texture(frame, self.params, self.heightfield_path())}
+
+    @staticmethod
+    def vertex_constants(obj: SceneObject, shell_depth: float | None = None) -> dict[str, Any]:
+        """Uniforms of the fur vertex shader fixed for the object (and the shell depth)."""
+        constants = {"u_fur_scale": fur_scale(obj)}
+        if shell_depth is not None:
+            constants["u_shell_depth"] = shell_depth
+        return constants
 
 
 def projected_fur_pixels(frame: Frame, obj: SceneObject, fur_length: float) -> float:
