@@ -15,7 +15,7 @@ The shells, their fur volume, level of detail and fins are the shared fur techni
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from pydantic import Field
 
@@ -78,22 +78,13 @@ class RevieFurParams(FurParams, BlinnPhongParams):
                                                    "occluded (off: Figure 2.8's error)")
 
 
-class FurShellPass(ShellPass):
-    """Material-phase shells reading light accumulation + G-buffer (shell.frag)."""
-
-    fragment = SHELL_FRAGMENT
-    vertex = FUR_VERTEX
-    colors = (COMPOSITE,)
-    extra_reads = (LIGHT_ACCUMULATION, ALBEDO_SPECULAR, NORMAL_EXPONENT_ID, LINEAR_DEPTH)
-
-
-class FurFinPass(FinPass):
-    """Material-phase fins, lit from the light accumulation like the shells (shell.frag)."""
-
-    fragment = SHELL_FRAGMENT
-    vertex = FUR_VERTEX
-    colors = (COMPOSITE,)
-    extra_reads = (LIGHT_ACCUMULATION, ALBEDO_SPECULAR, NORMAL_EXPONENT_ID, LINEAR_DEPTH)
+# Options of the shell and fin passes: in the material phase both take their light from the
+# light accumulation and the G-buffer (shell.frag); in the forward phase they light themselves.
+MATERIAL_LAYERS: dict[str, Any] = {
+    "vertex": FUR_VERTEX, "fragment": SHELL_FRAGMENT, "colors": (COMPOSITE,),
+    "extra_reads": (LIGHT_ACCUMULATION, ALBEDO_SPECULAR, NORMAL_EXPONENT_ID, LINEAR_DEPTH)}
+FORWARD_LAYERS: dict[str, Any] = {
+    "vertex": FUR_VERTEX, "fragment": FORWARD_SHELL_FRAGMENT, "colors": (COMPOSITE,)}
 
 
 @materials.register
@@ -143,10 +134,10 @@ class RevieFurMaterial(FurMaterial):
             # fins first: the shells composite over them, which fill the gaps between shell
             # rims at grazing angles
             if self.params.fins:
-                passes.append(FurFinPass(f"{obj.label}.fins", Phase.MATERIAL, obj,
-                                         constants=self.vertex_constants(obj)))
-            passes.append(FurShellPass(f"{obj.label}.shells", Phase.MATERIAL, obj,
-                                       constants=self.vertex_constants(obj)))
+                passes.append(FinPass(f"{obj.label}.fins", Phase.MATERIAL, obj,
+                                      constants=self.vertex_constants(obj), **MATERIAL_LAYERS))
+            passes.append(ShellPass(f"{obj.label}.shells", Phase.MATERIAL, obj,
+                                    constants=self.vertex_constants(obj), **MATERIAL_LAYERS))
         return passes
 
     def forward_passes(self, obj: SceneObject) -> list[RenderPass]:
@@ -156,11 +147,7 @@ class RevieFurMaterial(FurMaterial):
         if self.params.shells > 0:
             if self.params.fins:
                 passes.append(FinPass(f"{obj.label}.forward_fins", Phase.FORWARD, obj,
-                                      vertex=FUR_VERTEX, colors=(COMPOSITE,),
-                                      fragment=FORWARD_SHELL_FRAGMENT,
-                                      constants=self.vertex_constants(obj)))
+                                      constants=self.vertex_constants(obj), **FORWARD_LAYERS))
             passes.append(ShellPass(f"{obj.label}.forward_shells", Phase.FORWARD, obj,
-                                    vertex=FUR_VERTEX, colors=(COMPOSITE,),
-                                    fragment=FORWARD_SHELL_FRAGMENT,
-                                    constants=self.vertex_constants(obj)))
+                                    constants=self.vertex_constants(obj), **FORWARD_LAYERS))
         return passes
