@@ -48,11 +48,9 @@ from .techniques.fur import (
     FurMaterial,
     FurParams,
     debug_defines,
-    shell_count,
     tiles_per_unit,
 )
 from .techniques.fur_light import FurLightReader, fur_light_pass, fur_light_targets
-from .techniques.fur_volume import VOLUME_LAYERS
 from .techniques.shells import ShellPass
 from .techniques.strands import (
     StrandForces,
@@ -378,24 +376,12 @@ class ShellFurLayerPass(FurLightReader, ObjectStateInputs, ShellPass):
     vertex = FUR_VERTEX
     clumps = True
 
-    def draws(self, frame: Frame) -> int:
-        params = self.obj.material.params
-        self._count = shell_count(frame, self.obj, params) if params.shells > 0 else 0.0
-        self._layout = layer_layout(self._count, params.shell_range, params.debug) \
-            if self._count > 0 else []
-        return len(self._layout)
+    def layout(self, count: float, params: ShellFurParams) -> list[tuple[float, float] | None]:
+        # no layers, not even the skin, without shells
+        return layer_layout(count, params.shell_range, params.debug) if count > 0 else []
 
-    def draw_uniforms(self, frame: Frame, index: int, count: int) -> dict[str, Any] | None:
-        layer = self._layout[index]
-        if layer is None:
-            return None
-        h, fade = layer
-        self._root = index == 0
-        params = self.obj.material.params
-        # each layer stands for 1/N of the fur: the volume's slices per layer
-        return {"u_shell_depth": h, "u_shell_fade": fade, "u_root_shell": self._root,
-                "u_shell_weight": VOLUME_LAYERS / max(self._count, 1e-6),
-                "u_shell_count": self._count / max(params.shells, 1)}
+    def slabs(self, count: float) -> float:
+        return count  # N layers over the skin: each stands for 1/N of the fur
 
 
 class ShellFurFinPass(FurLightReader, ObjectStateInputs, FinPass):

@@ -11,7 +11,7 @@ from typing import Any
 
 from deferred.api import DEPTH, ObjectPass, Order
 
-from .fur import shell_count, shell_layout
+from .fur import FurParams, shell_count, shell_layout
 from .fur_volume import VOLUME_LAYERS
 
 ROOT_OFFSET = (-1.0, -2.0)  # glPolygonOffset (factor, units) of the root shell
@@ -28,10 +28,20 @@ class ShellPass(ObjectPass):
     blend = "alpha"
     order = Order.VOLUME
 
+    def layout(self, count: float, params: FurParams) -> list[tuple[float, float] | None]:
+        """(depth, fade) of each draw for a continuous shell count, the root shell first (None:
+        not drawn)."""
+        return shell_layout(count, params.shell_range, params.debug)
+
+    def slabs(self, count: float) -> float:
+        """How many slabs the fur volume is cut into for ``count`` shells: each shell above
+        the opaque root stands for one, its slices (``u_shell_weight``) the volume's share."""
+        return count - 1.0
+
     def draws(self, frame) -> int:
         params = self.obj.material.params
         self._count = shell_count(frame, self.obj, params)
-        self._layout = shell_layout(self._count, params.shell_range, params.debug)
+        self._layout = self.layout(self._count, params)
         return len(self._layout)
 
     def draw_uniforms(self, frame, index: int, count: int) -> dict[str, Any] | None:
@@ -42,7 +52,7 @@ class ShellPass(ObjectPass):
         params = self.obj.material.params
         self._root = index == 0
         return {"u_shell_depth": depth, "u_shell_fade": fade, "u_root_shell": self._root,
-                "u_shell_weight": VOLUME_LAYERS / max(self._count - 1.0, 1e-6),
+                "u_shell_weight": VOLUME_LAYERS / max(self.slabs(self._count), 1e-6),
                 "u_shell_count": self._count / max(params.shells, 1)}
 
     def draw(self, frame, program) -> None:
