@@ -213,7 +213,8 @@ def _float_texture(ctx: moderngl.Context, width: int, height: int) -> moderngl.T
 
 class ShellFurState:
     """An object's wetness mask and strands over time, with their textures (``u_wetness_mask``,
-    ``u_strand_tips``).
+    ``u_strand_tips``): one per object and renderer (:func:`object_state`), brought to each
+    frame's time by the object's passes' ``prepare``.
 
     Time is a count of fixed steps from t = 0: the state at time t is that after step
     ``floor(t / time_step)`` whatever frames came before, so the same time gives the same frame
@@ -221,7 +222,7 @@ class ShellFurState:
     ``n * time_step`` (``SceneObject.params_at``); droplets fall at the first step at or after
     their event; drying removes ``dry_rate * time_step`` per step. Before t = 0 the strands
     settle for ``settle`` seconds with the parameters at 0. Parameters the material reads once
-    (``TIMELINE_FIXED``) are the ones at t = 0: a timeline may not change them."""
+    (``timeline_fixed``) are the ones at t = 0: a timeline may not change them."""
 
     def __init__(self, ctx: moderngl.Context, obj: SceneObject, material: ShellFurMaterial):
         self.obj = obj
@@ -326,22 +327,46 @@ class ShellFurState:
 
 # -- passes -------------------------------------------------------------------------------------
 
+def object_state(frame: Frame, obj: SceneObject) -> ShellFurState:
+    """``obj``'s state in the frame's renderer, made the first time it is asked for; keyed by
+    the object itself, so objects sharing a material instance each have their own, and
+    released with the renderer's resources."""
+    return frame.resources.cached(("shell_fur_state", obj),
+                                  lambda ctx: ShellFurState(ctx, obj, obj.material))
+
+
 class ObjectStateInputs:
-    """Passes of a shell_fur object bind its state's textures (at the frame's time); those that
-    clump (``clumps``) learn whether the mesh's UVs wrap."""
+    """Passes of a shell_fur object: ``prepare`` brings the object's state to the frame's time
+    (the renderer prepares every pass before any draws, so all of the object's passes see the
+    same state); the pass binds the state's textures, and those that clump (``clumps``) learn
+    whether the mesh's UVs wrap."""
 
     obj: SceneObject
+    name: str
     clumps = False
+    _prepared: tuple[Frame, ShellFurState] | None = None
+
+    def prepare(self, frame: Frame) -> None:
+        state = object_state(frame, self.obj)
+        state.advance(frame.time)  # a no-op for the object's other passes: already there
+        self._prepared = (frame, state)
+
+    def state(self, frame: Frame) -> ShellFurState:
+        """The object's state as ``prepare`` left it for ``frame``."""
+        if self._prepared is None or self._prepared[0] is not frame:
+            raise RuntimeError(f"{self.name}: drawn in a frame it was not prepared for (the "
+                               "shell_fur state steps in prepare)")
+        return self._prepared[1]
 
     def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
-        state = self.obj.material.state(frame, self.obj)
+        state = self.state(frame)
         return {**super().textures(frame), "u_wetness_mask": state.mask_texture,
                 "u_strand_tips": state.tips_texture}
 
     def uniforms(self, frame: Frame) -> dict[str, Any]:
         uniforms = super().uniforms(frame)
         if self.clumps:
-            state = self.obj.material.state(frame, self.obj)
+            state = self.state(frame)
             uniforms["u_mask_wrap"] = tuple(float(w) for w in state.wrap)
             # the world density over the UVs: tiles per world unit x world units per UV unit
             uniforms["u_fur_uv_tiles"] = tiles_per_unit(self.obj.material.params) * \
@@ -416,14 +441,6 @@ class ShellFurMaterial(FurMaterial):
     uniform_overrides = {**FUR_UNIFORM_OVERRIDES, **{key: None for key in NOT_UNIFORMS},
                          "shells": _layers_uniform}
     # the simulation's set-up (ShellFurState), and the passes built once
-    def check_time(self, time: float, where: str) -> None:
-        steps = simulation_steps(self.params, time)
-        if steps > MAX_SIMULATION_STEPS:
-            raise InputError(f"t = {time:g} s needs {steps:,} simulation steps of "
-                             f"{self.params.time_step:g} s (with settle); the most is "
-                             f"{MAX_SIMULATION_STEPS:,}: render an earlier time or raise "
-                             "time_step", where)
-
     timeline_fixed = ("fur_length", "mask_size", "wetness_mask", "time_step", "settle", "seed",
                       "fins")
     debug_views = {
@@ -435,6 +452,14 @@ class ShellFurMaterial(FurMaterial):
         "wetness": ("the wetness mask on the skin: a colour per clump, as bright as it is "
                     "wet; black dry (Silva et al. Fig. 11's inset)", {"debug": "wetness"}),
     }
+
+    def check_time(self, time: float, where: str) -> None:
+        steps = simulation_steps(self.params, time)
+        if steps > MAX_SIMULATION_STEPS:
+            raise InputError(f"t = {time:g} s needs {steps:,} simulation steps of "
+                             f"{self.params.time_step:g} s (with settle); the most is "
+                             f"{MAX_SIMULATION_STEPS:,}: render an earlier time or raise "
+                             "time_step", where)
 
     def check_files(self, where: str | None) -> None:
         super().check_files(where)
@@ -480,13 +505,6 @@ class ShellFurMaterial(FurMaterial):
                 ("shell_fur_pattern", params.color_pattern, params.seed, params.color,
                  params.pattern_color), lambda ctx: pattern_texture(ctx, params))
         return textures
-
-    def state(self, frame: Frame, obj: SceneObject) -> ShellFurState:
-        """The object's state, advanced to the frame's time."""
-        state = frame.resources.cached(("shell_fur_state", id(obj)),
-                                       lambda ctx: ShellFurState(ctx, obj, self))
-        state.advance(float(getattr(frame, "time", 0.0)))
-        return state
 
     # -- passes ------------------------------------------------------------------------------
     @classmethod

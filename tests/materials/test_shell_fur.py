@@ -12,7 +12,12 @@ import pytest
 
 from deferred.gl.shaderlib import ShaderLibrary
 from deferred.io.images import write_image
-from deferred.materials.shell_fur import ShellFurMaterial, ShellFurState, layer_layout
+from deferred.materials.shell_fur import (
+    ShellFurMaterial,
+    ShellFurState,
+    layer_layout,
+    object_state,
+)
 from deferred.materials.techniques.strands import StrandForces, StrandSimulation, triangle_strands
 from deferred.materials.techniques.wetness import (
     DRY_CENTRE,
@@ -680,6 +685,81 @@ def test_render_at_the_same_time_twice_is_identical(render):
     repeat = renderer.render(time=1.3)
     np.testing.assert_array_equal(first.image, repeat.image)
     assert not np.array_equal(first.image, second.image)
+
+
+def shared_material_scene(event: dict | None = None):
+    """Two spheres drawn with one shell_fur Material instance, ``a`` on the left and ``b``
+    turned on its side on the right; ``event``: params ``a`` takes from t = 0.25 s."""
+    scene = scene_from_dict({
+        "size": [96, 48],
+        "camera": {"position": [0.0, 0.6, 3.0], "target": [0.0, 0.0, 0.0], "fov": 40.0},
+        "light": [{"type": "directional", "direction": [-0.4, -1.0, -0.5]},
+                  {"type": "ambient", "intensity": 0.4}]}, "shared")
+    material = ShellFurMaterial.from_dict({"fur_length": 0.25, "shells": 6, "damping": 0.2,
+                                           "settle": 0.2, "mask_size": 64})
+    a = scene.add("builtin:sphere", material, position=(-0.9, 0.0, 0.0), scale=0.5, label="a")
+    b = scene.add("builtin:sphere", material, position=(0.9, 0.0, 0.0), scale=0.5,
+                  rotation=(90.0, 0.0, 0.0), label="b")
+    assert a.material is b.material
+    if event is not None:
+        scene.add_event(a, 0.25, event)
+    return scene, a, b
+
+
+@pytest.mark.parametrize("pipeline", ["deferred", "forward"])
+def test_an_event_on_one_object_leaves_another_sharing_its_material_alone(render, pipeline):
+    """Each object's simulation is its own (keyed by the object, not by its material): wind
+    and rain on ``a`` change ``a`` alone, and ``b``, at another transform, has strands of its
+    own."""
+    plain, plain_a, plain_b = shared_material_scene()
+    windy, windy_a, windy_b = shared_material_scene({"wind": [0.3, 0.0, 0.0], "droplets": 40,
+                                                     "droplet_radius": 0.2})
+    before, plain_renderer = render(plain, pipeline, time=0.5)
+    after, windy_renderer = render(windy, pipeline, time=0.5)
+    # a changed, b's half of the image did not
+    assert not np.array_equal(before.hdr[:, :48], after.hdr[:, :48])
+    np.testing.assert_array_equal(before.hdr[:, 48:], after.hdr[:, 48:])
+
+    def states(renderer, a, b):
+        return (object_state(renderer.last_frame, a), object_state(renderer.last_frame, b))
+
+    (plain_a, plain_b), (windy_a, windy_b) = states(plain_renderer, plain_a, plain_b), \
+        states(windy_renderer, windy_a, windy_b)
+    assert windy_a.mask[..., 3].max() > 0.0 and windy_b.mask[..., 3].max() == 0.0
+    np.testing.assert_array_equal(windy_b.strands.tips, plain_b.strands.tips)
+    np.testing.assert_array_equal(windy_b.mask, plain_b.mask)
+    assert np.abs(windy_a.strands.tips - plain_a.strands.tips).max() > 1e-3
+    # the same mesh at two transforms: two sets of strands, sagging apart in object space
+    assert plain_a is not plain_b
+    assert np.abs(plain_a.strands.roots - plain_b.strands.roots).max() > 0.5
+    assert np.abs(plain_a.vertex_deflections() - plain_b.vertex_deflections()).max() > 1e-3
+
+
+@pytest.mark.xfail(strict=True, reason="Scene.apply_timeline sets an object's params on its "
+                   "material instance, and a material's uniforms are bound per instance: an "
+                   "object sharing it takes them (deferred/, not the material)")
+def test_an_event_changing_a_uniform_leaves_another_object_sharing_the_material_alone(render):
+    plain, _, _ = shared_material_scene()
+    tinted, _, _ = shared_material_scene({"color": [0.1, 0.6, 0.1]})
+    before, _ = render(plain, time=0.5)
+    after, _ = render(tinted, time=0.5)
+    np.testing.assert_array_equal(before.hdr[:, 48:], after.hdr[:, 48:])
+
+
+def test_the_strands_step_before_any_pass_draws_and_go_with_the_renderer(render):
+    scene, a, b = shared_material_scene({"wind": [0.3, 0.0, 0.0]})
+    steps = []
+
+    def before_pass(render_pass, frame):
+        if not steps:  # the first pass of the frame: every pass is prepared by now
+            steps.extend(object_state(frame, obj).step for obj in (a, b))
+
+    _, renderer = render(scene, time=0.5, before_pass=before_pass)
+    assert steps == [120, 120]  # 0.5 s of 1/240 s steps
+    states = [object_state(renderer.last_frame, obj) for obj in (a, b)]
+    textures = [t for state in states for t in (state.mask_texture, state.tips_texture)]
+    renderer.release()
+    assert all(type(t.mglo).__name__ == "InvalidObject" for t in textures)
 
 
 # -- bad input ---------------------------------------------------------------------------------
