@@ -9,9 +9,10 @@ events (the renderer does so before each frame). Scene files are read by
 """
 from __future__ import annotations
 
+import copy
 import math
-import sys
 from bisect import bisect_right
+from collections import Counter
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from types import MappingProxyType
@@ -31,11 +32,6 @@ from deferred.interfaces.shading import ShadingModel
 from deferred.params import validate_params
 from deferred.scene.camera import Camera, model_matrix
 from deferred.scene.meshes import load_mesh
-
-if sys.version_info >= (3, 11):
-    pass
-else:  # pragma: no cover
-    pass
 
 Vec3 = tuple[float, float, float]
 MAX_SIZE = 16384
@@ -174,10 +170,20 @@ class Scene:
 
     def apply_timeline(self, time: float) -> None:
         """Set each object's material parameters to those of ``time`` (seconds): objects
-        with events only; the others keep theirs."""
+        with events only; the others keep theirs. An object with events that shares its
+        material instance with another object (``Scene.add`` takes an instance) is given a copy
+        of its own first, so its events never change the other."""
+        users: dict[int, int] | None = None
         for obj in self.objects:
-            if obj.events:
-                obj.material.params = obj.params_at(time)
+            if not obj.events:
+                continue
+            if users is None:
+                users = Counter(id(other.material) for other in self.objects)
+            if users[id(obj.material)] > 1:
+                users[id(obj.material)] -= 1
+                obj.material = copy.copy(obj.material)
+                users[id(obj.material)] = 1
+            obj.material.params = obj.params_at(time)
 
     def add_event(self, obj: SceneObject | str, time: float, params: Mapping[str, Any],
                   where: str | None = None) -> TimelineEvent:

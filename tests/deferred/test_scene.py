@@ -1,3 +1,4 @@
+import numpy as np
 import pytest
 
 from deferred.errors import InputError
@@ -101,3 +102,37 @@ def test_texture_path_is_checked_relative_to_the_scene(tmp_path):
 def test_bad_sizes(text):
     with pytest.raises(InputError, match="--size"):
         parse_size(text)
+
+
+def shared_standard_scene(event: dict | None):
+    """Two spheres side by side drawn with one standard Material instance (the Python API
+    shares an instance where it is given one); ``event`` changes the left one's from 0.25 s."""
+    from deferred.interfaces.registry import materials
+    from deferred.lights.directional import DirectionalLight
+    from deferred.scene.camera import Camera
+    from deferred.scene.model import Scene
+
+    scene = Scene(camera=Camera(position=(0.0, 0.0, 5.0), target=(0.0, 0.0, 0.0)),
+                  size=(64, 32))
+    scene.lights = [DirectionalLight.from_dict({"direction": [0.0, 0.0, -1.0]})]
+    material = materials.get("standard").from_dict({"color": [0.8, 0.2, 0.2]})
+    left = scene.add("builtin:sphere", material, position=(-1.5, 0.0, 0.0))
+    right = scene.add("builtin:sphere", material, position=(1.5, 0.0, 0.0))
+    if event:
+        scene.add_event(left, 0.25, event)
+    return scene, left, right
+
+
+@pytest.mark.parametrize("pipeline", ["deferred", "forward"])
+def test_an_event_on_one_object_leaves_another_sharing_its_material_alone(render, pipeline):
+    plain, _, _ = shared_standard_scene(None)
+    scene, left, right = shared_standard_scene({"color": [0.1, 0.7, 0.1]})
+    shared = right.material
+    before, _ = render(plain, pipeline, time=0.5)
+    after, _ = render(scene, pipeline, time=0.5)
+    half = before.hdr.shape[1] // 2
+    np.testing.assert_array_equal(before.hdr[:, half:], after.hdr[:, half:])  # the right one
+    assert np.abs(before.hdr[:, :half] - after.hdr[:, :half]).max() > 0.1  # the left one
+    assert right.material is shared and left.material is not shared
+    assert shared.params.color == (0.8, 0.2, 0.2)
+    assert left.material.params.color == (0.1, 0.7, 0.1)

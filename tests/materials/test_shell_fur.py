@@ -735,9 +735,6 @@ def test_an_event_on_one_object_leaves_another_sharing_its_material_alone(render
     assert np.abs(plain_a.vertex_deflections() - plain_b.vertex_deflections()).max() > 1e-3
 
 
-@pytest.mark.xfail(strict=True, reason="Scene.apply_timeline sets an object's params on its "
-                   "material instance, and a material's uniforms are bound per instance: an "
-                   "object sharing it takes them (deferred/, not the material)")
 def test_an_event_changing_a_uniform_leaves_another_object_sharing_the_material_alone(render):
     plain, _, _ = shared_material_scene()
     tinted, _, _ = shared_material_scene({"color": [0.1, 0.6, 0.1]})
