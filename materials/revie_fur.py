@@ -54,7 +54,6 @@ from .techniques.stipple import (
 if TYPE_CHECKING:
     from deferred.api import SceneObject
 
-Vec3 = tuple[float, float, float]
 FUR_VERTEX = "materials/revie_fur/fur.vert"
 SHELL_FRAGMENT = "materials/revie_fur/shell.frag"
 FORWARD_SHELL_FRAGMENT = "materials/revie_fur/forward_shell.frag"

@@ -152,6 +152,12 @@ class Renderer:
         self.resources = Resources(ctx)
         self.light_buffer = LightBuffer(ctx)
         self.light_lists = LightLists(ctx) if features.compute_shaders else None
+        # The per-frame GPU resources every frame is given: by name on its blackboard (for the
+        # passes that fill or read them), and those that bind themselves to every program as
+        # its binding sources. A new global resource (a shadow atlas) is one more entry here.
+        self.blackboard = {LIGHT_BUFFER: self.light_buffer, LIGHT_LISTS: self.light_lists}
+        self.binding_sources = [source for source in (self.light_buffer, self.light_lists)
+                                if source is not None]
         self.last_frame: Frame | None = None
         error = ctx.error
         if error != "GL_NO_ERROR":  # the targets did not fit
@@ -211,13 +217,11 @@ class Renderer:
         inputs = FrameInputs(self.scene, self.object_transforms, self.kept_inputs, self.strict)
         frame = Frame(self.gl, self.shaders, self.targets, self.resources, self.scene, inputs,
                       strict=self.strict, time=time, time_gl_calls=time_gl_calls,
-                      blackboard={LIGHT_BUFFER: self.light_buffer, LIGHT_LISTS: self.light_lists})
+                      blackboard=self.blackboard, binding_sources=self.binding_sources)
         inputs.frame = frame
-        # what every program the frame binds may read: the scene's shading models' samplers,
-        # the lights' records and, on the list paths, the lists
-        shading = ShadingTextures.of(self.shading_models, frame)
-        frame.binding_sources = [source for source in (shading, self.light_buffer,
-                                                       self.light_lists) if source is not None]
+        shading = ShadingTextures.of(self.shading_models, frame)  # the models' samplers, if any
+        if shading is not None:
+            frame.binding_sources.insert(0, shading)
         self.light_buffer.upload(self.scene.lights, frame.view, frame.projection)
         self._check_gl("uploading the lights")
         for render_pass in self.passes:

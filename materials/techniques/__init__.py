@@ -7,6 +7,11 @@
 - :mod:`.shells`: concentric shells, n offset draws of a mesh (Revie 2.3.1)
 - :mod:`.fins`: fins at silhouette edges from a geometry shader (Lengyel et al. 2001)
 - :mod:`.stipple`: stippled G-buffer writes and their obliteration (Revie 2.3.4, 2.4.4)
+- :mod:`.fur_light`: the fur's light gathered once a frame from the light accumulation
+  (Revie 2.4.4, Listing 2.2)
+- :mod:`.strands`: one-particle mass-spring strands and their curl (Silva et al. 3.2.1, Eq. 2-4)
+- :mod:`.wetness`: the wetness mask of droplets and clumps (Silva et al. 3.1, Algorithm 1)
+- :mod:`.topology`: vertices welded by position across UV seams (fins, strands, clumps)
 
 Their GLSL lives in ``shaders/techniques/``.
 """

@@ -46,13 +46,6 @@ def dry_mask(size: int) -> np.ndarray:
     return mask
 
 
-def texel_centres(size: int) -> tuple[np.ndarray, np.ndarray]:
-    """(u, v) of every texel centre, each (size, size)."""
-    t = (np.arange(size) + 0.5) / size
-    v, u = np.meshgrid(t, t, indexing="ij")
-    return u, v
-
-
 def wrap_delta(delta: np.ndarray, wrap: tuple[bool, bool]) -> np.ndarray:
     """``delta`` (..., 2) in UV units, taken the short way round on wrapped axes."""
     out = np.array(delta, dtype=np.float64)
