@@ -22,6 +22,7 @@ from deferred.interfaces import registry
 from deferred.io.images import write_image
 from deferred.io.paths import check_output_path
 from deferred.io.safety import interrupt_exit_code, termination_as_interrupt
+from deferred.names import Pipeline
 from deferred.render.pipeline import PIPELINES
 from deferred.scene.loader import load_scene
 from deferred.scene.model import parse_size
@@ -67,7 +68,7 @@ def cli(debug: bool) -> None:
               help="Output: an image, .png (sRGB 8-bit) or .exr (linear float); a numbered "
                    "sequence, out_####.png (the run of # becomes the frame number); or a "
                    "video, .mp4 (H.264) or .gif.")
-@click.option("--pipeline", type=click.Choice(sorted(PIPELINES)), default="deferred",
+@click.option("--pipeline", type=click.Choice(sorted(PIPELINES)), default=Pipeline.DEFERRED.value,
               show_default=True)
 @click.option("--size", help="WIDTHxHEIGHT, overrides the scene's size.")
 @click.option("--frames", type=click.IntRange(min=1, max=100_000), default=1, show_default=True,
@@ -206,7 +207,7 @@ def _render_animation(renderer, out: Path, times: list[float],
 @click.option("-o", "--output", metavar="DIR",
               help="Dump folder (created if missing). With --compare: where difference images "
                    "go (default DIR_B-diff next to DIR_B).")
-@click.option("--pipeline", type=click.Choice(sorted(PIPELINES)), default="deferred",
+@click.option("--pipeline", type=click.Choice(sorted(PIPELINES)), default=Pipeline.DEFERRED.value,
               show_default=True)
 @click.option("--size", help="WIDTHxHEIGHT, overrides the scene's size.")
 @click.option("--passes", metavar="NAME,...",

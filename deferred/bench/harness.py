@@ -124,7 +124,7 @@ def check_output(path: str | Path, where: str) -> Path:
 class Sweep:
     lights: Sequence[int] = DEFAULT_LIGHTS
     shells: Sequence[int] = DEFAULT_SHELLS
-    pipelines: Sequence[str] = ("deferred", "forward")
+    pipelines: Sequence[str] = tuple(Pipeline)
     light_paths: Sequence[str] | None = None  # None: every path of each pipeline
     size: tuple[int, int] | None = None  # None: the scene's size
     runs: int = 10

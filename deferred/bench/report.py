@@ -17,6 +17,7 @@ import numpy as np
 
 from deferred.gl.context import GLContext
 from deferred.io.images import write_image, write_text
+from deferred.names import LightPath, Pipeline
 from deferred.scene.model import Scene
 
 COLUMNS = ("pipeline", "light_path", "lights", "shells", "width", "height", "runs", "median_ms",
@@ -205,11 +206,11 @@ def crossovers(report: BenchReport) -> list[str]:
         rows = [r for r in report.results if r.shells == shells]
         counts = sorted({r.lights for r in rows})
 
-        for against, paths in (("naive forward", ("naive",)), ("every forward path", None)):
+        for against, paths in (("naive forward", (LightPath.NAIVE,)), ("every forward path", None)):
             crossing = None
             for lights in counts:
-                deferred = _fastest(rows, "deferred", lights)
-                forward = _fastest(rows, "forward", lights, paths)
+                deferred = _fastest(rows, Pipeline.DEFERRED, lights)
+                forward = _fastest(rows, Pipeline.FORWARD, lights, paths)
                 if deferred is None or forward is None:
                     continue
                 if deferred.median_ms < forward.median_ms:
@@ -233,9 +234,9 @@ def speedups(report: BenchReport) -> list[str]:
     for shells in sorted({r.shells for r in report.results}):
         rows = [r for r in report.results if r.shells == shells]
         lights = max(r.lights for r in rows)
-        deferred = _fastest(rows, "deferred", lights)
-        naive = _fastest(rows, "forward", lights, ("naive",))
-        forward = _fastest(rows, "forward", lights)
+        deferred = _fastest(rows, Pipeline.DEFERRED, lights)
+        naive = _fastest(rows, Pipeline.FORWARD, lights, (LightPath.NAIVE,))
+        forward = _fastest(rows, Pipeline.FORWARD, lights)
         if deferred is None or forward is None:
             continue
         parts = []
@@ -256,10 +257,10 @@ def growth(report: BenchReport) -> list[str]:
     lines = []
     for shells in sorted({r.shells for r in report.results}):
         rows = [r for r in report.results if r.shells == shells]
-        best = _fastest(rows, "deferred", max(r.lights for r in rows))
+        best = _fastest(rows, Pipeline.DEFERRED, max(r.lights for r in rows))
         if best is None:
             continue
-        own = sorted((r for r in rows if r.pipeline == "deferred" and
+        own = sorted((r for r in rows if r.pipeline == Pipeline.DEFERRED and
                       r.light_path == best.light_path), key=lambda r: r.lights)
         if len(own) < 2:
             continue

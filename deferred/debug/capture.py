@@ -23,7 +23,7 @@ from deferred.gbuffer.layout import (
     decode,
 )
 from deferred.gl.target_spec import TargetSpec
-from deferred.names import LIST_PATHS
+from deferred.names import LIST_PATHS, Pipeline
 from deferred.render.renderer import Renderer
 
 GBUFFER_CHANNELS = ("albedo.R", "albedo.G", "albedo.B", "specular.intensity",
@@ -220,7 +220,7 @@ def capture_frame(renderer: Renderer, passes: Sequence[str] | None = None,
     light_lists = None
     if renderer.light_path in LIST_PATHS and renderer.light_lists is not None:
         depth = None  # deferred: only surfaces read a list (Forward+: every fragment drawn)
-        if renderer.pipeline_name == "deferred":  # GL's bottom row first, as the lists count
+        if renderer.pipeline_name == Pipeline.DEFERRED:  # GL's bottom row first, as the lists count
             depth = to_float(ends[LINEAR_DEPTH])[::-1, :, 0]
         light_lists = renderer.light_lists.pixel_counts(*renderer.size, depth)[::-1]
     return FrameCapture(

@@ -16,6 +16,7 @@ from deferred.api import (
     FullscreenPass,
     Order,
     Phase,
+    Pipeline,
     RenderPass,
     TargetSpec,
     effects,
@@ -41,7 +42,7 @@ class EdgesParams(EffectParams):
 class Edges(Effect):
     name = "edges"
     Params = EdgesParams
-    pipelines = ("deferred",)  # reads the G-buffer
+    pipelines = (Pipeline.DEFERRED,)  # reads the G-buffer
 
     def passes(self, scene, pipeline: str) -> list[RenderPass]:
         return [

@@ -17,6 +17,7 @@ from deferred.api import (
     EffectParams,
     FullscreenPass,
     Phase,
+    Pipeline,
     RenderPass,
     TargetSpec,
     effects,
@@ -36,7 +37,7 @@ class SSAOParams(EffectParams):
 class SSAO(Effect):
     name = "ssao"
     Params = SSAOParams
-    pipelines = ("deferred",)  # the forward pipeline has no G-buffer to sample
+    pipelines = (Pipeline.DEFERRED,)  # the forward pipeline has no G-buffer to sample
 
     def passes(self, scene, pipeline: str) -> list[RenderPass]:
         """Raw hemisphere SSAO, then a depth-aware blur into the ``ssao`` target."""

@@ -25,7 +25,7 @@ from deferred.lighting.buffer import LIGHT_BUFFER, LightBuffer
 from deferred.lighting.lists import LIGHT_LISTS, LightLists, check_light_limits
 from deferred.lighting.paths import resolve_light_path
 from deferred.memo import overrides
-from deferred.names import LightVolume
+from deferred.names import LightVolume, Pipeline
 from deferred.render.caches import FrameInputs, KeptMaterialInputs, ObjectTransforms
 from deferred.render.generated import generated_glsl
 from deferred.render.pipeline import PIPELINES, check_passes
@@ -93,7 +93,7 @@ class Renderer:
     of the tone mapping pass): a change to either takes a new renderer.
     """
 
-    def __init__(self, scene: Scene, pipeline: str = "deferred",
+    def __init__(self, scene: Scene, pipeline: str = Pipeline.DEFERRED,
                  size: tuple[int, int] | None = None, gl: GLContext | None = None,
                  strict: bool | None = None, light_path: str | None = None):
         if pipeline not in PIPELINES:
@@ -308,7 +308,8 @@ class Renderer:
         self.release()
 
 
-def render_scene(scene: Scene, pipeline: str = "deferred", size: tuple[int, int] | None = None,
-                 gl: GLContext | None = None, time: float = 0.0) -> RenderResult:
+def render_scene(scene: Scene, pipeline: str = Pipeline.DEFERRED,
+                 size: tuple[int, int] | None = None, gl: GLContext | None = None,
+                 time: float = 0.0) -> RenderResult:
     with Renderer(scene, pipeline, size, gl) as renderer:
         return renderer.render(time=time)
