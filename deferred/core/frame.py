@@ -80,6 +80,8 @@ class Frame:
         self.draw_fullscreen = device.draw_fullscreen
         self.gl_call = device.gl_call
         self.count_draw = device.count_draw
+        self.dispatch = device.dispatch
+        self.barrier = device.barrier
         self.current_pass: PassLike | None = None
 
     # -- passes --------------------------------------------------------------------------------
@@ -222,7 +224,8 @@ class Frame:
     def use_framebuffer(self, colors: tuple[str, ...] | list[str], depth: str | None = None,
                         depth_write: bool = True) -> moderngl.Framebuffer:
         """Bind the framebuffer of these targets, which the running pass must declare."""
-        request = (id(self.current_pass), tuple(colors), depth)
+        colors = tuple(colors)
+        request = (id(self.current_pass), colors, depth)
         # (pass, colours, depth) requests already checked against the pass's declarations:
         # declarations are fixed once the graph is compiled and targets are only ever added,
         # so a request that passed once passes for the renderer's life

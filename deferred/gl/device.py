@@ -1,4 +1,5 @@
-"""The device: the GL state a frame sets, its framebuffers, its draws and their timing.
+"""The device: the GL state a frame sets, its framebuffers, its draws and dispatches, their
+barriers and timing.
 
 A frame makes one :class:`Device` and sets fixed-function state, binds framebuffers and draws
 only through it, so it knows what GL holds and sets nothing twice: a pass stating the state the
@@ -92,10 +93,10 @@ class Device:
         self._depth_mask_known = False
         self._bound = None
 
-    def use_framebuffer(self, colors: tuple[str, ...] | list[str], depth: str | None = None,
+    def use_framebuffer(self, colors: tuple[str, ...], depth: str | None = None,
                         depth_write: bool = True) -> moderngl.Framebuffer:
         """Bind the framebuffer of these targets with this depth mask and its full viewport."""
-        key = (tuple(colors), depth)
+        key = (colors, depth)
         bound = self._bound
         # one pass of many objects after another: the same request, still bound, no clear
         # since, and the framebuffer's mask and viewport as this frame left them (a pass may
@@ -170,3 +171,13 @@ class Device:
         vao = self.resources.fullscreen_vertex_array(program)
         self.gl_call(lambda: vao.render(moderngl.TRIANGLES, vertices=3, instances=instances))
         self.stats.draw_calls += 1
+
+    # -- compute -----------------------------------------------------------------------------
+    def dispatch(self, shader: moderngl.ComputeShader, groups: tuple[int, int, int]) -> None:
+        """Run ``shader`` over ``groups`` work groups (timed as a drawing call; a pass counts
+        its dispatches as draws itself, with :meth:`count_draw`)."""
+        self.gl_call(lambda: shader.run(*groups))
+
+    def barrier(self) -> None:
+        """Make what shaders wrote to images and buffers visible to the GL work after it."""
+        self.ctx.memory_barrier()

@@ -89,12 +89,12 @@ class LightCullPass(RenderPass):
                           (shader, {**coarse["second"], **counts}, culling_tiles(grid))]
         for index, (program, uniforms, tiles) in enumerate(dispatches):
             if index:
-                frame.ctx.memory_barrier()
+                frame.barrier()
             frame.bind_compute(program, uniforms, textures)
             light_lists.bind_image(frame.shaders.uniforms(program))
             groups = math.ceil(tiles / CULL_GROUP_SIZE)  # an invocation a tile
-            frame.gl_call(lambda program=program, groups=groups: program.run(groups, 1, 1))
-        frame.ctx.memory_barrier()
+            frame.dispatch(program, (groups, 1, 1))
+        frame.barrier()
         frame.count_draw()
 
 
