@@ -60,7 +60,7 @@ def python_loop_ms() -> float:
 
 def moving_frames(renderer: Renderer, runs: int) -> tuple[float, int]:
     """:func:`time_cpu` with the camera moved before each frame (outside the timing): the
-    view changes each frame (before this stop's split of view and model, every object's
+    view changes each frame (before the view was split from the model, every object's
     transforms were made again with it)."""
     samples = []
     for index in range(runs):
