@@ -63,6 +63,17 @@ def kept_while(*sources: str) -> Callable[[F], F]:
                 value = method(self)
                 self.__dict__[slot] = (source, value)
                 return value
+        elif not with_arguments and len(names) == 2:
+            first, second = names
+
+            def kept(self):
+                a, b = getattr(self, first), getattr(self, second)
+                held = self.__dict__.get(slot)
+                if held is not None and held[0] is a and held[1] is b:
+                    return held[2]
+                value = method(self)
+                self.__dict__[slot] = (a, b, value)
+                return value
         elif not with_arguments:
             def kept(self):
                 current = made_from(self)

@@ -55,6 +55,7 @@ from deferred.gl.context import GLContext, create_context
 from deferred.io.paths import check_output_path
 from deferred.names import LIGHT_PATHS, LightPath, Pipeline
 from deferred.render.pipeline import PIPELINES
+from deferred.render.renderer import Renderer
 from deferred.scene.model import Scene
 
 DEFAULT_LIGHTS = (1, 16, 64, 256, 1024)
@@ -211,8 +212,6 @@ def run_bench(scene: Scene, sweep: Sweep, gl: GLContext | None = None,
     each at 1280x720 on lights.toml). Without it, one point is built, timed and released
     after another. ``progress(description)`` is called before each warm-up and each round.
     """
-    from deferred.render.renderer import Renderer
-
     if sweep.runs < 1:
         raise InputError(f"runs must be 1 or more, got {sweep.runs}", "--runs")
     if sweep.warmup < 0:

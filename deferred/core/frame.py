@@ -9,14 +9,14 @@ its material's inputs come from its ``inputs`` (:class:`deferred.core.protocols.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
 from typing import Any
 
 import moderngl
 
 from deferred.core.protocols import (
     BindingSource,
-    MaterialInputs,
     ObjectInputs,
     PassLike,
     SceneLike,
@@ -27,7 +27,24 @@ from deferred.gl.device import Device
 from deferred.gl.resources import Resources
 from deferred.gl.shaderlib import ShaderLibrary
 from deferred.gl.targets import FrameTargets
-from deferred.gl.uniforms import ProgramUniforms, gl_value
+from deferred.gl.uniforms import gl_value
+
+
+@dataclass(slots=True)
+class MaterialInputs:
+    """A material's uniforms and textures for one frame, and which of them its programs
+    declare (strict mode checks that each is declared by at least one)."""
+
+    material: Any  # a Material (deferred.interfaces.material)
+    uniforms: dict[str, Any]
+    textures: dict[str, moderngl.Texture]
+    params: Any = None  # the material's params they were made from
+    # kept across frames (deferred.render.caches.KeptMaterialInputs); its uniforms are then
+    # StableValues
+    kept: bool = False
+    declared: set[str] = field(default_factory=set)
+    programs: list[str] = field(default_factory=list)
+
 
 
 class Frame:
@@ -44,11 +61,25 @@ class Frame:
     functions: a pass of many objects pays no extra call a draw).
     """
 
+    # the device's calls, the frame's own (Device: the same bound methods)
+    set_state: Callable[..., None]
+    set_depth_offset: Callable[[tuple[float, float]], None]
+    draw_mesh: Callable[..., None]
+    draw_fullscreen: Callable[..., None]
+    dispatch: Callable[[moderngl.ComputeShader, tuple[int, int, int]], None]
+    barrier: Callable[[], None]
+    gl_call: Callable[[Callable[[], Any]], Any]
+    count_draw: Callable[[], None]
+    # the inputs' calls: an object's transforms, a material's inputs this frame
+    object_uniforms: Callable[[Any], dict[str, Any]]
+    material_inputs: Callable[[Any], MaterialInputs]
+
     def __init__(self, gl: GLContext, shaders: ShaderLibrary, targets: FrameTargets,
                  resources: Resources, scene: SceneLike, inputs: ObjectInputs, *,
                  strict: bool = False, time: float = 0.0, time_gl_calls: bool = False,
                  blackboard: Mapping[str, Any] | None = None,
-                 binding_sources: Sequence[BindingSource] = ()):
+                 binding_sources: Sequence[BindingSource] = (),
+                 checked_framebuffers: dict[tuple, Any] | None = None):
         self.gl = gl
         self.ctx = gl.ctx
         self.time = float(time)  # seconds: the scene's timeline is applied at this time
@@ -60,6 +91,11 @@ class Frame:
         self.blackboard: dict[str, Any] = dict(blackboard or {})
         self.binding_sources: list[BindingSource] = list(binding_sources)
         self.inputs = inputs
+        inputs.frame = self
+        # (pass, colours, depth) framebuffer requests already checked against the pass's
+        # declarations, kept by the renderer: declarations are fixed once the graph is compiled
+        # and targets are only ever added, so a request that passed once passes for its life
+        self.checked_framebuffers = {} if checked_framebuffers is None else checked_framebuffers
         self.object_uniforms = inputs.object_uniforms
         self.material_inputs = inputs.material_inputs
         self.width = targets.width
@@ -73,7 +109,6 @@ class Frame:
                               for name, value in self.camera_uniforms().items()}
         self.device = device = Device(gl.ctx, targets, resources, time_gl_calls)
         self.stats = device.stats
-        self.time_gl_calls = time_gl_calls
         self.set_state = device.set_state
         self.set_depth_offset = device.set_depth_offset
         self.draw_mesh = device.draw_mesh
@@ -159,11 +194,11 @@ class Frame:
         """Set uniforms and bind textures on ``program``.
 
         ``uniforms`` and ``textures`` are what the pass means to set: in strict mode each must
-        be declared by the program. The camera's values (:attr:`camera_values`), the
-        ``offered`` values (an object's transforms, :meth:`object_uniforms`), the
-        ``material``'s and the binding sources' are set where the program has them. A value
-        the program holds already is not written again; ``StableValues`` are planned once
-        (``set_stable``).
+        be declared by the program. The camera's values (:attr:`camera_values`), the binding
+        sources', the ``offered`` values (an object's transforms, :meth:`object_uniforms`) and
+        the ``material``'s are set where the program has them; of one name, the pass's wins
+        over the material's, and the material's over a source's. A value the program holds
+        already is not written again; ``StableValues`` are planned once (``set_stable``).
         """
         if self.strict:
             self._check_declared(program, "program", [*(uniforms or {}), *(textures or {})],
@@ -171,21 +206,21 @@ class Frame:
         program_uniforms = self.shaders.uniforms(program)
         program_uniforms.set_shared("camera", self.camera_values)
         # in order, a later value of a name winning (no merged copies: a pass of many objects
-        # binds once a draw)
+        # binds once a draw): the binding sources', the object's, the material's, the pass's
+        unit = 0
+        for source in self.binding_sources:
+            unit = source.bind(program_uniforms, unit)
         if offered:
             program_uniforms.set_stable(offered)
-        unit = 0
         if material is not None:
             if material.uniforms:
                 program_uniforms.set_stable(material.uniforms)  # kept inputs are StableValues
             if material.textures:
-                unit = bind_samplers(program_uniforms, material.textures, 0)
+                unit = program_uniforms.bind_samplers(material.textures, unit)
         if uniforms:
             program_uniforms.set(uniforms)
         if textures:
-            unit = bind_samplers(program_uniforms, textures, unit)
-        for source in self.binding_sources:
-            unit = source.bind(program_uniforms, unit)
+            program_uniforms.bind_samplers(textures, unit)
 
     def set_uniforms(self, program: moderngl.Program, values: dict[str, Any]) -> None:
         """Set the values ``program`` has (no strict check: :meth:`bind` does that); a value
@@ -202,7 +237,7 @@ class Frame:
         shader_uniforms = self.shaders.uniforms(shader)
         shader_uniforms.set_shared("camera", self.camera_values)
         shader_uniforms.set({**(offered or {}), **uniforms})
-        bind_samplers(shader_uniforms, textures, 0)
+        shader_uniforms.bind_samplers(textures, 0)
 
     # -- targets -------------------------------------------------------------------------------
     def target(self, name: str) -> moderngl.Texture:
@@ -226,25 +261,10 @@ class Frame:
         """Bind the framebuffer of these targets, which the running pass must declare."""
         colors = tuple(colors)
         request = (id(self.current_pass), colors, depth)
-        # (pass, colours, depth) requests already checked against the pass's declarations:
-        # declarations are fixed once the graph is compiled and targets are only ever added,
-        # so a request that passed once passes for the renderer's life
-        checked = self.resources.checked_framebuffers
+        checked = self.checked_framebuffers
         if request not in checked:
             for name in (*colors, *((depth,) if depth else ())):
                 self.target(name)  # declared by the pass, and existing
             checked[request] = self.current_pass  # kept alive: its id stays its own
         return self.device.use_framebuffer(colors, depth, depth_write)
 
-
-def bind_samplers(uniforms: ProgramUniforms, samplers: Mapping[str, moderngl.Texture],
-                  unit: int) -> int:
-    """Bind the samplers the program has to units ``unit``, ``unit + 1``, ...; the next free
-    unit."""
-    members = uniforms.members
-    for name, texture in samplers.items():
-        if name in members:
-            texture.use(location=unit)
-            uniforms.set_one(name, unit)
-            unit += 1
-    return unit

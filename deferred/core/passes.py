@@ -36,9 +36,6 @@ class Phase(str, Enum):
     OUTPUT = "output"
 
 
-PHASE_ORDER = (Phase.GEOMETRY, Phase.SCREEN, Phase.STIPPLE, Phase.LIGHTING, Phase.MATERIAL,
-               Phase.FORWARD, Phase.POST, Phase.OUTPUT)
-
 
 class Order:
     """Where a pass runs within its phase (the pipeline sorts by it).

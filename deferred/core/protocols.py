@@ -8,10 +8,8 @@ theirs.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Protocol
 
-import moderngl
 import numpy as np
 
 if TYPE_CHECKING:
@@ -35,22 +33,12 @@ class SceneLike(Protocol):
     objects: list
 
 
-class MaterialLike(Protocol):
-    """A material as the core reads it (:class:`deferred.interfaces.material.Material`)."""
-
-    name: str
-    params: Any
-
-    def defines(self, obj: Any) -> dict[str, str]: ...
-    def shader_folder(self) -> str: ...
-
-
 class SceneObjectLike(Protocol):
     """An object as an object pass draws it (:class:`deferred.scene.SceneObject`)."""
 
     label: str
     mesh: MeshData
-    material: Any  # a MaterialLike
+    material: Any  # a Material (deferred.interfaces.material)
 
 
 class PassLike(Protocol):
@@ -74,25 +62,11 @@ class BindingSource(Protocol):
         ...
 
 
-@dataclass(slots=True)
-class MaterialInputs:
-    """A material's uniforms and textures for one frame, and which of them its programs
-    declare (strict mode checks that each is declared by at least one)."""
-
-    material: Any  # a MaterialLike
-    uniforms: dict[str, Any]
-    textures: dict[str, moderngl.Texture]
-    params: Any = None  # the material's params they were made from
-    # kept across frames (deferred.render.caches.KeptMaterialInputs); its uniforms are then
-    # StableValues
-    kept: bool = False
-    declared: set[str] = field(default_factory=set)
-    programs: list[str] = field(default_factory=list)
-
-
 class ObjectInputs(Protocol):
     """Where a frame finds an object's transforms and its material's inputs
-    (:class:`deferred.render.caches.FrameInputs`)."""
+    (:class:`deferred.render.caches.FrameInputs`); ``frame`` is set by the frame it serves."""
+
+    frame: Any
 
     def object_uniforms(self, obj: Any) -> dict[str, Any]: ...
-    def material_inputs(self, material: Any) -> MaterialInputs: ...
+    def material_inputs(self, material: Any) -> Any: ...  # a MaterialInputs

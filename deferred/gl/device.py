@@ -2,7 +2,8 @@
 barriers and timing.
 
 A frame makes one :class:`Device` and sets fixed-function state, binds framebuffers and draws
-only through it, so it knows what GL holds and sets nothing twice: a pass stating the state the
+through it, so it knows what GL holds and sets nothing twice (a pass that changes other GL
+state, the light volumes' depth clamp, restores it): a pass stating the state the
 last one did, or asking for the framebuffer still bound, costs a comparison (one program drawing
 many objects). It also counts the draws (:class:`FrameStats`) and, when asked, the CPU time of
 the GL calls that draw (the bench's ``gl_call_seconds``).

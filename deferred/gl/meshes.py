@@ -18,7 +18,6 @@ from deferred.memo import kept_while
 # (name, components) in buffer order; the GLSL attribute is ``in_<name>``.
 VERTEX_ATTRIBUTES = (("position", 3), ("normal", 3), ("uv", 2), ("tangent", 3),
                      ("binormal", 3), ("comb", 4))
-VERTEX_FLOATS = sum(n for _, n in VERTEX_ATTRIBUTES)
 
 
 @dataclass

@@ -23,10 +23,6 @@ class Resources:
         self._mesh_refs: list[MeshData] = []  # keep ids stable while cached
         self._cached: dict[Any, Any] = {}
         self._fullscreen_vaos: dict[int, moderngl.VertexArray] = {}
-        # (pass, colours, depth) framebuffer requests already checked against the pass's
-        # declarations: declarations are fixed once the graph is compiled and targets are only
-        # ever added, so a request that passed once passes for the renderer's life
-        self.checked_framebuffers: dict[tuple, Any] = {}
 
     def gpu_mesh(self, mesh: MeshData) -> GpuMesh:
         gpu = self._meshes.get(id(mesh))

@@ -130,6 +130,17 @@ class ProgramUniforms:
             self._owner[name] = group
         self._shared[group] = values
 
+    def bind_samplers(self, samplers: Mapping[str, Any], unit: int) -> int:
+        """Bind the samplers the program has to units ``unit``, ``unit + 1``, ... (a later one
+        of a name the program already took wins it); the next free unit."""
+        members = self.members
+        for name, texture in samplers.items():
+            if name in members:
+                texture.use(location=unit)
+                self.set_one(name, unit)
+                unit += 1
+        return unit
+
     def set_one(self, name: str, value: Any) -> None:
         """Write one value the program has (one it lacks is skipped)."""
         if name in self.members:

@@ -137,24 +137,29 @@ class Material:
 
     @kept_while()  # the class, its shading model and so its data never change
     def _base_defines(self) -> dict[str, str]:
-        names = [data.name for data in material_data(self)]
+        names = [data.name for data in self.written_data()]
         return {"SURFACE_FILE": f'"{self.surface_shader}"',
                 "GBUFFER_DATA_WRITE": f'"{data_write_file(names)}"'}
 
-    @kept_while()
+    @kept_while()  # the class, its shading model and so its data never change
     def written_data(self) -> tuple[GBufferData, ...]:
         """The G-buffer data this material's objects write: its own and its shading
-        model's, by name (:func:`material_data`)."""
-        return _material_data(self)
+        model's, by name."""
+        model = registry.shading_models.get(self.shading_model)
+        merged: dict[str, GBufferData] = {}
+        for data in (*model.gbuffer_data, *self.gbuffer_data):
+            if data.name in merged and merged[data.name] != data:
+                raise InputError(f"material {self.name}: G-buffer data '{data.name}' is "
+                                 "declared twice with different formats")
+            merged[data.name] = data
+        return tuple(merged.values())
 
     def gbuffer_targets(self) -> tuple[str, ...]:
         """The targets this material's G-buffer passes write: the core G-buffer, then its data
         (its own and its shading model's), in the order of ``gbuffer/write.glsl``'s outputs."""
-        return (*GBUFFER_COLOR_TARGETS, *(data.name for data in material_data(self)))
+        return (*GBUFFER_COLOR_TARGETS, *(data.name for data in self.written_data()))
 
-    # asked for by every object, every frame; the type id is the class's from its registration
-    # on, and an unregistered class's (0) is refused, never kept
-    @kept_while("shading_model")
+    @kept_while("shading_model", "type_id")  # asked for by every object, every frame
     def surface_id(self) -> int:
         """The G-buffer id of this material's pixels: its shading model and its type id."""
         model_id = registry.shading_models.get(self.shading_model).type_id
@@ -242,29 +247,12 @@ def describe_model(model: type[BaseModel]) -> list[dict[str, Any]]:
     return rows
 
 
-def material_data(material: Material) -> tuple[GBufferData, ...]:
-    """The data ``material``'s objects write: its own and its shading model's, by name
-    (kept on the material: its class, model and parameters never change)."""
-    return material.written_data()
-
-
-def _material_data(material: Material) -> tuple[GBufferData, ...]:
-    model = registry.shading_models.get(material.shading_model)
-    merged: dict[str, GBufferData] = {}
-    for data in (*model.gbuffer_data, *material.gbuffer_data):
-        if data.name in merged and merged[data.name] != data:
-            raise InputError(f"material {material.name}: G-buffer data '{data.name}' is declared "
-                             f"twice with different formats")
-        merged[data.name] = data
-    return tuple(merged.values())
-
-
 def compose_layout(materials: Iterable[Material]) -> GBufferLayout:
     """The layout for a scene's materials; one name declared two ways is an error."""
     data: dict[str, GBufferData] = {}
     owners: dict[str, str] = {}
     for material in materials:
-        for entry in material_data(material):
+        for entry in material.written_data():
             if entry.name in data and data[entry.name] != entry:
                 raise InputError(f"G-buffer data '{entry.name}' is declared as {entry.format} "
                                  f"{entry.channels} by {material.name} and as "

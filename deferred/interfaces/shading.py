@@ -21,19 +21,16 @@ passes it straight through.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
 from importlib.resources.abc import Traversable
 from pathlib import Path
 from typing import TYPE_CHECKING, ClassVar
 
 import moderngl
 
-from deferred.core.frame import bind_samplers
 from deferred.gbuffer.layout import GBufferData
 
 if TYPE_CHECKING:
     from deferred.core.frame import Frame
-    from deferred.gl.uniforms import ProgramUniforms
 
 class ShadingModel:
     """A BRDF the lights call (see the module documentation)."""
@@ -50,26 +47,6 @@ class ShadingModel:
     def textures(cls, frame: Frame) -> dict[str, moderngl.Texture]:
         """Samplers the model's GLSL reads (e.g. a ramp), bound wherever lights are evaluated."""
         return {}
-
-
-class ShadingTextures:
-    """The samplers of a scene's shading models (ramps...), offered to every program a frame
-    binds (a binding source of the frame: wherever lights run)."""
-
-    def __init__(self, textures: dict[str, moderngl.Texture]):
-        self.textures = textures
-
-    @classmethod
-    def of(cls, models: Iterable[type[ShadingModel]], frame: Frame) -> ShadingTextures | None:
-        """The models' samplers this frame; ``None`` where they have none (most scenes: the
-        frame then has no source to ask at every draw)."""
-        textures: dict[str, moderngl.Texture] = {}
-        for model in models:
-            textures.update(model.textures(frame))
-        return cls(textures) if textures else None
-
-    def bind(self, uniforms: ProgramUniforms, texture_unit: int) -> int:
-        return bind_samplers(uniforms, self.textures, texture_unit)
 
 
 def shading_dispatch_glsl(models: list[type[ShadingModel]]) -> str:

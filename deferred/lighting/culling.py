@@ -12,6 +12,12 @@ import numpy as np
 from deferred.core.passes import FullscreenPass, Order, Phase, RenderPass
 from deferred.errors import RenderError
 from deferred.gbuffer.layout import LINEAR_DEPTH
+from deferred.gl.targets import (
+    COMPOSITE,
+    COMPOSITE_SPEC,
+    LIGHT_ACCUMULATION,
+    LIGHT_ACCUMULATION_SPEC,
+)
 from deferred.lighting import lists
 from deferred.lighting.buffer import LIGHT_BUFFER
 from deferred.lighting.lists import (
@@ -119,13 +125,6 @@ def list_shading_pass(name: str, clustered: bool, gbuffer: tuple[str, ...],
 
     It runs on surfaces only (:func:`deferred.lighting.volumes.surface_pass`; measured in
     benchmarks/README.md)."""
-    from deferred.gl.targets import (
-        COMPOSITE,
-        COMPOSITE_SPEC,
-        LIGHT_ACCUMULATION,
-        LIGHT_ACCUMULATION_SPEC,
-    )
-
     inputs = {f"u_{target}": target for target in gbuffer}
     defines = {}
     if occlusion:

@@ -108,7 +108,7 @@ class LightTypePass(RenderPass):
                 frame.ctx.disable_direct(GL_DEPTH_CLAMP)
         else:
             # On the far plane, drawn where the depth is nearer: the background's pixels are
-            # skipped, which an `if` in the shader cannot do on llvmpipe (light_lists.py).
+            # skipped, which an `if` in the shader cannot do on llvmpipe (surface_pass).
             frame.set_state(depth_test=True, depth_func="greater", blend="add")
             frame.bind(program, uniforms, textures)
             frame.draw_fullscreen(program, instances=count)

@@ -1,25 +1,31 @@
-"""What a renderer keeps from frame to frame, and the per-frame source of an object's inputs.
+"""What a renderer keeps from frame to frame, and what it gives each frame: the source of an
+object's inputs, and the shading models' samplers as a binding source.
 
 :class:`ObjectTransforms` holds every object's transform uniforms while the objects hold;
 :class:`KeptMaterialInputs` a material's uniforms and textures while its params hold;
 :class:`FrameInputs` gives a frame's passes both (:class:`deferred.core.protocols.ObjectInputs`)
 and, in strict mode, checks at the end of the frame that every uniform a material sets is
-declared by one of its programs.
+declared by one of its programs; :class:`ShadingTextures` binds the scene's shading models'
+samplers to every program.
 """
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from typing import TYPE_CHECKING, Any
 
+import moderngl
 import numpy as np
 
-from deferred.core.protocols import MaterialInputs
-from deferred.errors import RenderError
+from deferred.core.frame import MaterialInputs
+from deferred.errors import DeferredError, RenderError
 from deferred.gl.uniforms import StableValues
 
 if TYPE_CHECKING:
     from deferred.core.frame import Frame
+    from deferred.gl.uniforms import ProgramUniforms
     from deferred.interfaces.material import Material
+    from deferred.interfaces.shading import ShadingModel
     from deferred.scene import Scene, SceneObject
 
 
@@ -151,3 +157,29 @@ class FrameInputs:
                     f"material {inputs.material.name}: no program of it declares uniform "
                     f"{', '.join(repr(n) for n in unused)} (programs: "
                     f"{', '.join(dict.fromkeys(inputs.programs))})")
+
+
+class ShadingTextures:
+    """The samplers of a scene's shading models (ramps...), offered to every program a frame
+    binds (a binding source of the frame: wherever lights run)."""
+
+    def __init__(self, textures: dict[str, moderngl.Texture]):
+        self.textures = textures
+
+    @classmethod
+    def of(cls, models: Iterable[type[ShadingModel]], frame: Frame) -> ShadingTextures | None:
+        """The models' samplers this frame; ``None`` where they have none (most scenes: the
+        frame then has no source to ask at every draw)."""
+        textures: dict[str, moderngl.Texture] = {}
+        for model in models:
+            try:
+                textures.update(model.textures(frame))
+            except DeferredError:
+                raise
+            except Exception as exc:  # noqa: BLE001 - a plugin's model: say which
+                raise RenderError(f"shading model {model.name}: textures: "
+                                  f"{type(exc).__name__}: {exc}") from exc
+        return cls(textures) if textures else None
+
+    def bind(self, uniforms: ProgramUniforms, texture_unit: int) -> int:
+        return uniforms.bind_samplers(self.textures, texture_unit)

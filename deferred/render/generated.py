@@ -17,7 +17,7 @@ from deferred.gbuffer.layout import (
 )
 from deferred.gbuffer.surface_id import SURFACE_ID_FILE, surface_id_glsl
 from deferred.interfaces.light import Light
-from deferred.interfaces.material import Material, material_data
+from deferred.interfaces.material import Material
 from deferred.interfaces.shading import ShadingModel, shading_dispatch_glsl
 from deferred.lighting.dispatch import (
     DISPATCH_FILE,
@@ -42,6 +42,6 @@ def generated_glsl(light_types: list[type[Light]], shading_models: list[type[Sha
         SURFACE_ID_FILE: surface_id_glsl(),
     }
     for material in materials:
-        written = [data.name for data in material_data(material)]
+        written = [data.name for data in material.written_data()]
         files[data_write_file(written)] = data_write_glsl(written)
     return files

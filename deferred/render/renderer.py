@@ -20,13 +20,17 @@ from deferred.gl.shaderlib import ShaderLibrary
 from deferred.gl.target_spec import targets_bytes
 from deferred.gl.targets import COMPOSITE, FINAL, FrameTargets
 from deferred.interfaces.material import Material
-from deferred.interfaces.shading import ShadingTextures
 from deferred.lighting.buffer import LIGHT_BUFFER, LightBuffer
 from deferred.lighting.lists import LIGHT_LISTS, LightLists, check_light_limits
 from deferred.lighting.paths import resolve_light_path
 from deferred.memo import overrides
 from deferred.names import LightVolume, Pipeline
-from deferred.render.caches import FrameInputs, KeptMaterialInputs, ObjectTransforms
+from deferred.render.caches import (
+    FrameInputs,
+    KeptMaterialInputs,
+    ObjectTransforms,
+    ShadingTextures,
+)
 from deferred.render.generated import generated_glsl
 from deferred.render.pipeline import PIPELINES, check_passes
 from deferred.scene.model import Scene, check_size
@@ -158,6 +162,7 @@ class Renderer:
         self.blackboard = {LIGHT_BUFFER: self.light_buffer, LIGHT_LISTS: self.light_lists}
         self.binding_sources = [source for source in (self.light_buffer, self.light_lists)
                                 if source is not None]
+        self.checked_framebuffers: dict = {}  # Frame.use_framebuffer's, for the renderer's life
         self.last_frame: Frame | None = None
         error = ctx.error
         if error != "GL_NO_ERROR":  # the targets did not fit
@@ -217,8 +222,8 @@ class Renderer:
         inputs = FrameInputs(self.scene, self.object_transforms, self.kept_inputs, self.strict)
         frame = Frame(self.gl, self.shaders, self.targets, self.resources, self.scene, inputs,
                       strict=self.strict, time=time, time_gl_calls=time_gl_calls,
-                      blackboard=self.blackboard, binding_sources=self.binding_sources)
-        inputs.frame = frame
+                      blackboard=self.blackboard, binding_sources=self.binding_sources,
+                      checked_framebuffers=self.checked_framebuffers)
         shading = ShadingTextures.of(self.shading_models, frame)  # the models' samplers, if any
         if shading is not None:
             frame.binding_sources.insert(0, shading)
@@ -274,7 +279,7 @@ class Renderer:
         if times:
             latest = max(times)
             for obj in self.scene.objects:
-                if type(obj.material).check_time is not Material.check_time:  # most have none
+                if overrides(type(obj.material), Material, "check_time"):  # most have none
                     obj.material.check_time(latest, where)
 
     def _check_gl(self, stage: str) -> None:

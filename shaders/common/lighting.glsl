@@ -13,8 +13,8 @@ struct LightRecord {
     vec4 extra;
 };
 
-// The surface's shading model answers a light (generated dispatch, deferred.interfaces.shading): L unit
-// toward the light, V unit toward the viewer, radiance arriving at the point.
+// The surface's shading model answers a light (generated dispatch, deferred.interfaces.shading):
+// L unit toward the light, V unit toward the viewer, radiance arriving at the point.
 vec3 shade_light(Surface s, vec3 L, vec3 V, vec3 radiance);
 // ... and ambient irradiance (default: albedo * irradiance).
 vec3 shade_ambient(Surface s, vec3 irradiance);

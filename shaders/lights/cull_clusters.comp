@@ -5,7 +5,7 @@
 // atomics, and the lists come out in light order whatever the scheduling, so a frame shades
 // its lights in the same order every time (the same image, to the bit). A thread per light
 // appending with atomics, as before, gave the lists in the order the threads ran.
-layout(local_size_x = CULL_GROUP_SIZE) in;  // deferred.lighting
+layout(local_size_x = CULL_GROUP_SIZE) in;  // deferred.lighting.lists
 
 #include "common/light_buffer.glsl"
 #include "lights/light_lists.glsl"

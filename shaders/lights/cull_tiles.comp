@@ -7,7 +7,7 @@
 // CULL_FROM_NEAR (Forward+): the bounds run from the near plane to the farthest depth, or to the
 // far plane on tiles of background, since blended surfaces (fur shells) lie in front of it;
 // there is no box.
-// It runs twice (deferred.lighting): over coarse tiles of 4x4 tiles (CULL_COARSE) against
+// It runs twice (deferred.lighting.culling): over coarse tiles of 4x4 tiles (CULL_COARSE) against
 // every light, then over the tiles against their coarse tile's list only (CULL_CANDIDATES):
 // at 1024 lights and 1280x720, 3600 tiles each testing every light cost 15-22 ms, the two
 // dispatches 8.6-9.2 ms. The second writes the lists of each tile's four 8x8 quadrants
@@ -18,7 +18,7 @@
 // bounds with shared atomics, then sharing out the lights), as before, cost 4-5x as much on
 // llvmpipe, where a work group's invocations are SIMD lanes looped over on one CPU thread and
 // each barrier and shared atomic is a pass over them.
-layout(local_size_x = CULL_GROUP_SIZE) in;  // deferred.lighting
+layout(local_size_x = CULL_GROUP_SIZE) in;  // deferred.lighting.lists
 
 #include "common/light_buffer.glsl"
 #include "lights/light_lists.glsl"
@@ -30,7 +30,7 @@ uniform vec2 u_near_far;
 uniform vec4 u_pixel_to_view;  // view xy / linear depth = pixel * .xy + .zw (pixel_to_view)
 uniform int u_global_light_count;
 #ifdef CULL_CANDIDATES
-// The coarse lists (deferred.lighting: a first dispatch over tiles of u_candidate_ratio x
+// The coarse lists (deferred.lighting.lists: a first dispatch over tiles of u_candidate_ratio x
 // u_candidate_ratio tiles): a tile tests only its coarse tile's lights, which hold every light
 // that can touch it, in light order (the coarse tile's frustum, depth bounds and box hold the
 // tile's), instead of every light.

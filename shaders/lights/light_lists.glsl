@@ -1,4 +1,4 @@
-// Per-tile or per-cluster light lists (deferred.lighting): the tiled and clustered light
+// Per-tile or per-cluster light lists (deferred.lighting.lists): the tiled and clustered light
 // paths and Forward+. A list holds the volume lights that can touch its tile or cluster (the
 // full-screen ones, [0, u_global_light_count), apply to every pixel). The culling shaders
 // (lights/light_list_writer.glsl) write:
@@ -40,7 +40,7 @@ int light_list_of(ivec2 pixel, float depth) {
 #endif
 }
 
-// The shading texture's texel of a slot (SLOT_TEXELS in deferred.lighting).
+// The shading texture's texel of a slot (SLOT_TEXELS in deferred.lighting.lists).
 ivec2 light_list_texel(int slot) {
     return ivec2(slot & ((1 << u_list_row_shift) - 1), slot >> u_list_row_shift);
 }
@@ -56,8 +56,8 @@ int light_list_first_slot(int list) {
     return u_list_base + u_list_count + list * u_list_capacity;
 }
 
-// A listed light's slot: its bounding sphere (view-space centre, radius: deferred.lighting volume
-// "sphere") and its index in the light buffer.
+// A listed light's slot: its bounding sphere (view-space centre, radius: a light whose volume is
+// LightVolume.SPHERE, deferred.interfaces.light) and its index in the light buffer.
 struct ListedLight {
     vec4 sphere;
     int index;

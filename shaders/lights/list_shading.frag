@@ -17,7 +17,7 @@ uniform vec3 u_background;  // where the G-buffer holds no surface (alpha 0: cov
 
 layout(location = 0) out vec4 out_light;
 #ifdef WRITE_COMPOSITE
-// the composition buffer, where the frame has no material pass (deferred.lighting)
+// the composition buffer, where the frame has no material pass (deferred.lighting.culling)
 layout(location = 1) out vec4 out_composite;
 #endif
 

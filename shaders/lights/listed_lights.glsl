@@ -1,5 +1,5 @@
 // The volume lights of one light list at a surface point: the deferred tiled and clustered
-// shading and Forward+ (deferred.lighting).
+// shading and Forward+ (deferred.lighting.culling).
 //
 // A list holds the lights that touch its tile or cluster; many miss any one point of it
 // (lights.toml at 1024 lights, 640x360: 21.6 entries a pixel in the 8x8 tiled lists, 31.5 in
