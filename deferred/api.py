@@ -25,6 +25,10 @@ A plugin (the built-in materials, lights and effects, and the example package in
 - **GLSL**: :data:`GLSL_INCLUDES`, the framework's shader files a plugin's GLSL may include,
   each with what it gives; :func:`register_shader_root` for a folder of GLSL every scene
   searches (a class's own is its ``shader_root``).
+
+A plugin contributes passes, GLSL, parameters and G-buffer data; it cannot add a per-frame
+resource every program reads (a binding source, ``deferred.core.frame.Frame``): those are the
+renderer's (``Renderer.binding_sources``).
 """
 
 from __future__ import annotations

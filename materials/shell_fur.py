@@ -21,6 +21,7 @@ Pipelines:
 from __future__ import annotations
 
 import math
+import weakref
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
@@ -224,9 +225,8 @@ class ShellFurState:
     settle for ``settle`` seconds with the parameters at 0. Parameters the material reads once
     (``timeline_fixed``) are the ones at t = 0: a timeline may not change them."""
 
-    def __init__(self, ctx: moderngl.Context, obj: SceneObject, material: ShellFurMaterial):
-        self.obj = obj
-        self.material = material
+    def __init__(self, ctx: moderngl.Context, obj: SceneObject):
+        self.obj = obj  # its material is read from it each time (a timeline may give it a copy)
         params = self.params_at(0.0)
         self.dt = params.time_step
         self.linear_inverse = np.linalg.inv(obj.model[:3, :3])
@@ -252,7 +252,7 @@ class ShellFurState:
 
     def params_at(self, time: float) -> ShellFurParams:
         params_at = getattr(self.obj, "params_at", None)
-        return params_at(time) if params_at is not None else self.material.params
+        return params_at(time) if params_at is not None else self.obj.material.params
 
     def advance(self, time: float) -> None:
         """Bring the state to ``time`` (seconds) and upload it if it changed."""
@@ -277,7 +277,7 @@ class ShellFurState:
 
     def _start(self) -> None:
         params = self.params_at(0.0)
-        path = self.material.wetness_mask_path(params)
+        path = self.obj.material.wetness_mask_path(params)
         self.mask = load_wetness_mask(path, self.size) if path is not None \
             else dry_mask(self.size)
         self.fallen = 0
@@ -332,7 +332,7 @@ def object_state(frame: Frame, obj: SceneObject) -> ShellFurState:
     the object itself, so objects sharing a material instance each have their own, and
     released with the renderer's resources."""
     return frame.resources.cached(("shell_fur_state", obj),
-                                  lambda ctx: ShellFurState(ctx, obj, obj.material))
+                                  lambda ctx: ShellFurState(ctx, obj))
 
 
 class ObjectStateInputs:
@@ -344,16 +344,17 @@ class ObjectStateInputs:
     obj: SceneObject
     name: str
     clumps = False
-    _prepared: tuple[Frame, ShellFurState] | None = None
+    # the frame prepared for (weakly: a pass keeps no frame alive) and the state
+    _prepared: tuple[weakref.ref, ShellFurState] | None = None
 
     def prepare(self, frame: Frame) -> None:
         state = object_state(frame, self.obj)
         state.advance(frame.time)  # a no-op for the object's other passes: already there
-        self._prepared = (frame, state)
+        self._prepared = (weakref.ref(frame), state)
 
     def state(self, frame: Frame) -> ShellFurState:
         """The object's state as ``prepare`` left it for ``frame``."""
-        if self._prepared is None or self._prepared[0] is not frame:
+        if self._prepared is None or self._prepared[0]() is not frame:
             raise RuntimeError(f"{self.name}: drawn in a frame it was not prepared for (the "
                                "shell_fur state steps in prepare)")
         return self._prepared[1]

@@ -83,10 +83,6 @@ class Device:
         """Count a draw call (passes drawing by other means than the device call it)."""
         self.stats.draw_calls += 1
 
-    def error(self) -> str:
-        """GL's error flag, read (and so cleared)."""
-        return self.ctx.error
-
     # -- targets and framebuffers ------------------------------------------------------------
     def clear(self, name: str) -> None:
         """Clear target ``name`` to its declared value."""

@@ -5,6 +5,12 @@ Built-ins register themselves when their package is imported (``deferred.materia
 ``deferred.materials`` (``deferred.lights``, ``deferred.shading_models``, ``deferred.effects``)
 named as the class's ``name`` and pointing at the class; code can also call ``register``.
 
+The built-in packages are plugins too: they import ``deferred.api``, which sits above this
+layer, so the registry imports them by name when a registry is first asked
+(``importlib.import_module``), as it loads other plugins through their entry points. That is the
+one way a lower layer reaches a higher one: at run time, by name, never by an import statement
+(the layer contract, ``tests/deferred/test_layers.py``, covers import statements).
+
 Entry points load lazily: asking for a name loads that plugin only, so a broken plugin fails
 only the scenes that use it. Listing everything (``deferred materials``) loads every plugin and
 skips a broken one with a warning naming it.

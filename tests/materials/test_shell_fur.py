@@ -587,8 +587,7 @@ def test_forward_and_deferred_agree_on_straight_fur(render):
 def state_at(gl, scene_dict, times):
     scene = scene_from_dict(scene_dict, "anim")
     obj = scene.objects[0]
-    material: ShellFurMaterial = obj.material
-    state = ShellFurState(gl.ctx, obj, material)
+    state = ShellFurState(gl.ctx, obj)
     out = []
     for t in times:
         scene.apply_timeline(t)
@@ -661,7 +660,7 @@ def test_deflections_come_back_to_object_space(gl):
                          "params": {"fur_length": 0.2, "damping": 0.5}}]}
     loaded = scene_from_dict(scene, "s")
     obj = loaded.objects[0]
-    state = ShellFurState(gl.ctx, obj, obj.material)
+    state = ShellFurState(gl.ctx, obj)
     state.advance(0.0)  # settled under gravity
     deflection = state.vertex_deflections()
     linear = obj.model[:3, :3]
