@@ -103,4 +103,7 @@ def kept_while(*sources: str) -> Callable[[F], F]:
 def overrides(cls: type, base: type, *hooks: str) -> bool:
     """Whether ``cls`` (a subclass of ``base``) has its own version of any of ``hooks``: an
     attribute other than ``base``'s."""
-    return any(getattr(cls, hook) is not getattr(base, hook) for hook in hooks)
+    for hook in hooks:
+        if getattr(cls, hook) is not getattr(base, hook):
+            return True
+    return False

@@ -229,8 +229,11 @@ class Renderer:
             frame.binding_sources.insert(0, shading)
         self.light_buffer.upload(self.scene.lights, frame.view, frame.projection)
         self._check_gl("uploading the lights")
+        # asked of each class once a frame, not of each pass (a pass an object)
+        preparing = {cls for cls in {type(p) for p in self.passes}
+                     if overrides(cls, RenderPass, "prepare")}
         for render_pass in self.passes:
-            if not overrides(type(render_pass), RenderPass, "prepare"):
+            if type(render_pass) not in preparing:
                 continue  # nothing to prepare (most passes: skipping them saves a GL error read)
             try:
                 render_pass.prepare(frame)
@@ -278,8 +281,11 @@ class Renderer:
         latest of ``times``: an animation is refused before its first frame, not part way."""
         if times:
             latest = max(times)
-            for obj in self.scene.objects:
-                if overrides(type(obj.material), Material, "check_time"):  # most have none
+            objects = self.scene.objects
+            checking = {cls for cls in {type(obj.material) for obj in objects}
+                        if overrides(cls, Material, "check_time")}  # most have none
+            for obj in objects:
+                if type(obj.material) in checking:
                     obj.material.check_time(latest, where)
 
     def _check_gl(self, stage: str) -> None:
