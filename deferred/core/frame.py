@@ -15,12 +15,7 @@ from typing import Any
 
 import moderngl
 
-from deferred.core.protocols import (
-    BindingSource,
-    ObjectInputs,
-    PassLike,
-    SceneLike,
-)
+from deferred.core.protocols import BindingSource, ObjectInputs, PassLike, SceneLike
 from deferred.errors import DeferredError, InputError, RenderError, gl_error
 from deferred.gl.context import GLContext
 from deferred.gl.device import Device
@@ -44,7 +39,6 @@ class MaterialInputs:
     kept: bool = False
     declared: set[str] = field(default_factory=set)
     programs: list[str] = field(default_factory=list)
-
 
 
 class Frame:

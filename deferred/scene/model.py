@@ -172,7 +172,9 @@ class Scene:
         """Set each object's material parameters to those of ``time`` (seconds): objects
         with events only; the others keep theirs. An object with events that shares its
         material instance with another object (``Scene.add`` takes an instance) is given a copy
-        of its own first, so its events never change the other."""
+        of its own first (``copy.copy``: so ``obj.material`` is another object from the first
+        frame on, and state a material keeps in containers is shared by the copies), so its
+        events never change the other."""
         users: dict[int, int] | None = None
         for obj in self.objects:
             if not obj.events:
