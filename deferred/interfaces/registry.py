@@ -19,6 +19,7 @@ skips a broken one with a warning naming it.
 from __future__ import annotations
 
 import importlib
+import threading
 import warnings
 from collections.abc import Iterator
 from importlib.metadata import EntryPoint, entry_points
@@ -28,6 +29,11 @@ from deferred.errors import InputError
 from deferred.gbuffer.surface_id import MAX_MATERIAL_ID, MAX_SHADING_MODEL_ID
 
 T = TypeVar("T")
+
+
+# Held while a built-in package or a plugin loads (every registry: loading one package may
+# register into several)
+_loading = threading.RLock()
 
 
 class PluginWarning(UserWarning):
@@ -68,15 +74,24 @@ class Registry(Generic[T]):
 
     # -- loading -----------------------------------------------------------------------------
     def _load_builtins(self) -> None:
-        if not self._builtins_loaded:
-            self._builtins_loaded = True
-            importlib.import_module(self.builtin_package)
+        if self._builtins_loaded:
+            return
+        # Another thread asking meanwhile waits for the whole package, not a part of it; the
+        # lock is re-entrant since the package's modules register (and may ask) as they load.
+        with _loading:
+            if not self._builtins_loaded:
+                importlib.import_module(self.builtin_package)
+                self._builtins_loaded = True
 
     def _entry_points(self) -> list[EntryPoint]:
         return list(entry_points(group=self.group))
 
     def _load_entry(self, entry: EntryPoint) -> str | None:
         """Load and register one plugin; the error message, or None."""
+        with _loading:
+            return self._load_entry_locked(entry)
+
+    def _load_entry_locked(self, entry: EntryPoint) -> str | None:
         if entry.name in self._tried:
             return self._tried[entry.name]
         error = None

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import numbers
 import os
 import warnings
 from collections.abc import Callable
@@ -100,6 +101,7 @@ class Renderer:
     def __init__(self, scene: Scene, pipeline: str = Pipeline.DEFERRED,
                  size: tuple[int, int] | None = None, gl: GLContext | None = None,
                  strict: bool | None = None, light_path: str | None = None):
+        self._released = False
         if pipeline not in PIPELINES:
             raise InputError(f"unknown pipeline '{pipeline}' (choose from "
                              f"{', '.join(PIPELINES)})", "--pipeline")
@@ -185,6 +187,7 @@ class Renderer:
                     after: str | None = None) -> None:
         """Insert ``render_pass`` before or after the pass named so; the graph is checked again
         (and left as it was if the new pass does not fit) and new targets are created."""
+        self._check_alive()
         if (before is None) == (after is None):
             raise TypeError("insert_pass needs exactly one of before= or after=")
         index = self.graph.index(before if before is not None else after)
@@ -207,9 +210,12 @@ class Renderer:
         called around each pass; ``readback=False`` skips reading the images back (timing
         loops); ``time_gl_calls`` measures the CPU time of the drawing GL calls
         (``RenderResult.gl_call_seconds``, for the bench: two clock reads per call)."""
+        self._check_alive()
+        if isinstance(time, bool) or not isinstance(time, numbers.Real) or \
+                not math.isfinite(time) or time < 0.0:
+            raise InputError(f"frame time must be a finite number of seconds >= 0, got {time!r}",
+                             "time")
         time = float(time)
-        if not math.isfinite(time):
-            raise InputError(f"frame time must be a finite number of seconds, got {time}", "time")
         self.check_times([time], "time")
         self.scene.apply_timeline(time)
         self.gl.make_current()
@@ -294,13 +300,24 @@ class Renderer:
             raise gl_error(stage, error, self.size)
 
     def read_final(self) -> np.ndarray:
+        self._check_alive()
         data = np.frombuffer(self.targets[FINAL].read(alignment=1), dtype=np.uint8)
         return data.reshape(self.size[1], self.size[0], 4)[::-1].copy()
 
     def read_hdr(self) -> np.ndarray:
+        self._check_alive()
         return self.targets.read(COMPOSITE)[::-1].copy()
 
+    def _check_alive(self) -> None:
+        if self._released:
+            raise RenderError("this renderer was released; make a new one")
+
     def release(self) -> None:
+        """Release every GL object of the renderer and give its context back; releasing
+        again does nothing."""
+        if self._released:
+            return
+        self._released = True
         self.gl.make_current()
         self.gl.park()
         # every part made so far (a constructor that failed part way made only some)

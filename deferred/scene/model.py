@@ -11,9 +11,10 @@ from __future__ import annotations
 
 import copy
 import math
+import numbers
 from bisect import bisect_right
 from collections import Counter
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from types import MappingProxyType
 from typing import Any
@@ -248,7 +249,14 @@ def parse_size(text: str, where: str = "--size") -> tuple[int, int]:
 
 
 def check_size(size: tuple[int, int], where: str) -> tuple[int, int]:
-    width, height = size
+    """``size`` as (width, height) in whole pixels, each 1..``MAX_SIZE``; ``InputError``
+    naming ``where`` otherwise (a string, three numbers, a fraction of a pixel)."""
+    if isinstance(size, str | bytes) or not isinstance(size, Sequence) or len(size) != 2 or \
+            not all(isinstance(side, numbers.Integral) and not isinstance(side, bool)
+                    for side in size):
+        raise InputError(f"size must be (width, height) in whole pixels, e.g. (1280, 720), "
+                         f"got {size!r}", where)
+    width, height = (int(side) for side in size)
     if not (1 <= width <= MAX_SIZE and 1 <= height <= MAX_SIZE):
         raise InputError(f"size {width}x{height} is impossible (each side 1..{MAX_SIZE})", where)
     return width, height
