@@ -186,6 +186,8 @@ def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
                   size=model.size, background=model.background, exposure=model.exposure,
                   tonemap=model.tonemap, light_path=model.light_path, source=name)
     meshes: dict[str, MeshData] = {}
+    labels: set[str] = set()
+    next_index: dict[str, int] = {}  # unique_label's, for every unnamed object
     for index, obj in enumerate(model.object):
         where = f"{name}: object[{index}]"
         material_cls = registry.materials.get(obj.material, f"{where}.material")
@@ -193,9 +195,10 @@ def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
         if obj.mesh not in meshes:
             meshes[obj.mesh] = load_mesh(obj.mesh, base_dir, f"{where}.mesh")
         mesh = meshes[obj.mesh]
-        label = obj.name or unique_label(scene, mesh.name)
-        if any(o.label == label for o in scene.objects):
+        label = obj.name or unique_label(labels, mesh.name, next_index)
+        if label in labels:
             raise InputError(f"duplicate object name '{label}'", f"{where}.name")
+        labels.add(label)
         scene.objects.append(SceneObject(label, mesh, material,
                                          model_matrix(obj.position, obj.rotation, obj.scale)))
     for index, light in enumerate(model.light):
@@ -216,6 +219,14 @@ def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
         seen.add(kind)
         effect_cls = registry.effects.get(kind, f"{where}.type")
         scene.effects.append(effect_cls.from_dict(values, where))
+    # each object's events added at once (in the file's order: it breaks ties of time)
+    by_label = {obj.label: obj for obj in scene.objects}
+    grouped: dict[str, list[tuple[float, dict[str, Any], str]]] = {}
     for index, event in enumerate(model.event):
-        scene.add_event(event.object, event.time, event.params, f"{name}: event[{index}]")
+        where = f"{name}: event[{index}]"
+        if event.object not in by_label:
+            scene.add_event(event.object, event.time, event.params, where)  # names the choices
+        grouped.setdefault(event.object, []).append((event.time, event.params, where))
+    for label, events in grouped.items():
+        by_label[label].add_events(events)
     return scene

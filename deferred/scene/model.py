@@ -63,41 +63,84 @@ class SceneObject:
     model: np.ndarray
     base_params: MaterialParams | None = None
     events: tuple[TimelineEvent, ...] = ()
+    # params_at's validated states and the merged values they came from, by count of events
+    # applied (cleared when the events change)
     _states: dict[int, MaterialParams] = field(default_factory=dict, init=False, repr=False)
+    _values: dict[int, dict[str, Any]] = field(default_factory=dict, init=False, repr=False)
+    _times: tuple[float, ...] = field(default=(), init=False, repr=False)
 
     def __post_init__(self) -> None:
         if self.base_params is None:
             self.base_params = self.material.params
-        self.events = tuple(sorted(self.events, key=lambda event: event.time))  # stable
+        self._set_events(self.events)
+
+    def _set_events(self, events) -> None:
+        self.events = tuple(sorted(events, key=lambda event: event.time))  # stable
+        self._times = tuple(event.time for event in self.events)
+        self._states.clear()
+        self._values.clear()
 
     @property
     def event_times(self) -> tuple[float, ...]:
         """The times of this object's events, sorted."""
-        return tuple(event.time for event in self.events)
+        return self._times
 
     def params_at(self, time: float) -> MaterialParams:
         """The material parameters at ``time``: ``base_params`` updated by every event with
         ``event.time <= time``, in time order (ties: the order given). Validated once per
-        distinct set of events applied, then cached."""
-        count = bisect_right(self.event_times, time)
+        distinct set of events applied, then cached; the merged values are made from the
+        nearest earlier set's, so asking every event time in turn costs each event once."""
+        count = bisect_right(self._times, time)
         if count == 0:
             return self.base_params
         state = self._states.get(count)
         if state is None:
-            values = self.base_params.model_dump()
-            for event in self.events[:count]:
-                values.update(event.params)
             where = self.events[count - 1].where
-            state = validate_params(type(self.base_params), values,
+            state = validate_params(type(self.base_params), self._merged(count),
                                     f"{where}.params" if where else f"{self.label}: params")
             self._states[count] = state
         return state
+
+    def _merged(self, count: int) -> dict[str, Any]:
+        """``base_params`` with the first ``count`` events' params over them."""
+        known = count
+        while known > 0 and known not in self._values:
+            known -= 1
+        values = self._values[known] if known else self.base_params.model_dump()
+        for index in range(known, count):
+            values = {**values, **self.events[index].params}
+            self._values[index + 1] = values
+        return values
 
     def add_event(self, time: float, params: Mapping[str, Any],
                   where: str | None = None) -> TimelineEvent:
         """Add an event: from ``time`` (seconds, finite, >= 0) on, the material takes
         ``params``. ``params`` are checked over ``base_params`` at once, and so is the
         object's state at every event time from this one on; errors name ``where``."""
+        return self.add_events([(time, params, where)])[0]
+
+    def add_events(self, events: Sequence[tuple[float, Mapping[str, Any], str | None]]
+                   ) -> list[TimelineEvent]:
+        """:meth:`add_event` for several ``(time, params, where)`` at once: each is checked
+        alone, then every state from the earliest of their times on is checked once (a
+        scene file's events are added so: the cost grows with the events, not their
+        square). None is kept if any is refused."""
+        made = [self._checked_event(time, params, where) for time, params, where in events]
+        if not made:
+            return []
+        previous = self.events
+        self._set_events((*previous, *made))
+        earliest = min(event.time for event in made)
+        try:  # the merged states from its time on (the parameters' own cross-checks)
+            for later in sorted({t for t in self._times if t >= earliest}):
+                self.params_at(later)
+        except InputError:
+            self._set_events(previous)
+            raise
+        return made
+
+    def _checked_event(self, time: float, params: Mapping[str, Any],
+                       where: str | None) -> TimelineEvent:
         where = where or f"{self.label}: event"
         if not (isinstance(time, int | float) and math.isfinite(time) and time >= 0.0):
             raise InputError(f"must be a finite number of seconds >= 0, got {time!r}",
@@ -112,18 +155,7 @@ class SceneObject:
         changed = material_cls.from_dict({**self.base_params.model_dump(), **params},
                                          self.material.base_dir, params_where)
         self._check_same_passes(changed, params, params_where)
-        event = TimelineEvent(float(time), MappingProxyType(dict(params)), where)
-        previous = self.events
-        self.events = tuple(sorted((*previous, event), key=lambda e: e.time))
-        self._states.clear()
-        try:  # the merged states from its time on (the parameters' own cross-checks)
-            for later in sorted({t for t in self.event_times if t >= event.time}):
-                self.params_at(later)
-        except InputError:
-            self.events = previous
-            self._states.clear()
-            raise
-        return event
+        return TimelineEvent(float(time), MappingProxyType(dict(params)), where)
 
     def _check_same_passes(self, changed: Material, params: Mapping[str, Any],
                            where: str) -> None:
@@ -224,18 +256,24 @@ class Scene:
             mesh = load_mesh(mesh)
         if isinstance(material, str):
             material = registry.materials.get(material).from_dict(params or {})
-        obj = SceneObject(label or unique_label(self, mesh.name), mesh, material,
+        obj = SceneObject(label or unique_label({o.label for o in self.objects}, mesh.name),
+                          mesh, material,
                           model_matrix(position, rotation, scale))
         self.objects.append(obj)
         return obj
 
 
-def unique_label(scene: Scene, mesh_name: str) -> str:
+def unique_label(taken: set[str], mesh_name: str, next_index: dict[str, int] | None = None
+                 ) -> str:
+    """``<mesh stem><n>`` with the least ``n`` not ``taken``. ``next_index`` (kept by a caller
+    naming many objects, whose ``taken`` only grows) starts each stem's search where its last
+    one ended, so naming n objects costs n, not n squared."""
     stem = mesh_name.removeprefix("builtin:").rsplit(".", 1)[0] or "object"
-    taken = {obj.label for obj in scene.objects}
-    index = 0
+    index = next_index.get(stem, 0) if next_index is not None else 0
     while f"{stem}{index}" in taken:
         index += 1
+    if next_index is not None:
+        next_index[stem] = index
     return f"{stem}{index}"
 
 
