@@ -9,6 +9,7 @@ packed from [-1, 1] to [0, 1]; A: fur length scale).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import moderngl
 import numpy as np
@@ -34,6 +35,9 @@ class MeshData:
     indices: np.ndarray  # (M, 3)
     has_comb: bool = False  # True when the comb came from the file's vertex colours
     generated_uvs: bool = False
+    # the files it was read from: the mesh file and those it names (a material library, its
+    # textures, glTF buffers): inputs an output must not replace
+    sources: tuple[Path, ...] = ()
 
     @property
     def vertex_count(self) -> int:

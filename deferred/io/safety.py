@@ -107,7 +107,8 @@ def scene_inputs(scene: Any, scene_file: str | Path | None = None) -> list[Path]
     string in it (meshes, textures, heightfields, wetness masks, event parameters), found by
     walking the TOML rather than each material's parameter names, so a new material's file
     parameters are covered too; and the strings of each material's parameters, resolved the
-    way the material resolves them (scenes built in code)."""
+    way the material resolves them (scenes built in code); and the files each mesh was read
+    from (``MeshData.sources``: an OBJ's material library and its textures, glTF buffers)."""
     found: list[Path] = []
     if scene_file is not None and not str(scene_file).startswith("builtin:"):
         path = Path(scene_file)
@@ -120,6 +121,7 @@ def scene_inputs(scene: Any, scene_file: str | Path | None = None) -> list[Path]
             candidate = Path(text)
             found.append(candidate if candidate.is_absolute() else path.parent / candidate)
     for obj in getattr(scene, "objects", ()):
+        found.extend(getattr(getattr(obj, "mesh", None), "sources", ()))
         material = obj.material
         sets = [material.params, obj.base_params, *(event.params for event in obj.events)]
         for params in sets:
