@@ -6,8 +6,10 @@ difference images.
 from __future__ import annotations
 
 import json
+import re
 import secrets
 import shutil
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -15,13 +17,14 @@ from typing import Any
 import numpy as np
 
 from deferred.debug.dump import safe_name
-from deferred.debug.dump_folder import swap_in_folder
+from deferred.debug.dump_folder import DUMP_FILES, carry_over, swap_in_folder
 from deferred.debug.preview import heat_colors, to_uint8
 from deferred.errors import InputError, RenderError
 from deferred.io.images import read_channels, write_image, write_text
 from deferred.io.safety import same_file
 
 COMPARE_FILE = "compare.json"  # marks a folder as a comparison's output
+DIFFERENCE_PASS_IMAGE = re.compile(r"passes/[^/]+\.(exr|png)")
 
 
 @dataclass
@@ -112,12 +115,32 @@ def compare_dumps(first: str | Path, second: str | Path,
         write_text(staging / COMPARE_FILE, json.dumps(
             {"a": str(first), "b": str(second), "buffers": [r.describe() for r in results]},
             indent=2) + "\n")
+        if out.is_dir():  # an earlier comparison: the user's files in it stay
+            carry_over(out, staging, _comparison_files(out))
         swap_in_folder(staging, out)  # the earlier comparison stays if the swap fails
     except OSError as exc:
         raise RenderError(f"cannot write {output}: {exc.strerror or exc}") from exc
     finally:
         shutil.rmtree(staging, ignore_errors=True)
     return results
+
+
+def _comparison_files(folder: Path) -> Callable[[str], bool]:
+    """Whether a path (relative to ``folder``, an earlier comparison) is one a comparison
+    writes: its record, and difference images, by name (``gbuffer``, ``light``, ``final``,
+    ``passes/*``, each ``.exr`` and ``.png``) and those the record names; every other file is
+    the user's."""
+    own = {COMPARE_FILE, *(f"{name.removesuffix('.exr')}.{kind}" for name in DUMP_FILES
+                           if name.endswith(".exr") for kind in ("exr", "png"))}
+    try:
+        record = json.loads((folder / COMPARE_FILE).read_text(encoding="utf-8"))
+        for entry in record.get("buffers", []):
+            image = entry.get("image") if isinstance(entry, dict) else None
+            if isinstance(image, str) and image.endswith(".exr"):
+                own |= {image, f"{image.removesuffix('.exr')}.png"}
+    except (OSError, ValueError, AttributeError):
+        pass  # an unreadable record: the names alone say which files are the comparison's
+    return lambda relative: relative in own or DIFFERENCE_PASS_IMAGE.fullmatch(relative) is not None
 
 
 def _compare_all(a_files: dict[str, Path], b_files: dict[str, Path], first: str | Path,

@@ -12,7 +12,7 @@ import re
 import secrets
 import shutil
 import stat
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -157,20 +157,28 @@ def _link_or_copy(source: str, target: str) -> None:
         shutil.copy2(source, target)
 
 
-def carry_over(old: Path, new: Path) -> None:
-    """Files in the old dump folder that no dump writes (the user's notes, a scene) go into
-    the new one: hard links where the file system has them, so the old folder keeps its copy
-    until the swap and an interrupted dump loses nothing."""
+def carry_over(old: Path, new: Path, own: Callable[[str], bool] = is_dump_file,
+               prefix: str = "") -> None:
+    """Files in the old folder that are not the writer's ``own`` (by path relative to the
+    folder; a dump's by default: :func:`is_dump_file`) go into the new one, the user's notes
+    or a scene: hard links where the file system has them, so the old folder keeps its copy
+    until the swap and an interrupted write loses nothing. Folders are merged with what the
+    new one holds (a dump's ``passes/``)."""
     for entry in old.iterdir():
-        if entry.name in DUMP_FILES:
+        relative = f"{prefix}{entry.name}"
+        if own(relative):
             continue
-        if entry.name == "passes" and entry.is_dir() and not entry.is_symlink():
-            (new / "passes").mkdir(exist_ok=True)
-            for item in entry.iterdir():
-                if PASS_FILE.fullmatch(item.name) is None:
-                    _carry(item, new / "passes" / item.name)
+        target = new / entry.name
+        if entry.is_dir() and not entry.is_symlink():
+            made = not os.path.lexists(target)
+            if made:
+                target.mkdir()
+            if target.is_dir() and not target.is_symlink():
+                carry_over(entry, target, own, f"{relative}/")
+                if made and not any(target.iterdir()):
+                    target.rmdir()  # it held the writer's files only
             continue
-        _carry(entry, new / entry.name)
+        _carry(entry, target)
 
 
 def _carry(source: Path, target: Path) -> None:

@@ -507,11 +507,16 @@ def test_cli_compare_output_is_whole_and_never_a_folder_of_other_files(tmp_path,
         assert run(capsys, "dump", "-o", tmp_path / name, "--size", "64x36")[0] == 0
     out = tmp_path / "diff"
     out.mkdir()
-    (out / "stale.png").write_bytes(b"an earlier difference image")
-    (out / "compare.json").write_text("{}")  # an earlier comparison: replaced as a whole
+    (out / "final.png").write_bytes(b"an earlier difference image")
+    (out / "passes").mkdir()
+    (out / "passes" / "post.tonemap.exr").write_bytes(b"another")
+    (out / "notes.txt").write_text("mine")  # the user's, kept as a dump keeps them
+    (out / "compare.json").write_text("{}")  # an earlier comparison: its own files replaced
     code, _, err = run(capsys, "dump", "--compare", tmp_path / "a", tmp_path / "b", "-o", out)
     assert code == 0, err
-    assert sorted(p.name for p in out.iterdir()) == ["compare.json"]  # equal dumps: no images
+    # equal dumps: no images; the earlier ones gone, the notes kept
+    assert sorted(p.name for p in out.iterdir()) == ["compare.json", "notes.txt"]
+    assert (out / "notes.txt").read_text() == "mine"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a", "b", "diff"]  # no staging left
     notes = tmp_path / "notes"
     notes.mkdir()
