@@ -84,7 +84,7 @@ def write_image(path: str | Path, pixels: np.ndarray, channels: Sequence[str] | 
         # has_error tells. Collect every signal, then check the file it left.
         if not ok or not closed or output.has_error:
             raise failed(output.geterror(), oiio.geterror())
-        _fsync(temporary, path)
+        sync_file(temporary, path)
         _check_image_file(temporary, path, width, height, count)
 
     _write_atomically(path, write)
@@ -105,7 +105,7 @@ def _os_reason(exc: OSError) -> str:
     return exc.strerror or str(exc) or type(exc).__name__
 
 
-def _fsync(temporary: str, path: Path) -> None:
+def sync_file(temporary: str | Path, path: Path) -> None:
     """Flush the written file to the disk: delayed allocation and network file systems report
     a full disk only here, after the writer closed the file without complaint."""
     try:
@@ -118,9 +118,15 @@ def _fsync(temporary: str, path: Path) -> None:
         raise RenderError(f"cannot write {path}: {_os_reason(exc)}") from exc
 
 
+# Rows a written image is read back at a time (about 16 MB of float pixels at most)
+READ_BACK_BYTES = 1 << 24
+
+
 def _check_image_file(temporary: str, path: Path, width: int, height: int, count: int) -> None:
-    """Read back the header of a written image: a writer that lost data without saying so
-    leaves an empty or unreadable file, caught here before it replaces the old one."""
+    """Read a written image back, all of it, a band of rows at a time: a writer that lost data
+    without saying so (OIIO's PNG and EXR writers on a full disk leave a file cut short and
+    report success) leaves an empty, unreadable or truncated file, caught here before it
+    replaces the old one."""
     import OpenImageIO as oiio
 
     if os.path.getsize(temporary) == 0:
@@ -132,12 +138,20 @@ def _check_image_file(temporary: str, path: Path, width: int, height: int, count
     try:
         spec = image.spec()
         got = (spec.width, spec.height, spec.nchannels)
+        if got != (width, height, count):
+            raise RenderError(f"cannot write {path}: the written file reads back as "
+                              f"{got[0]}x{got[1]} with {got[2]} channels, not "
+                              f"{width}x{height} with {count}")
+        rows = max(1, READ_BACK_BYTES // (4 * width * count))
+        for first in range(0, height, rows):
+            band = image.read_scanlines(0, 0, first, min(first + rows, height), 0, 0, count,
+                                        "float")
+            if band is None or image.has_error:
+                raise RenderError(f"cannot write {path}: the written file is cut short or "
+                                  f"damaged ({_reason(image.geterror(), oiio.geterror())}); "
+                                  "is the disk full?")
     finally:
         image.close()
-    if got != (width, height, count):
-        raise RenderError(f"cannot write {path}: the written file reads back as "
-                          f"{got[0]}x{got[1]} with {got[2]} channels, not "
-                          f"{width}x{height} with {count}")
 
 
 def write_text(path: str | Path, text: str) -> Path:

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from deferred.errors import InputError, RenderError
-from deferred.io.images import write_image
+from deferred.io.images import sync_file, write_image
 from deferred.io.paths import expand_pattern, output_kind, temporary_path
 
 GIF_TICK_MS = 10  # GIF frame delays are whole hundredths of a second
@@ -121,7 +121,12 @@ class AnimationWriter:
             if self.suffix == ".gif":
                 self._gif_frames.append(rgb)
             else:
-                self._mp4().append_data(rgb)
+                try:
+                    self._mp4().append_data(rgb)
+                except Exception as exc:  # noqa: BLE001 - ffmpeg gone: a full disk, a kill
+                    self.abort()
+                    raise RenderError(f"cannot write {self.path}: "
+                                      f"{video_failure(exc, self.path)}") from exc
         self.frames += 1
 
     def _mp4(self):
@@ -132,7 +137,7 @@ class AnimationWriter:
             self._video = iio.get_writer(
                 str(self._temporary), format="FFMPEG", mode="I", fps=self.fps,
                 codec="libx264", pixelformat="yuv420p", quality=MP4_QUALITY,
-                macro_block_size=1, ffmpeg_log_level="error")
+                macro_block_size=1, ffmpeg_log_level="quiet")  # failures: video_failure
         return self._video
 
     def close(self) -> list[Path]:
@@ -146,6 +151,10 @@ class AnimationWriter:
                 else:
                     video, self._video = self._video, None
                     video.close()
+                # written to the end, or not renamed over the old file: a full disk leaves
+                # a video cut short while its writer says nothing (ffmpeg's trailer, Pillow)
+                sync_file(self._temporary, self.path)
+                check_video_file(self._temporary, self.path, self.suffix)
                 os.replace(self._temporary, self.path)
                 self._temporary = None
                 self.written.append(self.path)
@@ -153,18 +162,22 @@ class AnimationWriter:
             self.abort()
             if isinstance(exc, RenderError | InputError):
                 raise
-            raise RenderError(f"cannot write {self.path}: {type(exc).__name__}: {exc}") \
+            raise RenderError(f"cannot write {self.path}: {video_failure(exc, self.path)}") \
                 from exc
         self._closed = True
         return self.written
 
     def _write_gif(self) -> None:
-        import imageio.v3 as iio
+        # Pillow directly, into a file this writer closes: its errors (a full or read-only
+        # disk) surface here, once, with no writer object left to fail again when collected
+        from PIL import Image
 
         self._temporary = temporary_path(self.path)
-        iio.imwrite(self._temporary, np.stack(self._gif_frames), plugin="pillow",
-                    extension=".gif", duration=gif_durations(self.frames, self.fps), loop=0)
+        frames = [Image.fromarray(rgb) for rgb in self._gif_frames]
         self._gif_frames.clear()
+        with open(self._temporary, "wb") as file:
+            frames[0].save(file, format="GIF", save_all=True, append_images=frames[1:],
+                           duration=gif_durations(self.frames, self.fps), loop=0)
 
     def abort(self) -> None:
         """Stop and remove an unfinished video (completed sequence frames stay)."""
@@ -188,6 +201,48 @@ class AnimationWriter:
             self.close()
         else:
             self.abort()
+
+
+def video_failure(exc: BaseException, path: Path) -> str:
+    """One line saying why a video writer failed: a full disk by name (ffmpeg's own words
+    are many lines, ending in a broken pipe), else the first line of the error."""
+    try:
+        stat = os.statvfs(path.parent if str(path.parent) else ".")
+        if stat.f_bavail * stat.f_frsize < (1 << 20):
+            return "no space left on the disk"
+    except OSError:
+        pass
+    lines = [line.strip() for line in str(exc).splitlines() if line.strip()]
+    return f"{type(exc).__name__}: {lines[0]}" if lines else type(exc).__name__
+
+
+def check_video_file(temporary: Path, path: Path, suffix: str) -> None:
+    """A written video is whole: a GIF ends with its trailer byte; an MP4's top-level boxes
+    fill the file exactly and include ``moov`` (the index ffmpeg writes last: a full disk
+    loses it first). ``RenderError`` naming ``path`` otherwise."""
+    size = temporary.stat().st_size
+    with open(temporary, "rb") as file:
+        if suffix == ".gif":
+            file.seek(max(0, size - 1))
+            whole = size > 13 and file.read(1) == b"\x3b"
+        else:
+            boxes, offset = set(), 0
+            while offset + 8 <= size:
+                file.seek(offset)
+                header = file.read(16)
+                length = int.from_bytes(header[:4], "big")
+                boxes.add(header[4:8])
+                if length == 1 and len(header) == 16:  # a 64-bit size follows the type
+                    length = int.from_bytes(header[8:16], "big")
+                elif length == 0:  # the box runs to the end of the file
+                    length = size - offset
+                if length < 8:
+                    break
+                offset += length
+            whole = offset == size and b"moov" in boxes
+    if not whole:
+        raise RenderError(f"cannot write {path}: the written {suffix[1:]} is cut short; "
+                          "is the disk full?")
 
 
 def describe_written(files: Sequence[Path]) -> str:
