@@ -459,6 +459,9 @@ def _interrupted(exc: KeyboardInterrupt) -> int:
 
 
 def _main(argv: list[str] | None) -> int:
+    if not (sys.argv[1:] if argv is None else argv):  # no command: the help, not an error
+        click.echo(cli.get_help(click.Context(cli, info_name="deferred")))
+        return 0
     try:
         cli.main(args=argv, prog_name="deferred", standalone_mode=False)
         return 0

@@ -49,7 +49,16 @@ def format_validation_error(exc: ValidationError, where: str | None) -> tuple[st
     """(message, where) for the first error; ``where`` is extended with the key's path."""
     errors = exc.errors()
     first = errors[0]
-    key = location(tuple(first["loc"]))
+    loc = tuple(first["loc"])
+    if first["type"] == "missing" and loc and isinstance(loc[-1], int) and \
+            isinstance(first.get("input"), list | tuple):
+        # a list one value short is the list's problem, not a "missing key" at its end
+        given = first["input"]
+        first = {**first, "type": "too_short",
+                 "msg": f"expected more than the {len(given)} value"
+                        f"{'s' if len(given) != 1 else ''} given"}
+        loc = loc[:-1]
+    key = location(loc)
     return _message(first, len(errors)), join_where(where, key)
 
 

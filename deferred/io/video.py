@@ -38,6 +38,9 @@ def frame_times(frames: int, fps: float, start: float = 0.0) -> list[float]:
         raise InputError(f"must be a finite number > 0, got {fps!r}", "--fps")
     if not (math.isfinite(start) and start >= 0.0):
         raise InputError(f"must be a finite number of seconds >= 0, got {start!r}", "--time")
+    if not math.isfinite(start + (frames - 1) / fps):
+        raise InputError(f"{fps!r} frames a second puts the last frame at no finite time; "
+                         "give a larger rate", "--fps")
     return [start + index / fps for index in range(frames)]
 
 

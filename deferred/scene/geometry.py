@@ -113,6 +113,9 @@ def build_mesh(name: str, positions: np.ndarray, indices: np.ndarray,
     generated = False
     if uvs is not None and len(uvs) == len(positions) and not np.isfinite(uvs).all():
         raise InputError("mesh has non-finite UVs (NaN or infinity)", name)
+    if colors is not None and not np.isfinite(np.asarray(colors, dtype=np.float64)).all():
+        # they carry the fur's comb (Revie 2.4.1): a NaN direction is no direction
+        raise InputError("mesh has non-finite vertex colours (NaN or infinity)", name)
     if uvs is None or len(uvs) != len(positions):
         positions, normals, colors, indices, uvs = unwrap_vertices(positions, normals, colors,
                                                                    indices, name)

@@ -41,6 +41,7 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 Vec3 = tuple[float, float, float]
+MIN_SCALE = 1e-6  # an object smaller is a mistake of units; 1/scale must fit float32
 MAX_DEPTH_RANGE = 1e7  # far / near
 DEMO_SCENE = "demo.toml"
 
@@ -100,6 +101,8 @@ class ObjectModel(_Strict):
         scale = np.broadcast_to(np.asarray(self.scale, dtype=float), (3,))
         if np.any(scale == 0.0):
             raise ValueError("scale must not be zero")
+        if np.any(np.abs(scale) < MIN_SCALE):  # its normal matrix would overflow float32
+            raise ValueError(f"scale must be at least {MIN_SCALE:g} in size")
         return self
 
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 import copy
 import math
 import numbers
+import re
 from bisect import bisect_right
 from collections import Counter
 from collections.abc import Mapping, Sequence
@@ -36,6 +37,7 @@ from deferred.scene.meshes import load_mesh
 
 Vec3 = tuple[float, float, float]
 MAX_SIZE = 16384
+SIZE_TEXT = re.compile(r"([0-9]+)[xX]([0-9]+)")
 
 
 @dataclass(frozen=True)
@@ -278,12 +280,10 @@ def unique_label(taken: set[str], mesh_name: str, next_index: dict[str, int] | N
 
 
 def parse_size(text: str, where: str = "--size") -> tuple[int, int]:
-    parts = text.lower().split("x")
-    try:
-        width, height = (int(p) for p in parts)
-    except ValueError:
-        raise InputError(f"expected WIDTHxHEIGHT such as 1280x720, got '{text}'", where) from None
-    return check_size((width, height), where)
+    match = SIZE_TEXT.fullmatch(text.strip())  # digits only: int() takes "1_60" and "+160"
+    if match is None:
+        raise InputError(f"expected WIDTHxHEIGHT such as 1280x720, got '{text}'", where)
+    return check_size((int(match.group(1)), int(match.group(2))), where)
 
 
 def check_size(size: tuple[int, int], where: str) -> tuple[int, int]:

@@ -41,6 +41,10 @@ def test_render_forward_exr_is_linear_float(tmp_path, capsys):
     (["render", "missing.toml"], "missing.toml: scene file not found"),
     (["render", "--size", "0x10"], "--size: size 0x10 is impossible"),
     (["render", "--size", "big"], "--size: expected WIDTHxHEIGHT"),
+    (["render", "--size", "1_60x9_0"], "--size: expected WIDTHxHEIGHT"),
+    (["render", "--size", "+160x90"], "--size: expected WIDTHxHEIGHT"),
+    (["render", "-o", "x.gif", "--frames", "2", "--fps", "5e-324"],
+     "--fps: 5e-324 frames a second puts the last frame at no finite time"),
     (["render", "-o", "x.jpg"], "-o: output must end in .png, .exr, .mp4 or .gif"),
     (["render", "--pipeline", "raytrace"], "Invalid value for '--pipeline'"),
     (["render", "--frames", "0"], "Invalid value for '--frames'"),
@@ -55,6 +59,12 @@ def test_bad_input_exits_2_with_one_line(tmp_path, capsys, monkeypatch, args, fr
     assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
     assert [p.name for p in tmp_path.iterdir()] == ["folder.png"]
     assert list((tmp_path / "folder.png").iterdir()) == []
+
+
+def test_no_command_prints_the_help_and_exits_0(capsys):
+    code, out, err = run(capsys)
+    assert code == 0 and err == ""
+    assert out.startswith("Usage: deferred [OPTIONS] COMMAND") and "render" in out
 
 
 def test_bad_scene_leaves_no_output(tmp_path, capsys):

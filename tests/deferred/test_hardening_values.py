@@ -105,7 +105,7 @@ CASES = [
     ("background", [NAN, 0.0, 0.0], "finite"),
     ("background", [-1.0, 0.0, 0.0], "greater than or equal to 0"),
     ("background", [INF, 0.0, 0.0], "finite"),
-    ("background", [0.1, 0.1], "missing"),
+    ("background", [0.1, 0.1], "expected more than the 2 values given"),
     ("tonemap", 3, "expected one of 'reinhard', 'aces', 'none'"),
     ("light_path", "warp", "expected one of"),
     ("camera.position", [NAN, 0.0, 0.0], "finite"),
@@ -123,6 +123,8 @@ CASES = [
     ("object[0].rotation", [0.0, INF, 0.0], "finite"),
     ("object[0].scale", NAN, "finite"),
     ("object[0].scale", 0.0, "scale must not be zero"),
+    ("object[0].scale", 1e-300, "scale must be at least 1e-06 in size"),
+    ("object[0].scale", [1.0, -1e-9, 1.0], "scale must be at least 1e-06 in size"),
     ("object[0].scale", [1.0, INF, 1.0], "finite"),
     ("object[0].scale", True, "expected a number"),
     ("object[0].material", "chrome", "chrome"),
@@ -176,7 +178,9 @@ def test_bad_scene_value_exits_2_naming_the_key(tmp_path, capsys, monkeypatch, k
     assert "Traceback" not in err and len(err.strip().splitlines()) == 1, err
     # the key is named: object[0].params.color, light[2].radius, camera.fov, size
     named = key if fragment not in ("up is parallel", "far must be greater than near",
-                                    "scale must not be zero") else NAMED_BY_TABLE[key]
+                                    "scale must not be zero",
+                                    "scale must be at least 1e-06 in size") \
+        else NAMED_BY_TABLE[key]
     assert err.startswith(f"error: s.toml: {named}"), err
     assert fragment in err, err
     assert (tmp_path / "out.png").read_bytes() == before

@@ -98,3 +98,15 @@ def test_two_threads_asking_a_registry_first_both_find_its_builtins(tmp_path, mo
     monkeypatch.delitem(sys.modules, "slow_builtins")
     monkeypatch.delitem(sys.modules, "test_python_api_errors_registry")
     assert errors == [] and found == ["slow"] * 4
+
+
+def test_non_finite_vertex_colours_are_refused():
+    import numpy as np
+
+    from deferred.scene.geometry import build_mesh
+
+    positions = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], float)
+    colours = np.full((3, 4), 0.5)
+    colours[1, 0] = np.nan
+    with pytest.raises(InputError, match=r"^tri: mesh has non-finite vertex colours"):
+        build_mesh("tri", positions, np.array([[0, 1, 2]]), colors=colours)
