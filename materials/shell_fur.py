@@ -468,10 +468,8 @@ class ShellFurMaterial(FurMaterial):
             value = getattr(self.params, key)
             if value is None:
                 continue
-            path = self.resolve_path(value)
             name = f"{where}.{key}" if where else key
-            if not path.is_file():
-                raise InputError(f"image not found: {path}", name)
+            path = self.file_parameter(value, key.replace("_", " ") + " image", name)
             try:
                 read_mask_image(path) if key == "wetness_mask" else read_image(path)
             except InputError as exc:

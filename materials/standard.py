@@ -13,7 +13,6 @@ from deferred.api import (
     Material,
     check_image,
     materials,
-    require_regular_file,
 )
 
 if TYPE_CHECKING:
@@ -35,10 +34,9 @@ class StandardMaterial(Material):
     def check_files(self, where: str | None) -> None:
         if self.params.texture is None:
             return
-        path = self.resolve_path(self.params.texture)
         key = f"{where}.texture" if where else "texture"
         self._texture_key = key
-        require_regular_file(path, "texture file", key)
+        path = self.file_parameter(self.params.texture, "texture file", key)
         # the texture is read when GL draws it: a bad file fails now, not after GL starts
         check_image(path, key)
 

@@ -37,6 +37,7 @@ from deferred.gl.targets import COMPOSITE
 from deferred.interfaces import registry
 from deferred.memo import kept_while
 from deferred.params import Params, UniformOverrides, params_uniforms, validate_params
+from deferred.validation import require_regular_file
 
 if TYPE_CHECKING:
     from deferred.core.frame import Frame
@@ -121,6 +122,16 @@ class Material:
         path = Path(value)
         if not path.is_absolute() and self.base_dir is not None:
             path = self.base_dir / path
+        return path
+
+    def file_parameter(self, value: str | Path, what: str, key: str) -> Path:
+        """A parameter naming a file (relative to the scene's folder), checked to be one:
+        ``InputError`` naming ``key`` for an empty name, a missing file, a folder, a pipe or a
+        device (each said so; a pipe would block the read for good)."""
+        if not str(value).strip():
+            raise InputError(f"is empty; name the {what}", key)
+        path = self.resolve_path(value)
+        require_regular_file(path, what, key)
         return path
 
     # -- shader inputs -----------------------------------------------------------------------

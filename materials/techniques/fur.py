@@ -25,7 +25,7 @@ import moderngl
 import numpy as np
 from pydantic import Field, model_validator
 
-from deferred.api import InputError, Material, MaterialParams
+from deferred.api import Material, MaterialParams
 
 from .fur_volume import FurPattern, pattern, strand_volume, volume_texture
 from .heightfield import heightfield_volume, load_heightfield
@@ -128,16 +128,6 @@ def tiles_per_unit(params: FurParams) -> float:
     return math.sqrt(params.density / strands_per_tile(params))
 
 
-def check_heightfield(path: Path | None, where: str | None) -> None:
-    """Bad input for a heightfield image that is missing or unreadable (before GL work)."""
-    if path is None:
-        return
-    key = f"{where}.heightfield" if where else "heightfield"
-    if not path.is_file():
-        raise InputError(f"heightfield image not found: {path}", key)
-    load_heightfield(path, key)  # its errors name the file and the key
-
-
 def fur_volume_texture(frame: Frame, params: FurParams,
                        heightfield: Path | None) -> moderngl.TextureArray:
     """The object's fur volume, made once per renderer and pattern."""
@@ -170,7 +160,13 @@ class FurMaterial(Material):
     params: FurParams
 
     def check_files(self, where: str | None) -> None:
-        check_heightfield(self.heightfield_path(), where)
+        """Bad input for a heightfield image that is missing, not a file or unreadable
+        (before GL work); its errors name the file and the key."""
+        if self.params.heightfield is None:
+            return
+        key = f"{where}.heightfield" if where else "heightfield"
+        load_heightfield(self.file_parameter(self.params.heightfield, "heightfield image",
+                                             key), key)
 
     def heightfield_path(self) -> Path | None:
         return None if self.params.heightfield is None else \

@@ -61,7 +61,7 @@ CASES = [
     ("folder-texture", scene(params='texture = "textures"'), None, folder_texture,
      ["object[0].params.texture", "is a folder"]),
     ("empty-texture-name", scene(params='texture = ""'), None, None,
-     ["object[0].params.texture", "is a folder"]),
+     ["object[0].params.texture", "is empty; name the texture file"]),
     ("fifo-mesh", scene(mesh="pipe.png"), None, fifo, ["object[0].mesh", "not a regular file"]),
     ("huge-builtin", scene(mesh="builtin:sphere?segments=4096&rings=4096"), None, None,
      ["object[0].mesh", "33,554,432 triangles"]),

@@ -780,8 +780,14 @@ material = "shell_fur"
 
 
 @pytest.mark.parametrize("params, message", [
-    ('wetness_mask = "missing.png"', "object[0].params.wetness_mask: image not found"),
-    ('color_texture = "nope.png"', "object[0].params.color_texture: image not found"),
+    ('wetness_mask = "missing.png"',
+     "object[0].params.wetness_mask: wetness mask image not found"),
+    ('color_texture = "nope.png"', "object[0].params.color_texture: color texture image not found"),
+    ('wetness_mask = ""', "object[0].params.wetness_mask: is empty; name the wetness mask image"),
+    ('wetness_mask = "."', "object[0].params.wetness_mask: wetness mask image is a folder"),
+    ('color_texture = "/dev/zero"',
+     "object[0].params.color_texture: color texture image is not a regular file (a device or "
+     "pipe)"),
     ('color_pattern = "tartan"', "object[0].params.color_pattern"),
     ("curl_radius = -1.0", "object[0].params.curl_radius"),
     ("droplets = 1.5", "object[0].params.droplets"),
