@@ -58,6 +58,11 @@ def format_validation_error(exc: ValidationError, where: str | None) -> tuple[st
                  "msg": f"expected more than the {len(given)} value"
                         f"{'s' if len(given) != 1 else ''} given"}
         loc = loc[:-1]
+    error = first.get("ctx", {}).get("error")
+    if isinstance(error, LaxValueError) and isinstance(error.problem, Problem):
+        # found inside the field's value: name where, and show what is there
+        loc = (*loc, *error.problem.path)
+        first = {**first, "input": error.problem.value}
     key = location(loc)
     return _message(first, len(errors)), join_where(where, key)
 
@@ -146,16 +151,16 @@ def lax_problem(value: Any, annotation: Any) -> str | None:
         arguments = typing.get_args(annotation)
         if origin is not tuple or (len(arguments) == 2 and arguments[1] is Ellipsis):
             arguments = (arguments[0],) * len(value) if arguments else ()
-        for element, element_type in zip(value, arguments, strict=False):
+        for index, (element, element_type) in enumerate(zip(value, arguments, strict=False)):
             problem = lax_problem(element, element_type)
             if problem is not None:
-                return problem
+                return Problem.within(problem, index, element)
     if origin in (dict, collections.abc.Mapping) and isinstance(value, dict):
         arguments = typing.get_args(annotation)
-        for element in value.values() if len(arguments) == 2 else ():
+        for key, element in value.items() if len(arguments) == 2 else ():
             problem = lax_problem(element, arguments[1])
             if problem is not None:
-                return problem
+                return Problem.within(problem, key, element)
     if isinstance(annotation, type) and issubclass(annotation, StrictValues):
         return None  # a nested model checks its own fields
     if isinstance(annotation, type) and issubclass(annotation, BaseModel) and \
@@ -164,8 +169,33 @@ def lax_problem(value: Any, annotation: Any) -> str | None:
             if name in value:
                 problem = lax_problem(value[name], field.annotation)
                 if problem is not None:
-                    return f"{name}: {problem}"
+                    return Problem.within(problem, name, value[name])
     return None
+
+
+class Problem(str):
+    """A :func:`lax_problem` message found inside a value: ``path`` says where (list indices,
+    keys, field names) and ``value`` what is there, so an error names ``light[0].type`` and
+    shows ``3``, not the whole list of tables."""
+
+    path: tuple = ()
+    value: Any = None
+
+    @classmethod
+    def within(cls, problem: str, part: Any, element: Any) -> Problem:
+        made = cls(problem)
+        inner = problem if isinstance(problem, Problem) else None
+        made.path = (part, *(inner.path if inner else ()))
+        made.value = inner.value if inner else element
+        return made
+
+
+class LaxValueError(ValueError):
+    """A field's value refused by :func:`lax_problem` (its message a :class:`Problem`)."""
+
+    def __init__(self, problem: str):
+        super().__init__(str(problem))
+        self.problem = problem
 
 
 def _bare(annotation: Any) -> Any:
@@ -197,7 +227,7 @@ class StrictValues(BaseModel):
             return value
         problem = lax_problem(value, field.annotation)
         if problem is not None:
-            raise ValueError(problem)
+            raise LaxValueError(problem)
         return value
 
 

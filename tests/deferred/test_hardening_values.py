@@ -108,6 +108,7 @@ CASES = [
     ("background", [0.1, 0.1], "expected more than the 2 values given"),
     ("tonemap", 3, "expected one of 'reinhard', 'aces', 'none'"),
     ("light_path", "warp", "expected one of"),
+    ("light[0].type", 3, "expected a string (got 3)"),  # not the whole list of tables
     ("camera.position", [NAN, 0.0, 0.0], "finite"),
     ("camera.position", ["1", 0.0, 0.0], "expected a number, not a string"),
     ("camera.target", [0.0, INF, 0.0], "finite"),
@@ -220,7 +221,7 @@ def test_the_python_api_takes_numpy_values_and_a_fields_own_conversion():
     assert validate_params(Hex, {"n": "0x10"}, "p").n == 16  # the plugin's conversion runs
     with pytest.raises(InputError, match=r"expected a number, not true or false"):
         registry.lights.get("point").from_dict({"intensity": np.bool_(True)}, "l")
-    with pytest.raises(InputError, match=r"scale: expected a number, not true or false"):
+    with pytest.raises(InputError, match=r"scale\[2\]: expected a number, not true or false"):
         scene_from_dict({"object": [{"mesh": "builtin:sphere", "scale": [1, 2, True]}]})
 
 
@@ -240,10 +241,12 @@ def test_a_plugins_nested_fields_are_held_to_the_same_rules():
         samples: Sequence[float] = ()
         inner: Inner = Inner()
 
-    cases = [({"weights": {"a": True}}, "weights: expected a number, not true or false"),
-             ({"weights": {"a": "2.5"}}, "weights: expected a number, not a string"),
-             ({"samples": [1.0, 1e300]}, "samples: must be within"),
-             ({"inner": {"x": float("nan")}}, "inner: x: must be a finite number")]
+    # the key names where inside the field the value lies, and shows it
+    cases = [({"weights": {"a": True}},
+              r"weights\.a: expected a number, not true or false \(got True\)"),
+             ({"weights": {"a": "2.5"}}, r"weights\.a: expected a number, not a string"),
+             ({"samples": [1.0, 1e300]}, r"samples\[1\]: must be within"),
+             ({"inner": {"x": float("nan")}}, r"inner\.x: must be a finite number")]
     for values, message in cases:
         with pytest.raises(InputError, match=message):
             validate_params(Plugin, values, "p")
