@@ -28,6 +28,7 @@ from deferred.api import InputError, MeshData, read_channels, read_image
 from .topology import weld
 
 DRY_CENTRE = -8.0  # the (R, G) of a dry texel: no clump centre is ever within reach of it
+BLEND_BAND_TEXELS = 1 << 18  # texels blended at once (a dozen float64 arrays of them)
 
 
 @dataclass(frozen=True)
@@ -75,6 +76,20 @@ def blend_droplet(mask: np.ndarray, droplet: Droplet,
     rows = _texel_range(cv, r, size, wrap[1])
     if len(columns) == 0 or len(rows) == 0:
         return
+    # a band of rows at a time: each texel's update is its own, and a droplet covering a
+    # 4096^2 mask would otherwise hold a dozen float64 copies of it at once (2.7 GB)
+    band = max(1, BLEND_BAND_TEXELS // len(columns))
+    for first in range(0, len(rows), band):
+        _blend_block(mask, rows[first:first + band], columns, droplet, wrap)
+
+
+def _blend_block(mask: np.ndarray, rows: np.ndarray, columns: np.ndarray, droplet: Droplet,
+                 wrap: tuple[bool, bool]) -> None:
+    """Algorithm 1 over the texels of ``rows`` x ``columns`` (texel indices, possibly outside
+    the mask on wrapped axes, taken modulo its size)."""
+    size = mask.shape[0]
+    cu, cv = droplet.centre
+    r = droplet.radius
     index = np.ix_(rows % size, columns % size)
     block = mask[index]
     u = (columns + 0.5) / size

@@ -948,3 +948,24 @@ def test_fur_over_the_screen_border_is_lit_as_inside(render):
     border[:2], border[-2:], border[:, :2], border[:, -2:] = True, True, True, True
     assert error[~border].mean() < 1e-3  # the pipelines agree on this short fur
     assert error[border].mean() < 3.0 * error[~border].mean() + 1e-5
+
+
+def test_a_droplet_blends_in_bands_of_rows_as_it_does_at_once(monkeypatch):
+    """Blending a band of rows at a time (bounded memory for a droplet covering a large mask)
+    gives the texels blending all of them at once gives, wrapped or not."""
+    from deferred.materials.techniques import wetness
+
+    droplets = [Droplet((0.3, 0.4), 0.35, 0.5), Droplet((0.95, 0.5), 0.3, 0.7),
+                Droplet((0.5, 0.02), 0.6, 0.4)]
+    for wrap in ((False, False), (True, False), (True, True)):
+        masks = []
+        for band_texels in (1 << 30, 64, 1):  # all at once, a few rows, one row a band
+            monkeypatch.setattr(wetness, "BLEND_BAND_TEXELS", band_texels)
+            mask = dry_mask(48)
+            for droplet in droplets:
+                blend_droplet(mask, droplet, wrap)
+            masks.append(mask)
+        assert (masks[0][..., 3] > 0).mean() > 0.5  # the droplets wet most of it
+        np.testing.assert_array_equal(masks[0], masks[1])
+        np.testing.assert_array_equal(masks[0], masks[2])
+
