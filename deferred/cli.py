@@ -460,7 +460,7 @@ def _interrupted(exc: KeyboardInterrupt) -> int:
 
 def _main(argv: list[str] | None) -> int:
     if not (sys.argv[1:] if argv is None else argv):  # no command: the help, not an error
-        click.echo(cli.get_help(click.Context(cli, info_name="deferred")))
+        click.echo(cli.get_help(cli.make_context("deferred", [], resilient_parsing=True)))
         return 0
     try:
         cli.main(args=argv, prog_name="deferred", standalone_mode=False)

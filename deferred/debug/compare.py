@@ -138,7 +138,7 @@ def _comparison_files(folder: Path) -> Callable[[str], bool]:
             image = entry.get("image") if isinstance(entry, dict) else None
             if isinstance(image, str) and image.endswith(".exr"):
                 own |= {image, f"{image.removesuffix('.exr')}.png"}
-    except (OSError, ValueError, AttributeError):
+    except (OSError, ValueError, AttributeError, TypeError):
         pass  # an unreadable record: the names alone say which files are the comparison's
     return lambda relative: relative in own or DIFFERENCE_PASS_IMAGE.fullmatch(relative) is not None
 

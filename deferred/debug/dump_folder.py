@@ -158,15 +158,18 @@ def _link_or_copy(source: str, target: str) -> None:
 
 
 def carry_over(old: Path, new: Path, own: Callable[[str], bool] = is_dump_file,
-               prefix: str = "") -> None:
+               prefix: str = "") -> bool:
     """Files in the old folder that are not the writer's ``own`` (by path relative to the
     folder; a dump's by default: :func:`is_dump_file`) go into the new one, the user's notes
     or a scene: hard links where the file system has them, so the old folder keeps its copy
     until the swap and an interrupted write loses nothing. Folders are merged with what the
-    new one holds (a dump's ``passes/``)."""
+    new one holds (a dump's ``passes/``). Whether any of the writer's own files was left out
+    (a folder that held only those is not made again)."""
+    skipped = False
     for entry in old.iterdir():
         relative = f"{prefix}{entry.name}"
         if own(relative):
+            skipped = True
             continue
         target = new / entry.name
         if entry.is_dir() and not entry.is_symlink():
@@ -174,11 +177,13 @@ def carry_over(old: Path, new: Path, own: Callable[[str], bool] = is_dump_file,
             if made:
                 target.mkdir()
             if target.is_dir() and not target.is_symlink():
-                carry_over(entry, target, own, f"{relative}/")
-                if made and not any(target.iterdir()):
+                inner = carry_over(entry, target, own, f"{relative}/")
+                skipped |= inner
+                if made and inner and not any(target.iterdir()):
                     target.rmdir()  # it held the writer's files only
             continue
         _carry(entry, target)
+    return skipped
 
 
 def _carry(source: Path, target: Path) -> None:

@@ -48,6 +48,7 @@ class Registry(Generic[T]):
         self.max_id = max_id  # ids are stored in the G-buffer for some registries
         self._classes: dict[str, type[T]] = {}
         self._builtins_loaded = False
+        self._importing = False  # the built-in package is being imported (by this thread)
         self._tried: dict[str, str | None] = {}  # entry point name -> error (None: loaded)
         self._next_id = 1  # ids are never reused: 0 means "none" in GPU buffers
 
@@ -79,9 +80,14 @@ class Registry(Generic[T]):
         # Another thread asking meanwhile waits for the whole package, not a part of it; the
         # lock is re-entrant since the package's modules register (and may ask) as they load.
         with _loading:
-            if not self._builtins_loaded:
+            if self._builtins_loaded or self._importing:  # done, or asked while importing it
+                return
+            self._importing = True
+            try:
                 importlib.import_module(self.builtin_package)
                 self._builtins_loaded = True
+            finally:
+                self._importing = False
 
     def _entry_points(self) -> list[EntryPoint]:
         return list(entry_points(group=self.group))

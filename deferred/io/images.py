@@ -144,8 +144,9 @@ def _check_image_file(temporary: str, path: Path, width: int, height: int, count
                               f"{width}x{height} with {count}")
         rows = max(1, READ_BACK_BYTES // (4 * width * count))
         for first in range(0, height, rows):
-            band = image.read_scanlines(0, 0, first, min(first + rows, height), 0, 0, count,
-                                        "float")
+            with _quiet_stderr():  # libpng prints a cut-short file's error itself
+                band = image.read_scanlines(0, 0, first, min(first + rows, height), 0, 0,
+                                            count, "float")
             if band is None or image.has_error:
                 raise RenderError(f"cannot write {path}: the written file is cut short or "
                                   f"damaged ({_reason(image.geterror(), oiio.geterror())}); "

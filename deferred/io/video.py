@@ -219,6 +219,20 @@ def video_failure(exc: BaseException, path: Path) -> str:
     return f"{type(exc).__name__}: {lines[0]}" if lines else type(exc).__name__
 
 
+def _gif_decodes(file) -> bool:
+    """Whether a GIF decodes to its last frame and ends with its trailer."""
+    from PIL import Image, ImageSequence
+
+    try:
+        with Image.open(file) as image:
+            for frame in ImageSequence.Iterator(image):
+                frame.load()
+        file.seek(-1, os.SEEK_END)
+        return file.read(1) == b"\x3b"
+    except (OSError, ValueError, SyntaxError, EOFError):
+        return False
+
+
 def check_video_file(temporary: Path, path: Path, suffix: str) -> None:
     """A written video is whole: a GIF ends with its trailer byte; an MP4's top-level boxes
     fill the file exactly and include ``moov`` (the index ffmpeg writes last: a full disk
@@ -226,8 +240,7 @@ def check_video_file(temporary: Path, path: Path, suffix: str) -> None:
     size = temporary.stat().st_size
     with open(temporary, "rb") as file:
         if suffix == ".gif":
-            file.seek(max(0, size - 1))
-            whole = size > 13 and file.read(1) == b"\x3b"
+            whole = _gif_decodes(file)
         else:
             boxes, offset = set(), 0
             while offset + 8 <= size:

@@ -108,7 +108,9 @@ class Renderer:
         self.scene = scene
         self.pipeline_name = pipeline
         self.strict = strict_default() if strict is None else strict
-        self.size = check_size(size or scene.size, "size" if size else f"{scene.source}: size")
+        given = size is not None
+        self.size = check_size(size if given else scene.size,
+                               "size" if given else f"{scene.source}: size")
         # The pass graph and the generated GLSL are built and checked before any GL object
         # exists: bad input never leaves a context behind. The light path is checked by name
         # now and against the context's features once it exists; the provisional graph (the
@@ -116,7 +118,7 @@ class Renderer:
         requested = light_path if light_path is not None else scene.light_path
         provisional = resolve_light_path(pipeline, requested, FULL_FEATURES)
         self.graph: PassGraph = check_passes(PIPELINES[pipeline](provisional).build(scene))
-        check_target_memory(self.graph, self.size, "size" if size else f"{scene.source}: size")
+        check_target_memory(self.graph, self.size, "size" if given else f"{scene.source}: size")
         light_types = scene.light_types()
         shading_models = self.shading_models = scene.shading_models()
         self.object_transforms = ObjectTransforms()  # kept across frames
@@ -318,16 +320,18 @@ class Renderer:
         if self._released:
             return
         self._released = True
-        self.gl.make_current()
-        self.gl.park()
-        # every part made so far (a constructor that failed part way made only some)
-        for name in ("kept_inputs", "light_buffer", "light_lists", "resources", "targets",
-                     "shaders"):
-            part = getattr(self, name, None)
-            if part is not None:
-                part.release()
-        if self._owns_context:
-            give_back_context(self.gl)
+        try:
+            self.gl.make_current()
+            self.gl.park()
+            # every part made so far (a constructor that failed part way made only some)
+            for name in ("kept_inputs", "light_buffer", "light_lists", "resources", "targets",
+                         "shaders"):
+                part = getattr(self, name, None)
+                if part is not None:
+                    part.release()
+        finally:
+            if self._owns_context:  # whatever failed above, the context goes back
+                give_back_context(self.gl)
 
     def __enter__(self) -> Renderer:
         return self

@@ -5,11 +5,8 @@ trimesh parses it when it is larger than ``MAX_MESH_FILE_BYTES``.
 """
 from __future__ import annotations
 
-import json
-import mmap
 import os
 from pathlib import Path
-from urllib.parse import unquote
 
 import numpy as np
 
@@ -45,20 +42,18 @@ def load_mesh(spec: str, base_dir: Path | None = None, where: str | None = None)
     if size > MAX_MESH_FILE_BYTES:  # before trimesh spends minutes and gigabytes parsing it
         raise InputError(f"mesh file {path.name} is {size:,} bytes, more than the "
                          f"{MAX_MESH_FILE_BYTES:,} the framework reads; simplify it", where)
-    # trimesh reads these too, and swallows every exception there (Ctrl-C included): a pipe or
-    # a device among them would block the load for good, so they are refused first
-    references = [ref for ref in mesh_references(path) if os.path.lexists(ref)]
-    for ref in references:
-        require_regular_file(ref, f"{ref.name}, named by mesh file {path.name},", where)
     import trimesh
 
+    resolver = _regular_file_resolver(trimesh, path)
     try:
-        loaded = trimesh.load(str(path), force="mesh", process=False)
+        loaded = trimesh.load(str(path), force="mesh", process=False, resolver=resolver)
     except ImportError:
         raise  # a broken installation (exit 1), not a bad file
     except Exception as exc:  # noqa: BLE001 - trimesh raises many exception types
         reason = str(exc) or type(exc).__name__
         raise InputError(f"cannot read mesh {path.name}: {reason}", where) from None
+    for refused in resolver.refused:  # named by the mesh, not opened: say so
+        require_regular_file(refused, f"file {refused.name} named by {path.name}", where)
     if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:
         raise InputError(f"mesh {path.name} has no triangles", where)
     positions = np.asarray(loaded.vertices, dtype=np.float64)
@@ -77,81 +72,42 @@ def load_mesh(spec: str, base_dir: Path | None = None, where: str | None = None)
         # ``where`` is a scene key (``scene.toml: object[0].mesh``): say which file too
         message = exc.message if where == spec else f"{path.name}: {exc.message}"
         raise InputError(message, where) from None
-    mesh.sources = (path, *references)
+    mesh.sources = (path, *dict.fromkeys(resolver.read))
     return mesh
 
 
-def mesh_references(path: Path) -> list[Path]:
-    """The files trimesh reads for mesh file ``path`` besides it, found as trimesh finds them:
-    an OBJ's material library (the rest of the line of its first ``mtllib``) and that
-    library's ``map_Kd`` textures, and a glTF's (or GLB's) buffers and images given by a
-    relative URI; all relative to the mesh file's folder. Files that do not exist are listed
-    too (trimesh goes without them)."""
-    suffix = path.suffix.lower()
-    names: list[str] = []
-    if suffix == ".obj":
-        library = _obj_library(path)
-        if library:
-            names.append(library)
-            names += _mtl_textures(path.parent / library)
-    elif suffix in (".gltf", ".glb"):
-        names += _gltf_uris(path)
-    return [path.parent / name for name in dict.fromkeys(names)]
+def _regular_file_resolver(trimesh, path: Path):
+    """A trimesh resolver for the files ``path`` names (an OBJ's material library and its
+    textures, a glTF's buffers and images), found as trimesh's own finds them, that opens
+    regular files only and keeps which it read (``read``) and which it would not (``refused``).
+    trimesh swallows every exception while it reads them, Ctrl-C included: a pipe or a device
+    opened there would block the load for good."""
 
+    class RegularFileResolver(trimesh.resolvers.FilePathResolver):
+        def __init__(self, source: str, read: list[Path], refused: list[Path]):
+            super().__init__(source)
+            self.read, self.refused = read, refused
 
-def _obj_library(path: Path) -> str | None:
-    if path.stat().st_size == 0:
-        return None
-    with open(path, "rb") as file, \
-            mmap.mmap(file.fileno(), 0, access=mmap.ACCESS_READ) as data:
-        start = data.find(b"mtllib")  # anywhere, as trimesh looks for it
-        if start < 0:
-            return None
-        end = data.find(b"\n", start)
-        line = data[start + 6:end if end >= 0 else len(data)]
-    return line.decode("utf-8", errors="replace").strip() or None
+        def get(self, name: str) -> bytes:
+            for candidate in (name.strip(), name.strip().lstrip("/"), os.path.split(name)[-1]):
+                try:
+                    found = self.absolute(candidate)
+                except ValueError:
+                    continue
+                if found.exists():
+                    if not found.is_file():
+                        self.refused.append(found)
+                        raise FileNotFoundError(name)
+                    self.read.append(found)
+                    return found.read_bytes()
+            self.absolute(name)  # a name escaping the mesh's folder: trimesh's own error
+            raise FileNotFoundError(name)
 
+        def namespaced(self, namespace: str):
+            return RegularFileResolver(os.path.join(self.parent, namespace), self.read,
+                                       self.refused)
 
-def _mtl_textures(library: Path) -> list[str]:
-    try:  # a library that is not a regular file is refused by the caller, not read here
-        if not library.is_file() or library.stat().st_size > MAX_MESH_FILE_BYTES:
-            return []
-        text = library.read_text(encoding="utf-8", errors="replace")
-    except OSError:
-        return []
-    names = []
-    for line in text.splitlines():
-        split = line.split()
-        if split and split[0].lower() == "map_kd":
-            name = line[line.lower().index("map_kd") + 6:].strip()
-            if name:
-                names.append(name)
-    return names
-
-
-def _gltf_uris(path: Path) -> list[str]:
-    try:
-        if path.suffix.lower() == ".glb":
-            with open(path, "rb") as file:
-                header = file.read(20)
-                if len(header) < 20 or header[:4] != b"glTF" or header[16:20] != b"JSON":
-                    return []
-                document = json.loads(file.read(int.from_bytes(header[12:16], "little")))
-        else:
-            document = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return []  # trimesh says what is wrong with the file
-    if not isinstance(document, dict):
-        return []
-    uris = []
-    for key in ("buffers", "images"):
-        entries = document.get(key)
-        for entry in entries if isinstance(entries, list) else ():
-            uri = entry.get("uri") if isinstance(entry, dict) else None
-            if isinstance(uri, str) and uri and not uri.startswith("data:") and \
-                    "://" not in uri:
-                uris.append(unquote(uri))
-    return uris
+    return RegularFileResolver(str(path), [], [])
 
 
 def _vertex_colours(loaded) -> np.ndarray | None:

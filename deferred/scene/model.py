@@ -37,7 +37,7 @@ from deferred.scene.meshes import load_mesh
 
 Vec3 = tuple[float, float, float]
 MAX_SIZE = 16384
-SIZE_TEXT = re.compile(r"([0-9]+)[xX]([0-9]+)")
+SIZE_TEXT = re.compile(r"([0-9]+)\s*[xX]\s*([0-9]+)")
 
 
 @dataclass(frozen=True)
@@ -139,6 +139,7 @@ class SceneObject:
         except InputError:
             self._set_events(previous)
             raise
+        self._values.clear()  # every state is made: the merged values are not needed again
         return made
 
     def _checked_event(self, time: float, params: Mapping[str, Any],
@@ -289,10 +290,12 @@ def parse_size(text: str, where: str = "--size") -> tuple[int, int]:
 def check_size(size: tuple[int, int], where: str) -> tuple[int, int]:
     """``size`` as (width, height) in whole pixels, each 1..``MAX_SIZE``; ``InputError``
     naming ``where`` otherwise (a string, three numbers, a fraction of a pixel)."""
+    if isinstance(size, np.ndarray) and size.ndim == 1:
+        size = size.tolist()
     if isinstance(size, str | bytes) or not isinstance(size, Sequence) or len(size) != 2 or \
             not all(isinstance(side, numbers.Integral) and not isinstance(side, bool)
                     for side in size):
-        raise InputError(f"size must be (width, height) in whole pixels, e.g. (1280, 720), "
+        raise InputError(f"expected (width, height) in whole pixels, e.g. (1280, 720), "
                          f"got {size!r}", where)
     width, height = (int(side) for side in size)
     if not (1 <= width <= MAX_SIZE and 1 <= height <= MAX_SIZE):

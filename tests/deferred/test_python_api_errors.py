@@ -35,7 +35,7 @@ def test_a_renderer_released_twice_breaks_no_later_renderer():
 
 
 @pytest.mark.parametrize("size", ["64x36", (64.5, 36), (64, 36, 1), (True, 36), 64, None,
-                                  (0, 36), (64, 20000)])
+                                  (0, 36), (64, 20000), (), 0])
 def test_a_size_that_is_not_one_is_named(size):
     scene = scene_from_dict(SCENE)
     if size is None:  # the scene's own size is used: no error
@@ -69,6 +69,13 @@ class Slow:
 time.sleep(0.3)  # a package that takes a while to import, as the built-ins do the first time
 REGISTRY.register(Slow)
 """
+
+
+def test_a_numpy_size_is_a_size():
+    import numpy as np
+
+    with Renderer(scene_from_dict(SCENE), size=np.array([40, 20])) as renderer:
+        assert renderer.size == (40, 20) and renderer.render().image.shape == (20, 40, 4)
 
 
 def test_two_threads_asking_a_registry_first_both_find_its_builtins(tmp_path, monkeypatch):
