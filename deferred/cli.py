@@ -489,7 +489,8 @@ def _main(argv: list[str] | None) -> int:
 def _fail(message: str) -> None:
     if Options.debug:
         traceback.print_exc()
-    click.echo(message, err=True)
+    # one line, whatever a file name holds: a newline in one is shown as \n
+    click.echo(message.replace("\r", "\\r").replace("\n", "\\n"), err=True)
 
 
 def entry() -> None:

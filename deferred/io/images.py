@@ -342,8 +342,8 @@ def _open(path: Path, where: str | None, config, max_size: int | None, bytes_per
                    f"texture may have; scale it down")
     elif width * height * bytes_per_pixel(count) > IMAGE_MEMORY_BUDGET:
         need = width * height * bytes_per_pixel(count)
-        problem = (f"is {width}x{height}: it would take {_amount(need)} of memory here, more "
-                   f"than the {_amount(IMAGE_MEMORY_BUDGET)} allowed; scale it down")
+        problem = (f"is {width}x{height}: it would take {amount(need)} of memory here, more "
+                   f"than the {amount(IMAGE_MEMORY_BUDGET)} allowed; scale it down")
     if problem is not None:
         image.close()
         raise InputError(f"image {name} {problem}", where)
@@ -366,11 +366,12 @@ def _decode(path: Path, where: str | None, config, max_size: int | None, bytes_p
     return np.asarray(pixels, dtype=np.float32), spec
 
 
-def _amount(size: int) -> str:
+def amount(size: int) -> str:
+    """``size`` bytes as people read it: ``12.5 MiB``, ``3.0 KiB``, ``7 bytes``."""
     for unit, scale in (("GiB", 1 << 30), ("MiB", 1 << 20), ("KiB", 1 << 10)):
         if size >= scale:
             return f"{size / scale:.1f} {unit}"
-    return f"{size} bytes"
+    return f"{size} byte{'' if size == 1 else 's'}"
 
 
 _PNG_IEND = b"\x00\x00\x00\x00IEND\xaeB`\x82"

@@ -21,6 +21,7 @@ from deferred.gl.shaderlib import ShaderLibrary
 from deferred.gl.target_spec import targets_bytes
 from deferred.gl.targets import COMPOSITE, FINAL, FrameTargets
 from deferred.interfaces.material import Material
+from deferred.io.images import amount
 from deferred.lighting.buffer import LIGHT_BUFFER, LightBuffer
 from deferred.lighting.lists import LIGHT_LISTS, LightLists, check_light_limits
 from deferred.lighting.paths import resolve_light_path
@@ -79,9 +80,9 @@ def check_target_memory(graph: PassGraph, size: tuple[int, int], where: str = "s
     needed = targets_bytes(graph.targets.values(), *size)
     budget = target_memory_budget()
     if needed > budget:
-        raise InputError(f"{size[0]}x{size[1]} needs {needed >> 20} MiB of render targets "
+        raise InputError(f"{size[0]}x{size[1]} needs {amount(needed)} of render targets "
                          f"({len(graph.targets)} targets); the budget is "
-                         f"{budget >> 20} MiB (DEFERRED_TARGET_MEMORY)", where)
+                         f"{amount(budget)} (DEFERRED_TARGET_MEMORY)", where)
 
 
 class Renderer:

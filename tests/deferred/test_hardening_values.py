@@ -96,7 +96,7 @@ CASES = [
     ("size", ["48", 32], "expected a number, not a string"),
     ("size", [0, 32], "impossible"),
     ("size", [20000, 32], "impossible"),
-    ("size", [16384, 16384], "MiB of render targets"),
+    ("size", [16384, 16384], "GiB of render targets"),
     ("exposure", NAN, "finite"),
     ("exposure", INF, "finite"),
     ("exposure", -1.0, "greater than 0"),
