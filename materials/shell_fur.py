@@ -442,6 +442,7 @@ class ShellFurMaterial(FurMaterial):
     uniform_overrides = {**FUR_UNIFORM_OVERRIDES, **{key: None for key in NOT_UNIFORMS},
                          "shells": _layers_uniform}
     # the simulation's set-up (ShellFurState), and the passes built once
+    timeline_growing = ("droplets",)  # fallen droplets stay (Algorithm 1 blends, never removes)
     timeline_fixed = ("fur_length", "mask_size", "wetness_mask", "time_step", "settle", "seed",
                       "fins")
     debug_views = {

@@ -91,6 +91,9 @@ class Material:
     # parameters the material reads once, at t = 0 (a simulation's set-up): a scene timeline
     # may not change them
     timeline_fixed: ClassVar[tuple[str, ...]] = ()
+    # parameters a timeline may raise but not lower: what they count has happened (droplets
+    # fallen), and a simulation does not take it back
+    timeline_growing: ClassVar[tuple[str, ...]] = ()
     # Whether uniforms() and textures() are a function of the params alone (textures made
     # through frame.resources, which last as long as the renderer): the renderer then keeps
     # them from frame to frame while the params are the same object. None: where the class

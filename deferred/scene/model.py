@@ -136,11 +136,30 @@ class SceneObject:
         try:  # the merged states from its time on (the parameters' own cross-checks)
             for later in sorted({t for t in self._times if t >= earliest}):
                 self.params_at(later)
+            self._check_growing()
         except InputError:
             self._set_events(previous)
             raise
         self._values.clear()  # every state is made: the merged values are not needed again
         return made
+
+    def _check_growing(self) -> None:
+        """The material's ``timeline_growing`` parameters never fall from one state of the
+        timeline to the next (an event lowering one would be ignored by its simulation)."""
+        growing = type(self.material).timeline_growing
+        if not growing:
+            return
+        before = self.base_params
+        for time in sorted(set(self._times)):
+            state = self.params_at(time)
+            for key in growing:
+                if getattr(state, key) < getattr(before, key):
+                    event = self.events[bisect_right(self._times, time) - 1]
+                    where = f"{event.where or self.label + ': event'}.params.{key}"
+                    raise InputError(f"{key} may rise on a timeline, not fall (from "
+                                     f"{getattr(before, key)} to {getattr(state, key)} at "
+                                     f"{time:g} s): what it counts has happened", where)
+            before = state
 
     def _checked_event(self, time: float, params: Mapping[str, Any],
                        where: str | None) -> TimelineEvent:

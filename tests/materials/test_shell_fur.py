@@ -969,3 +969,29 @@ def test_a_droplet_blends_in_bands_of_rows_as_it_does_at_once(monkeypatch):
         np.testing.assert_array_equal(masks[0], masks[1])
         np.testing.assert_array_equal(masks[0], masks[2])
 
+
+
+def test_droplets_may_rise_on_a_timeline_but_not_fall(tmp_path, capsys):
+    """Fallen droplets stay (the simulation only ever blends more in): an event lowering
+    ``droplets`` would be ignored, so it is refused, naming the event."""
+    scene = write_scene(tmp_path / "s.toml", "droplets = 10")
+    scene.write_text(scene.read_text() + """
+[[event]]
+time = 0.5
+object = "plane0"
+params = { droplets = 20 }
+[[event]]
+time = 1.0
+object = "plane0"
+params = { droplets = 15 }
+""")
+    code, out = cli(capsys, "render", str(scene), "-o", str(tmp_path / "out.png"))
+    assert code == 2, out
+    assert out.strip().splitlines() == [
+        "error: s.toml: event[1].params.droplets: droplets may rise on a timeline, not fall "
+        "(from 20 to 15 at 1 s): what it counts has happened"]
+    assert not (tmp_path / "out.png").exists()
+    raised = scene.read_text().replace("droplets = 15", "droplets = 25")
+    scene.write_text(raised)
+    code, out = cli(capsys, "render", str(scene), "-o", str(tmp_path / "out.png"))
+    assert code == 0, out
