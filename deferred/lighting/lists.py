@@ -24,7 +24,7 @@ import numpy as np
 from deferred.errors import InputError, RenderError
 from deferred.lighting.buffer import fullscreen_overflow
 from deferred.lighting.dispatch import FULLSCREEN_LIGHT_CAPACITY
-from deferred.names import LIST_PATHS, LightPath
+from deferred.names import LIST_PATHS, LightPath, LightVolume
 
 if TYPE_CHECKING:
     from deferred.gl.uniforms import ProgramUniforms
@@ -127,29 +127,45 @@ def _lists_too_big(what: str, grid: ListGrid, size: int, limit: int) -> str:
 
 
 def check_light_limits(light_path: str, size: tuple[int, int], volume_lights: int,
-                       lights: int, max_texture_size: int) -> None:
+                       lights: int, max_texture_size: int, where: str = "light") -> None:
     """Refuse, before any frame, a light count the light path cannot hold: the lists' storage
     buffer (tiled: the coarse lists, a slot per volume light in each; the shading's texture of
     the lists is sized to the frame's lights, :meth:`LightLists.prepare`), the light buffer's
     texture (a row per light) and the full-screen lights' uniform array (any path: forward
     reads it)."""
     if lights - volume_lights > FULLSCREEN_LIGHT_CAPACITY:
-        raise InputError(fullscreen_overflow(lights - volume_lights), "light")
+        raise InputError(fullscreen_overflow(lights - volume_lights), where)
     if light_path in LIST_PATHS:
         grid = list_grid(*size, light_path == LightPath.CLUSTERED)
         overflow = list_overflow(grid, volume_lights)  # every light in one list: the most
         if overflow is not None:
             raise InputError(_lists_too_big(f"{volume_lights} lights", grid, *overflow),
-                             "light")
+                             where)
         if lights > MAX_LISTED_LIGHTS:  # a listed light's index in the light buffer
             raise InputError(f"{lights} lights; the light lists index at most "
-                             f"{MAX_LISTED_LIGHTS}", "light")
+                             f"{MAX_LISTED_LIGHTS}", where)
     if lights > max_texture_size:
         raise InputError(f"{lights} lights; lights are kept in a texture of at most "
-                         f"{max_texture_size} rows (GL_MAX_TEXTURE_SIZE)", "light")
+                         f"{max_texture_size} rows (GL_MAX_TEXTURE_SIZE)", where)
 
 
 MAX_LISTED_RADIUS = 65504.0  # the largest half float: a listed light's radius is one
+
+
+def check_light_radii(light_path: str, lights: list, where: str = "light") -> None:
+    """Refuse, before any frame, a volume light whose radius the light lists cannot hold,
+    naming it (``where[index].radius``); the record's ``position.w`` is a volume light's
+    radius (``deferred.interfaces.light``), whatever its parameters call it."""
+    if light_path not in LIST_PATHS:
+        return
+    for index, light in enumerate(lights):
+        if light.volume == LightVolume.FULLSCREEN:
+            continue
+        radius = float(np.asarray(light.record(np.eye(4)), dtype=np.float64).reshape(4, 4)[1, 3])
+        if radius > MAX_LISTED_RADIUS:
+            raise InputError(f"a radius of {radius:g} is more than the light lists hold "
+                             f"({MAX_LISTED_RADIUS:g}, a half float): use the volumes path",
+                             f"{where}[{index}].radius")
 
 
 def check_list_radii(spheres: np.ndarray) -> None:

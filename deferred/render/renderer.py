@@ -23,7 +23,12 @@ from deferred.gl.targets import COMPOSITE, FINAL, FrameTargets
 from deferred.interfaces.material import Material
 from deferred.io.images import amount
 from deferred.lighting.buffer import LIGHT_BUFFER, LightBuffer
-from deferred.lighting.lists import LIGHT_LISTS, LightLists, check_light_limits
+from deferred.lighting.lists import (
+    LIGHT_LISTS,
+    LightLists,
+    check_light_limits,
+    check_light_radii,
+)
 from deferred.lighting.paths import resolve_light_path
 from deferred.memo import overrides
 from deferred.names import LightVolume, Pipeline
@@ -146,7 +151,8 @@ class Renderer:
         self.light_path = resolve_light_path(pipeline, requested, features)
         volume_lights = sum(1 for light in scene.lights if light.volume != LightVolume.FULLSCREEN)
         check_light_limits(self.light_path, self.size, volume_lights, len(scene.lights),
-                           self.gl.max_texture_size)
+                           self.gl.max_texture_size, f"{scene.source}: light")
+        check_light_radii(self.light_path, scene.lights, f"{scene.source}: light")
         self.pipeline = PIPELINES[pipeline](self.light_path)
         if self.light_path != provisional:
             self.graph = check_passes(self.pipeline.build(scene))

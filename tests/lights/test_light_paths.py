@@ -255,7 +255,7 @@ def test_more_lights_than_the_coarse_lists_hold_is_refused_before_a_frame(gl, mo
 
     scene = scene_with(200)
     monkeypatch.setattr(light_lists, "MAX_LIST_BYTES", 4096)
-    with pytest.raises(InputError, match=r"^light: \d+ lights: the light lists need \d+ MiB"):
+    with pytest.raises(InputError, match=r": light: \d+ lights: the light lists need \d+ MiB"):
         Renderer(scene, gl=gl, light_path="tiled")
     Renderer(scene_with(40), gl=gl, light_path="tiled").release()  # 3 KB: accepted
     with Renderer(scene, gl=gl, light_path="volumes") as renderer:  # volumes has no lists
@@ -280,7 +280,7 @@ def test_more_lights_than_the_gl33_light_texture_holds_is_refused(gl, monkeypatc
     gl33 = GLContext(gl.ctx, Features(storage_buffers=False, compute_shaders=False))
     scene = scene_with(12)
     monkeypatch.setattr(GLContext, "max_texture_size", property(lambda self: 8))
-    with pytest.raises(InputError, match=r"^light: 16 lights; .* at most 8 rows"):
+    with pytest.raises(InputError, match=r": light: 16 lights; .* at most 8 rows"):
         Renderer(scene, gl=gl33)
 
 
@@ -485,7 +485,7 @@ def test_more_full_screen_lights_than_a_frame_holds_is_refused_before_a_frame(gl
     scene = scene_with(0)
     scene.lights = [*scene.lights, *(scene_light({"type": "directional", "intensity": 0.1})
                                      for _ in range(FULLSCREEN_LIGHT_CAPACITY - 1))]
-    with pytest.raises(InputError, match=rf"^light: {FULLSCREEN_LIGHT_CAPACITY + 1} full-screen "
+    with pytest.raises(InputError, match=rf": light: {FULLSCREEN_LIGHT_CAPACITY + 1} full-screen "
                                          rf".* at most {FULLSCREEN_LIGHT_CAPACITY}$"):
         Renderer(scene, gl=gl, light_path="volumes")
     scene.lights = scene.lights[:-1]  # at the capacity: renders
@@ -522,12 +522,21 @@ def test_a_radius_past_a_half_float_is_refused_on_the_list_paths(gl):
     huge = scene_from_dict({"size": [32, 24], "object": [{"mesh": "builtin:plane"}],
                             "light": [{"type": "point", "position": [0.0, 1.0, 0.0],
                                        "radius": 70000.0}]})
-    with Renderer(huge, gl=gl, light_path="tiled") as renderer:
+    # refused before a frame, naming the light
+    with pytest.raises(InputError, match=r"^<dict>: light\[0\]\.radius: a radius of 70000 is "
+                                         r"more than the light lists hold \(65504, a half float\)"):
+        Renderer(huge, gl=gl, light_path="tiled")
+    with Renderer(huge, gl=gl, light_path="volumes") as renderer:
+        assert renderer.render().hdr[..., :3].max() > 0.0
+    # and a light given that radius after the renderer was made, at the frame
+    small = scene_from_dict({"size": [32, 24], "object": [{"mesh": "builtin:plane"}],
+                             "light": [{"type": "point", "position": [0.0, 1.0, 0.0],
+                                        "radius": 7.0}]})
+    with Renderer(small, gl=gl, light_path="tiled") as renderer:
+        small.lights = huge.lights
         with pytest.raises(InputError, match=r"^light: a light's radius of 70000 is more than "
                                              r"the light lists hold \(65504, a half float\)"):
             renderer.render()
-    with Renderer(huge, gl=gl, light_path="volumes") as renderer:
-        assert renderer.render().hdr[..., :3].max() > 0.0
 
 
 def side_plane_counts(spheres, inverse, width, height, tile, slices=None):
