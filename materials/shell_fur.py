@@ -84,6 +84,9 @@ GUST_WAVELENGTH = 1.0  # world units between gust fronts along the wind
 # The state at time t is settle / time_step + t / time_step steps from scratch (about 0.4 ms a
 # step on two cores at 9,360 strands): more is refused rather than left to run for hours.
 MAX_SIMULATION_STEPS = 100_000
+# Steps x strands a render may simulate: the work grows with both, so a fine mesh reaches the
+# limit at an earlier time (benchmarks/README.md has what a strand step costs)
+MAX_STRAND_STEPS = 200_000_000
 
 
 class ShellFurParams(FurParams, BlinnPhongParams):
@@ -462,6 +465,18 @@ class ShellFurMaterial(FurMaterial):
                              f"{self.params.time_step:g} s (with settle); the most is "
                              f"{MAX_SIMULATION_STEPS:,}: render an earlier time or raise "
                              "time_step", where)
+
+    def check_time_for(self, obj: SceneObject, time: float, where: str) -> None:
+        """The steps, and the steps times the object's strands (one a triangle): the work
+        grows with both, so a fine mesh reaches its limit sooner."""
+        self.check_time(time, where)
+        steps, strands = simulation_steps(self.params, time), len(obj.mesh.indices)
+        if steps * strands > MAX_STRAND_STEPS:
+            raise InputError(f"t = {time:g} s needs {steps:,} simulation steps of "
+                             f"{strands:,} strands ({obj.label}: one a triangle), "
+                             f"{steps * strands:,} strand steps; the most is "
+                             f"{MAX_STRAND_STEPS:,}: render an earlier time, raise time_step "
+                             "or give the object a coarser mesh", where)
 
     def check_files(self, where: str | None) -> None:
         super().check_files(where)

@@ -209,6 +209,11 @@ class Material:
         """Refuse (``InputError`` naming ``where``) a frame time this material cannot reach in
         bounded work, before any frame is rendered: a simulation stepping from 0 to it."""
 
+    def check_time_for(self, obj: SceneObjectLike, time: float, where: str) -> None:
+        """:meth:`check_time` for this material on ``obj``, whose mesh may set the work (a
+        simulation of a strand a triangle); by default :meth:`check_time`."""
+        self.check_time(time, where)
+
     # -- passes per phase --------------------------------------------------------------------
     def geometry_passes(self, obj: SceneObjectLike) -> list[RenderPass]:
         return [GBufferPass(f"{obj.label}.gbuffer", Phase.GEOMETRY, obj)]

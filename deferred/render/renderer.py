@@ -298,10 +298,10 @@ class Renderer:
             latest = max(times)
             objects = self.scene.objects
             checking = {cls for cls in {type(obj.material) for obj in objects}
-                        if overrides(cls, Material, "check_time")}  # most have none
-            for obj in objects:
+                        if overrides(cls, Material, "check_time", "check_time_for")}
+            for obj in objects:  # most materials have no check
                 if type(obj.material) in checking:
-                    obj.material.check_time(latest, where)
+                    obj.material.check_time_for(obj, latest, where)
 
     def _check_gl(self, stage: str) -> None:
         error = self.gl.ctx.error

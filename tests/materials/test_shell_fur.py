@@ -995,3 +995,26 @@ params = { droplets = 15 }
     scene.write_text(raised)
     code, out = cli(capsys, "render", str(scene), "-o", str(tmp_path / "out.png"))
     assert code == 0, out
+
+
+def test_the_simulation_budget_grows_with_the_strands(render, monkeypatch):
+    """Refused before a frame: the steps to reach a time times the object's strands (one a
+    triangle) past MAX_STRAND_STEPS; the same time on a coarser mesh renders."""
+    import deferred.materials.shell_fur as shell_fur
+
+    monkeypatch.setattr(shell_fur, "MAX_STRAND_STEPS", 20_000)
+
+    def scene(divisions: int):
+        return scene_from_dict({"size": [32, 24], "object": [
+            {"name": "fur", "mesh": f"builtin:plane?divisions={divisions}",
+             "material": "shell_fur", "params": {"time_step": 0.01, "settle": 0.5}}],
+            "light": [{"type": "directional"}]}, "s.toml")
+
+    from deferred.errors import InputError
+
+    with pytest.raises(InputError, match=r"^time: t = 1 s needs 150 simulation steps of 200 "
+                                         r"strands \(fur: one a triangle\), 30,000 strand "
+                                         r"steps; the most is 20,000"):
+        render(scene(10), time=1.0)  # 200 triangles x 150 steps
+    result, _ = render(scene(4), time=1.0)  # 32 triangles x 150 steps
+    assert result.image is not None
