@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from deferred.api import InputError, MeshData, read_channels, read_image
+from deferred.api import InputError, MeshData, check_image, read_image
 
 from .topology import weld
 
@@ -219,10 +219,10 @@ def read_mask_image(path: Path) -> np.ndarray:
     """A wetness mask image's pixels, (H, W, 4) RGBA as stored (no sRGB decoding), top row
     first; ``InputError`` unless it has the four channels (an RGB image is not a mask with
     wetness 1 everywhere)."""
-    _, names, _ = read_channels(path)
-    if len(names) < 4:
+    _, _, channels = check_image(path)  # the header only: a mask is refused before decoding
+    if channels < 4:
         raise InputError(f"wetness mask {path.name} needs 4 channels (R, G centre, B radius, "
-                         f"A wetness), it has {len(names)}")
+                         f"A wetness), it has {channels}")
     # unassociated: the colour channels are data, not colour premultiplied by the alpha
     return read_image(path, unassociated_alpha=True)
 

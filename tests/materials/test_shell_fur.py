@@ -1018,3 +1018,20 @@ def test_the_simulation_budget_grows_with_the_strands(render, monkeypatch):
         render(scene(10), time=1.0)  # 200 triangles x 150 steps
     result, _ = render(scene(4), time=1.0)  # 32 triangles x 150 steps
     assert result.image is not None
+
+
+def test_a_mask_with_too_few_channels_is_refused_by_its_header(tmp_path, monkeypatch):
+    """Refused before a pixel is decoded (a one-channel 16384^2 mask was decoded whole, 2.1 GB,
+    to count its channels)."""
+    from deferred.errors import InputError
+    from deferred.io.images import write_image
+    from deferred.materials.techniques import wetness
+
+    write_image(tmp_path / "grey.exr", np.zeros((16, 16, 1), np.float32), channels=("Y",))
+
+    def decoded(*args, **kwargs):
+        raise AssertionError("decoded")
+
+    monkeypatch.setattr(wetness, "read_image", decoded)
+    with pytest.raises(InputError, match=r"grey.exr needs 4 channels .* it has 1$"):
+        wetness.read_mask_image(tmp_path / "grey.exr")
