@@ -42,6 +42,7 @@ def load_mesh(spec: str, base_dir: Path | None = None, where: str | None = None)
     if size > MAX_MESH_FILE_BYTES:  # before trimesh spends minutes and gigabytes parsing it
         raise InputError(f"mesh file {path.name} is {size:,} bytes, more than the "
                          f"{MAX_MESH_FILE_BYTES:,} the framework reads; simplify it", where)
+    _check_magic(path, where)
     import trimesh
 
     resolver = _regular_file_resolver(trimesh, path)
@@ -74,6 +75,22 @@ def load_mesh(spec: str, base_dir: Path | None = None, where: str | None = None)
         raise InputError(message, where) from None
     mesh.sources = (path, *dict.fromkeys(resolver.read))
     return mesh
+
+
+# The first bytes of formats that have them: a file without them is refused before trimesh
+# reads it (a 1 GiB file of NUL bytes named .ply took 8 GB to be called "not a ply file")
+MAGIC = {".ply": b"ply", ".glb": b"glTF"}
+
+
+def _check_magic(path: Path, where: str) -> None:
+    magic = MAGIC.get(path.suffix.lower())
+    if magic is None:
+        return
+    with open(path, "rb") as file:
+        start = file.read(len(magic))
+    if start != magic:
+        raise InputError(f"{path.name} is not a {path.suffix.lower()[1:].upper()} file (it does "
+                         f"not begin with {magic.decode()!r})", where)
 
 
 def _regular_file_resolver(trimesh, path: Path):

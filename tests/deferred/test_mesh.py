@@ -96,6 +96,23 @@ def test_other_formats_load(tmp_path, suffix):
     assert len(mesh.indices) >= 12
 
 
+@pytest.mark.parametrize("suffix, magic", [(".ply", "ply"), (".glb", "glTF")])
+def test_a_file_without_its_formats_first_bytes_is_refused_before_it_is_parsed(
+        tmp_path, monkeypatch, suffix, magic):
+    """A 1 GiB file of NUL bytes named .ply took 8 GB to be called "not a ply file"."""
+    path = tmp_path / f"zeros{suffix}"
+    path.write_bytes(b"\0" * 4096)
+
+    def parsed(*args, **kwargs):
+        raise AssertionError("trimesh was asked")
+
+    monkeypatch.setattr(trimesh, "load", parsed)
+    with pytest.raises(InputError, match=rf"^s.toml: object\[0\].mesh: zeros{suffix} is not a "
+                                         rf"{suffix[1:].upper()} file \(it does not begin with "
+                                         rf"'{magic}'\)$"):
+        load_mesh(str(path), where="s.toml: object[0].mesh")
+
+
 def test_bad_meshes_are_input_errors(tmp_path):
     with pytest.raises(InputError, match="not found"):
         load_mesh("missing.obj", tmp_path, where="scene.toml: object[0].mesh")
