@@ -21,7 +21,11 @@ from deferred.errors import DeferredError, InputError, RenderError, ShaderError
 from deferred.interfaces import registry
 from deferred.io.images import write_image
 from deferred.io.paths import check_output_path
-from deferred.io.safety import interrupt_exit_code, termination_as_interrupt
+from deferred.io.safety import (
+    interrupt_exit_code,
+    raise_if_stop_requested,
+    termination_as_interrupt,
+)
 from deferred.names import Pipeline
 from deferred.render.pipeline import PIPELINES
 from deferred.scene.loader import load_scene
@@ -448,7 +452,9 @@ def main(argv: list[str] | None = None) -> int:
     # SIGTERM unwinds like Ctrl-C, through the finally blocks that remove temporary files.
     with termination_as_interrupt():
         try:
-            return _main(argv)
+            code = _main(argv)
+            raise_if_stop_requested()  # a signal whose exception was lost (a __del__ ate it)
+            return code
         except KeyboardInterrupt as exc:
             return _interrupted(exc)
 

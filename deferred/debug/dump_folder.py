@@ -18,7 +18,7 @@ from pathlib import Path
 
 from deferred.errors import InputError
 from deferred.io.paths import NAME_MAX
-from deferred.io.safety import signals_deferred
+from deferred.io.safety import raise_if_stop_requested, signals_deferred
 
 # The files a dump writes at the top of its folder; with "passes/NN_<pass>.exr" (PASS_FILE),
 # everything else in a dump folder is the user's and is kept.
@@ -200,6 +200,7 @@ def _carry(source: Path, target: Path) -> None:
 def swap_in_folder(staging: Path, directory: Path) -> None:
     """Replace ``directory`` with ``staging``: two renames with signals held between them, so
     the folder is always the old dump or the new one; then the old one is removed."""
+    raise_if_stop_requested()  # a signal's exception lost on the way: the old folder stays
     old = _sibling(directory, f"old-{secrets.token_hex(4)}")
     with signals_deferred():
         had_old = os.path.lexists(directory)

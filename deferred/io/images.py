@@ -18,6 +18,7 @@ import numpy as np
 
 from deferred.errors import InputError, RenderError
 from deferred.io.paths import temporary_path
+from deferred.io.safety import raise_if_stop_requested
 
 
 def srgb_encode(linear: np.ndarray) -> np.ndarray:
@@ -179,6 +180,7 @@ def _write_atomically(path: Path, write: Callable[[str], None]) -> None:
     temporary = str(temporary_path(path))
     try:
         write(temporary)
+        raise_if_stop_requested()  # a signal's exception lost on the way: no output still
         os.replace(temporary, path)
     except OSError as exc:
         raise RenderError(f"cannot write {path}: {_os_reason(exc)}") from exc

@@ -33,23 +33,56 @@ def interrupt_exit_code(exc: BaseException) -> int:
     return 128 + (exc.signum if isinstance(exc, Terminated) else signal.SIGINT)
 
 
+# The signals that asked the running command to stop: kept, because the exception a handler
+# raises can be lost (raised inside a ``__del__``, Python prints "Exception ignored" and goes
+# on; a library may catch BaseException), and the command must still end without output.
+_stop_requests: list[int] = []
+
+
+def stop_requested() -> BaseException | None:
+    """The interrupt a signal asked for while :func:`termination_as_interrupt` was active
+    (``KeyboardInterrupt`` or :class:`Terminated`), or ``None``."""
+    if not _stop_requests:
+        return None
+    signum = _stop_requests[0]
+    return KeyboardInterrupt() if signum == signal.SIGINT else Terminated(signum)
+
+
+def raise_if_stop_requested() -> None:
+    """Raise the interrupt a signal asked for, where its own exception may have been lost:
+    before an output file is renamed into place, so a stopped command leaves none."""
+    requested = stop_requested()
+    if requested is not None:
+        raise requested
+
+
 @contextmanager
 def termination_as_interrupt() -> Iterator[None]:
-    """Turn SIGTERM into :class:`Terminated` while the block runs (main thread only: Python
-    runs signal handlers there). Without it SIGTERM kills the process on the spot and leaves
-    temporary files and folders behind."""
+    """Turn SIGTERM into :class:`Terminated`, and SIGINT into ``KeyboardInterrupt`` as Python
+    does, while the block runs, and keep that they came (:func:`raise_if_stop_requested`:
+    main thread only, where Python runs signal handlers). Without it SIGTERM kills the process
+    on the spot and leaves temporary files and folders behind."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
+    _stop_requests.clear()
 
     def terminate(signum: int, frame: Any) -> None:
+        _stop_requests.append(signum)
         raise Terminated(signum)
 
-    previous = signal.signal(signal.SIGTERM, terminate)
+    def interrupt(signum: int, frame: Any) -> None:
+        _stop_requests.append(signum)
+        raise KeyboardInterrupt
+
+    previous = {signal.SIGTERM: signal.signal(signal.SIGTERM, terminate)}
+    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:  # not ignored, not set
+        previous[signal.SIGINT] = signal.signal(signal.SIGINT, interrupt)
     try:
         yield
     finally:
-        signal.signal(signal.SIGTERM, previous if previous is not None else signal.SIG_DFL)
+        for signum, handler in previous.items():
+            signal.signal(signum, handler if handler is not None else signal.SIG_DFL)
 
 
 @contextmanager

@@ -25,6 +25,7 @@ import numpy as np
 from deferred.errors import InputError, RenderError
 from deferred.io.images import sync_file, write_image
 from deferred.io.paths import expand_pattern, output_kind, temporary_path
+from deferred.io.safety import raise_if_stop_requested
 
 GIF_TICK_MS = 10  # GIF frame delays are whole hundredths of a second
 MP4_QUALITY = 7  # imageio's 0..10 scale: libx264 CRF 15
@@ -158,6 +159,7 @@ class AnimationWriter:
                 # a video cut short while its writer says nothing (ffmpeg's trailer, Pillow)
                 sync_file(self._temporary, self.path)
                 check_video_file(self._temporary, self.path, self.suffix)
+                raise_if_stop_requested()  # a signal's exception lost on the way
                 os.replace(self._temporary, self.path)
                 self._temporary = None
                 self.written.append(self.path)
