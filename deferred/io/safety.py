@@ -83,6 +83,7 @@ def termination_as_interrupt() -> Iterator[None]:
     finally:
         for signum, handler in previous.items():
             signal.signal(signum, handler if handler is not None else signal.SIG_DFL)
+        _stop_requests.clear()  # the command they asked to stop is over
 
 
 @contextmanager
