@@ -51,7 +51,11 @@ def load_mesh(spec: str, base_dir: Path | None = None, where: str | None = None)
     except ImportError:
         raise  # a broken installation (exit 1), not a bad file
     except Exception as exc:  # noqa: BLE001 - trimesh raises many exception types
-        reason = str(exc) or type(exc).__name__
+        for refused in resolver.refused:  # a file it named and could not have: the cause
+            require_regular_file(refused, f"file {refused.name} named by {path.name}", where)
+        lines = str(exc).strip().splitlines()
+        reason = lines[0] if lines else \
+            f"it is malformed (trimesh stopped with a bare {type(exc).__name__})"
         raise InputError(f"cannot read mesh {path.name}: {reason}", where) from None
     for refused in resolver.refused:  # named by the mesh, not opened: say so
         require_regular_file(refused, f"file {refused.name} named by {path.name}", where)

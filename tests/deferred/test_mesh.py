@@ -113,6 +113,26 @@ def test_a_file_without_its_formats_first_bytes_is_refused_before_it_is_parsed(
         load_mesh(str(path), where="s.toml: object[0].mesh")
 
 
+def test_a_mesh_trimesh_fails_on_without_a_message_is_called_malformed(tmp_path):
+    """A glTF whose data URI is not base64 stopped trimesh with a bare AssertionError, which
+    was the whole message."""
+    import json
+
+    gltf = tmp_path / "bad.gltf"
+    gltf.write_text(json.dumps({
+        "asset": {"version": "2.0"},
+        "buffers": [{"uri": "data:application/octet-stream;base64,AAAA!!", "byteLength": 36}],
+        "bufferViews": [{"buffer": 0, "byteLength": 36}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                       "max": [1, 1, 0], "min": [0, 0, 0]}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+        "nodes": [{"mesh": 0}], "scenes": [{"nodes": [0]}], "scene": 0}))
+    with pytest.raises(InputError, match=r"^s.toml: object\[0\].mesh: cannot read mesh "
+                                         r"bad.gltf: it is malformed \(trimesh stopped with a "
+                                         r"bare \w+\)$"):
+        load_mesh(str(gltf), where="s.toml: object[0].mesh")
+
+
 def test_bad_meshes_are_input_errors(tmp_path):
     with pytest.raises(InputError, match="not found"):
         load_mesh("missing.obj", tmp_path, where="scene.toml: object[0].mesh")
