@@ -69,7 +69,7 @@ def write_image(path: str | Path, pixels: np.ndarray, channels: Sequence[str] | 
     def write(temporary: str) -> None:
         def failed(*messages: str) -> RenderError:
             # the reader knows the file by its name, not by the temporary one
-            reason = _reason(*messages).replace(os.path.basename(temporary), path.name)
+            reason = first_line(*messages).replace(os.path.basename(temporary), path.name)
             return RenderError(f"cannot write {path}: {reason}")
 
         output = oiio.ImageOutput.create(temporary)
@@ -92,14 +92,16 @@ def write_image(path: str | Path, pixels: np.ndarray, channels: Sequence[str] | 
     return path
 
 
-def _reason(*messages: str) -> str:
-    """The first line of the first non-empty writer message: errors are one line, and a
-    failure always says why, even when the writer did not."""
+def first_line(*messages: str,
+               default: str = "the writer reported an error without a reason") -> str:
+    """The first line of the first non-empty message (a writer's, a library's exception):
+    errors are one line, and a failure always says why (``default``), even when the library
+    did not."""
     for message in messages:
         lines = [line.strip() for line in (message or "").splitlines() if line.strip()]
         if lines:
             return lines[0]
-    return "the writer reported an error without a reason"
+    return default
 
 
 def _os_reason(exc: OSError) -> str:
@@ -135,7 +137,7 @@ def _check_image_file(temporary: str, path: Path, width: int, height: int, count
     image = oiio.ImageInput.open(temporary)
     if image is None:
         raise RenderError(f"cannot write {path}: the written file does not read back: "
-                          f"{_reason(oiio.geterror())}")
+                          f"{first_line(oiio.geterror())}")
     try:
         spec = image.spec()
         got = (spec.width, spec.height, spec.nchannels)
@@ -150,7 +152,7 @@ def _check_image_file(temporary: str, path: Path, width: int, height: int, count
                                             count, "float")
             if band is None or image.has_error:
                 raise RenderError(f"cannot write {path}: the written file is cut short or "
-                                  f"damaged ({_reason(image.geterror(), oiio.geterror())}); "
+                                  f"damaged ({first_line(image.geterror(), oiio.geterror())}); "
                                   "is the disk full?")
     finally:
         image.close()

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from deferred.errors import InputError, RenderError
-from deferred.io.images import sync_file, write_image
+from deferred.io.images import first_line, sync_file, write_image
 from deferred.io.paths import expand_pattern, output_kind, temporary_path
 from deferred.io.safety import raise_if_stop_requested
 
@@ -217,8 +217,8 @@ def video_failure(exc: BaseException, path: Path) -> str:
             return "no space left on the disk"
     except OSError:
         pass
-    lines = [line.strip() for line in str(exc).splitlines() if line.strip()]
-    return f"{type(exc).__name__}: {lines[0]}" if lines else type(exc).__name__
+    reason = first_line(str(exc), default="")
+    return f"{type(exc).__name__}: {reason}" if reason else type(exc).__name__
 
 
 def _gif_decodes(file) -> bool:

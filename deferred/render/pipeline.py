@@ -127,7 +127,7 @@ def phase_passes(scene: Scene, phase: Phase, fixed: list[RenderPass],
 
 
 class Pipeline:
-    """A pipeline for one light path (:mod:`deferred.lighting.lists`)."""
+    """A pipeline for one light path (:mod:`deferred.lighting.paths`)."""
 
     name = ""
     light_paths: tuple[str, ...] = ()

@@ -95,7 +95,7 @@ class Renderer:
 
     ``strict`` turns a uniform set by name that a program does not declare into an error
     (default: the ``DEFERRED_STRICT`` environment variable). ``light_path`` chooses how lights
-    reach the pixels (:mod:`deferred.lighting.lists`; default: the scene's ``light_path``, else
+    reach the pixels (:mod:`deferred.lighting.paths`; default: the scene's ``light_path``, else
     the fastest the context allows).
 
     The scene's objects, lights, camera and materials' parameters may change between frames.

@@ -128,7 +128,7 @@ class SceneModel(_Strict):
     exposure: float = Field(1.0, gt=0.0)
     tonemap: Literal["reinhard", "aces", "none"] = "aces"
     light_path: LightPath | None = Field(
-        None, description="how lights reach the pixels (deferred.lighting.lists); default the "
+        None, description="how lights reach the pixels (deferred.lighting.paths); default the "
                           "fastest the context allows")
     camera: CameraModel = Field(default_factory=CameraModel)
     ssao: dict[str, Any] | None = Field(

@@ -12,6 +12,7 @@ import numpy as np
 
 from deferred.errors import InputError
 from deferred.gl.meshes import MeshData
+from deferred.io.images import first_line
 from deferred.scene.builtin_meshes import BUILTIN_PREFIX, BUILTIN_SHAPES, builtin_arguments
 from deferred.scene.geometry import build_mesh
 from deferred.validation import require_regular_file
@@ -53,9 +54,8 @@ def load_mesh(spec: str, base_dir: Path | None = None, where: str | None = None)
     except Exception as exc:  # noqa: BLE001 - trimesh raises many exception types
         for refused in resolver.refused:  # a file it named and could not have: the cause
             require_regular_file(refused, f"file {refused.name} named by {path.name}", where)
-        lines = str(exc).strip().splitlines()
-        reason = lines[0] if lines else \
-            f"it is malformed (trimesh stopped with a bare {type(exc).__name__})"
+        reason = first_line(str(exc), default="it is malformed (trimesh stopped with a bare "
+                                               f"{type(exc).__name__})")
         raise InputError(f"cannot read mesh {path.name}: {reason}", where) from None
     for refused in resolver.refused:  # named by the mesh, not opened: say so
         require_regular_file(refused, f"file {refused.name} named by {path.name}", where)
