@@ -63,6 +63,7 @@ from .techniques.strands import (
 from .techniques.wetness import (
     blend_droplet,
     dry_mask,
+    footprint_texels,
     dry_out,
     load_wetness_mask,
     mean_uv_scale,
@@ -87,6 +88,9 @@ MAX_SIMULATION_STEPS = 100_000
 # Steps x strands a render may simulate: the work grows with both, so a fine mesh reaches the
 # limit at an earlier time (benchmarks/README.md has what a strand step costs)
 MAX_STRAND_STEPS = 200_000_000
+# Wetness-mask texels the droplets of a render may blend (each droplet blends the texels under
+# it: radius^2 x droplets); benchmarks/README.md has what a texel costs
+MAX_DROPLET_TEXELS = 400_000_000
 
 
 class ShellFurParams(FurParams, BlinnPhongParams):
@@ -155,6 +159,37 @@ def simulation_steps(params: ShellFurParams, time: float) -> int:
     """Steps simulated from scratch to reach ``time``: the settling, then t / time_step."""
     return int(round(params.settle / params.time_step)) + \
         int(math.floor(max(time, 0.0) / params.time_step + 1e-9))
+
+
+def _params_at(obj: SceneObject, time: float) -> ShellFurParams:
+    params_at = getattr(obj, "params_at", None)
+    return params_at(time) if params_at is not None else obj.material.params
+
+
+def droplet_texels(obj: SceneObject, time: float) -> tuple[int, str]:
+    """The wetness-mask texels blended by the droplets fallen on ``obj`` by ``time`` (each count
+    of droplets on its timeline falls with the radius of its own time, as
+    :class:`ShellFurState` rains them), and where the droplets that pass
+    :data:`MAX_DROPLET_TEXELS` were asked for (the object's params or an event's)."""
+    first = _params_at(obj, 0.0)
+    wrap, fallen, texels = None, 0, 0
+    named = getattr(obj, "where", None)
+    where = f"{named}.params" if named else f"{obj.label}: params"
+    blame = where
+    events = [e for e in getattr(obj, "events", ()) if e.time <= time]
+    for at in [0.0, *(e.time for e in events if e.time > 0.0)]:
+        params = _params_at(obj, at)
+        if params.droplets > fallen:
+            wrap = uv_wrap(obj.mesh) if wrap is None else wrap
+            texels += footprint_texels(
+                random_droplets(obj.mesh, obj.model, params.droplets - fallen,
+                                params.droplet_radius, params.droplet_wetness, params.seed,
+                                start=fallen), first.mask_size, wrap)
+            fallen = params.droplets
+            if texels > MAX_DROPLET_TEXELS and blame is where:
+                latest = [e for e in events if e.time <= at and "droplets" in e.params]
+                blame = f"{latest[-1].where}.params" if latest and latest[-1].where else where
+    return texels, f"{blame}.droplets"
 
 
 def _layers_uniform(shells: int) -> dict[str, Any]:
@@ -254,8 +289,7 @@ class ShellFurState:
         self._uploaded: int | None = None
 
     def params_at(self, time: float) -> ShellFurParams:
-        params_at = getattr(self.obj, "params_at", None)
-        return params_at(time) if params_at is not None else self.obj.material.params
+        return _params_at(self.obj, time)
 
     def advance(self, time: float) -> None:
         """Bring the state to ``time`` (seconds) and upload it if it changed."""
@@ -477,6 +511,14 @@ class ShellFurMaterial(FurMaterial):
                              f"{steps * strands:,} strand steps; the most is "
                              f"{MAX_STRAND_STEPS:,}: render an earlier time, raise time_step "
                              "or give the object a coarser mesh", where)
+        texels, blame = droplet_texels(obj, time)
+        if texels > MAX_DROPLET_TEXELS:
+            params = _params_at(obj, time)
+            raise InputError(f"{params.droplets:,} droplets by t = {time:g} s blend "
+                             f"{texels:,} wetness-mask texels (each the texels under it: "
+                             f"droplet_radius and mask_size set how many); the most is "
+                             f"{MAX_DROPLET_TEXELS:,}: fewer or smaller droplets, or a smaller "
+                             "mask_size", blame)
 
     def check_files(self, where: str | None) -> None:
         super().check_files(where)

@@ -203,7 +203,8 @@ def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
             raise InputError(f"duplicate object name '{label}'", f"{where}.name")
         labels.add(label)
         scene.objects.append(SceneObject(label, mesh, material,
-                                         model_matrix(obj.position, obj.rotation, obj.scale)))
+                                         model_matrix(obj.position, obj.rotation, obj.scale),
+                                         where=where))
     for index, light in enumerate(model.light):
         where = f"{name}: light[{index}]"
         light_cls = registry.lights.get(light.type, f"{where}.type")

@@ -65,6 +65,7 @@ class SceneObject:
     model: np.ndarray
     base_params: MaterialParams | None = None
     events: tuple[TimelineEvent, ...] = ()
+    where: str | None = None  # names the object in errors (``scene.toml: object[2]``)
     # params_at's validated states and the merged values they came from, by count of events
     # applied (cleared when the events change)
     _states: dict[int, MaterialParams] = field(default_factory=dict, init=False, repr=False)

@@ -65,6 +65,18 @@ def _texel_range(centre: float, radius: float, size: int, wrap: bool) -> np.ndar
     return np.arange(max(first, 0), min(last, size))
 
 
+def footprint_texels(droplets: list[Droplet], size: int,
+                     wrap: tuple[bool, bool] = (False, False)) -> int:
+    """The texels :func:`blend_droplet` visits for ``droplets`` on a mask of ``size``: the work
+    of blending them, which grows with each droplet's radius squared."""
+    total = 0
+    for droplet in droplets:
+        columns = _texel_range(droplet.centre[0], droplet.radius, size, wrap[0])
+        rows = _texel_range(droplet.centre[1], droplet.radius, size, wrap[1])
+        total += len(columns) * len(rows)
+    return total
+
+
 def blend_droplet(mask: np.ndarray, droplet: Droplet,
                   wrap: tuple[bool, bool] = (False, False)) -> None:
     """Blend ``droplet`` into ``mask`` in place with Algorithm 1, at every texel it covers;

@@ -1035,3 +1035,60 @@ def test_a_mask_with_too_few_channels_is_refused_by_its_header(tmp_path, monkeyp
     monkeypatch.setattr(wetness, "read_image", decoded)
     with pytest.raises(InputError, match=r"grey.exr needs 4 channels .* it has 1$"):
         wetness.read_mask_image(tmp_path / "grey.exr")
+
+
+def test_a_droplets_work_is_the_texels_under_it():
+    """footprint_texels counts what blend_droplet visits: about (2 r size)^2 a droplet, the
+    texel centres inside its circle among them, and no more than its square of texels."""
+    from deferred.materials.techniques.wetness import footprint_texels
+
+    size = 256
+    for radius in (0.02, 0.05, 0.1, 0.2):
+        droplet = Droplet((0.43, 0.57), radius, 0.5)
+        texels = footprint_texels([droplet], size)
+        side = 2.0 * radius * size
+        assert side ** 2 <= texels <= (side + 2) ** 2
+        mask = dry_mask(size)
+        blend_droplet(mask, droplet)
+        assert np.count_nonzero(mask[..., 3]) <= texels
+    # the sum over droplets; a droplet wrapping round covers the mask once at most
+    droplets = [Droplet((0.1 * k, 0.5), 0.05, 0.5) for k in range(10)]
+    assert footprint_texels(droplets, size) == sum(footprint_texels([d], size) for d in droplets)
+    assert footprint_texels([Droplet((0.5, 0.5), 3.0, 0.5)], size, (True, True)) == size * size
+    assert footprint_texels([Droplet((0.5, 0.5), 3.0, 0.5)], size) == size * size
+
+
+def test_droplet_work_past_the_budget_is_refused_before_a_frame(tmp_path, capsys, monkeypatch):
+    """radius^2 x droplets past MAX_DROPLET_TEXELS is refused naming the params or the event
+    that asked for the droplets (10,000 droplets of radius 1 on a 4096^2 mask would take hours);
+    fewer droplets render, and nothing is written for the refused ones."""
+    import deferred.materials.shell_fur as shell_fur
+
+    monkeypatch.setattr(shell_fur, "MAX_DROPLET_TEXELS", 20_000)
+    out = tmp_path / "out.png"
+    scene = write_scene(tmp_path / "s.toml", "droplets = 40\ndroplet_radius = 1.0\nmask_size = 64")
+    code, text = cli(capsys, "render", str(scene), "-o", str(out))
+    assert code == 2, text
+    assert text.strip().splitlines() == [text.strip()]
+    assert text.startswith("error: s.toml: object[0].params.droplets: 40 droplets by t = 0 s "
+                           "blend "), text
+    assert "the most is 20,000: fewer or smaller droplets, or a smaller mask_size" in text
+    assert not out.exists()
+    few = write_scene(tmp_path / "s.toml", "droplets = 2\ndroplet_radius = 1.0\nmask_size = 64")
+    code, text = cli(capsys, "render", str(few), "-o", str(out))
+    assert code == 0, text
+    # droplets an event adds: the event is named, and only at a time that reaches it
+    few.write_text(few.read_text() + """
+[[event]]
+time = 1.0
+object = "plane0"
+params = { droplets = 40 }
+""")
+    out.unlink()
+    code, text = cli(capsys, "render", str(few), "-o", str(out))
+    assert code == 0, text
+    code, text = cli(capsys, "render", str(few), "-o", str(tmp_path / "late.png"), "--time", "1")
+    assert code == 2, text
+    assert text.startswith("error: s.toml: event[0].params.droplets: 40 droplets by t = 1 s"), \
+        text
+    assert not (tmp_path / "late.png").exists()
