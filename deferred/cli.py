@@ -109,7 +109,7 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
         write_view,
     )
     from deferred.io.paths import output_kind
-    from deferred.io.video import check_video_size, frame_times
+    from deferred.io.video import check_animation_memory, check_video_size, frame_times
     from deferred.lighting.paths import resolve_light_path
     from deferred.render.renderer import FULL_FEATURES, Renderer
 
@@ -132,6 +132,7 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
     size_override = _size_option(size)
     if kind == "video":
         check_video_size(out, size_override or loaded.size)
+        check_animation_memory(out, size_override or loaded.size, frames)
     shown_name = view_name
     if view_name is not None:
         debug_scene = with_material_view(loaded, view_name)

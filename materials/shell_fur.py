@@ -63,8 +63,8 @@ from .techniques.strands import (
 from .techniques.wetness import (
     blend_droplet,
     dry_mask,
-    footprint_texels,
     dry_out,
+    footprint_texels,
     load_wetness_mask,
     mean_uv_scale,
     random_droplets,

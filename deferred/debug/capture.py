@@ -22,7 +22,7 @@ from deferred.gbuffer.layout import (
     GBufferLayout,
     decode,
 )
-from deferred.gl.target_spec import TargetSpec
+from deferred.gl.target_spec import TargetSpec, targets_bytes
 from deferred.names import LIST_PATHS, Pipeline
 from deferred.render.renderer import Renderer
 
@@ -171,6 +171,18 @@ def select_passes(passes: Sequence[RenderPass], patterns: Sequence[str] | None) 
                              "--passes")
         chosen.update(matched)
     return chosen
+
+
+def capture_bytes(renderer: Renderer, passes: Sequence[str] | None = None) -> int:
+    """Bytes :func:`capture_frame` holds: the targets each selected pass writes and every target
+    at the end of the frame, in their stored types."""
+    width, height = renderer.size
+    specs = renderer.graph.targets
+    selected = select_passes(renderer.passes, passes)
+    written = [name for p in renderer.passes if p.name in selected
+               for name in dict.fromkeys(p.writes)]
+    return targets_bytes([specs[name] for name in written], width, height) + \
+        targets_bytes(specs.values(), width, height)
 
 
 def capture_frame(renderer: Renderer, passes: Sequence[str] | None = None,

@@ -9,14 +9,24 @@ import hashlib
 import json
 import re
 from collections.abc import Callable, Sequence
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
 from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from deferred.debug.capture import FrameCapture, PassCapture, capture_frame, fits_half, to_float
+from deferred.debug.capture import (
+    GBUFFER_CHANNELS,
+    FrameCapture,
+    PassCapture,
+    capture_bytes,
+    capture_frame,
+    channel_suffixes,
+    fits_half,
+    select_passes,
+    to_float,
+)
 from deferred.debug.dump_folder import (
     carry_over,
     check_dump_folder,
@@ -28,13 +38,15 @@ from deferred.debug.preview import Tile, contact_sheet, target_views
 from deferred.debug.views import view
 from deferred.errors import RenderError
 from deferred.gbuffer.layout import GBUFFER_COLOR_TARGETS
-from deferred.gl.target_spec import TargetSpec
+from deferred.gl.target_spec import TargetSpec, targets_bytes
 from deferred.gl.targets import COMPOSITE, LIGHT_ACCUMULATION
 from deferred.io.images import write_image, write_text
+from deferred.io.memory import check_memory
 from deferred.io.safety import signals_deferred
 from deferred.render.renderer import Renderer
 
 MANIFEST_FORMAT = "deferred-dump/1"
+WRITERS = 2  # files compressed at once (OIIO drops the GIL while it compresses)
 
 
 def stack_buffers(raws: Sequence[np.ndarray], dtype: type = np.float32) -> np.ndarray:
@@ -129,11 +141,16 @@ def _write_files(capture: FrameCapture, directory: Path, files: dict[str, str],
     # OIIO drops the GIL while it compresses: files compress in parallel while numpy prepares
     # the next one (this is most of a dump's time). Pass files go first so the pool starts
     # at once; the contact sheet is built in the pool too.
-    pool = ThreadPoolExecutor(max_workers=2)
+    pool = ThreadPoolExecutor(max_workers=WRITERS)
     try:
-        pending = []
+        pending: list[Future] = []
 
         def write(name: str, *args: Any, **kwargs: Any) -> None:
+            # the arrays of queued files are held until written: no more than a file
+            # prepared ahead of each writer (every pass's float buffers at once would
+            # be several times the capture)
+            while sum(not future.done() for future in pending) > WRITERS:
+                wait(pending, return_when=FIRST_COMPLETED)
             step(name)
             pending.append(pool.submit(write_image, directory / name, *args, **kwargs))
 
@@ -251,11 +268,35 @@ def build_manifest(capture: FrameCapture, files: dict[str, str],
     return manifest
 
 
+def dump_memory(renderer: Renderer, passes: Sequence[str] | None = None) -> int:
+    """Bytes a dump of ``renderer``'s frame holds at most: the render targets, the capture
+    (:func:`~deferred.debug.capture.capture_bytes`), and while files are written the float
+    buffers of a pass file prepared for each writer and one more, and the decoded G-buffer
+    (its channels, their stack and the decoder's temporaries)."""
+    width, height = renderer.size
+    specs = renderer.graph.targets
+    selected = select_passes(renderer.passes, passes)
+    pass_channels = [sum(len(channel_suffixes(specs[name])) for name in dict.fromkeys(p.writes))
+                     for p in renderer.passes if p.name in selected]
+    gbuffer_channels = len(GBUFFER_CHANNELS) + sum(
+        len(data.channels) for data in renderer.scene.gbuffer_layout().data.values())
+    float_bytes = 4 * width * height
+    return (targets_bytes(specs.values(), width, height) + capture_bytes(renderer, passes)
+            + (WRITERS + 1) * max(pass_channels, default=0) * float_bytes
+            + 3 * gbuffer_channels * float_bytes)
+
+
 def dump_scene(renderer: Renderer, directory: str | Path, passes: Sequence[str] | None = None,
                pixel: tuple[int, int] | None = None, scene_file: str | None = None,
                progress: Callable[[str], None] | None = None
                ) -> tuple[dict[str, Any], list[PixelEvent] | None]:
-    """Capture a frame with ``renderer`` (and the pixel's history) and write the dump."""
+    """Capture a frame with ``renderer`` (and the pixel's history) and write the dump; one
+    that would hold more than the memory budget is refused before the frame."""
+    width, height = renderer.size
+    check_memory(dump_memory(renderer, passes),
+                 f"a dump of {width}x{height} holds {{}} (the targets, every captured pass's "
+                 "buffers, the files being written)", renderer.size_where,
+                 "a smaller --size, or --passes to capture fewer passes")
     capture = capture_frame(renderer, passes)
     history = pixel_history(renderer, *pixel) if pixel is not None else None
     manifest = write_dump(capture, directory, history, pixel, scene_file, progress)

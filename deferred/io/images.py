@@ -372,7 +372,7 @@ def _decode(path: Path, where: str | None, config, max_size: int | None, bytes_p
 
 def amount(size: int) -> str:
     """``size`` bytes as people read it: ``12.5 MiB``, ``3.0 KiB``, ``7 bytes``."""
-    for unit, scale in (("GiB", 1 << 30), ("MiB", 1 << 20), ("KiB", 1 << 10)):
+    for unit, scale in (("TiB", 1 << 40), ("GiB", 1 << 30), ("MiB", 1 << 20), ("KiB", 1 << 10)):
         if size >= scale:
             return f"{size / scale:.1f} {unit}"
     return f"{size} byte{'' if size == 1 else 's'}"

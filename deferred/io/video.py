@@ -6,8 +6,9 @@ scene's ``[[event]]`` timeline and animated materials follow ``frame.time``) and
 - a numbered sequence for a name with a run of ``#`` (``out_####.png``, ``.exr`` too): the run
   becomes the frame number, zero-padded to its length (wider numbers keep every digit);
 - a video for ``.mp4`` (H.264, yuv420p, through imageio's ffmpeg plugin; even sizes only) or
-  ``.gif`` (imageio's pillow plugin, looping forever; Pillow merges identical consecutive frames
-  into one longer frame).
+  ``.gif`` (Pillow, looping forever; Pillow merges identical consecutive frames into one longer
+  frame, so a GIF's frames are held, a byte a pixel, until it is written at the end:
+  :func:`check_animation_memory` refuses more than the memory budget before the first frame).
 
 A video is written to a hidden temporary file next to the output and renamed when complete, so
 a failure or Ctrl-C leaves no partial file; each file of a sequence is written atomically.
@@ -21,9 +22,11 @@ from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
+from PIL import Image
 
 from deferred.errors import InputError, RenderError
 from deferred.io.images import first_line, sync_file, write_image
+from deferred.io.memory import check_memory
 from deferred.io.paths import expand_pattern, output_kind, temporary_path
 from deferred.io.safety import raise_if_stop_requested
 
@@ -53,6 +56,24 @@ def check_video_size(path: str | Path, size: tuple[int, int], where: str = "-o")
         even = f"{width + width % 2}x{height + height % 2}"
         raise InputError(f"an .mp4 (H.264, yuv420p) needs an even width and height, got "
                          f"{width}x{height}; render at --size {even}", where)
+
+
+# What a GIF frame holds until the file is written at the end (Pillow merges identical
+# frames and crops each to what changed, so it takes every frame before writing one): the
+# writer's palette frame and Pillow's copy of it, a byte a pixel each
+GIF_BYTES_PER_PIXEL = 2
+
+
+def check_animation_memory(path: str | Path, size: tuple[int, int], frames: int,
+                           where: str = "--frames") -> None:
+    """Refuse, before a frame is rendered, a GIF whose frames would take more than the memory
+    budget (a sequence or an .mp4 holds none: each frame goes to its file or to ffmpeg)."""
+    if Path(path).suffix.lower() != ".gif":
+        return
+    width, height = size
+    check_memory(frames * width * height * GIF_BYTES_PER_PIXEL,
+                 f"{frames:,} frames of {width}x{height} held for a GIF take {{}}", where,
+                 "fewer frames, a smaller size, an .mp4 or a frame pattern")
 
 
 def gif_durations(frames: int, fps: float) -> list[int]:
@@ -100,7 +121,7 @@ class AnimationWriter:
         self.frames = 0
         self._temporary: Path | None = None
         self._video = None  # the imageio ffmpeg writer
-        self._gif_frames: list[np.ndarray] = []
+        self._gif_frames: list[Image.Image] = []  # palette images
         self._closed = False
 
     @property
@@ -123,7 +144,10 @@ class AnimationWriter:
             if rgb.dtype != np.uint8:
                 raise ValueError("video frames are uint8 sRGB")
             if self.suffix == ".gif":
-                self._gif_frames.append(rgb)
+                # a byte a pixel from here on: Pillow makes the same adaptive palette of an RGB
+                # frame when it saves, so the file is the one the RGB frames give
+                self._gif_frames.append(Image.fromarray(rgb).convert(
+                    "P", palette=Image.Palette.ADAPTIVE))
             else:
                 try:
                     self._mp4().append_data(rgb)
@@ -175,11 +199,8 @@ class AnimationWriter:
     def _write_gif(self) -> None:
         # Pillow directly, into a file this writer closes: its errors (a full or read-only
         # disk) surface here, once, with no writer object left to fail again when collected
-        from PIL import Image
-
         self._temporary = temporary_path(self.path)
-        frames = [Image.fromarray(rgb) for rgb in self._gif_frames]
-        self._gif_frames.clear()
+        frames, self._gif_frames = self._gif_frames, []
         with open(self._temporary, "wb") as file:
             frames[0].save(file, format="GIF", save_all=True, append_images=frames[1:],
                            duration=gif_durations(self.frames, self.fps), loop=0)

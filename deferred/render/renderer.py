@@ -21,7 +21,7 @@ from deferred.gl.shaderlib import ShaderLibrary
 from deferred.gl.target_spec import targets_bytes
 from deferred.gl.targets import COMPOSITE, FINAL, FrameTargets
 from deferred.interfaces.material import Material
-from deferred.io.images import amount
+from deferred.io.memory import check_memory
 from deferred.lighting.buffer import LIGHT_BUFFER, LightBuffer
 from deferred.lighting.lists import (
     LIGHT_LISTS,
@@ -60,34 +60,11 @@ def strict_default() -> bool:
     return os.environ.get("DEFERRED_STRICT", "") in ("1", "true", "yes")
 
 
-# Render targets live in system memory on llvmpipe: a size whose targets pass this is refused
-# before the context allocates them (one that does not fit would be killed, without a message).
-TARGET_MEMORY_BUDGET = 4 << 30  # bytes; DEFERRED_TARGET_MEMORY overrides it
-
-
-def target_memory_budget() -> int:
-    """:data:`TARGET_MEMORY_BUDGET`, or the environment's ``DEFERRED_TARGET_MEMORY`` (bytes)."""
-    text = os.environ.get("DEFERRED_TARGET_MEMORY")
-    if text is None:
-        return TARGET_MEMORY_BUDGET
-    try:
-        budget = int(text)
-    except ValueError:
-        budget = 0
-    if budget <= 0:
-        raise InputError(f"must be a whole number of bytes > 0, got {text[:40]!r}",
-                         "DEFERRED_TARGET_MEMORY")
-    return budget
-
-
 def check_target_memory(graph: PassGraph, size: tuple[int, int], where: str = "size") -> None:
-    """Refuse a frame size whose render targets need more than the budget."""
-    needed = targets_bytes(graph.targets.values(), *size)
-    budget = target_memory_budget()
-    if needed > budget:
-        raise InputError(f"{size[0]}x{size[1]} needs {amount(needed)} of render targets "
-                         f"({len(graph.targets)} targets); the budget is "
-                         f"{amount(budget)} (DEFERRED_TARGET_MEMORY)", where)
+    """Refuse a frame size whose render targets need more than the memory budget."""
+    check_memory(targets_bytes(graph.targets.values(), *size),
+                 f"{size[0]}x{size[1]} needs {{}} of render targets "
+                 f"({len(graph.targets)} targets)", where)
 
 
 class Renderer:
@@ -124,7 +101,9 @@ class Renderer:
         requested = light_path if light_path is not None else scene.light_path
         provisional = resolve_light_path(pipeline, requested, FULL_FEATURES)
         self.graph: PassGraph = check_passes(PIPELINES[pipeline](provisional).build(scene))
-        check_target_memory(self.graph, self.size, "size" if given else f"{scene.source}: size")
+        # where the frame size came from, for errors about it
+        self.size_where = "size" if given else f"{scene.source}: size"
+        check_target_memory(self.graph, self.size, self.size_where)
         light_types = scene.light_types()
         shading_models = self.shading_models = scene.shading_models()
         self.object_transforms = ObjectTransforms()  # kept across frames

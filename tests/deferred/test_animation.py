@@ -289,3 +289,43 @@ params = { shells = 32, fur_length = 0.3 }
     assert swept.params_at(0.0).shells == 4
     assert swept.params_at(1.0).shells == 4 and swept.params_at(1.0).fur_length == 0.3
     assert scene.objects[0].params_at(1.0).shells == 32  # the original keeps its timeline
+
+
+def test_a_gif_past_the_memory_budget_is_refused_before_a_frame(tmp_path, capsys, scene_file,
+                                                                 monkeypatch):
+    """A GIF's frames are held until it is written (Pillow merges and crops them): their bytes
+    are counted before the first frame, naming --frames and the budget, and nothing is
+    written; a sequence and an .mp4 hold none. (4096x4096 x 100,000 frames was accepted.)"""
+    out = tmp_path / "anim.gif"
+    code, _, err = run(capsys, "render", "--size", "4096x4096", "--frames", 100000, "-o", out)
+    assert code == 2 and err.strip().splitlines() == [
+        "error: --frames: 100,000 frames of 4096x4096 held for a GIF take 3.1 TiB; the budget "
+        "is 4.0 GiB (DEFERRED_TARGET_MEMORY): fewer frames, a smaller size, an .mp4 or a frame "
+        "pattern"], err
+    # 64x48 x 3 frames hold 18 KiB: refused under a 16 KiB budget, written under 64 KiB
+    monkeypatch.setenv("DEFERRED_TARGET_MEMORY", str(16 << 10))
+    code, _, err = run(capsys, "render", scene_file, "--frames", 3, "--fps", 10, "-o", out)
+    assert code == 2 and "3 frames of 64x48 held for a GIF take 18.0 KiB" in err, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]
+    monkeypatch.setenv("DEFERRED_TARGET_MEMORY", str(1 << 30))
+    code, _, err = run(capsys, "render", scene_file, "--frames", 3, "--fps", 10, "-o", out)
+    assert code == 0, err
+
+
+def test_gif_frames_held_as_palettes_write_the_file_rgb_frames_give(tmp_path):
+    """The writer keeps each frame as Pillow's adaptive palette image (a byte a pixel, not
+    three): the file is byte for byte the one Pillow writes from the RGB frames."""
+    from PIL import Image
+
+    from deferred.io.video import AnimationWriter
+
+    rng = np.random.default_rng(5)
+    frames = [(rng.random((30, 40, 4)) * 255).astype(np.uint8) for _ in range(3)]
+    frames.append(frames[-1].copy())  # merged into the one before
+    with AnimationWriter(tmp_path / "held.gif", 10.0) as writer:
+        for frame in frames:
+            writer.write(frame)
+    rgb = [Image.fromarray(np.ascontiguousarray(f[..., :3])) for f in frames]
+    rgb[0].save(tmp_path / "direct.gif", format="GIF", save_all=True, append_images=rgb[1:],
+                duration=gif_durations(4, 10.0), loop=0)
+    assert (tmp_path / "held.gif").read_bytes() == (tmp_path / "direct.gif").read_bytes()

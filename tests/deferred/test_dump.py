@@ -639,3 +639,79 @@ def test_a_dump_of_a_list_path_holds_the_light_lists(tmp_path, renderer, gl):
     volumes = capture_frame(renderer(small_scene()))
     assert volumes.light_lists is None
     assert "light_lists" not in write_dump(volumes, tmp_path / "other")["files"]
+
+
+def test_a_dump_past_the_memory_budget_is_refused_before_the_frame(tmp_path, capsys, gl,
+                                                                    monkeypatch):
+    """A dump holds every captured pass's buffers and the files being written, several times
+    a render's targets (the demo at 4096x4096 peaked at 12.8 GB): counted before the frame
+    and refused past the budget, naming the size; --passes captures less and fits."""
+    out = tmp_path / "dump"
+    code, _, err = run(capsys, "dump", "-o", out, "--size", "4096x4096")
+    assert code == 2 and err.startswith("error: size: a dump of 4096x4096 holds ") and \
+        err.strip().endswith("the budget is 4.0 GiB (DEFERRED_TARGET_MEMORY): a smaller "
+                             "--size, or --passes to capture fewer passes"), err
+    assert not out.exists()
+    # a budget the render's targets and a dump of one pass fit in, and the whole dump does not
+    from deferred.cli import _scene
+    from deferred.debug.dump import dump_memory
+
+    with Renderer(_scene(None), "deferred", (96, 64), gl=gl) as demo:
+        whole, one = dump_memory(demo), dump_memory(demo, ["post.tonemap"])
+    assert one < whole
+    monkeypatch.setenv("DEFERRED_TARGET_MEMORY", str((one + whole) // 2))
+    code, _, err = run(capsys, "render", "-o", tmp_path / "x.png", "--size", "96x64")
+    assert code == 0, err
+    code, _, err = run(capsys, "dump", "-o", out, "--size", "96x64")
+    assert code == 2 and "a dump of 96x64 holds" in err, err
+    assert not out.exists()
+    code, _, err = run(capsys, "dump", "-o", out, "--size", "96x64", "--passes", "post.tonemap")
+    assert code == 0, err
+
+
+def test_the_dump_estimate_covers_what_the_capture_holds(renderer):
+    """dump_memory counts at least the arrays a capture keeps (each selected pass's targets,
+    every target at the end) plus the render targets."""
+    from deferred.debug.capture import capture_bytes
+    from deferred.debug.dump import dump_memory
+    from deferred.gl.target_spec import targets_bytes
+
+    renderer = renderer(small_scene())
+    for passes in (None, ["lighting.*"], ["post.tonemap"]):
+        capture = capture_frame(renderer, passes)
+        held = sum(raw.nbytes for p in capture.passes for raw in p.raw.values()) + \
+            sum(raw.nbytes for raw in capture.targets.values())
+        assert capture_bytes(renderer, passes) == held
+        assert dump_memory(renderer, passes) >= held + targets_bytes(
+            renderer.graph.targets.values(), *renderer.size)
+
+
+def test_a_dump_prepares_no_more_files_than_its_writers_take(tmp_path, renderer, monkeypatch):
+    """Files wait for a writer with their float buffers in memory: no more than one queued for
+    each writer, whatever the number of passes."""
+    import threading
+    import time
+
+    import deferred.debug.dump as dump
+
+    lock, queued, most = threading.Lock(), [0], [0]
+    real_submit = dump.ThreadPoolExecutor.submit
+
+    def submit(pool, fn, *args, **kwargs):
+        with lock:
+            queued[0] += 1
+            most[0] = max(most[0], queued[0])
+
+        def slow(*a, **k):
+            time.sleep(0.02)
+            try:
+                return fn(*a, **k)
+            finally:
+                with lock:
+                    queued[0] -= 1
+        return real_submit(pool, slow, *args, **kwargs)
+
+    monkeypatch.setattr(dump.ThreadPoolExecutor, "submit", submit)
+    write_dump(capture_frame(renderer(small_scene())), tmp_path / "dump")
+    assert len(list((tmp_path / "dump" / "passes").iterdir())) > 2 * dump.WRITERS
+    assert most[0] <= 2 * dump.WRITERS + 1
