@@ -13,6 +13,8 @@ import numpy as np
 from deferred.gl.meshes import GpuMesh, MeshData
 from deferred.io.images import read_image
 
+UPLOAD_BAND_PIXELS = 1 << 20  # texels written to a texture at once
+
 
 class Resources:
     """GPU objects that outlive one frame: meshes, textures loaded from files, helper geometry."""
@@ -52,10 +54,15 @@ class Resources:
         names it in a read error."""
         def create(ctx: moderngl.Context) -> moderngl.Texture:
             pixels = read_image(path, srgb_to_linear=srgb, where=where,
-                                max_size=ctx.info["GL_MAX_TEXTURE_SIZE"])
+                                max_size=ctx.info["GL_MAX_TEXTURE_SIZE"], dtype=np.float16)
             height, width, _ = pixels.shape
-            texture = ctx.texture((width, height), 4, np.ascontiguousarray(
-                pixels[::-1]).astype(np.float16).tobytes(), dtype="f2")
+            texture = ctx.texture((width, height), 4, dtype="f2")
+            # bottom row first, a band at a time (no flipped copy of a large image)
+            rows = max(1, UPLOAD_BAND_PIXELS // width)
+            for first in range(0, height, rows):
+                band = pixels[first:first + rows]
+                texture.write(np.ascontiguousarray(band[::-1]),
+                              viewport=(0, height - first - len(band), width, len(band)))
             texture.build_mipmaps()
             texture.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
             return texture

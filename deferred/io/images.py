@@ -203,13 +203,16 @@ MAX_TEXTURE_SIZE = 16384  # GL_MAX_TEXTURE_SIZE of desktop GPUs and llvmpipe; th
 #                           value where one is at hand (``max_size``)
 IMAGE_MEMORY_BUDGET = 1 << 30  # bytes an image may take once decoded (``bytes_per_pixel`` each)
 RGBA_FLOAT_BYTES = 16  # what read_image makes of every pixel: float32 RGBA
+READ_BAND_PIXELS = 1 << 20  # pixels read_image converts at once
 
 
 def read_image(path: str | Path, srgb_to_linear: bool = False,
                unassociated_alpha: bool = False, *, where: str | None = None,
                max_size: int | None = MAX_TEXTURE_SIZE,
-               bytes_per_pixel: int = RGBA_FLOAT_BYTES) -> np.ndarray:
-    """Read an image as float32 RGBA (H, W, 4), top row first. ``unassociated_alpha`` keeps the
+               bytes_per_pixel: int = RGBA_FLOAT_BYTES,
+               dtype: type = np.float32) -> np.ndarray:
+    """Read an image as RGBA (H, W, 4) of ``dtype`` (float32; float16 for a texture, checked
+    before the conversion), top row first. ``unassociated_alpha`` keeps the
     colour channels as stored where a format would associate them with alpha (PNG: data in
     RGBA channels, such as a wetness mask, must not be premultiplied).
 
@@ -227,28 +230,52 @@ def read_image(path: str | Path, srgb_to_linear: bool = False,
     pixels, spec = _decode(path, where, config, max_size, lambda _: bytes_per_pixel)
     if pixels.ndim == 2:
         pixels = pixels[..., None]
-    count = pixels.shape[2]
-    if count < 3:
-        pixels = np.concatenate([np.repeat(pixels[..., :1], 3, axis=2),
-                                 pixels[..., 1:2] if count == 2 else
-                                 np.ones(pixels.shape[:2] + (1,), np.float32)], axis=2)
-    elif count == 3:
-        pixels = np.concatenate([pixels, np.ones(pixels.shape[:2] + (1,), np.float32)], axis=2)
-    pixels = pixels[..., :4]  # extra channels (a depth, an id) are not read: not checked
-    # Every image a scene reads (colours, heights, wetness) holds values from 0 up: NaN,
-    # infinity or a clearly negative value (a float EXR) would shade black or spread NaN
-    # through the frame. Slightly negative values (filter ringing in an HDR image) are 0.
-    bad = ~np.isfinite(pixels) | (pixels < -NEGATIVE_TOLERANCE)
-    if bad.any():
-        y, x = np.argwhere(bad.any(axis=-1))[0]
-        raise InputError(f"image {_culprit(path, where)} has {int(bad.sum()):,} values that are "
-                         f"NaN, infinite or negative (the first at pixel {x}, {y}: "
-                         f"{np.array2string(pixels[y, x], precision=3)}); images hold values "
-                         ">= 0", where)
-    np.maximum(pixels, 0.0, out=pixels)
-    if srgb_to_linear and spec.format.basetype != oiio.FLOAT and spec.format.basetype != oiio.HALF:
-        pixels[..., :3] = srgb_decode(pixels[..., :3])
-    return pixels
+    height, width, count = pixels.shape
+    decode_srgb = srgb_to_linear and spec.format.basetype not in (oiio.FLOAT, oiio.HALF)
+    out = np.empty((height, width, 4), dtype)
+    # a band of rows at a time: the whole image's temporaries (its RGBA expansion, the value
+    # checks, the sRGB curve in float64) were several times the image
+    rows = max(1, READ_BAND_PIXELS // max(width, 1))
+    for first in range(0, height, rows):
+        band = _rgba(pixels[first:first + rows], count)
+        _check_values(band, first, pixels, count, path, where)
+        np.maximum(band, 0.0, out=band)
+        if decode_srgb:
+            band[..., :3] = srgb_decode(band[..., :3])
+        out[first:first + rows] = band
+    return out
+
+
+def _rgba(pixels: np.ndarray, count: int) -> np.ndarray:
+    """(H, W, C) pixels as float32 RGBA: grey to RGB, an opaque alpha where there is none, extra
+    channels (a depth, an id) left out (not read: not checked)."""
+    band = np.empty(pixels.shape[:2] + (4,), np.float32)
+    band[..., :3] = pixels[..., :1] if count < 3 else pixels[..., :3]
+    band[..., 3] = pixels[..., 1] if count == 2 else pixels[..., 3] if count >= 4 else 1.0
+    return band
+
+
+def _check_values(band: np.ndarray, first: int, pixels: np.ndarray, count: int, path: Path,
+                  where: str | None) -> None:
+    """Every image a scene reads (colours, heights, wetness) holds values from 0 up: NaN,
+    infinity or a clearly negative value (a float EXR) would shade black or spread NaN through
+    the frame; slightly negative values (filter ringing in an HDR image) read as 0. ``band``
+    is rows ``first ...`` of ``pixels``; an error counts the bad values of the whole image."""
+    def bad_values(rgba: np.ndarray) -> np.ndarray:
+        return ~np.isfinite(rgba) | (rgba < -NEGATIVE_TOLERANCE)
+
+    bad = bad_values(band)
+    if not bad.any():
+        return
+    y, x = np.argwhere(bad.any(axis=-1))[0]
+    rows = len(band)
+    total = int(bad.sum()) + sum(
+        int(bad_values(_rgba(pixels[start:start + rows], count)).sum())
+        for start in range(first + rows, len(pixels), rows))
+    raise InputError(f"image {_culprit(path, where)} has {total:,} values that are "
+                     f"NaN, infinite or negative (the first at pixel {x}, {first + y}: "
+                     f"{np.array2string(band[y, x], precision=3)}); images hold values "
+                     ">= 0", where)
 
 
 def read_channels(path: str | Path, *, where: str | None = None, max_size: int | None = None

@@ -1,0 +1,73 @@
+"""Images are read and uploaded a band of rows at a time (#22: an 8192^2 grey texture inside
+the image budget peaked at 7.8 GB): the result is the whole-image conversion's, checked against
+a numpy reference of read_image's rules, with bands of a few rows."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import deferred.gl.resources as resources
+import deferred.io.images as images
+from deferred.errors import InputError
+from deferred.io.images import read_image, write_image
+
+
+def reference_rgba(stored: np.ndarray, srgb: bool) -> np.ndarray:
+    """read_image's rules on the whole image: grey to RGB, alpha 1 where there is none, values
+    under 0 to 0, the sRGB curve on colour."""
+    count = stored.shape[2]
+    rgb = np.repeat(stored[..., :1], 3, axis=2) if count < 3 else stored[..., :3]
+    alpha = stored[..., 1:2] if count == 2 else stored[..., 3:4] if count >= 4 else \
+        np.ones(stored.shape[:2] + (1,))
+    out = np.maximum(np.concatenate([rgb, alpha], axis=2).astype(np.float64), 0.0)
+    if srgb:
+        c = out[..., :3]
+        out[..., :3] = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+    return out
+
+
+@pytest.mark.parametrize("count", [1, 2, 3, 4, 5])
+def test_banded_reading_is_the_whole_images(tmp_path, monkeypatch, count):
+    monkeypatch.setattr(images, "READ_BAND_PIXELS", 3 * 17)  # three rows a band, one short
+    rng = np.random.default_rng(count)
+    stored = rng.random((23, 17, count)).astype(np.float32) - 0.0005  # some read as 0
+    exr = write_image(tmp_path / "c.exr", stored, channels=("R", "G", "B", "A", "Z")[:count]
+                      if count != 2 else ("Y", "A"))
+    files = [(exr, stored, False)]
+    if count in (1, 3):  # 8-bit, decoded from sRGB
+        codes = (rng.random((23, 17, count)) * 255).astype(np.uint8)
+        files.append((write_image(tmp_path / "c.png", codes), codes / 255.0, True))
+    for path, values, srgb in files:
+        got = read_image(path, srgb_to_linear=srgb)
+        assert got.dtype == np.float32 and got.shape == (23, 17, 4)
+        np.testing.assert_allclose(got, reference_rgba(values, srgb), atol=1e-6)
+        half = read_image(path, srgb_to_linear=srgb, dtype=np.float16)
+        assert half.dtype == np.float16
+        np.testing.assert_array_equal(half, got.astype(np.float16))
+
+
+def test_bad_values_are_counted_over_every_band(tmp_path, monkeypatch):
+    monkeypatch.setattr(images, "READ_BAND_PIXELS", 2 * 8)
+    pixels = np.full((10, 8, 3), 0.5, np.float32)
+    pixels[3, 5, 1] = np.nan  # the first, in the second band
+    pixels[9, 0, :] = -1.0  # three more, in the last band
+    write_image(tmp_path / "bad.exr", pixels, channels=("R", "G", "B"))
+    with pytest.raises(InputError, match=r"has 4 values that are NaN, infinite or negative "
+                                         r"\(the first at pixel 5, 3: "):
+        read_image(tmp_path / "bad.exr")
+
+
+def test_a_texture_uploaded_in_bands_is_the_image_bottom_row_first(tmp_path, gl, monkeypatch):
+    monkeypatch.setattr(resources, "UPLOAD_BAND_PIXELS", 4 * 13)  # four rows a band
+    rng = np.random.default_rng(2)
+    stored = (rng.random((30, 13, 4)) * 255).astype(np.uint8)
+    path = write_image(tmp_path / "t.png", stored)
+    cache = resources.Resources(gl.ctx)
+    try:
+        texture = cache.image_texture(path, srgb=False)
+        texels = np.frombuffer(texture.read(), np.float16).reshape(30, 13, 4)
+        expected = read_image(path, dtype=np.float16)[::-1]
+        np.testing.assert_array_equal(texels, expected)
+    finally:
+        cache.release()
