@@ -24,6 +24,7 @@ from deferred.io.images import read_channels, write_image, write_text
 from deferred.io.safety import same_file
 
 COMPARE_FILE = "compare.json"  # marks a folder as a comparison's output
+COMPARE_BAND_PIXELS = 1 << 20  # pixels compared at once
 DIFFERENCE_PASS_IMAGE = re.compile(r"passes/[^/]+\.(exr|png)")
 
 
@@ -164,18 +165,42 @@ def _compare_buffer(key: str, path_a: Path, path_b: Path, out: Path | None) -> B
     if sorted(names_a) != sorted(names_b):
         return BufferDiff(key, names_b, problem="channels differ: "
                           f"{' '.join(names_a)} vs {' '.join(names_b)}")
-    b = b[..., [names_b.index(n) for n in names_a]]
-    both_nan = np.isnan(a) & np.isnan(b)
-    diff = np.where(both_nan, 0.0, np.abs(b - a))
-    diff = np.where(np.isnan(diff), np.inf, diff).astype(np.float32)
-    result = BufferDiff(key, names_a, float(diff.max()), float(diff.mean()),
-                        int(np.count_nonzero(diff.max(axis=-1))),
-                        {n: float(diff[..., k].max()) for k, n in enumerate(names_a)})
+    order = [names_b.index(n) for n in names_a]
+    height, width, count = a.shape
+    # |B - A| into A's array, a band of rows at a time: two 8192^2 EXRs and their float
+    # temporaries peaked at six times one of them
+    diff = a
+    rows = max(1, COMPARE_BAND_PIXELS // width)
+    total = np.zeros(count)
+    channel_max = np.zeros(count, np.float32)
+    pixels = 0
+    finite_peak = 0.0  # of the largest channel difference, for the heat image
+    for first in range(0, height, rows):
+        band_a, band_b = a[first:first + rows], b[first:first + rows][..., order]
+        both_nan = np.isnan(band_a) & np.isnan(band_b)
+        band = np.abs(band_b - band_a)
+        band[np.isnan(band)] = np.inf  # NaN against a number
+        band[both_nan] = 0.0
+        diff[first:first + rows] = band
+        total += band.sum(axis=(0, 1), dtype=np.float64)
+        channel_max = np.maximum(channel_max, band.max(axis=(0, 1)))
+        largest = band.max(axis=-1)
+        pixels += int(np.count_nonzero(largest))
+        finite = largest[np.isfinite(largest)]
+        finite_peak = max(finite_peak, float(finite.max()) if finite.size else 0.0)
+    del b
+    result = BufferDiff(key, names_a, float(channel_max.max()),
+                        float(total.sum() / max(diff.size, 1)), pixels,
+                        {n: float(channel_max[k]) for k, n in enumerate(names_a)})
     if out is not None and result.max > 0.0:
         stem = _image_stem(key)
         (out / stem).parent.mkdir(parents=True, exist_ok=True)
         write_image(out / f"{stem}.exr", diff, channels=names_a)
-        write_image(out / f"{stem}.png", to_uint8(heat_colors(diff.max(axis=-1))))
+        heat = np.empty((height, width, 3), np.uint8)
+        for first in range(0, height, rows):
+            heat[first:first + rows] = to_uint8(heat_colors(
+                diff[first:first + rows].max(axis=-1), finite_peak))
+        write_image(out / f"{stem}.png", heat)
         result.image = f"{stem}.exr"
     return result
 

@@ -72,11 +72,13 @@ def depth_colors(depth: np.ndarray, covered: np.ndarray) -> np.ndarray:
     return rgb
 
 
-def heat_colors(values: np.ndarray) -> np.ndarray:
-    """Turbo from 0 to the largest finite value (infinite ones at the top); exact 0 black."""
+def heat_colors(values: np.ndarray, peak: float | None = None) -> np.ndarray:
+    """Turbo from 0 to ``peak``, by default the largest finite value (infinite ones at the
+    top); exact 0 black. (A band of a larger image is coloured with the image's peak.)"""
     values = np.asarray(values, dtype=np.float32)
     finite = np.isfinite(values)
-    peak = float(values[finite].max()) if finite.any() else 0.0
+    if peak is None:
+        peak = float(values[finite].max()) if finite.any() else 0.0
     t = np.where(finite, values / peak if peak > 0.0 else 0.0, 1.0)
     rgb = _lut("turbo")[np.clip(t * 255.0, 0, 255).astype(np.int32)]
     return np.where((values != 0.0)[..., None], rgb, 0.0).astype(np.float32)

@@ -71,3 +71,44 @@ def test_a_texture_uploaded_in_bands_is_the_image_bottom_row_first(tmp_path, gl,
         np.testing.assert_array_equal(texels, expected)
     finally:
         cache.release()
+
+
+def test_a_comparison_in_bands_is_the_whole_buffers(tmp_path, monkeypatch):
+    """dump --compare takes |B - A| a band of rows at a time (two 8192^2 EXRs peaked at six
+    times one of them): statistics and difference images as numpy gives them for the whole
+    buffers, NaN equal to NaN and infinite against a number, channels matched by name."""
+    import json
+
+    import deferred.debug.compare as compare
+    from deferred.debug.preview import heat_colors, to_uint8
+    from deferred.io.images import read_channels
+
+    monkeypatch.setattr(compare, "COMPARE_BAND_PIXELS", 2 * 11)  # two rows a band
+    rng = np.random.default_rng(9)
+    a = rng.random((9, 11, 3)).astype(np.float32)
+    b = a.copy()
+    b[1:4, 2:5, 0] += 0.25
+    b[7, 8, 2] = 3.0
+    a[5, 5, 1] = b[5, 5, 1] = np.nan  # equal
+    b[6, 1, 1] = np.nan  # NaN against a number
+    (tmp_path / "a").mkdir()
+    (tmp_path / "b").mkdir()
+    write_image(tmp_path / "a" / "light.exr", a, channels=("R", "G", "B"))
+    # B's channels in another order: matched by name
+    write_image(tmp_path / "b" / "light.exr", b[..., [2, 0, 1]], channels=("B", "R", "G"))
+    [result] = compare.compare_dumps(tmp_path / "a", tmp_path / "b", tmp_path / "out")
+    diff = np.abs(b - a)
+    diff[np.isnan(diff)] = np.inf
+    diff[np.isnan(a) & np.isnan(b)] = 0.0
+    assert result.max == np.inf and result.mean == np.inf
+    assert result.pixels == int(np.count_nonzero(diff.max(axis=-1)))
+    assert result.per_channel_max == pytest.approx(
+        {"R": float(diff[..., 0].max()), "G": np.inf, "B": float(diff[..., 2].max())})
+    written, names, _ = read_channels(tmp_path / "out" / "light.exr")
+    assert names == ["R", "G", "B"]
+    np.testing.assert_array_equal(written, diff)
+    heat = read_image(tmp_path / "out" / "light.png")[..., :3]
+    np.testing.assert_allclose(heat, to_uint8(heat_colors(diff.max(axis=-1))) / 255.0,
+                               atol=1e-6)
+    record = json.loads((tmp_path / "out" / "compare.json").read_text())
+    assert record["buffers"][0]["pixels"] == result.pixels
