@@ -454,7 +454,8 @@ def main(argv: list[str] | None = None) -> int:
     with termination_as_interrupt():
         try:
             code = _main(argv)
-            raise_if_stop_requested()  # a signal whose exception was lost (a __del__ ate it)
+            if code < 128:  # not ended by a signal already (said so once)
+                raise_if_stop_requested()  # a signal whose exception was lost (a __del__ ate it)
             return code
         except KeyboardInterrupt as exc:
             return _interrupted(exc)

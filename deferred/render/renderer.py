@@ -22,6 +22,7 @@ from deferred.gl.target_spec import targets_bytes
 from deferred.gl.targets import COMPOSITE, FINAL, FrameTargets
 from deferred.interfaces.material import Material
 from deferred.io.memory import check_memory
+from deferred.io.safety import raise_if_stop_requested
 from deferred.lighting.buffer import LIGHT_BUFFER, LightBuffer
 from deferred.lighting.lists import (
     LIGHT_LISTS,
@@ -199,6 +200,7 @@ class Renderer:
         loops); ``time_gl_calls`` measures the CPU time of the drawing GL calls
         (``RenderResult.gl_call_seconds``, for the bench: two clock reads per call)."""
         self._check_alive()
+        raise_if_stop_requested()  # a signal a library swallowed ends the command here
         if isinstance(time, bool) or not isinstance(time, numbers.Real) or \
                 not math.isfinite(time) or time < 0.0:
             raise InputError(f"frame time must be a finite number of seconds >= 0, got {time!r}",
@@ -245,6 +247,7 @@ class Renderer:
         passes = self.passes
         hooked = before_pass is not None or on_pass is not None
         for index, render_pass in enumerate(passes):
+            raise_if_stop_requested()  # a signal lost in a pass's library or a __del__
             if before_pass:
                 before_pass(render_pass, frame)
             try:

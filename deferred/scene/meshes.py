@@ -13,6 +13,7 @@ import numpy as np
 from deferred.errors import InputError
 from deferred.gl.meshes import MeshData
 from deferred.io.images import first_line
+from deferred.io.safety import raise_if_stop_requested
 from deferred.scene.builtin_meshes import BUILTIN_PREFIX, BUILTIN_SHAPES, builtin_arguments
 from deferred.scene.geometry import build_mesh
 from deferred.validation import require_regular_file
@@ -57,6 +58,9 @@ def load_mesh(spec: str, base_dir: Path | None = None, where: str | None = None)
         reason = first_line(str(exc), default="it is malformed (trimesh stopped with a bare "
                                                f"{type(exc).__name__})")
         raise InputError(f"cannot read mesh {path.name}: {reason}", where) from None
+    # trimesh catches BaseException in places: a Ctrl-C or SIGTERM it swallowed stops here,
+    # not after the rest of the command
+    raise_if_stop_requested()
     for refused in resolver.refused:  # named by the mesh, not opened: say so
         require_regular_file(refused, f"file {refused.name} named by {path.name}", where)
     if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:
