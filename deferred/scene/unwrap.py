@@ -146,8 +146,7 @@ def unwrap_uvs(positions: np.ndarray, indices: np.ndarray,
     finally:
         receiver.close()
         if child.is_alive():  # out of time, interrupted, or the wait itself failed
-            child.terminate()
-            child.join(1.0)
-            if child.is_alive():
-                child.kill()
+            # SIGKILL: it holds nothing to clean up, and a child stopped before it set its
+            # signals up would take SIGTERM through the parent's handler and print a traceback
+            child.kill()
         child.join()

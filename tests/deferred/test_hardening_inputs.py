@@ -199,6 +199,26 @@ def test_unwrap_time_limit(tmp_path, capfd, monkeypatch):
     assert multiprocessing.active_children() == []
 
 
+def test_an_unwrap_ended_before_it_set_its_signals_up_prints_nothing(tmp_path, capfd,
+                                                                      monkeypatch):
+    """DEFERRED_UNWRAP_TIMEOUT=1e-9 printed the child's traceback now and then: a child ended
+    before it set its own signal handlers ran the parent's SIGTERM handler. Here the child
+    waits before setting them up, every time: the error is still one line."""
+    (tmp_path / "tet.obj").write_text(TETRAHEDRON)
+    real_child = deferred.scene.unwrap._unwrap_child
+
+    def slow_to_start(*args):
+        time.sleep(2.0)
+        real_child(*args)
+
+    monkeypatch.setattr(deferred.scene.unwrap, "_unwrap_child", slow_to_start)
+    monkeypatch.setenv("DEFERRED_UNWRAP_TIMEOUT", "0.2")
+    code, err, out = render_scene(tmp_path, capfd, {"mesh": "tet.obj", "material": "standard"})
+    assert_one_line_error(code, err, "object[0].mesh", "tet.obj",
+                          "UV unwrap did not finish in 0.2 s; give the mesh UVs or simplify it")
+    assert multiprocessing.active_children() == []
+
+
 def test_ctrl_c_ends_the_unwrap(tmp_path, monkeypatch):
     (tmp_path / "tet.obj").write_text(TETRAHEDRON)
     monkeypatch.setattr(deferred.scene.unwrap, "_xatlas_parametrize", _sleep_for_ever)
