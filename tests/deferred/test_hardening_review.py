@@ -47,6 +47,11 @@ def folder_texture(folder):
     (folder / "textures").mkdir()
 
 
+def fifo_material_library(folder):
+    (folder / "tri.obj").write_text("mtllib lib.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    os.mkfifo(folder / "lib.mtl")
+
+
 # (id, scene text, command after "render s.toml -o out.png" or a whole command, setup,
 #  fragments of the one line)
 CASES = [
@@ -90,6 +95,32 @@ CASES = [
     ("frames-too-many", scene(), ["--frames", "100000000"], None, ["--frames"]),
     ("output-folder-name-too-long", scene(), ["-o", "d" * 300 + "/out.png"], None,
      ["-o", "folder name longer than 255 bytes"]),
+    # issue #22
+    ("droplets-covering-the-mask", scene(material="shell_fur", params="droplets = 10000\n"
+                                         "droplet_radius = 100.0\nmask_size = 4096"),
+     None, None, ["object[0].params.droplets", "wetness-mask texels", "the most is 400,000,000"]),
+    ("many-droplets-of-radius-1", scene(material="shell_fur", params="droplets = 10000\n"
+                                        "droplet_radius = 1.0\nmask_size = 4096"),
+     None, None, ["object[0].params.droplets", "10,000 droplets by t = 0 s"]),
+    ("droplets-falling", scene(material="shell_fur", params="droplets = 20",
+                               extra='[[event]]\ntime = 1.0\nobject = "ball"\n'
+                                     'params = {droplets = 5}'), None, None,
+     ["event[0].params.droplets", "may rise on a timeline, not fall"]),
+    ("gif-frames-past-the-budget", scene(), ["--size", "4096x4096", "--frames", "100000", "-o",
+                                             "x.gif"], None,
+     ["--frames", "100,000 frames of 4096x4096 held for a GIF take 3.1 TiB"]),
+    ("dump-past-the-budget", scene(), ["dump", "s.toml", "-o", "dump", "--size", "4096x4096"],
+     None, ["size: a dump of 4096x4096 holds", "--passes to capture fewer passes"]),
+    ("size-with-underscores", scene(), ["--size", "1_60x9_0"], None, ["--size"]),
+    ("fps-whose-last-frame-overflows", scene(), ["--fps", "5e-324", "--frames", "3"], None,
+     ["--fps", "no finite time"]),
+    ("scale-too-small", scene().replace('material = "standard"',
+                                        'material = "standard"\nscale = 1e-300'), None, None,
+     ["object[0]", "scale must be at least 1e-06"]),
+    ("wind-one-short", scene(material="shell_fur", params="wind = [1.0, 2.0]"), None, None,
+     ["object[0].params.wind", "expected more than the 2 values given"]),
+    ("fifo-material-library", scene(mesh="tri.obj"), None, fifo_material_library,
+     ["object[0].mesh", "lib.mtl", "not a regular file"]),
 ]
 
 
@@ -103,8 +134,10 @@ def test_hostile_input_exits_2_with_one_short_line(tmp_path, capsys, monkeypatch
         setup(tmp_path)
     before = sorted(p.name for p in tmp_path.iterdir())
     args = ["render", "s.toml", "-o", "out.png", *(options or [])]
-    if options and options[0] == "-o":
+    if options and "-o" in options:
         args = ["render", "s.toml", *options]
+    if options and options[0] == "dump":
+        args = options
     start = time.perf_counter()
     code = main(args)
     elapsed = time.perf_counter() - start
