@@ -53,6 +53,7 @@ from deferred.gbuffer import (
     GBufferData,
 )
 from deferred.gl.meshes import GpuMesh, MeshData
+from deferred.gl.resources import image_texture_bytes
 from deferred.gl.shaderlib import register_shader_root
 from deferred.gl.target_spec import TargetSpec
 from deferred.gl.targets import (
@@ -122,7 +123,8 @@ __all__ = [
     "LightParams", "LightPath", "LightVolume", "Material", "MaterialParams", "MeshData",
     "NonZeroVec3", "ObjectPass", "Order", "Params", "Phase", "Pipeline", "Radiance",
     "RenderError", "RenderPass", "Scene", "SceneObject", "ShadingModel", "TargetSpec",
-    "UniformOverrides", "check_image", "copy_pass", "effects", "lights", "materials",
+    "UniformOverrides", "check_image", "copy_pass", "effects", "image_texture_bytes", "lights",
+    "materials",
     "radiances", "read_channels", "read_image", "register_shader_root", "require_regular_file",
     "shading_models",
     "view_direction", "view_directions", "view_point", "view_points",

@@ -38,6 +38,8 @@ from deferred.api import (
     InputError,
     Phase,
     RenderPass,
+    check_image,
+    image_texture_bytes,
     materials,
     read_image,
 )
@@ -532,6 +534,17 @@ class ShellFurMaterial(FurMaterial):
                 read_mask_image(path) if key == "wetness_mask" else read_image(path)
             except InputError as exc:
                 raise InputError(exc.message, name) from None
+
+    def held_memory(self, obj: SceneObject) -> dict[str, int]:
+        """The fur volume, the colour texture, and the wetness mask: its array and its float
+        RGBA texture, ``mask_size`` squared each."""
+        held = super().held_memory(obj)
+        if self.params.color_texture is not None:
+            path = self.resolve_path(self.params.color_texture)
+            width, height, _ = check_image(path)
+            held[f"texture {path}"] = image_texture_bytes(width, height)
+        held[f"wetness mask of {obj.label}"] = 2 * self.params.mask_size ** 2 * 16
+        return held
 
     def wetness_mask_path(self, params: ShellFurParams | None = None) -> Path | None:
         params = params or self.params

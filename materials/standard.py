@@ -12,6 +12,7 @@ from deferred.api import (
     BlinnPhongParams,
     Material,
     check_image,
+    image_texture_bytes,
     materials,
 )
 
@@ -39,6 +40,13 @@ class StandardMaterial(Material):
         path = self.file_parameter(self.params.texture, "texture file", key)
         # the texture is read when GL draws it: a bad file fails now, not after GL starts
         check_image(path, key)
+
+    def held_memory(self, obj) -> dict[str, int]:
+        if self.params.texture is None:
+            return {}
+        path = self.resolve_path(self.params.texture)
+        width, height, _ = check_image(path, getattr(self, "_texture_key", None))
+        return {f"texture {path}": image_texture_bytes(width, height)}
 
     def defines(self, obj) -> dict[str, str]:
         defines = super().defines(obj)

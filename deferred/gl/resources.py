@@ -16,6 +16,12 @@ from deferred.io.images import read_image
 UPLOAD_BAND_PIXELS = 1 << 20  # texels written to a texture at once
 
 
+def image_texture_bytes(width: int, height: int) -> int:
+    """GPU bytes of :meth:`Resources.image_texture` for an image of ``width`` x ``height``:
+    float16 RGBA and its mipmaps (a third more)."""
+    return width * height * 8 * 4 // 3
+
+
 class Resources:
     """GPU objects that outlive one frame: meshes, textures loaded from files, helper geometry."""
 

@@ -205,6 +205,13 @@ class Material:
                 return False
         return False  # not a Material subclass's MRO (a mixin listed after it)
 
+    def held_memory(self, obj: SceneObjectLike) -> dict[str, int]:
+        """Bytes this material will hold for ``obj`` (textures, simulation state) by what they
+        are, counted with the render targets against the memory budget before the first frame:
+        a key names the thing (``texture /path/fur.png``), so a texture objects share counts
+        once. Files are sized by their headers. By default nothing."""
+        return {}
+
     def check_time(self, time: float, where: str) -> None:
         """Refuse (``InputError`` naming ``where``) a frame time this material cannot reach in
         bounded work, before any frame is rendered: a simulation stepping from 0 to it."""

@@ -21,6 +21,7 @@ from deferred.gl.shaderlib import ShaderLibrary
 from deferred.gl.target_spec import targets_bytes
 from deferred.gl.targets import COMPOSITE, FINAL, FrameTargets
 from deferred.interfaces.material import Material
+from deferred.io.images import amount
 from deferred.io.memory import check_memory
 from deferred.io.safety import raise_if_stop_requested
 from deferred.lighting.buffer import LIGHT_BUFFER, LightBuffer
@@ -61,11 +62,29 @@ def strict_default() -> bool:
     return os.environ.get("DEFERRED_STRICT", "") in ("1", "true", "yes")
 
 
-def check_target_memory(graph: PassGraph, size: tuple[int, int], where: str = "size") -> None:
-    """Refuse a frame size whose render targets need more than the memory budget."""
-    check_memory(targets_bytes(graph.targets.values(), *size),
-                 f"{size[0]}x{size[1]} needs {{}} of render targets "
-                 f"({len(graph.targets)} targets)", where)
+def check_target_memory(graph: PassGraph, size: tuple[int, int], where: str = "size",
+                        held: dict[str, int] | None = None, held_where: str = "scene") -> None:
+    """Refuse a frame size whose render targets need more than the memory budget (naming
+    ``where``), then a scene whose materials will hold more (``held``:
+    :meth:`~deferred.interfaces.material.Material.held_memory`) than what the targets leave
+    (naming ``held_where`` and the largest of what they hold)."""
+    targets = targets_bytes(graph.targets.values(), *size)
+    check_memory(targets, f"{size[0]}x{size[1]} needs {{}} of render targets "
+                          f"({len(graph.targets)} targets)", where)
+    if held:
+        largest = max(held, key=held.__getitem__)
+        check_memory(targets + sum(held.values()),
+                     f"the materials' textures and state ({len(held)}, the largest "
+                     f"{largest}: {amount(held[largest])}) and the render targets at "
+                     f"{size[0]}x{size[1]} need {{}}", held_where)
+
+
+def held_memory(scene: Scene) -> dict[str, int]:
+    """What every object's material will hold, by what it is (a shared texture once)."""
+    held: dict[str, int] = {}
+    for obj in scene.objects:
+        held.update(obj.material.held_memory(obj))
+    return held
 
 
 class Renderer:
@@ -104,7 +123,8 @@ class Renderer:
         self.graph: PassGraph = check_passes(PIPELINES[pipeline](provisional).build(scene))
         # where the frame size came from, for errors about it
         self.size_where = "size" if given else f"{scene.source}: size"
-        check_target_memory(self.graph, self.size, self.size_where)
+        check_target_memory(self.graph, self.size, self.size_where, held_memory(scene),
+                            scene.source)
         light_types = scene.light_types()
         shading_models = self.shading_models = scene.shading_models()
         self.object_transforms = ObjectTransforms()  # kept across frames

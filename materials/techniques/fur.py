@@ -25,10 +25,15 @@ import moderngl
 import numpy as np
 from pydantic import Field, model_validator
 
-from deferred.api import Material, MaterialParams
+from deferred.api import Material, MaterialParams, check_image
 
 from .fur_volume import FurPattern, pattern, strand_volume, volume_texture
-from .heightfield import heightfield_volume, load_heightfield
+from .heightfield import (
+    HEIGHTFIELD_BYTES_PER_TEXEL,
+    HEIGHTFIELD_GPU_BYTES_PER_TEXEL,
+    heightfield_volume,
+    load_heightfield,
+)
 
 if TYPE_CHECKING:
     from deferred.api import Frame, SceneObject
@@ -167,6 +172,13 @@ class FurMaterial(Material):
         key = f"{where}.heightfield" if where else "heightfield"
         load_heightfield(self.file_parameter(self.params.heightfield, "heightfield image",
                                              key), key)
+
+    def held_memory(self, obj: SceneObject) -> dict[str, int]:
+        path = self.heightfield_path()
+        if path is None:
+            return {}
+        width, height, _ = check_image(path, bytes_per_pixel=HEIGHTFIELD_BYTES_PER_TEXEL)
+        return {f"fur volume of {path}": width * height * HEIGHTFIELD_GPU_BYTES_PER_TEXEL}
 
     def heightfield_path(self) -> Path | None:
         return None if self.params.heightfield is None else \

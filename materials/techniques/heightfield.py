@@ -19,6 +19,7 @@ from .fur_volume import VOLUME_LAYERS
 # counts this. On the GPU a texel then takes 61 RGBA8 subslices with their mipmaps, about 325
 # bytes.
 HEIGHTFIELD_BYTES_PER_TEXEL = VOLUME_LAYERS * 64
+HEIGHTFIELD_GPU_BYTES_PER_TEXEL = 325
 
 
 def load_heightfield(path: Path, where: str | None = None) -> np.ndarray:

@@ -112,3 +112,40 @@ def test_a_comparison_in_bands_is_the_whole_buffers(tmp_path, monkeypatch):
                                atol=1e-6)
     record = json.loads((tmp_path / "out" / "compare.json").read_text())
     assert record["buffers"][0]["pixels"] == result.pixels
+
+
+def test_textures_and_material_state_count_against_the_memory_budget(tmp_path, capsys,
+                                                                      monkeypatch):
+    """Before GL starts, each object's material says what it will hold (held_memory: a texture
+    by its header, a wetness mask by mask_size); with the render targets past the budget the
+    scene is refused naming the largest. A texture two objects share counts once. (Eight
+    8192^2 textures were each inside the image budget and 5.3 GiB together.)"""
+    from deferred.cli import main
+    from deferred.gl.resources import image_texture_bytes
+    from deferred.render.renderer import held_memory
+    from deferred.scene.loader import load_scene
+
+    write_image(tmp_path / "a.png", np.zeros((64, 128, 3), np.uint8))
+    write_image(tmp_path / "b.png", np.zeros((32, 32, 3), np.uint8))
+    objects = "".join(f'[[object]]\nmesh = "builtin:sphere"\nmaterial = "standard"\n'
+                      f'position = [{k}, 0, 0]\n[object.params]\ntexture = "{name}"\n'
+                      for k, name in enumerate(["a.png", "a.png", "b.png"]))
+    objects += ('[[object]]\nmesh = "builtin:plane"\nmaterial = "shell_fur"\n'
+                '[object.params]\nmask_size = 512\n')
+    scene_file = tmp_path / "s.toml"
+    scene_file.write_text("size = [32, 18]\n" + objects)
+    held = held_memory(load_scene(scene_file))
+    assert held == {f"texture {tmp_path / 'a.png'}": image_texture_bytes(128, 64),
+                    f"texture {tmp_path / 'b.png'}": image_texture_bytes(32, 32),
+                    "wetness mask of plane0": 2 * 512 * 512 * 16}
+    assert image_texture_bytes(128, 64) == 128 * 64 * 8 * 4 // 3
+    # a budget the targets fit in, and not the wetness mask with them
+    monkeypatch.setenv("DEFERRED_TARGET_MEMORY", str(8 << 20))
+    code = main(["render", str(scene_file), "-o", str(tmp_path / "out.png")])
+    err = capsys.readouterr().err
+    assert code == 2 and err.startswith(
+        "error: s.toml: the materials' textures and state (3, the largest wetness mask "
+        "of plane0: 8.0 MiB) and the render targets at 32x18 need 8."), err
+    assert not (tmp_path / "out.png").exists()
+    monkeypatch.setenv("DEFERRED_TARGET_MEMORY", str(16 << 20))
+    assert main(["render", str(scene_file), "-o", str(tmp_path / "out.png")]) == 0
