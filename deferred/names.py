@@ -20,6 +20,8 @@ class NameEnum(str, Enum):
 
 
 class Pipeline(NameEnum):
+    """The two pipelines (``--pipeline``): G-buffer then lights, or one lit pass per object."""
+
     DEFERRED = "deferred"
     FORWARD = "forward"
 

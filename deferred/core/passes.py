@@ -26,6 +26,8 @@ if TYPE_CHECKING:
 
 
 class Phase(str, Enum):
+    """The phases of a frame, in the order they run; a pass belongs to one."""
+
     GEOMETRY = "geometry"  # opaque G-buffer passes
     SCREEN = "screen"  # effects needing a clean G-buffer (SSAO, edges), before stipple
     STIPPLE = "stipple"  # stippled G-buffer passes

@@ -34,6 +34,11 @@ class EffectParams(Params):
 
 
 class Effect:
+    """A scene-level effect (``[[effect]]`` in a scene file): a ``name``, a validated
+    ``Params`` model and the passes it adds to a pipeline (:meth:`passes`, in any phase).
+    ``pipelines`` names the pipelines it applies to; the others skip it with a warning.
+    """
+
     name: ClassVar[str]
     Params: ClassVar[type[EffectParams]] = EffectParams
     pipelines: ClassVar[tuple[str, ...]] = tuple(Pipeline)

@@ -27,11 +27,19 @@ from deferred.validation import Radiance
 Vec3 = tuple[float, float, float]
 
 class LightParams(Params):
+    """Base of every light's parameter model: a colour and its intensity."""
+
     color: Radiance = Field((1.0, 1.0, 1.0), description="linear RGB colour, each >= 0")
     intensity: float = Field(1.0, ge=0.0, description="multiplier of color")
 
 
 class Light:
+    """A light type: a ``name``, a validated ``Params`` model, a GLSL function
+    (``glsl_file``, ``glsl_function``: ``vec3 f(LightRecord light, Surface s, vec3 P, vec3 V)``)
+    and how it packs itself for the GPU (:meth:`record`: four ``vec4`` in view space).
+    ``volume`` says whether it lights the whole screen or a sphere around it.
+    """
+
     name: ClassVar[str]
     Params: ClassVar[type[LightParams]] = LightParams
     glsl_file: ClassVar[str] = ""
@@ -66,6 +74,7 @@ class Light:
 
 
 def view_point(view: np.ndarray, point) -> np.ndarray:
+    """A world-space point in view space (``view`` is the 4x4 world-to-view matrix)."""
     return (view @ np.append(np.asarray(point, dtype=np.float64), 1.0))[:3]
 
 
@@ -87,5 +96,6 @@ def radiances(lights: list[Light]) -> np.ndarray:
 
 
 def view_direction(view: np.ndarray, direction) -> np.ndarray:
+    """A world-space direction in view space, normalised (rotation only)."""
     d = view[:3, :3] @ np.asarray(direction, dtype=np.float64)
     return d / max(np.linalg.norm(d), 1e-12)

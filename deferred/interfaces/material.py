@@ -79,6 +79,15 @@ class ForwardLitPass(ObjectPass):
 
 
 class Material:
+    """A material: a unique ``name``, a validated ``Params`` model and a GLSL surface function
+    (``surface_shader``, ``Surface material_surface(SurfaceInput i)``) lit by ``shading_model``.
+
+    The base class gives each object a G-buffer pass and a forward lit pass; the per-object
+    hooks (:meth:`geometry_passes`, :meth:`stipple_passes`, :meth:`material_passes`,
+    :meth:`forward_passes`, ...) and :meth:`scene_passes` add more. Every parameter becomes a
+    ``u_<field>`` uniform unless ``uniform_overrides`` says otherwise.
+    """
+
     name: ClassVar[str]
     Params: ClassVar[type[MaterialParams]] = MaterialParams
     surface_shader: ClassVar[str] = ""

@@ -352,5 +352,6 @@ class Renderer:
 def render_scene(scene: Scene, pipeline: str = Pipeline.DEFERRED,
                  size: tuple[int, int] | None = None, gl: GLContext | None = None,
                  time: float = 0.0) -> RenderResult:
+    """Render one frame of ``scene`` at ``time`` with a renderer made and released for it."""
     with Renderer(scene, pipeline, size, gl) as renderer:
         return renderer.render(time=time)

@@ -168,6 +168,8 @@ def load_scene(path: str | Path | None = None) -> Scene:
 
 
 def scene_from_toml(text: str, name: str = "<string>", base_dir: Path | None = None) -> Scene:
+    """A scene from the text of a scene file; ``name`` is what errors call it, ``base_dir``
+    where relative mesh and texture paths are found."""
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -179,6 +181,8 @@ def scene_from_toml(text: str, name: str = "<string>", base_dir: Path | None = N
 
 def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
                     base_dir: Path | None = None) -> Scene:
+    """A scene from a scene file's tables as a dict (what :func:`scene_from_toml` parses);
+    validated the same way, errors naming ``name`` and the key."""
     try:
         model = SceneModel(**data)
     except ValidationError as exc:
