@@ -8,7 +8,7 @@ a define, a file) or to a function of the value giving the uniforms it becomes.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from typing import Any
 
 from pydantic import BaseModel, ConfigDict, ValidationError
@@ -32,6 +32,15 @@ class Params(StrictValues):
     finite and nothing is converted from another type (:class:`StrictValues`)."""
 
     model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+    def model_copy(self, *, update: Mapping[str, Any] | None = None,
+                   deep: bool = False) -> Params:
+        """A copy with ``update``'s values, validated as a scene file's are (pydantic's
+        ``model_copy`` takes them unchecked: ``specular_exponent=-5`` would render);
+        ``InputError`` naming the key."""
+        if not update:
+            return super().model_copy(deep=deep)
+        return validate_params(type(self), {**self.model_dump(), **update}, None)
 
 
 def validate_params(model: type[Params], values: dict[str, Any], where: str | None) -> Params:

@@ -37,6 +37,7 @@ def render(gl):
     def _render(scene, pipeline="deferred", size=None, light_path=None, **kwargs):
         renderer = Renderer(scene, pipeline, size, gl=gl, light_path=light_path)
         made.append(renderer)
+        kwargs.setdefault("hdr", kwargs.get("readback", True))  # tests compare it later
         return renderer.render(**kwargs), renderer
 
     yield _render

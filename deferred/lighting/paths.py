@@ -34,7 +34,7 @@ if TYPE_CHECKING:
     from deferred.gl.context import Features
 
 def resolve_light_path(pipeline: str, requested: str | None, features: Features,
-                       where: str = "--light-path") -> str:
+                       where: str = "light_path") -> str:
     """The light path a pipeline runs: ``requested`` (either pipeline's name of it), or the
     fastest this context allows (tiled when compute shaders exist; volumes and naive on GL 3.3,
     where they are the only ones)."""

@@ -136,7 +136,7 @@ class Pipeline:
         self.light_path = light_path or names.LightPath.TILED
         if self.light_path not in self.light_paths:
             raise InputError(f"the {self.name} pipeline has no light path '{self.light_path}' "
-                             f"(choose from {', '.join(self.light_paths)})", "--light-path")
+                             f"(choose from {', '.join(self.light_paths)})", "light_path")
 
     def build(self, scene: Scene) -> list[RenderPass]:
         raise NotImplementedError

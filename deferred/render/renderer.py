@@ -7,13 +7,14 @@ import numbers
 import os
 import warnings
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
 from deferred.core.frame import Frame
 from deferred.core.graph import PassGraph, PassGraphError
-from deferred.core.passes import RenderPass
+from deferred.core.passes import Phase, RenderPass
 from deferred.errors import DeferredError, InputError, RenderError, gl_error
 from deferred.gl.context import Features, GLContext, acquire_context, give_back_context
 from deferred.gl.resources import Resources
@@ -21,7 +22,7 @@ from deferred.gl.shaderlib import ShaderLibrary
 from deferred.gl.target_spec import targets_bytes
 from deferred.gl.targets import COMPOSITE, FINAL, FrameTargets
 from deferred.interfaces.material import Material
-from deferred.io.images import amount
+from deferred.io.images import amount, write_image
 from deferred.io.memory import check_memory
 from deferred.io.safety import raise_if_stop_requested
 from deferred.lighting.buffer import LIGHT_BUFFER, LightBuffer
@@ -42,7 +43,7 @@ from deferred.render.caches import (
 )
 from deferred.render.generated import generated_glsl
 from deferred.render.pipeline import PIPELINES, check_passes
-from deferred.scene.model import Scene, check_size
+from deferred.scene.model import Scene, SceneObject, check_size
 
 PassCallback = Callable[[RenderPass, Frame], None]
 FULL_FEATURES = Features(storage_buffers=True, compute_shaders=True)
@@ -50,11 +51,54 @@ FULL_FEATURES = Features(storage_buffers=True, compute_shaders=True)
 
 @dataclass
 class RenderResult:
-    image: np.ndarray | None  # (H, W, 4) uint8, sRGB, top row first (None: no readback)
-    hdr: np.ndarray | None  # (H, W, 4) float32, linear composite, top row first
+    """One frame: ``image`` (H, W, 4) uint8 sRGB, top row first (None: rendered with
+    ``readback=False``); ``hdr`` the linear float composite (H, W, 4), read from the GPU when
+    first asked for, which must be before the renderer's next frame (or ask for it at once
+    with ``render(hdr=True)``); the draw calls, in all and by pass. ``save(path)`` writes the
+    frame (.png the image, .exr the composite); in a notebook the result shows as its image."""
+
+    image: np.ndarray | None
     draw_calls: int
     draws_by_pass: dict[str, int]
     gl_call_seconds: float = 0.0  # inside drawing GL calls (FrameStats; time_gl_calls only)
+    _hdr: np.ndarray | None = field(default=None, repr=False)
+    _read_hdr: Callable[[], np.ndarray] | None = field(default=None, repr=False, compare=False)
+
+    @property
+    def hdr(self) -> np.ndarray:
+        if self._hdr is None:
+            if self._read_hdr is None:
+                raise RenderError("this result has no HDR composite (rendered with "
+                                  "readback=False)")
+            self._hdr = self._read_hdr()
+            self._read_hdr = None
+        return self._hdr
+
+    def save(self, path: str | Path) -> Path:
+        """Write the frame to ``path``: the image as .png, the linear composite as .exr
+        (float RGBA). Written whole or not at all; returns the path."""
+        path = Path(path)
+        suffix = path.suffix.lower()
+        if suffix == ".exr":
+            return write_image(path, self.hdr, channels=("R", "G", "B", "A"))
+        if suffix != ".png":
+            raise InputError(f"saves .png (the image) or .exr (the linear composite), got "
+                             f"'{path.name}'", "path")
+        if self.image is None:
+            raise RenderError("this result has no image (rendered with readback=False)")
+        return write_image(path, self.image)
+
+    def _repr_png_(self) -> bytes | None:
+        """The image as PNG bytes: how Jupyter shows a result."""
+        if self.image is None:
+            return None
+        from io import BytesIO
+
+        from PIL import Image
+
+        buffer = BytesIO()
+        Image.fromarray(np.ascontiguousarray(self.image)).save(buffer, format="PNG")
+        return buffer.getvalue()
 
 
 def strict_default() -> bool:
@@ -107,9 +151,11 @@ class Renderer:
         self._released = False
         if pipeline not in PIPELINES:
             raise InputError(f"unknown pipeline '{pipeline}' (choose from "
-                             f"{', '.join(PIPELINES)})", "--pipeline")
+                             f"{', '.join(PIPELINES)})", "pipeline")
         self.scene = scene
         self.pipeline_name = pipeline
+        self._size_arg, self._light_path_arg = size, light_path  # for a rebuild
+        self._inserted: list[tuple[RenderPass, str | None, str | None]] = []  # insert_pass's
         self.strict = strict_default() if strict is None else strict
         given = size is not None
         self.size = check_size(size if given else scene.size,
@@ -143,6 +189,66 @@ class Renderer:
             # nothing made here outlives a failed constructor, and the context goes back
             self._release_partial()
             raise
+        self._frame_number = 0
+        self._note_scene()
+
+    # -- following the scene -------------------------------------------------------------------
+    def _scene_structure(self) -> tuple:
+        """What the passes, targets and programs are built from, apart from parameters: which
+        objects (their meshes, their materials' types), which lights and effects, the clear
+        colour, the tone mapping operator, the light path and the size asked for."""
+        scene = self.scene
+        return (tuple((id(obj), id(obj.mesh), type(obj.material)) for obj in scene.objects),
+                tuple(map(type, scene.lights)), tuple(map(id, scene.effects)),
+                tuple(scene.background), scene.tonemap, scene.light_path,
+                scene.size if self._size_arg is None else None)
+
+    @staticmethod
+    def _object_passes(obj: SceneObject) -> list[str]:
+        return [p.name for phase in Phase for p in obj.material.passes(phase, obj)]
+
+    def _note_scene(self) -> None:
+        """Keep what the passes were built from (after a frame: the timeline's parameters)."""
+        self._structure = self._scene_structure()
+        self._params_seen = {id(obj): obj.material.params for obj in self.scene.objects}
+        if not hasattr(self, "_passes_seen") or self._frame_number == 0:
+            self._passes_seen = {id(obj): self._object_passes(obj) for obj in self.scene.objects}
+
+    def _follow_scene(self) -> None:
+        """Rebuild before a frame where the scene changed in what the passes are built from;
+        parameters that only change values (uniforms, defines) need nothing here."""
+        changed = self._scene_structure() != self._structure
+        if not changed:
+            for obj in self.scene.objects:
+                params = obj.material.params
+                if params is self._params_seen.get(id(obj)):
+                    continue
+                passes = self._object_passes(obj)
+                if passes != self._passes_seen.get(id(obj)):
+                    changed = True
+                    break
+                self._params_seen[id(obj)] = params
+        if changed:
+            self._rebuild()
+
+    def _rebuild(self) -> None:
+        """A renderer built afresh for the scene on this one's context takes this one's place
+        (this one is left as it was if that fails); passes inserted with insert_pass are
+        inserted again."""
+        replacement = Renderer(self.scene, self.pipeline_name, self._size_arg, gl=self.gl,
+                               strict=self.strict, light_path=self._light_path_arg)
+        try:
+            for render_pass, before, after in self._inserted:
+                replacement.insert_pass(render_pass, before=before, after=after)
+        except BaseException:
+            replacement.release()
+            raise
+        owns, inserted, frame_number = self._owns_context, self._inserted, self._frame_number
+        self._release_parts()
+        self.__dict__.update(replacement.__dict__)
+        replacement._released = True  # its parts are this renderer's now
+        self._owns_context, self._inserted = owns, inserted
+        self._frame_number = frame_number + 1  # results of earlier frames cannot read these
 
     def _build(self, scene: Scene, pipeline: str, requested: str | None, provisional: str,
                roots: list, generated: dict[str, str]) -> None:
@@ -210,15 +316,23 @@ class Renderer:
         self.graph = graph
         self.gl.make_current()
         self._declare_targets()
+        self._inserted.append((render_pass, before, after))
 
     def render(self, on_pass: PassCallback | None = None,
                before_pass: PassCallback | None = None, readback: bool = True,
-               time: float = 0.0, time_gl_calls: bool = False) -> RenderResult:
+               time: float = 0.0, time_gl_calls: bool = False,
+               hdr: bool = False) -> RenderResult:
         """Run every pass once for the frame at ``time`` (seconds: the scene's timeline is
         applied first, and passes see it as ``frame.time``). ``on_pass``/``before_pass`` are
         called around each pass; ``readback=False`` skips reading the images back (timing
-        loops); ``time_gl_calls`` measures the CPU time of the drawing GL calls
-        (``RenderResult.gl_call_seconds``, for the bench: two clock reads per call)."""
+        loops); ``hdr=True`` reads the float composite now (else when ``result.hdr`` is first
+        asked for); ``time_gl_calls`` measures the CPU time of the drawing GL calls
+        (``RenderResult.gl_call_seconds``, for the bench: two clock reads per call).
+
+        Changes to the scene since the last frame are picked up first: objects, lights and
+        effects added or removed, a material or mesh replaced, parameters that add or remove
+        passes, a new background, tone mapping operator or size rebuild the passes and
+        targets (recompiling programs; simulations start over) on the same context."""
         self._check_alive()
         raise_if_stop_requested()  # a signal a library swallowed ends the command here
         if isinstance(time, bool) or not isinstance(time, numbers.Real) or \
@@ -226,6 +340,7 @@ class Renderer:
             raise InputError(f"frame time must be a finite number of seconds >= 0, got {time!r}",
                              "time")
         time = float(time)
+        self._follow_scene()
         self.check_times([time], "time")
         self.scene.apply_timeline(time)
         self.gl.make_current()
@@ -289,9 +404,25 @@ class Renderer:
         if self.strict:
             inputs.check_material_uniforms()
         self.last_frame = frame
-        image, hdr = (self.read_final(), self.read_hdr()) if readback else (None, None)
-        return RenderResult(image, hdr, frame.stats.draw_calls, dict(frame.stats.draws_by_pass),
-                            frame.stats.gl_call_seconds)
+        self._frame_number += 1
+        self._note_scene()
+        result = RenderResult(self.read_final() if readback else None, frame.stats.draw_calls,
+                              dict(frame.stats.draws_by_pass), frame.stats.gl_call_seconds)
+        if readback:
+            if hdr:
+                result._hdr = self.read_hdr()
+            else:
+                result._read_hdr = self._hdr_reader(self._frame_number)
+        return result
+
+    def _hdr_reader(self, frame_number: int) -> Callable[[], np.ndarray]:
+        def read() -> np.ndarray:
+            if self._released or self._frame_number != frame_number:
+                raise RenderError("the HDR composite of this frame is gone: the renderer has "
+                                  "rendered again or been released since; read result.hdr "
+                                  "first, or render(hdr=True)")
+            return self.read_hdr()
+        return read
 
     def check_times(self, times: list[float], where: str = "--time") -> None:
         """Every material's :meth:`~deferred.interfaces.material.Material.check_time` for the
@@ -330,17 +461,21 @@ class Renderer:
             return
         self._released = True
         try:
-            self.gl.make_current()
-            self.gl.park()
-            # every part made so far (a constructor that failed part way made only some)
-            for name in ("kept_inputs", "light_buffer", "light_lists", "resources", "targets",
-                         "shaders"):
-                part = getattr(self, name, None)
-                if part is not None:
-                    part.release()
+            self._release_parts()
         finally:
             if self._owns_context:  # whatever failed above, the context goes back
                 give_back_context(self.gl)
+
+    def _release_parts(self) -> None:
+        """Every GL object the renderer made (a constructor that failed part way made only
+        some), not the context."""
+        self.gl.make_current()
+        self.gl.park()
+        for name in ("kept_inputs", "light_buffer", "light_lists", "resources", "targets",
+                     "shaders"):
+            part = getattr(self, name, None)
+            if part is not None:
+                part.release()
 
     def __enter__(self) -> Renderer:
         return self

@@ -17,10 +17,12 @@ from bisect import bisect_right
 from collections import Counter
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
 import numpy as np
+from pydantic import ConfigDict, field_validator
 
 from deferred.core.passes import Phase
 from deferred.errors import InputError
@@ -34,10 +36,29 @@ from deferred.interfaces.shading import ShadingModel
 from deferred.params import validate_params
 from deferred.scene.camera import Camera, model_matrix
 from deferred.scene.meshes import load_mesh
+from deferred.validation import StrictValues
 
 Vec3 = tuple[float, float, float]
 MAX_SIZE = 16384
+MIN_SCALE = 1e-6  # an object smaller is a mistake of units; 1/scale must fit float32
 SIZE_TEXT = re.compile(r"([0-9]+)\s*[xX]\s*([0-9]+)")
+
+
+class Transform(StrictValues):
+    """An object's placement as a scene file gives it: finite numbers, a scale of at least
+    ``MIN_SCALE`` on each axis (its normal matrix would overflow float32)."""
+
+    model_config = ConfigDict(extra="forbid")
+    position: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    rotation: tuple[float, float, float] = (0.0, 0.0, 0.0)  # degrees, X then Y then Z
+    scale: float | tuple[float, float, float] = 1.0
+
+    @field_validator("scale")
+    @classmethod
+    def _check_scale(cls, scale: float | tuple[float, float, float]):
+        if np.any(np.abs(np.broadcast_to(np.asarray(scale, dtype=float), (3,))) < MIN_SCALE):
+            raise ValueError(f"must be at least {MIN_SCALE:g} in size")
+        return scale
 
 
 @dataclass(frozen=True)
@@ -71,6 +92,9 @@ class SceneObject:
     _states: dict[int, MaterialParams] = field(default_factory=dict, init=False, repr=False)
     _values: dict[int, dict[str, Any]] = field(default_factory=dict, init=False, repr=False)
     _times: tuple[float, ...] = field(default=(), init=False, repr=False)
+    # the parameters the timeline set last, and at what time (apply_time)
+    _applied: MaterialParams | None = field(default=None, init=False, repr=False)
+    _applied_time: float = field(default=0.0, init=False, repr=False)
 
     def __post_init__(self) -> None:
         if self.base_params is None:
@@ -199,6 +223,52 @@ class SceneObject:
                              "once from t = 0; set it in the object's own params",
                              f"{where}.{keys[0]}" if len(keys) == 1 else where)
 
+    @property
+    def params(self) -> MaterialParams:
+        """The material's parameters as drawn last (the timeline's state at the frame's time
+        for an object with events). Change them with :meth:`set_params`."""
+        return self.material.params
+
+    def set_params(self, **values: Any) -> MaterialParams:
+        """Change material parameters from Python, validated as a scene file's are
+        (``InputError`` naming the object and the key: ``ball: params.shells: ...``); returns
+        the new parameters. They become the object's base: a timeline's events apply over
+        them from their times on, and every state of the timeline is checked again. The object
+        gets a material instance of its own first, so objects that shared one keep theirs. A
+        renderer drawing the object picks the change up at its next frame (and rebuilds its
+        passes where the change adds or removes some)."""
+        where = f"{self.where}.params" if self.where else f"{self.label}: params"
+        material_cls = type(self.material)
+        changed = material_cls.from_dict({**self.base_params.model_dump(), **values},
+                                         self.material.base_dir, where)
+        previous = self.base_params
+        self.base_params = changed.params
+        self._states.clear()
+        self._values.clear()
+        try:
+            for time in sorted(set(self._times)):
+                self.params_at(time)
+            self._check_growing()
+        except InputError:
+            self.base_params = previous
+            self._states.clear()
+            raise
+        self._values.clear()
+        self.material = copy.copy(self.material)
+        self.material.params = self.params_at(self._applied_time)
+        self._applied = self.material.params
+        return self.base_params
+
+    def apply_time(self, time: float) -> None:
+        """Set the material's parameters to those of ``time`` (objects with events). Parameters
+        assigned to ``material.params`` since the last time become the base, as
+        :meth:`set_params` makes them, rather than being overwritten by the timeline."""
+        if self._applied is not None and self.material.params is not self._applied:
+            assigned = self.material.params
+            self.set_params(**assigned.model_dump())
+        self._applied_time = time
+        self.material.params = self._applied = self.params_at(time)
+
     def with_material(self, material: Material,
                       overrides: Mapping[str, Any] | None = None) -> SceneObject:
         """A copy of this object drawn with ``material``, whose parameters become the base;
@@ -213,7 +283,7 @@ class SceneObject:
 class Scene:
     """A scene ready to render (meshes loaded, materials and lights validated)."""
 
-    camera: Camera
+    camera: Camera = field(default_factory=Camera)
     objects: list[SceneObject] = field(default_factory=list)
     lights: list[Light] = field(default_factory=list)
     size: tuple[int, int] = (1280, 720)
@@ -241,7 +311,7 @@ class Scene:
                 users[id(obj.material)] -= 1
                 obj.material = copy.copy(obj.material)
                 users[id(obj.material)] = 1
-            obj.material.params = obj.params_at(time)
+            obj.apply_time(time)
 
     def add_event(self, obj: SceneObject | str, time: float, params: Mapping[str, Any],
                   where: str | None = None) -> TimelineEvent:
@@ -271,19 +341,72 @@ class Scene:
         """The light types of the scene, by id (only these are compiled)."""
         return sorted({type(light) for light in self.lights}, key=lambda cls: cls.type_id)
 
-    def add(self, mesh: MeshData | str, material: Material | str = "standard",
-            position=(0.0, 0.0, 0.0), rotation=(0.0, 0.0, 0.0), scale=1.0,
-            label: str | None = None, params: dict[str, Any] | None = None) -> SceneObject:
-        """Add an object from Python (scene files go through :func:`load_scene`)."""
+    def add_object(self, mesh: MeshData | str, material: Material | str = "standard",
+                   position=(0.0, 0.0, 0.0), rotation=(0.0, 0.0, 0.0), scale=1.0,
+                   label: str | None = None, params: Mapping[str, Any] | None = None,
+                   base_dir: str | Path | None = None) -> SceneObject:
+        """Add an object: ``mesh`` a :class:`MeshData` or a name as a scene file gives it
+        (``builtin:torus?segments=78``, a file relative to ``base_dir``); ``material`` a
+        registered name with ``params`` (validated as a scene file's are) or an instance;
+        position, rotation (degrees, XYZ) and scale as in a scene file. Errors are
+        ``InputError``s naming the argument (``mesh``, ``material``, ``ball: params.shells``).
+        A renderer drawing the scene draws the object from its next frame."""
+        if label is not None and not (isinstance(label, str) and label.strip()):
+            raise InputError(f"must be a name, got {label!r}", "label")
+        taken = {o.label for o in self.objects}
+        if label in taken:
+            raise InputError(f"an object is named '{label}' already", "label")
+        folder = None if base_dir is None else Path(base_dir)
         if isinstance(mesh, str):
-            mesh = load_mesh(mesh)
+            mesh = load_mesh(mesh, folder, "mesh")
+        elif not isinstance(mesh, MeshData):
+            raise InputError(f"expected a MeshData or a mesh name, got {type(mesh).__name__}",
+                             "mesh")
+        label = label or unique_label(taken, mesh.name)
         if isinstance(material, str):
-            material = registry.materials.get(material).from_dict(params or {})
-        obj = SceneObject(label or unique_label({o.label for o in self.objects}, mesh.name),
-                          mesh, material,
-                          model_matrix(position, rotation, scale))
+            material = registry.materials.get(material, "material").from_dict(
+                dict(params or {}), folder, f"{label}: params")
+        elif not isinstance(material, Material):
+            raise InputError(f"expected a Material or a material name, got "
+                             f"{type(material).__name__}", "material")
+        elif params:
+            raise InputError("give params with a material name; an instance has its own",
+                             "params")
+        place = validate_params(Transform, {"position": position, "rotation": rotation,
+                                            "scale": scale}, None)
+        obj = SceneObject(label, mesh, material,
+                          model_matrix(place.position, place.rotation, place.scale))
         self.objects.append(obj)
         return obj
+
+    add = add_object  # the shorter name of earlier versions
+
+    def add_light(self, type: str, **params: Any) -> Light:
+        """Add a light of a registered ``type`` (``point``, ``spot``, ``directional``,
+        ``ambient``, a plugin's) with its parameters, validated as a scene file's are
+        (``InputError`` naming the light and the key). A renderer drawing the scene lights
+        with it from its next frame."""
+        light = registry.lights.get(type, "type").from_dict(
+            params, f"light[{len(self.lights)}] ({type})")
+        self.lights.append(light)
+        return light
+
+    def remove(self, item: SceneObject | Light | Effect | str) -> None:
+        """Remove an object (itself or its label), a light or an effect; ``InputError`` when
+        the scene does not hold it. A renderer drawing the scene leaves it out from its next
+        frame."""
+        if isinstance(item, str):
+            found = [o for o in self.objects if o.label == item]
+            if not found:
+                names = ", ".join(o.label for o in self.objects[:10]) or "none"
+                raise InputError(f"no object named '{item[:80]}' (objects: {names})", "item")
+            item = found[0]
+        for collection in (self.objects, self.lights, self.effects):
+            for index, held in enumerate(collection):
+                if held is item:
+                    del collection[index]
+                    return
+        raise InputError(f"the scene holds no {type(item).__name__} {item!r:.80}", "item")
 
 
 def unique_label(taken: set[str], mesh_name: str, next_index: dict[str, int] | None = None

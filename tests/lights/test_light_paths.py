@@ -234,7 +234,7 @@ def test_without_compute_shaders_the_gl33_paths_run(gl):
         assert renderer.light_path == "volumes"
     with Renderer(scene, "forward", gl=gl33) as renderer:
         assert renderer.light_path == "naive"
-    with pytest.raises(InputError, match="--light-path: light path 'tiled' needs compute "
+    with pytest.raises(InputError, match="light_path: light path 'tiled' needs compute "
                                          "shaders"):
         Renderer(scene, gl=gl33, light_path="tiled")
 
