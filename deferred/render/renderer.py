@@ -139,10 +139,13 @@ class Renderer:
     reach the pixels (:mod:`deferred.lighting.paths`; default: the scene's ``light_path``, else
     the fastest the context allows).
 
-    The scene's objects, lights, camera and materials' parameters may change between frames.
-    Its background and tone mapping operator are read when the passes are built, here (the
-    background is the clear value of the targets the lighting creates, the operator a define
-    of the tone mapping pass): a change to either takes a new renderer.
+    The scene may change between frames: objects, lights and effects added or removed
+    (``Scene.add_object``, ``add_light``, ``remove``), materials' parameters
+    (``SceneObject.set_params``), the camera, the background, the tone mapping operator. Each
+    frame picks the changes up; where they change what the passes are built from (another
+    object, light type or effect, parameters that add or remove passes, the background, which
+    is the clear value of targets, the operator, a define), the renderer builds its passes,
+    targets and programs again on the same context first (:meth:`render`).
     """
 
     def __init__(self, scene: Scene, pipeline: str = Pipeline.DEFERRED,

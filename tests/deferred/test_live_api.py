@@ -9,7 +9,7 @@ import io
 import numpy as np
 import pytest
 
-from deferred import InputError, RenderError, Renderer, Scene
+from deferred import InputError, Renderer, RenderError, Scene
 from deferred.io.images import read_image
 from deferred.scene.camera import Camera
 
@@ -96,7 +96,7 @@ def test_renderer_arguments_are_named_as_python_arguments(gl):
         Renderer(small_scene(), gl=gl, light_path="fast")
 
 
-# -- a renderer follows the scene -------------------------------------------------------------------
+# -- a renderer follows the scene ---------------------------------------------------------------
 
 def test_an_object_added_after_the_first_frame_is_drawn_and_removing_it_restores_the_image(
         renderer):
@@ -215,12 +215,12 @@ def test_the_hdr_composite_is_read_when_asked_for(renderer, monkeypatch):
     stale = r.render()
     r.render()
     with pytest.raises(RenderError, match="rendered again or been released"):
-        stale.hdr
+        _ = stale.hdr
     eager = r.render(hdr=True)
     r.render()
     np.testing.assert_array_equal(eager.hdr, hdr)
     with pytest.raises(RenderError, match="readback=False"):
-        r.render(readback=False).hdr
+        _ = r.render(readback=False).hdr
 
 
 def test_a_result_saves_and_shows_in_a_notebook(renderer, tmp_path):
