@@ -15,6 +15,10 @@ from deferred.errors import DeferredError, InputError, RenderError, ShaderError
 __version__ = "0.1.0"
 
 _LAZY = {
+    "Camera": "deferred.scene.camera",
+    "SceneObject": "deferred.scene.model",
+    "read_image": "deferred.io.images",
+    "write_image": "deferred.io.images",
     "create_context": "deferred.gl.context",
     "Renderer": "deferred.render.renderer",
     "RenderResult": "deferred.render.renderer",
@@ -27,9 +31,11 @@ _LAZY = {
 
 if TYPE_CHECKING:
     from deferred.gl.context import create_context
+    from deferred.io.images import read_image, write_image
     from deferred.render.renderer import Renderer, RenderResult, render_scene
+    from deferred.scene.camera import Camera
     from deferred.scene.loader import load_scene, scene_from_dict, scene_from_toml
-    from deferred.scene.model import Scene
+    from deferred.scene.model import Scene, SceneObject
 
 
 def __getattr__(name: str) -> Any:
@@ -45,6 +51,6 @@ def __dir__() -> list[str]:
     return sorted({*globals(), *_LAZY})
 
 
-__all__ = ["DeferredError", "InputError", "RenderError", "RenderResult", "Renderer", "Scene",
-           "ShaderError", "create_context", "load_scene", "render_scene", "scene_from_dict",
-           "scene_from_toml"]
+__all__ = ["Camera", "DeferredError", "InputError", "RenderError", "RenderResult", "Renderer",
+           "Scene", "SceneObject", "ShaderError", "create_context", "load_scene", "read_image",
+           "render_scene", "scene_from_dict", "scene_from_toml", "write_image"]
