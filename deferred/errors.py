@@ -2,13 +2,16 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 
 class DeferredError(Exception):
     """Base class of the framework's own errors."""
 
 
 class InputError(DeferredError):
-    """Bad input: a scene, mesh, parameter or option. Exit code 2, one line on stderr.
+    """Bad input: a scene, mesh, parameter or option. Exit code 2, one line on stderr (a line
+    per problem where :class:`InputErrors` says several).
 
     ``where`` names the file and key (``scene.toml: object[0].params.shells``) so the message says
     exactly what to fix.
@@ -18,6 +21,31 @@ class InputError(DeferredError):
         self.where = where
         self.message = message
         super().__init__(f"{where}: {message}" if where else message)
+
+    @property
+    def problems(self) -> tuple[InputError, ...]:
+        """Each problem, one line each: this error alone, or an :class:`InputErrors`' list."""
+        return (self,)
+
+
+class InputErrors(InputError):
+    """Several problems of one input (every problem of a scene file, found at once): its
+    ``problems`` are one :class:`InputError` each, and ``str()`` is one line per problem."""
+
+    def __init__(self, problems: Sequence[InputError]):
+        self._problems = tuple(one for problem in problems for one in problem.problems)
+        super().__init__("\n".join(map(str, self._problems)))
+
+    @property
+    def problems(self) -> tuple[InputError, ...]:
+        return self._problems
+
+
+def input_error(problems: Sequence[InputError]) -> InputError:
+    """The error saying ``problems`` (at least one): the one problem, or all of them."""
+    if not problems:
+        raise ValueError("no problems to say")
+    return problems[0] if len(problems) == 1 else InputErrors(problems)
 
 
 class ShaderError(DeferredError):

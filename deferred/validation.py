@@ -1,13 +1,15 @@
-"""Turning pydantic validation errors into one clear line naming the key."""
+"""Turning pydantic validation errors into clear lines, one a problem, each naming its key."""
 
 from __future__ import annotations
 
 import collections.abc
+import difflib
 import math
 import numbers
 import stat
 import types
 import typing
+from collections.abc import Iterable
 from enum import Enum
 from pathlib import Path
 from typing import Annotated, Any, Literal
@@ -26,7 +28,7 @@ from pydantic import (
     field_validator,
 )
 
-from deferred.errors import InputError
+from deferred.errors import InputError, input_error
 
 # Floats beyond this are refused (world units, intensities, rates): float32 shading has lost
 # every digit by then and a product of two overflows to inf.
@@ -46,25 +48,124 @@ def location(loc: tuple) -> str:
 
 
 def format_validation_error(exc: ValidationError, where: str | None) -> tuple[str, str | None]:
-    """(message, where) for the first error; ``where`` is extended with the key's path."""
-    errors = exc.errors()
-    first = errors[0]
-    loc = tuple(first["loc"])
-    if first["type"] == "missing" and loc and isinstance(loc[-1], int) and \
-            isinstance(first.get("input"), list | tuple):
+    """(message, where) for the first error; ``where`` is extended with the key's path. The
+    message counts the others: :func:`validation_problems` says each of them."""
+    problems = validation_problems(exc, where)
+    first = problems[0]
+    count = len(problems)
+    more = f" (and {count - 1} more problem{'s' if count > 2 else ''})" if count > 1 else ""
+    return first.message + more, first.where
+
+
+def validation_problems(exc: ValidationError, where: str | None,
+                        model: type[BaseModel] | None = None) -> list[InputError]:
+    """Every error of ``exc`` as an :class:`InputError` naming its key (``where`` extended
+    with the key's path), one per key. With the ``model`` that raised it, the errors of one
+    value against each member of a union are one problem (the most specific), and an
+    unknown key names the closest known one."""
+    problems: dict[tuple, tuple[int, InputError]] = {}
+    for error in exc.errors():
+        loc, site, parent = _key_path(model, tuple(error["loc"]))
+        problem = _problem({**error, "loc": loc}, where, parent)
+        # one value against a union's members: the error found deepest inside it says most
+        group = loc[:site] if site is not None else loc
+        depth = len(loc)
+        if group in problems and problems[group][0] >= depth:
+            continue
+        problems[group] = (depth, problem)
+    return [problem for _, problem in problems.values()]
+
+
+def validation_error(exc: ValidationError, where: str | None,
+                     model: type[BaseModel] | None = None) -> InputError:
+    """The :class:`InputError` of :func:`validation_problems`: one problem, or all of them."""
+    return input_error(validation_problems(exc, where, model))
+
+
+def _problem(error: dict, where: str | None, parent: type[BaseModel] | None) -> InputError:
+    loc = tuple(error["loc"])
+    if error["type"] == "missing" and loc and isinstance(loc[-1], int) and \
+            isinstance(error.get("input"), list | tuple):
         # a list one value short is the list's problem, not a "missing key" at its end
-        given = first["input"]
-        first = {**first, "type": "too_short",
+        given = error["input"]
+        error = {**error, "type": "too_short",
                  "msg": f"expected more than the {len(given)} value"
                         f"{'s' if len(given) != 1 else ''} given"}
         loc = loc[:-1]
-    error = first.get("ctx", {}).get("error")
-    if isinstance(error, LaxValueError) and isinstance(error.problem, Problem):
+    lax = error.get("ctx", {}).get("error")
+    if isinstance(lax, LaxValueError) and isinstance(lax.problem, Problem):
         # found inside the field's value: name where, and show what is there
-        loc = (*loc, *error.problem.path)
-        first = {**first, "input": error.problem.value}
-    key = location(loc)
-    return _message(first, len(errors)), join_where(where, key)
+        loc = (*loc, *lax.problem.path)
+        error = {**error, "input": lax.problem.value}
+    message = _message(error)
+    if error["type"] == "extra_forbidden" and parent is not None and loc:
+        message += did_you_mean(loc[-1], parent.model_fields)
+    return InputError(message, join_where(where, location(loc)))
+
+
+def _key_path(model: type[BaseModel] | None, loc: tuple
+              ) -> tuple[tuple, int | None, type[BaseModel] | None]:
+    """``loc`` without pydantic's tags naming a union's member (``scale.float``), the length
+    of the path to the union's value (``None``: no union), and the model holding the last
+    key (``None`` where not known)."""
+    annotation: Any = model
+    out: list = []
+    site = None
+    parent = None
+    for part in loc:
+        annotation = _optional_member(_bare(annotation))
+        if typing.get_origin(annotation) in (typing.Union, types.UnionType) and \
+                isinstance(part, str):
+            site = len(out) if site is None else site
+            members = [m for m in typing.get_args(annotation) if m is not type(None)]
+            annotation = next((m for m in members if getattr(m, "__name__", str(m)) == part or
+                               str(m).replace("typing.", "") == part), None)
+            continue
+        out.append(part)
+        parent = None
+        if isinstance(annotation, type) and issubclass(annotation, BaseModel) and \
+                isinstance(part, str):
+            parent = annotation
+            field = annotation.model_fields.get(part)
+            annotation = field.annotation if field is not None else None
+        elif isinstance(part, int) and typing.get_origin(annotation) in (
+                tuple, list, collections.abc.Sequence):
+            arguments = typing.get_args(annotation)
+            if typing.get_origin(annotation) is tuple and not (
+                    len(arguments) == 2 and arguments[1] is Ellipsis):
+                annotation = arguments[part] if part < len(arguments) else None
+            else:
+                annotation = arguments[0] if arguments else None
+        elif typing.get_origin(annotation) in (dict, collections.abc.Mapping):
+            arguments = typing.get_args(annotation)
+            annotation = arguments[1] if len(arguments) == 2 else None
+        else:
+            annotation = None
+    return tuple(out), site, parent
+
+
+def _optional_member(annotation: Any) -> Any:
+    """``X`` of ``X | None`` (pydantic names no member of an optional value)."""
+    if typing.get_origin(annotation) in (typing.Union, types.UnionType):
+        members = [m for m in typing.get_args(annotation) if m is not type(None)]
+        if len(members) == 1:
+            return _bare(members[0])
+    return annotation
+
+
+def closest(name: object, choices: Iterable[str]) -> str | None:
+    """The choice closest to ``name`` (a misspelling of it), or ``None`` when none is close."""
+    if not isinstance(name, str) or not name:
+        return None
+    found = difflib.get_close_matches(name[:200], list(choices), n=1, cutoff=0.6)
+    return found[0] if found else None
+
+
+def did_you_mean(name: object, choices: Iterable[str]) -> str:
+    """`` (did you mean 'x'?)`` with the choice closest to ``name``; ``""`` when none is
+    close."""
+    match = closest(name, choices)
+    return f" (did you mean '{match}'?)" if match is not None else ""
 
 
 def join_where(where: str | None, key: str) -> str | None:
@@ -76,20 +177,18 @@ def join_where(where: str | None, key: str) -> str | None:
     return f"{where}.{key}" if ": " in where else f"{where}: {key}"
 
 
-def _message(first: dict, count: int) -> str:
-    message = first["msg"]
-    if first["type"] == "extra_forbidden":
+def _message(error: dict) -> str:
+    message = error["msg"]
+    if error["type"] == "extra_forbidden":
         message = "unknown parameter"
-    elif first["type"] == "missing":
+    elif error["type"] == "missing":
         message = "missing required key"
-    elif first["type"] == "value_error":
+    elif error["type"] == "value_error":
         message = message.removeprefix("Value error, ")
-    if first["type"] not in ("extra_forbidden", "missing") and "input" in first and \
-            not isinstance(first["input"], dict):
-        got = repr(first["input"])
+    if error["type"] not in ("extra_forbidden", "missing") and "input" in error and \
+            not isinstance(error["input"], dict):
+        got = repr(error["input"])
         message += f" (got {got if len(got) <= 80 else got[:60] + ' ... ' + got[-15:]})"
-    if count > 1:
-        message += f" (and {count - 1} more problem{'s' if count > 2 else ''})"
     return message
 
 

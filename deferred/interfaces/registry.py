@@ -27,6 +27,7 @@ from typing import Generic, TypeVar
 
 from deferred.errors import InputError
 from deferred.gbuffer.surface_id import MAX_MATERIAL_ID, MAX_SHADING_MODEL_ID
+from deferred.validation import closest
 
 T = TypeVar("T")
 
@@ -131,9 +132,16 @@ class Registry(Generic[T]):
                     raise InputError(error, where or f"entry point {self.group}")
         cls = self._classes.get(name)
         if cls is None:
-            raise InputError(f"unknown {self.what} '{name}' (choose from {', '.join(self)})",
-                             where)
+            raise InputError(self.unknown(name), where)
         return cls
+
+    def unknown(self, name: object) -> str:
+        """The message for an unknown ``name``: the closest registered name, else them all."""
+        match = closest(name, self)
+        shown = repr(name) if not isinstance(name, str) else f"'{name[:80]}'"
+        if match is not None:
+            return f"unknown {self.what} {shown} (did you mean '{match}'?)"
+        return f"unknown {self.what} {shown} (choose from {', '.join(self)})"
 
     def builtins(self) -> list[type[T]]:
         """The classes of the built-in package, whatever plugins are installed."""

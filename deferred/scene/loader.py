@@ -6,10 +6,12 @@ Validation names the file, the key and the problem in one line
 """
 from __future__ import annotations
 
+import re
 import sys
+from collections.abc import Callable
 from importlib import resources
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, Literal, TypeVar
 
 import numpy as np
 from pydantic import (
@@ -21,7 +23,7 @@ from pydantic import (
     model_validator,
 )
 
-from deferred.errors import InputError
+from deferred.errors import InputError, input_error
 from deferred.gl.meshes import MeshData
 from deferred.interfaces import registry
 from deferred.names import LightPath
@@ -31,8 +33,10 @@ from deferred.scene.model import Scene, SceneObject, check_size, unique_label
 from deferred.validation import (
     Radiance,
     StrictValues,
-    format_validation_error,
+    closest,
     require_regular_file,
+    validation_error,
+    validation_problems,
 )
 
 if sys.version_info >= (3, 11):
@@ -44,6 +48,8 @@ Vec3 = tuple[float, float, float]
 MIN_SCALE = 1e-6  # an object smaller is a mistake of units; 1/scale must fit float32
 MAX_DEPTH_RANGE = 1e7  # far / near
 DEMO_SCENE = "demo.toml"
+T = TypeVar("T")
+M = TypeVar("M", bound=BaseModel)
 
 
 class _Strict(StrictValues):
@@ -181,60 +187,206 @@ def scene_from_toml(text: str, name: str = "<string>", base_dir: Path | None = N
 
 def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
                     base_dir: Path | None = None) -> Scene:
-    """A scene from a scene file's tables as a dict (what :func:`scene_from_toml` parses);
-    validated the same way, errors naming ``name`` and the key."""
+    """The scene ``data`` describes (a scene file's tables). Every problem is found before one
+    is raised: an :class:`InputError` for one, :class:`InputErrors` naming each (in the file's
+    order) for several; unknown keys and names say the closest known one."""
+    problems: list[InputError] = []
     try:
         model = SceneModel(**data)
+        objects, lights, effects_, events = ([(item, set()) for item in items] for items in (
+            model.object, model.light, model.effect, model.event))
     except ValidationError as exc:
-        raise InputError(*format_validation_error(exc, name)) from None
-    check_size(model.size, f"{name}: size")
+        problems += validation_problems(exc, name, SceneModel)
+        # the parts valid alone are checked further: all problems are said at once
+        bad = {error["loc"][0] for error in exc.errors() if error["loc"]}
+        model = _valid_alone(SceneModel, {k: v for k, v in data.items()
+                                          if k not in bad and k not in _LISTS})[0]
+        objects, lights, effects_, events = (_each(cls, data.get(key)) for key, cls in (
+            ("object", ObjectModel), ("light", TypedModel), ("effect", TypedModel),
+            ("event", EventModel)))
+    _collect(problems, check_size, model.size, f"{name}: size")
     c = model.camera
     scene = Scene(camera=Camera(c.position, c.target, c.up, c.fov, c.near, c.far),
                   size=model.size, background=model.background, exposure=model.exposure,
                   tonemap=model.tonemap, light_path=model.light_path, source=name)
-    meshes: dict[str, MeshData] = {}
-    labels: set[str] = set()
+    meshes: dict[str, MeshData | None] = {}
+    labels: dict[str, SceneObject | None] = {}  # None: the object is not made (a problem)
+    taken: set[str] = set()  # the labels, for unique_label
+    unlabelled = False  # an object whose label is not known (its mesh failed)
     next_index: dict[str, int] = {}  # unique_label's, for every unnamed object
-    for index, obj in enumerate(model.object):
+    for index, (obj, bad) in enumerate(objects):
         where = f"{name}: object[{index}]"
-        material_cls = registry.materials.get(obj.material, f"{where}.material")
-        material = material_cls.from_dict(obj.params, base_dir, f"{where}.params")
-        if obj.mesh not in meshes:
-            meshes[obj.mesh] = load_mesh(obj.mesh, base_dir, f"{where}.mesh")
-        mesh = meshes[obj.mesh]
-        label = obj.name or unique_label(labels, mesh.name, next_index)
+        if obj is None:
+            continue
+        material = None
+        if "material" not in bad:
+            material_cls = _collect(problems, registry.materials.get, obj.material,
+                                    f"{where}.material")
+            if material_cls is not None and "params" not in bad:
+                material = _collect(problems, _made, material_cls, material_cls.Params,
+                                    obj.params, f"{where}.params", base_dir)
+        mesh = None
+        if "mesh" not in bad:
+            if obj.mesh not in meshes:
+                meshes[obj.mesh] = _collect(problems, load_mesh, obj.mesh, base_dir,
+                                            f"{where}.mesh")
+            mesh = meshes[obj.mesh]
+        if "name" in bad or (obj.name is None and mesh is None):
+            unlabelled = True
+            continue
+        label = obj.name or unique_label(taken, mesh.name, next_index)
         if label in labels:
-            raise InputError(f"duplicate object name '{label}'", f"{where}.name")
-        labels.add(label)
-        scene.objects.append(SceneObject(label, mesh, material,
-                                         model_matrix(obj.position, obj.rotation, obj.scale),
-                                         where=where))
-    for index, light in enumerate(model.light):
+            problems.append(InputError(f"duplicate object name '{label}'", f"{where}.name"))
+            continue
+        made = None
+        if not bad and material is not None and mesh is not None:
+            made = SceneObject(label, mesh, material,
+                               model_matrix(obj.position, obj.rotation, obj.scale), where=where)
+            scene.objects.append(made)
+        labels[label] = made
+        taken.add(label)
+    for index, (light, bad) in enumerate(lights):
         where = f"{name}: light[{index}]"
-        light_cls = registry.lights.get(light.type, f"{where}.type")
-        scene.lights.append(light_cls.from_dict(light.model_extra or {}, where))
+        if light is None or "type" in bad:
+            continue
+        light_cls = _collect(problems, registry.lights.get, light.type, f"{where}.type")
+        if light_cls is not None:
+            made = _collect(problems, _made, light_cls, light_cls.Params,
+                            light.model_extra or {}, where)
+            if made is not None:
+                scene.lights.append(made)
     effects = [(f"{name}: effect[{index}]", e.type, e.model_extra or {})
-               for index, e in enumerate(model.effect)]
+               for index, (e, bad) in enumerate(effects_) if e is not None and "type" not in bad]
     if model.ssao is not None:  # the [ssao] table of earlier scene files
         if any(kind == "ssao" for _, kind, _ in effects):
-            raise InputError("ssao is given both as [ssao] and as an [[effect]]; keep one",
-                             f"{name}: ssao")
-        effects.insert(0, (f"{name}: ssao", "ssao", model.ssao))
+            problems.append(InputError("ssao is given both as [ssao] and as an [[effect]]; "
+                                       "keep one", f"{name}: ssao"))
+        else:
+            effects.insert(0, (f"{name}: ssao", "ssao", model.ssao))
     seen: set[str] = set()
     for where, kind, values in effects:
         if kind in seen:
-            raise InputError(f"effect '{kind}' is given twice (one of each type)", f"{where}.type")
+            problems.append(InputError(f"effect '{kind}' is given twice (one of each type)",
+                                       f"{where}.type"))
+            continue
         seen.add(kind)
-        effect_cls = registry.effects.get(kind, f"{where}.type")
-        scene.effects.append(effect_cls.from_dict(values, where))
+        effect_cls = _collect(problems, registry.effects.get, kind, f"{where}.type")
+        if effect_cls is not None:
+            made = _collect(problems, _made, effect_cls, effect_cls.Params, values, where)
+            if made is not None:
+                scene.effects.append(made)
     # each object's events added at once (in the file's order: it breaks ties of time)
-    by_label = {obj.label: obj for obj in scene.objects}
     grouped: dict[str, list[tuple[float, dict[str, Any], str]]] = {}
-    for index, event in enumerate(model.event):
+    for index, (event, bad) in enumerate(events):
         where = f"{name}: event[{index}]"
-        if event.object not in by_label:
-            scene.add_event(event.object, event.time, event.params, where)  # names the choices
-        grouped.setdefault(event.object, []).append((event.time, event.params, where))
-    for label, events in grouped.items():
-        by_label[label].add_events(events)
+        if event is None or "object" in bad:
+            continue
+        if event.object not in labels:
+            if not unlabelled:
+                problems.append(InputError(_no_object(event.object, list(labels)),
+                                           f"{where}.object"))
+            continue
+        if labels[event.object] is not None and not bad:
+            grouped.setdefault(event.object, []).append((event.time, event.params, where))
+    for label, timeline in grouped.items():
+        target = labels[label]
+        try:
+            target.add_events(timeline)
+        except InputError as exc:
+            # the timeline stops at its first problem: every event's keys and values are
+            # checked too, so each of their problems is said
+            found = [problem for _, params, where in timeline
+                     for problem in _every_problem(
+                         exc, type(target.base_params),
+                         {**target.base_params.model_dump(), **params},
+                         f"{where}.params").problems if problem is not exc]
+            problems += found if any(p.where == exc.where for p in found) else [exc, *found]
+    if problems:
+        order = {key: position for position, key in enumerate(data)}
+        raise input_error(sorted(problems, key=lambda p: _file_order(p.where, name, order)))
     return scene
+
+
+_LISTS = ("object", "light", "effect", "event")  # lists of tables, checked item by item
+
+
+def _collect(problems: list[InputError], function: Callable[..., T], *args: Any) -> T | None:
+    """``function(*args)``, or ``None`` with its ``InputError`` added to ``problems``."""
+    try:
+        return function(*args)
+    except InputError as exc:
+        problems.append(exc)
+        return None
+
+
+def _validated(model: type[BaseModel], values: dict[str, Any], where: str) -> BaseModel:
+    """``model(**values)``, or an ``InputError`` naming each of its problems."""
+    try:
+        return model(**values)
+    except ValidationError as exc:
+        raise validation_error(exc, where, model) from None
+
+
+def _made(cls: Any, params: type[BaseModel], values: dict[str, Any], where: str,
+          *base_dir: Path | None) -> Any:
+    """``cls.from_dict(values, *base_dir, where)`` (a material, light or effect); where its
+    parameters are what it refuses, every problem of them is said (``from_dict`` says the
+    first)."""
+    try:
+        return cls.from_dict(values, *base_dir, where)
+    except InputError as exc:
+        raise _every_problem(exc, params, values, where) from None
+
+
+def _every_problem(exc: InputError, model: type[BaseModel], values: dict[str, Any],
+                   where: str) -> InputError:
+    """Each problem ``model`` finds in ``values``, or ``exc`` where it finds none (the refusal
+    was another check's)."""
+    try:
+        model(**values)
+    except ValidationError as error:
+        return validation_error(error, where, model)
+    return exc
+
+
+def _valid_alone(cls: type[M], values: dict[str, Any]) -> tuple[M, set[str]]:
+    """``cls(**values)``, or, where that fails, a ``cls`` of the fields that are valid alone
+    and the names of those that are not ("" for the whole table)."""
+    try:
+        return cls(**values), set()
+    except ValidationError as exc:
+        bad = {str(error["loc"][0]) if error["loc"] else "" for error in exc.errors()}
+        kept = {k: v for k, v in values.items() if k not in bad and
+                (k in cls.model_fields or cls.model_config.get("extra") == "allow")}
+        try:
+            return cls(**kept), bad
+        except ValidationError:  # a check across fields: the fields it needs stay unknown
+            return cls.model_construct(**kept), bad | {""}
+
+
+def _each(cls: type[M], items: Any) -> list[tuple[M | None, set[str]]]:
+    """Each table of a list validated alone: (the table's valid part, its invalid fields), or
+    ``(None, ...)`` for an item that is not a table (the scene's validation said so)."""
+    if not isinstance(items, list):
+        return []
+    return [_valid_alone(cls, item) if isinstance(item, dict) else (None, {""})
+            for item in items]
+
+
+def _no_object(label: str, labels: list[str]) -> str:
+    match = closest(label, labels)
+    if match is not None:
+        return f"no object named '{label[:80]}' (did you mean '{match[:80]}'?)"
+    names = ", ".join(name[:40] for name in labels[:10]) or "none"
+    if len(labels) > 10:
+        names += f", ... ({len(labels)} in all)"
+    return f"no object named '{label[:80]}' (objects: {names})"
+
+
+def _file_order(where: str | None, name: str, order: dict[str, int]) -> tuple[int, int]:
+    """Where a problem's key comes in the file: its table's place among the file's keys,
+    then the item's index (``object[2]``)."""
+    key = (where or "").removeprefix(f"{name}: ")
+    match = re.match(r"([^.\[]*)(?:\[(\d+)\])?", key)
+    top, index = match.group(1), match.group(2)
+    return order.get(top, len(order)), int(index) if index is not None else -1
