@@ -84,8 +84,8 @@ FORWARD_SHELL_FRAGMENT = "materials/shell_fur/forward_shell.frag"
 TIPS_WIDTH = 1024  # texels per row of the per-vertex strand texture
 COLOR_MAP_SIZE = 256
 GUST_WAVELENGTH = 1.0  # world units between gust fronts along the wind
-# The state at time t is settle / time_step + t / time_step steps from scratch (about 0.4 ms a
-# step on two cores at 9,360 strands): more is refused rather than left to run for hours.
+# The state at time t is settle / time_step + t / time_step steps from scratch (a step's cost
+# is in benchmarks/README.md): more is refused rather than left to run for hours.
 MAX_SIMULATION_STEPS = 100_000
 # Steps x strands a render may simulate: the work grows with both, so a fine mesh reaches the
 # limit at an earlier time (benchmarks/README.md has what a strand step costs)

@@ -252,7 +252,7 @@ class ObjectPass(RenderPass):
         # Where the pass keeps ObjectPass.defines, its defines are the material's, a function
         # of its params and the object's mesh (Material.defines), and its own fixed ones: while
         # those are the same objects, so is the program (building and comparing the defines
-        # cost 2 us of a 12 us draw).
+        # was a sixth of a draw's CPU time: benchmarks/README.md).
         if fresh and memo[2] is material and memo[3] is material.params and \
                 memo[4] is self.obj.mesh and not self._own_defines:
             return memo[6]
@@ -271,8 +271,8 @@ class ObjectPass(RenderPass):
         material = frame.material_inputs(self.obj.material)
         if self._hooks_unchanged and not self.extra_reads:
             # one draw and nothing of the pass's own but its constants (most objects'
-            # G-buffer and forward passes): the hooks' empty answers are not asked for, 1.4 us
-            # of a 16 us draw
+            # G-buffer and forward passes): the hooks' empty answers are not asked for
+            # (benchmarks/README.md has what asking cost)
             frame.bind(program, self.constants, None, offered=frame.object_uniforms(self.obj),
                        material=material)
             self.draw(frame, program)

@@ -6,9 +6,9 @@ lighting pass draws one contiguous range and the tiled paths loop ``[0, global_c
 lights every pixel gets. Volume lights whose sphere lies outside the view frustum are dropped on
 the CPU before anything is uploaded (:func:`visible_spheres`, vectorised). The records live in an
 RGBA32F texture, one row per light (``u_lights``, read by ``common/light_buffer.glsl``), on every
-GL level: llvmpipe fetches texels about 3.4 times as fast as storage-buffer vec4s. The full-screen
-lights' records are also a uniform array (``u_fullscreen_lights``), which the light loops of the
-list and forward paths read at every pixel.
+GL level: llvmpipe fetches texels faster than storage-buffer vec4s (benchmarks/README.md). The
+full-screen lights' records are also a uniform array (``u_fullscreen_lights``), which the light
+loops of the list and forward paths read at every pixel.
 """
 
 from __future__ import annotations

@@ -12,9 +12,8 @@ SHADING_DISPATCH_FILE = "generated/shading_models.glsl"
 RANGE_UNIFORM_PREFIX = "u_light_range_"
 # Full-screen lights a frame may have: their records are also a uniform array
 # (``u_fullscreen_lights``, four vec4s each), which every pixel reads in the list and forward
-# paths: llvmpipe reads a uniform faster than a texel. lights.toml, 1 light, interleaved in one
-# process: the tiled shading 13.0 -> 11.7 ms at 640x360 and 45-47 -> 40-42 ms at 1280x720;
-# the Forward+ frame at 16 lights 30.8-31.0 -> 27.7-28.5 ms at 640x360.
+# paths: llvmpipe reads a uniform faster than a texel (benchmarks/README.md, "What llvmpipe
+# skips").
 FULLSCREEN_LIGHT_CAPACITY = 16
 FULLSCREEN_UNIFORM = "u_fullscreen_lights"
 FULLSCREEN_LIGHTS_FILE = "common/fullscreen_lights.glsl"
@@ -85,9 +84,8 @@ def listed_dispatch_glsl(light_types: list[type[Light]]) -> str:
     type order (:class:`~deferred.lighting.buffer.LightBuffer`), so each type's entries follow one
     another: each loop runs over its type's and calls its function, where a switch on the type
     per entry ran every type's evaluation for every entry on llvmpipe (an `if` skips nothing
-    there; lights.toml at 640x360, half the lights spots: the tiled shading 35.9 -> 50.8 ms at
-    1024 lights). A loop but the last stops at the first entry past its type's range, whose
-    evaluation runs masked once on llvmpipe."""
+    there; benchmarks/README.md has the cost). A loop but the last stops at the first entry
+    past its type's range, whose evaluation runs masked once on llvmpipe."""
     volumes = sorted((cls for cls in light_types if cls.volume != LightVolume.FULLSCREEN),
                      key=lambda cls: cls.type_id)
     lines = ["vec3 evaluate_listed_slots(int first, int length, Surface s, vec3 P, vec3 V) {",

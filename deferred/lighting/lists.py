@@ -40,7 +40,7 @@ CLUSTER_SLICES = 16  # exponential depth slices between the near and far planes
 # Invocations per culling work group, an invocation per tile. llvmpipe gives each CPU thread
 # whole groups, so smaller groups share the tiles out over more threads (at 640x360: 920 tiles,
 # 29 groups; 240 cluster tiles, 8 groups); 16 cost more than 32 or 64 in the groups' own
-# overhead (the tiled culling 4.2-6.1 ms at 1024 lights with 64 or 32, 8.0-8.6 with 16).
+# overhead (benchmarks/README.md).
 CULL_GROUP_SIZE = 32
 # The tiled culling runs twice: over coarse tiles of COARSE_RATIO x COARSE_RATIO tiles against
 # every light, then over the tiles against their coarse tile's lights only.

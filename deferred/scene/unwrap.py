@@ -97,8 +97,8 @@ def _unwrap_child(connection, positions: np.ndarray, indices: np.ndarray,
 
 
 def _process_context():
-    # fork: the child starts in about 10 ms with the arrays already in its memory (spawn: about
-    # 300 ms to import numpy and xatlas again); spawn where fork is missing or unsafe (macOS).
+    # fork: the child starts at once with the arrays already in its memory (spawn imports numpy
+    # and xatlas again); spawn where fork is missing or unsafe (macOS).
     if sys.platform != "darwin" and "fork" in multiprocessing.get_all_start_methods():
         return multiprocessing.get_context("fork")
     return multiprocessing.get_context("spawn")

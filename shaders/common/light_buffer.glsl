@@ -1,7 +1,7 @@
 // All lights of the frame (deferred.lighting.buffer): an RGBA32F texture, four texels per row, one
 // row per light. A texture on every GL level, not a storage buffer where there is one: llvmpipe
-// reads a texel about 3.4 times as fast as a storage buffer's vec4 (brute-force light loop,
-// benchmarks/brute_force.py), and the light loops read little else.
+// reads a texel faster than a storage buffer's vec4 (benchmarks/README.md, measured with the
+// brute-force light loop), and the light loops read little else.
 #include "common/lighting.glsl"
 
 uniform int u_light_count;

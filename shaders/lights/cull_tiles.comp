@@ -8,15 +8,14 @@
 // far plane on tiles of background, since blended surfaces (fur shells) lie in front of it;
 // there is no box.
 // It runs twice (deferred.lighting.culling): over coarse tiles of 4x4 tiles (CULL_COARSE) against
-// every light, then over the tiles against their coarse tile's list only (CULL_CANDIDATES):
-// at 1024 lights and 1280x720, 3600 tiles each testing every light cost 15-22 ms, the two
-// dispatches 8.6-9.2 ms. The second writes the lists of each tile's four 8x8 quadrants
+// every light, then over the tiles against their coarse tile's list only (CULL_CANDIDATES),
+// about half the time of every tile testing every light (benchmarks/README.md). The second writes the lists of each tile's four 8x8 quadrants
 // (LIST_QUADRANTS, below).
 // An invocation per tile, looping the tile's pixels and then every light in order: the lists
 // come out in light order whatever the scheduling (the same image every frame, on any driver),
 // and no invocation waits on another. A work group per tile (its invocations reducing the
-// bounds with shared atomics, then sharing out the lights), as before, cost 4-5x as much on
-// llvmpipe, where a work group's invocations are SIMD lanes looped over on one CPU thread and
+// bounds with shared atomics, then sharing out the lights), as before, cost several times as
+// much on llvmpipe, where a work group's invocations are SIMD lanes looped over on one CPU thread and
 // each barrier and shared atomic is a pass over them.
 layout(local_size_x = CULL_GROUP_SIZE) in;  // deferred.lighting.lists
 
@@ -45,10 +44,10 @@ uniform int u_candidate_capacity; // slots per coarse list
 // (deferred.lighting.lists.LIST_SPLIT), each with its own side planes, depth bounds and box. A
 // light is tested against the whole tile first, and only where it touches it against the
 // quadrants, all four at once in the lanes of a vec4. lights.toml at 1024 lights, 640x360: the
-// shading loops 21.6 entries a pixel instead of 31.5 (the tiled shading 53-55 -> 40-45 ms), for
-// 3.5 -> 4.2-5.5 ms of culling, most of it the 2.6x as many writes (benchmarks/README.md).
+// shading loops 21.6 entries a pixel instead of 31.5, for a dearer culling, most of it the
+// more numerous writes (benchmarks/README.md).
 // Indexing the quadrants' data with a variable (an array of structs, a loop over the lanes)
-// cost the culling 3x on llvmpipe.
+// made the culling slower on llvmpipe, which keeps such arrays in memory.
 
 // A tile's (or quadrant's) depth bounds and the view-space box of its points.
 struct TileBounds {
@@ -306,8 +305,7 @@ void main() {
             counts += ivec4(touched);
             // one write a touched quadrant, in a loop over their bits: a block of SIMD lanes
             // runs as many writes as its lane touching the most quadrants, where four `if`s
-            // ran each one any lane needed (the culling 8.3 -> 7.3 ms at 1024 lights, 640x360;
-            // Forward+'s 18.4 -> 12.3)
+            // ran each one any lane needed (benchmarks/README.md)
             uint quadrants = uint(touched.x) | uint(touched.y) << 1 | uint(touched.z) << 2 |
                              uint(touched.w) << 3;
             while (quadrants != 0u) {

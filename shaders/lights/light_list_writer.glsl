@@ -3,10 +3,9 @@
 // texel a listed light (its sphere and index, at light_list_texel(slot)), and the list's count (also in
 // the storage buffer, for statistics). The coarse lists, which only the tiled culling's second
 // dispatch reads, are light indices in the storage buffer. The fine lists' indices are not
-// written there too: the quadrant lists (lights/cull_tiles.comp) made 2.6x as many entries, and
-// each write is a masked scatter over a SIMD block on llvmpipe (the culling at 1024 lights,
-// 640x360: 9.0 -> 7.4 ms without them; one texel a slot instead of two, the sphere and the
-// colour: 22.6 -> 15.1 ms at 1280x720).
+// written there too: the quadrant lists (lights/cull_tiles.comp) made many more entries, and
+// each write is a masked scatter over a SIMD block on llvmpipe (as is each texel of a slot:
+// one texel, not two for the sphere and the colour; benchmarks/README.md has the costs).
 #ifndef CULL_COARSE
 // bound to its unit in the layout: moderngl 5.13 writes no value to an unsigned image uniform
 layout(rgba32ui, binding = LIST_IMAGE_UNIT) uniform writeonly uimage2D u_light_list_image;

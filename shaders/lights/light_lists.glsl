@@ -10,8 +10,8 @@
 //   buffer (high 16 bits) and its radius as a half float rounded up (low 16 bits).
 //   The shading loop reads one texel a listed light, and the light's colour (and, for the
 //   types that read them, the rest of its record) from the light buffer for each that reaches
-//   the pixel, where a list of indices cost the index, the sphere and the colour (lights.toml
-//   at 1024 lights, 640x360: the tiled shading 62-67 -> 51-58 ms, benchmarks/README.md).
+//   the pixel, where a list of indices cost the index, the sphere and the colour
+//   (benchmarks/README.md).
 layout(std430, binding = 1) buffer LightLists {
     uint light_list_data[];
 };

@@ -12,8 +12,8 @@
 // light's whole evaluation whether it reaches the pixel or not (an `if` that never holds costs
 // as much as this one, benchmarks/README.md), and only a loop's trip count saves work: the
 // cost is entries x (fetch + sphere test + evaluation). The loop is a do-while, since a for
-// loop runs its body once more than its trips, masked, to find every lane done (1.2-2.2 ms of
-// the tiled shading's 22-36 ms at 256-1024 lights, 640x360). The sphere test stays: it costs
+// loop runs its body once more than its trips, masked, to find every lane done
+// (benchmarks/README.md). The sphere test stays: it costs
 // nothing measurable there and spares the evaluation on GPUs that branch.
 // Tried and slower or no faster on llvmpipe (benchmarks/README.md): a bit mask of reached
 // entries with a loop over its set bits; a loop that skips to the next entry some lane (or,
