@@ -139,9 +139,8 @@ class Registry(Generic[T]):
         """The message for an unknown ``name``: the closest registered name, else them all."""
         match = closest(name, self)
         shown = repr(name) if not isinstance(name, str) else f"'{name[:80]}'"
-        if match is not None:
-            return f"unknown {self.what} {shown} (did you mean '{match}'?)"
-        return f"unknown {self.what} {shown} (choose from {', '.join(self)})"
+        hint = f"did you mean '{match}'? " if match is not None else ""
+        return f"unknown {self.what} {shown} ({hint}choose from {', '.join(self)})"
 
     def builtins(self) -> list[type[T]]:
         """The classes of the built-in package, whatever plugins are installed."""

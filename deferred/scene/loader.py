@@ -26,6 +26,7 @@ from pydantic import (
 from deferred.errors import InputError, input_error
 from deferred.gl.meshes import MeshData
 from deferred.interfaces import registry
+from deferred.interfaces.material import Material
 from deferred.names import LightPath
 from deferred.scene.camera import Camera, model_matrix
 from deferred.scene.meshes import load_mesh
@@ -50,6 +51,7 @@ MAX_DEPTH_RANGE = 1e7  # far / near
 DEMO_SCENE = "demo.toml"
 T = TypeVar("T")
 M = TypeVar("M", bound=BaseModel)
+E = TypeVar("E")
 
 
 class _Strict(StrictValues):
@@ -210,15 +212,16 @@ def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
                   size=model.size, background=model.background, exposure=model.exposure,
                   tonemap=model.tonemap, light_path=model.light_path, source=name)
     meshes: dict[str, MeshData | None] = {}
-    labels: dict[str, SceneObject | None] = {}  # None: the object is not made (a problem)
+    # label -> (the object, or None where it is not made; its material class, where known)
+    labels: dict[str, tuple[SceneObject | None, type[Material] | None]] = {}
     taken: set[str] = set()  # the labels, for unique_label
-    unlabelled = False  # an object whose label is not known (its mesh failed)
+    unlabelled = False  # an object whose label is not known (its name is refused)
     next_index: dict[str, int] = {}  # unique_label's, for every unnamed object
     for index, (obj, bad) in enumerate(objects):
         where = f"{name}: object[{index}]"
         if obj is None:
             continue
-        material = None
+        material = material_cls = None
         if "material" not in bad:
             material_cls = _collect(problems, registry.materials.get, obj.material,
                                     f"{where}.material")
@@ -231,10 +234,12 @@ def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
                 meshes[obj.mesh] = _collect(problems, load_mesh, obj.mesh, base_dir,
                                             f"{where}.mesh")
             mesh = meshes[obj.mesh]
-        if "name" in bad or (obj.name is None and mesh is None):
+        if "name" in bad or (obj.name is None and "mesh" in bad):
             unlabelled = True
             continue
-        label = obj.name or unique_label(taken, mesh.name, next_index)
+        # a mesh that failed to load is named as it would be, for the events naming it
+        label = obj.name or unique_label(taken, mesh.name if mesh is not None else
+                                         _mesh_name(obj.mesh), next_index)
         if label in labels:
             problems.append(InputError(f"duplicate object name '{label}'", f"{where}.name"))
             continue
@@ -243,7 +248,7 @@ def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
             made = SceneObject(label, mesh, material,
                                model_matrix(obj.position, obj.rotation, obj.scale), where=where)
             scene.objects.append(made)
-        labels[label] = made
+        labels[label] = (made, material_cls)
         taken.add(label)
     for index, (light, bad) in enumerate(lights):
         where = f"{name}: light[{index}]"
@@ -286,10 +291,16 @@ def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
                 problems.append(InputError(_no_object(event.object, list(labels)),
                                            f"{where}.object"))
             continue
-        if labels[event.object] is not None and not bad:
+        target, material_cls = labels[event.object]
+        if target is not None and not bad:
             grouped.setdefault(event.object, []).append((event.time, event.params, where))
+        elif material_cls is not None and "params" not in bad:
+            # the object is refused: the event's own keys and values are still checked
+            found = _every_problem(None, material_cls.Params, event.params, f"{where}.params")
+            if found is not None:
+                problems.append(found)
     for label, timeline in grouped.items():
-        target = labels[label]
+        target = labels[label][0]
         try:
             target.add_events(timeline)
         except InputError as exc:
@@ -303,7 +314,8 @@ def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
             problems += found if any(p.where == exc.where for p in found) else [exc, *found]
     if problems:
         order = {key: position for position, key in enumerate(data)}
-        raise input_error(sorted(problems, key=lambda p: _file_order(p.where, name, order)))
+        each = [one for problem in problems for one in problem.problems]
+        raise input_error(sorted(each, key=lambda p: _file_order(p.where, name, order)))
     return scene
 
 
@@ -338,8 +350,8 @@ def _made(cls: Any, params: type[BaseModel], values: dict[str, Any], where: str,
         raise _every_problem(exc, params, values, where) from None
 
 
-def _every_problem(exc: InputError, model: type[BaseModel], values: dict[str, Any],
-                   where: str) -> InputError:
+def _every_problem(exc: E, model: type[BaseModel], values: dict[str, Any],
+                   where: str) -> InputError | E:
     """Each problem ``model`` finds in ``values``, or ``exc`` where it finds none (the refusal
     was another check's)."""
     try:
@@ -347,6 +359,11 @@ def _every_problem(exc: InputError, model: type[BaseModel], values: dict[str, An
     except ValidationError as error:
         return validation_error(error, where, model)
     return exc
+
+
+def _mesh_name(spec: str) -> str:
+    """The name :func:`load_mesh` gives the mesh of ``spec`` (a label's stem)."""
+    return spec.split("?", 1)[0] if spec.startswith("builtin:") else Path(spec).name
 
 
 def _valid_alone(cls: type[M], values: dict[str, Any]) -> tuple[M, set[str]]:
@@ -375,12 +392,11 @@ def _each(cls: type[M], items: Any) -> list[tuple[M | None, set[str]]]:
 
 def _no_object(label: str, labels: list[str]) -> str:
     match = closest(label, labels)
-    if match is not None:
-        return f"no object named '{label[:80]}' (did you mean '{match[:80]}'?)"
+    hint = f"did you mean '{match[:80]}'? " if match is not None else ""
     names = ", ".join(name[:40] for name in labels[:10]) or "none"
     if len(labels) > 10:
         names += f", ... ({len(labels)} in all)"
-    return f"no object named '{label[:80]}' (objects: {names})"
+    return f"no object named '{label[:80]}' ({hint}objects: {names})"
 
 
 def _file_order(where: str | None, name: str, order: dict[str, int]) -> tuple[int, int]:

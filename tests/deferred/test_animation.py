@@ -124,7 +124,7 @@ def test_timeline_from_python():
 
 @pytest.mark.parametrize("event, expected", [
     ('time = 0.1\nobject = "bal"\nparams = { color = [1.0, 1.0, 1.0] }',
-     "error: s.toml: event[0].object: no object named 'bal' (did you mean 'ball'?)"),
+     "error: s.toml: event[0].object: no object named 'bal' (did you mean 'ball'? objects: ball, cube0)"),
     ('time = 0.1\nobject = "ball"\nparams = { color = [1.0, 1.0] }',
      "error: s.toml: event[0].params.color"),
     ('time = 0.1\nobject = "ball"\nparams = { wind = 2.0 }',
@@ -192,13 +192,19 @@ def test_pattern_single_frame_and_start_time(tmp_path, capsys, scene_file):
     assert read_image(tmp_path / "out_0000.png")[24, 32, 1] > 0.5  # green: t = 0.15
 
 
-def test_plain_image_frames_advance_time(tmp_path, capsys, scene_file):
+def test_frames_to_a_plain_image_are_refused_with_the_fix(tmp_path, capsys, scene_file):
     code, _, err = run(capsys, "render", scene_file, "--frames", 3, "--fps", 10, "-o",
                        tmp_path / "last.png")
+    assert code == 2
+    assert err == ("error: --frames: 3 frames cannot go to one image, last.png: use a # "
+                   "pattern such as last_####.png, or .mp4/.gif\n")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]
+    # time advances frame by frame: the third frame of a pattern, t = 0.2, is blue
+    code, _, err = run(capsys, "render", scene_file, "--frames", 3, "--fps", 10, "-o",
+                       tmp_path / "frame_#.png")
     assert code == 0, err
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["last.png", "s.toml"]
-    pixel = read_image(tmp_path / "last.png")[24, 32]
-    assert pixel[2] > pixel[1]  # the last frame, t = 0.2: blue
+    pixel = read_image(tmp_path / "frame_2.png")[24, 32]
+    assert pixel[2] > pixel[1]
 
 
 def test_gif(tmp_path, capsys, scene_file):

@@ -1,0 +1,124 @@
+"""A JSON Schema of scene files, for editors (Taplo, VS Code's Even Better TOML): completion,
+descriptions and checks as a scene is written. ``deferred schema`` writes it.
+
+It is built from the scene model (:class:`~deferred.scene.loader.SceneModel`) and the registries
+(plugins included): each ``[[object]]``'s ``material`` selects its ``params`` model, each
+``[[light]]``'s and ``[[effect]]``'s ``type`` its parameters, through ``if``/``then`` on a
+``const`` (an editor's message names the one type that failed, not every alternative). Keys the
+loader refuses are refused here too (``additionalProperties: false``). The loader stays the
+authority: what a schema cannot say (a file that must exist, checks across keys, an event's
+parameters, which depend on its object's material) it checks when the scene loads.
+
+JSON Schema draft-07, which editors' TOML support reads (tuples as ``items`` arrays).
+"""
+
+from __future__ import annotations
+
+import copy
+import warnings
+from typing import Any
+
+from pydantic import BaseModel
+from pydantic.json_schema import GenerateJsonSchema, models_json_schema
+
+from deferred.interfaces import registry
+from deferred.scene.loader import ObjectModel, SceneModel
+
+DRAFT = "http://json-schema.org/draft-07/schema#"
+DEFAULT_MATERIAL = ObjectModel.model_fields["material"].default
+
+
+class _Generator(GenerateJsonSchema):
+    """Pydantic's generator; a type with no JSON form (a plugin's own validator) is any
+    value, not an error: the loader checks it."""
+
+    def handle_invalid_for_json_schema(self, schema: Any, error_info: str) -> dict[str, Any]:
+        return {}
+
+
+def scene_schema() -> dict[str, Any]:
+    """The JSON Schema (draft-07) of a scene file, for every registered material, light and
+    effect."""
+    kinds = {"material": registry.materials.items(), "light": registry.lights.items(),
+             "effect": registry.effects.items()}
+    models: list[type[BaseModel]] = [SceneModel]
+    for types in kinds.values():
+        for _, cls in types:
+            if cls.Params not in models:
+                models.append(cls.Params)
+    with warnings.catch_warnings():  # a default with no JSON form is left out, said here
+        warnings.simplefilter("ignore")
+        refs, top = models_json_schema([(model, "validation") for model in models],
+                                       ref_template="#/definitions/{model}",
+                                       schema_generator=_Generator)
+    definitions: dict[str, Any] = top.get("$defs", {})
+
+    def ref(model: type[BaseModel]) -> str:
+        return refs[(model, "validation")]["$ref"]
+
+    def definition(model: type[BaseModel]) -> dict[str, Any]:
+        return definitions[ref(model).rsplit("/", 1)[1]]
+
+    root = definitions.pop(ref(SceneModel).rsplit("/", 1)[1])
+    properties = root["properties"]
+    # [[object]]: the material names, and each material's params
+    objects = definitions[properties["object"]["items"]["$ref"].rsplit("/", 1)[1]]
+    names = [name for name, _ in kinds["material"]]
+    objects["properties"]["material"] = {
+        "enum": names, "default": DEFAULT_MATERIAL,
+        "description": "the material (deferred params material lists them)"}
+    objects["properties"]["params"] = {
+        "type": "object", "description": "the material's parameters"}
+    objects["allOf"] = [
+        {"if": {"properties": {"material": {"const": name}},
+                **({} if name == DEFAULT_MATERIAL else {"required": ["material"]})},
+         "then": {"properties": {"params": {"$ref": ref(cls.Params)}}}}
+        for name, cls in kinds["material"]]
+    # [[light]] and [[effect]]: the type names, and each type's parameters beside it
+    typed = properties["light"]["items"]["$ref"].rsplit("/", 1)[1]
+    for kind, key in (("light", "light"), ("effect", "effect")):
+        names = [name for name, _ in kinds[kind]]
+        branches = []
+        for name, cls in kinds[kind]:
+            params = copy.deepcopy(definition(cls.Params))
+            params["properties"] = {"type": {"const": name}, **params.get("properties", {})}
+            params["required"] = ["type", *params.get("required", [])]
+            params["additionalProperties"] = False
+            definitions[f"{kind}.{name}"] = params
+            branches.append({"if": {"properties": {"type": {"const": name}},
+                                    "required": ["type"]},
+                             "then": {"$ref": f"#/definitions/{kind}.{name}"}})
+        definitions[kind] = {
+            "type": "object", "required": ["type"],
+            "properties": {"type": {"enum": names,
+                                    "description": f"the {kind} type (deferred params "
+                                                   f"{kind} lists them)"}},
+            "allOf": branches}
+        properties[key]["items"] = {"$ref": f"#/definitions/{kind}"}
+    definitions.pop(typed, None)
+    ssao = dict(kinds["effect"]).get("ssao")
+    if ssao is not None:  # the [ssao] table: the ssao effect's parameters
+        properties["ssao"] = {"$ref": ref(ssao.Params),
+                              "description": properties["ssao"].get("description", "")}
+    events = definitions[properties["event"]["items"]["$ref"].rsplit("/", 1)[1]]
+    events["properties"]["params"] = {
+        "type": "object",
+        "description": "parameters of the object's material, merged over the object's"}
+    schema = {"$schema": DRAFT, "title": "deferred scene file",
+              "description": "A scene for deferred (TOML); written by `deferred schema` for the "
+                             "materials, lights and effects registered where it ran.",
+              **root, "definitions": definitions}
+    return _draft_07(schema)
+
+
+def _draft_07(node: Any) -> Any:
+    """Pydantic's draft 2020-12 tuples (``prefixItems``) as draft-07's ``items`` arrays."""
+    if isinstance(node, list):
+        return [_draft_07(item) for item in node]
+    if not isinstance(node, dict):
+        return node
+    out = {key: _draft_07(value) for key, value in node.items()}
+    if "prefixItems" in out:
+        out["items"] = out.pop("prefixItems")
+        out.setdefault("additionalItems", False)
+    return out
