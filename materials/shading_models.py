@@ -17,6 +17,8 @@ import numpy as np
 
 from deferred.api import GBufferData, ShadingModel, shading_models
 
+from .techniques.xtoon import RAMP_HEIGHT, RAMP_WIDTH, XToonRamp, ramp_layer, scene_ramps
+
 if TYPE_CHECKING:
     from deferred.api import Frame
 
@@ -72,6 +74,12 @@ TOON_RAMP_NAMES = tuple(toon_ramps())
 
 @shading_models.register
 class Toon(ShadingModel):
+    """N.L through a ramp: the built-in 1D ramps (layers 0 .. 3 of ``u_toon_ramps``, over N.L
+    from -1 to 1, filtered) and the scene's X-toon ramps after them (2D, over max(N.L, 0) and a
+    metric, fetched unfiltered: :mod:`deferred.materials.techniques.xtoon`). A material writes
+    its ramp's layer into the G-buffer datum ``toon_ramp``; ``u_toon_ramp_constants`` holds a
+    row per layer: metric, its two constants, and whether the layer is an X-toon ramp."""
+
     name = "toon"
     glsl_file = "shading_models/toon.glsl"
     glsl_function = "toon"
@@ -79,18 +87,38 @@ class Toon(ShadingModel):
 
     @classmethod
     def textures(cls, frame: Frame) -> dict[str, moderngl.Texture]:
+        ramps = scene_ramps(frame.scene)
+        key = ("toon_ramps", tuple(ramps))
+
         def create(ctx: moderngl.Context) -> moderngl.Texture:
-            rows = np.stack(list(toon_ramps().values()))  # (rows, width, 3)
-            data = np.concatenate([rows, np.ones(rows.shape[:2] + (1,))], axis=-1)
-            texture = ctx.texture((rows.shape[1], rows.shape[0]), 4,
-                                  data.astype(np.float32).tobytes(), dtype="f4")
+            layers = [np.repeat(row[None, :, :], RAMP_HEIGHT, axis=0)
+                      for row in toon_ramps(RAMP_WIDTH).values()]
+            layers += [ramp.texels() for ramp in ramps]
+            data = np.stack(layers).astype(np.float32)  # (layers, height, width, 3)
+            texture = ctx.texture_array((RAMP_WIDTH, RAMP_HEIGHT, len(layers)), 3,
+                                        data.tobytes(), dtype="f4")
             texture.filter = (moderngl.LINEAR, moderngl.LINEAR)
             texture.repeat_x = texture.repeat_y = False
             return texture
 
-        return {"u_toon_ramps": frame.resources.texture("toon_ramps", create)}
+        def create_constants(ctx: moderngl.Context) -> moderngl.Texture:
+            rows = [(0.0, 0.0, 0.0, 0.0)] * len(TOON_RAMP_NAMES)
+            rows += [ramp.constants() for ramp in ramps]
+            texture = ctx.texture((len(rows), 1), 4, np.asarray(rows, np.float32).tobytes(),
+                                  dtype="f4")
+            texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            return texture
+
+        return {"u_toon_ramps": frame.resources.texture(key, create),
+                "u_toon_ramp_constants": frame.resources.texture(
+                    ("toon_ramp_constants", tuple(ramps)), create_constants)}
 
     @staticmethod
     def ramp_row(name: str) -> float:
-        """The ``toon_ramp`` value selecting ramp ``name``."""
+        """The ``toon_ramp`` value selecting built-in ramp ``name``."""
         return TOON_RAMP_NAMES.index(name) / 255.0
+
+    @staticmethod
+    def xtoon_row(scene, ramp: XToonRamp) -> float:
+        """The ``toon_ramp`` value selecting X-toon ``ramp`` in ``scene``."""
+        return ramp_layer(scene, ramp, len(TOON_RAMP_NAMES)) / 255.0

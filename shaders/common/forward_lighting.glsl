@@ -8,11 +8,13 @@
 #include "lights/listed_lights.glsl"
 
 vec3 forward_lighting(Surface s, vec3 P, vec3 V) {
+    s.view_depth = -P.z;
     int list = light_list_of(ivec2(gl_FragCoord.xy), -P.z);
     return evaluate_fullscreen_lights(s, P, V) + evaluate_listed_lights(list, s, P, V);
 }
 #else
 vec3 forward_lighting(Surface s, vec3 P, vec3 V) {
+    s.view_depth = -P.z;
     return evaluate_fullscreen_lights(s, P, V) + evaluate_volume_lights(s, P, V);
 }
 #endif

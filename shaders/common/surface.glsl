@@ -18,6 +18,7 @@ struct Surface {
     vec3 normal;               // view space, unit: the normal lights use
     float occlusion;           // ambient occlusion [0, 1]; set by the pipeline, not the material
     int shading_model;         // the BRDF lights call; set by the framework from u_surface_id
+    float view_depth;          // -z in view space; set by the framework where lights shade
     SurfaceData data;          // G-buffer data the scene's materials declare, by name
 };
 

@@ -16,6 +16,7 @@ GBufferSample gbuffer_decode(vec4 albedo_specular, vec4 normal_exponent_id, floa
     g.surface.normal = octahedral_decode(normal_exponent_id.xy);
     g.surface.specular_exponent = normal_exponent_id.z;
     g.surface.occlusion = 1.0;
+    g.surface.view_depth = linear_depth;
     g.surface.shading_model = surface_shading_model(normal_exponent_id.w);
     g.surface_id = normal_exponent_id.w;
     g.material_id = surface_material_id(normal_exponent_id.w);

@@ -163,3 +163,118 @@ def test_only_the_models_a_scene_uses_are_compiled(gl):
         render_hdr(gl, scene, "deferred")  # the broken model is registered, never compiled
     finally:
         registry.shading_models.unregister(Broken.name)
+
+
+# -- X-toon ramps (Costigan 4.3.3-4.3.6) ---------------------------------------------------------
+
+@pytest.fixture
+def xtoon_material():
+    from model_materials import XToonMaterial
+
+    registry.materials.register(XToonMaterial)
+    yield
+    registry.materials.unregister(XToonMaterial.name)
+
+
+XTOON_STOPS = [[0.0, "#202040"], [0.3, "#606090"], [0.7, "#c0c0f0"]]
+
+
+def sphere_scene(params: dict, lights=None, size=(96, 96), objects=None):
+    return scene_from_dict({
+        "size": list(size), "tonemap": "none", "background": [0.0, 0.0, 0.0],
+        "camera": {"position": [0.0, 0.0, 3.0], "target": [0.0, 0.0, 0.0], "fov": 45.0},
+        "object": objects or [{"mesh": "builtin:sphere?segments=96&rings=48",
+                               "material": "test_xtoon", "params": params}],
+        "light": lights or [{"type": "directional", "direction": [-0.6, -0.5, -0.6],
+                             "intensity": 1.0}]})
+
+
+@pytest.mark.parametrize("pipeline", ["deferred", "forward"])
+def test_an_xtoon_sphere_has_no_more_tones_than_its_ramp_has_bands(gl, xtoon_material, pipeline):
+    from deferred.materials.techniques.xtoon import hex_to_linear
+
+    scene = sphere_scene({"ramp": XTOON_STOPS})
+    with Renderer(scene, pipeline, gl=gl) as renderer:
+        hdr = renderer.render(hdr=True).hdr
+    covered = hdr[..., 3] > 0.999
+    bands = np.array([hex_to_linear(c) for _, c in XTOON_STOPS])
+    colours = hdr[covered][:, :3]
+    distance = np.abs(colours[:, None, :] - bands[None, :, :]).max(axis=-1)  # (pixels, bands)
+    # exactly the ramp's tones (to the composite's half-float precision), nothing between
+    assert distance.min(axis=1).max() < 2e-3
+    assert len(set(distance.argmin(axis=1))) == 3  # and the sphere shows each band
+
+
+def test_xtoon_forward_and_deferred_agree_on_one_light(gl, xtoon_material):
+    from conftest import psnr
+
+    scene = sphere_scene({"ramp": XTOON_STOPS, "ramp_metric": "backlight",
+                          "backlight_power": 0.5})
+    images = {}
+    for pipeline in ("deferred", "forward"):
+        with Renderer(scene, pipeline, gl=gl) as renderer:
+            images[pipeline] = renderer.render(hdr=True).hdr[..., :3]
+    assert psnr(images["deferred"], images["forward"]) > 40.0
+
+
+def test_the_depth_metric_washes_out_far_objects(gl, xtoon_material):
+    """D = 1 - log(z/z_min)/log(z_max/z_min): the far sphere's tones move toward grey (less
+    contrast between its lit and shadowed bands) against the near one of the same ramp."""
+    params = {"ramp": [[0.0, "#101030"], [0.5, "#e0e0ff"]], "ramp_metric": "depth",
+              "depth_range": [2.5, 14.0]}
+    objects = [{"mesh": "builtin:sphere?segments=64&rings=32", "material": "test_xtoon",
+                "position": [-0.9, 0.0, 0.5], "scale": 0.5, "params": params},
+               {"mesh": "builtin:sphere?segments=64&rings=32", "material": "test_xtoon",
+                "position": [2.5, 0.0, -10.0], "scale": 2.0, "params": params}]
+    scene = sphere_scene({}, objects=objects, size=(128, 64))
+    with Renderer(scene, gl=gl) as renderer:
+        hdr = renderer.render(hdr=True).hdr
+    luminance = hdr[..., :3].mean(axis=-1)
+    covered = hdr[..., 3] > 0.999
+    near, far = covered.copy(), covered.copy()
+    near[:, 64:] = False
+    far[:, :64] = False
+    contrast = [luminance[m].max() - luminance[m].min() for m in (near, far)]
+    assert contrast[1] < 0.7 * contrast[0]
+    assert luminance[far].min() > luminance[near].min() + 0.05  # washed toward light grey
+
+
+def test_xtoon_generated_ramps_against_the_formulas():
+    from deferred.materials.techniques.xtoon import (
+        HIGHLIGHT_EDGE,
+        RIM_EDGE,
+        generated_ramp,
+        hex_to_linear,
+        stop_colours,
+    )
+
+    stops = [(0.0, "#000000"), (0.25, "#808080"), (0.5, "#ffffff")]
+    row = stop_colours(stops, 8)  # texel centres 1/16, 3/16, ...: each stop holds to the next
+    grey = ((128 / 255 + 0.055) / 1.055) ** 2.4
+    assert hex_to_linear("#808080") == pytest.approx((grey, grey, grey))
+    np.testing.assert_allclose(row[:, 0], [0, 0, grey, grey, 1, 1, 1, 1], atol=1e-6)
+    rim = generated_ramp(stops, "backlight", (0.5, 0.0, 0.0), width=8, height=10)
+    y = (np.arange(10) + 0.5) / 10
+    np.testing.assert_allclose(rim[:, 0, 0], np.where(y < RIM_EDGE, 0.5, 0.0))
+    spec = generated_ramp(stops, "specular", highlight_color=(0.25, 0.25, 0.25), width=8,
+                          height=10)
+    np.testing.assert_allclose(spec[:, 7, 1], 1.0 + np.where(y >= HIGHLIGHT_EDGE, 0.25, 0.0))
+    depth = generated_ramp(stops, "depth", width=8, height=10)
+    np.testing.assert_allclose(depth[-1, :, 0], row[:, 0], atol=0.1)  # near: about the ramp
+    assert np.ptp(depth[0, :, 0]) < 0.5 * np.ptp(depth[-1, :, 0])  # far: less contrast
+
+
+def test_xtoon_params_are_refused_with_the_key():
+    from deferred.errors import InputError
+    from deferred.materials.techniques.xtoon import XToonParams
+
+    for values, fragment in [({"ramp": [[0.1, "#000000"]]}, "start at 0"),
+                             ({"ramp": [[0.0, "#000000"], [0.0, "#ffffff"]]}, "rise"),
+                             ({"ramp": [[0.0, "red"]]}, "#rrggbb"),
+                             ({"ramp": []}, "at least one"),
+                             ({"depth_range": [5.0, 1.0]}, "z_min < z_max"),
+                             ({"ramp_metric": "fog"}, "ramp_metric")]:
+        with pytest.raises(InputError, match=fragment):
+            from deferred.params import validate_params
+
+            validate_params(XToonParams, values, None)
