@@ -1,7 +1,6 @@
 #!/bin/sh
-# Re-run the sweeps whose results benchmarks/README.md reports (about 30 minutes on two cores:
-# naive forward with 1024 lights takes 3.5 s a frame at 640x360 and 11 s at 1280x720, and each
-# point renders its warm-up, three frames a run, and a frame a run for the timer queries).
+# Re-run the sweeps whose results benchmarks/README.md reports, with the commands it gives
+# (about 30 minutes on two cores: naive forward with 1024 lights is the slow part).
 # Run from the repository root with the package installed (`pip install -e .`).
 set -e
 out=benchmarks/results
@@ -24,7 +23,7 @@ deferred bench builtin:overdraw --size 640x360 --runs 3 --warmup 1 --lights 1,16
     --plot $out/overdraw-640x360.png
 
 # Fur shells: the built-in demo scene (Revie's fur on a torus and a sphere, 4 scene lights, SSAO).
-deferred bench --size 640x360 --runs 3 --warmup 1 --light-paths volumes,naive \
+deferred bench --size 640x360 --runs 2 --warmup 1 --light-paths tiled,naive \
     --lights 0,16,64 --shells 0,16,64 \
     --json $out/shells-640x360.json --csv $out/shells-640x360.csv --plot $out/shells-640x360.png
 

@@ -13,7 +13,7 @@ cost follows the pixels a light touches.
 
 from __future__ import annotations
 
-from importlib.resources.abc import Traversable
+import sys
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -23,6 +23,11 @@ from pydantic import Field
 from deferred.names import LightVolume
 from deferred.params import Params, validate_params
 from deferred.validation import Radiance
+
+if sys.version_info >= (3, 11):
+    from importlib.resources.abc import Traversable
+else:  # Python 3.10
+    from importlib.abc import Traversable
 
 Vec3 = tuple[float, float, float]
 
@@ -67,8 +72,8 @@ class Light:
     @classmethod
     def records(cls, lights: list[Light], view: np.ndarray) -> np.ndarray:
         """``(len(lights), 4, 4)`` float32: :meth:`record` of each light of this type. A type
-        with many lights a frame (point, spot) overrides it with numpy over all of them: one
-        ``record`` call per light cost 25 ms a frame at 1024 lights."""
+        with many lights a frame (point, spot) overrides it with numpy over all of them (a
+        ``record`` call per light is slow at a thousand lights: benchmarks/README.md)."""
         return np.stack([np.asarray(light.record(view), dtype=np.float32).reshape(4, 4)
                          for light in lights]) if lights else np.zeros((0, 4, 4), np.float32)
 
