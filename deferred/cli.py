@@ -34,6 +34,9 @@ from deferred.scene.model import parse_size
 stderr = Console(stderr=True, soft_wrap=True)  # status lines never wrap on pipes
 
 
+MAX_PROBLEM_LINES = 50  # a scene file's problems shown; the rest are counted
+
+
 class Options:
     debug = False
 
@@ -405,20 +408,74 @@ def _write_result(out: Path, result) -> None:
         write_image(out, result.image)
 
 
+@cli.command("params")
+@click.argument("kind", required=False)
+@click.argument("name", required=False)
+@click.option("--json", "as_json", is_flag=True, help="The listing as JSON on stdout.")
+def params_command(kind: str | None, name: str | None, as_json: bool) -> None:
+    """List the parameters of every registered type: name, type, default, range, choices and
+    description. KIND is material, light, effect or shading_model; NAME one type of it
+    (`deferred params light point`). Plugins are listed too."""
+    from deferred.interfaces.catalogue import catalogue
+
+    _print_params(catalogue(kind, name), as_json)
+
+
 @cli.command()
-def materials() -> None:
-    """List registered materials and their parameters."""
-    console = Console()
-    for name, cls in registry.materials.items():
-        table = Table(title=f"{name}  (id {cls.type_id}, shading model {cls.shading_model}, "
-                            f"{cls.__module__})", title_justify="left")
-        for column in ("parameter", "type", "default", "range"):
-            table.add_column(column, no_wrap=True)
-        table.add_column("description")
-        for row in cls.describe_params():
-            table.add_row(row["name"], row["type"], repr(row["default"]), row["range"],
-                          row["doc"])
-        console.print(table)
+@click.option("--json", "as_json", is_flag=True, help="The listing as JSON on stdout.")
+def materials(as_json: bool) -> None:
+    """List registered materials and their parameters (`deferred params material`)."""
+    from deferred.interfaces.catalogue import catalogue
+
+    _print_params(catalogue("material"), as_json)
+
+
+def _print_params(entries: list[dict], as_json: bool) -> None:
+    """A rich table per type on a terminal; plain lines at full width to a pipe or a file
+    (a table squeezed to 80 columns cuts cells and drops descriptions)."""
+    import json
+
+    from deferred.interfaces.catalogue import default_text, heading, plain_lines, range_text
+
+    if as_json:
+        click.echo(json.dumps(entries, indent=2))
+        return
+    console = Console(markup=False, highlight=False)
+    if not console.is_terminal:
+        click.echo("\n".join(plain_lines(entries)))
+        return
+    for entry in entries:
+        title = heading(entry) + (f"\n{entry['summary']}" if entry["summary"] else "")
+        table = Table(title=title, title_justify="left")
+        table.add_column("parameter", no_wrap=True)
+        for column in ("type", "default", "range"):
+            table.add_column(column, overflow="fold")
+        table.add_column("description", ratio=1, overflow="fold")
+        for row in entry["params"]:
+            table.add_row(row["name"], row["type"], default_text(row), range_text(row),
+                          row["description"])
+        console.print(table if entry["params"] else f"{title}\n  (no parameters)")
+
+
+@cli.command()
+@click.option("-o", "--output", metavar="FILE.json",
+              help="Write the schema here (default: stdout).")
+def schema(output: str | None) -> None:
+    """Write the JSON Schema of scene files (draft-07), for an editor's completion and
+    checks: each object's material selects its params, each light's and effect's type its
+    parameters (registered plugins included)."""
+    import json
+
+    from deferred.io.images import write_text
+    from deferred.scene.schema import scene_schema
+
+    out = check_output_path(output, "-o", (".json",), patterns=False) if output else None
+    text = json.dumps(scene_schema(), indent=2) + "\n"
+    if out is None:
+        click.echo(text, nl=False)
+        return
+    write_text(out, text)
+    stderr.print(f"wrote {out}", markup=False, highlight=False)
 
 
 @cli.command()
@@ -483,8 +540,12 @@ def _main(argv: list[str] | None) -> int:
     except click.ClickException as exc:
         _fail(f"error: {exc.format_message()}")
         return 2
-    except InputError as exc:
-        _fail(f"error: {exc}")
+    except InputError as exc:  # a line per problem (a scene file's are said at once)
+        problems = exc.problems
+        shown = [f"error: {problem}" for problem in problems[:MAX_PROBLEM_LINES]]
+        if len(problems) > MAX_PROBLEM_LINES:
+            shown.append(f"error: ... and {len(problems) - MAX_PROBLEM_LINES} more problems")
+        _fail(*shown)
         return 2
     except (RenderError, ShaderError, DeferredError) as exc:
         _fail(f"render failed: {exc}")
@@ -494,11 +555,12 @@ def _main(argv: list[str] | None) -> int:
         return 1
 
 
-def _fail(message: str) -> None:
+def _fail(*messages: str) -> None:
     if Options.debug:
         traceback.print_exc()
-    # one line, whatever a file name holds: a newline in one is shown as \n
-    click.echo(message.replace("\r", "\\r").replace("\n", "\\n"), err=True)
+    # one line each, whatever a file name holds: a newline in one is shown as \n
+    for message in messages:
+        click.echo(message.replace("\r", "\\r").replace("\n", "\\n"), err=True)
 
 
 def entry() -> None:
