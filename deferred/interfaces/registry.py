@@ -12,7 +12,7 @@ one way a lower layer reaches a higher one: at run time, by name, never by an im
 (the layer contract, ``tests/deferred/test_layers.py``, covers import statements).
 
 Entry points load lazily: asking for a name loads that plugin only, so a broken plugin fails
-only the scenes that use it. Listing everything (``deferred materials``) loads every plugin and
+only the scenes that use it. Listing everything (``deferred params``) loads every plugin and
 skips a broken one with a warning naming it.
 """
 
