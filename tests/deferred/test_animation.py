@@ -124,7 +124,8 @@ def test_timeline_from_python():
 
 @pytest.mark.parametrize("event, expected", [
     ('time = 0.1\nobject = "bal"\nparams = { color = [1.0, 1.0, 1.0] }',
-     "error: s.toml: event[0].object: no object named 'bal' (did you mean 'ball'? objects: ball, cube0)"),
+     "error: s.toml: event[0].object: no object named 'bal' (did you mean 'ball'? objects: "
+     "ball, cube0)"),
     ('time = 0.1\nobject = "ball"\nparams = { color = [1.0, 1.0] }',
      "error: s.toml: event[0].params.color"),
     ('time = 0.1\nobject = "ball"\nparams = { wind = 2.0 }',
