@@ -1,0 +1,486 @@
+"""Tonal art maps and hatching (Costigan, "Cartoon Hair Simulation", 2.4.3 and 4.3.8, after Praun
+et al., "Real-time hatching", SIGGRAPH 2001).
+
+A tonal art map (TAM) is a row of hatching images of rising tone, each with its own mip levels
+(the thesis: 6 tones x 3 mips at 512x512, 78 strokes, 10 candidates; Table 5.1). It is made
+from one stroke image (the thesis' appendix Fig. 6; here a soft-ended dark line unless an image
+is given) by adding strokes one at a time:
+
+- **candidates** (2.4.3, 4.3.8): each stroke is the best of ``candidates`` random ones, the one
+  that adds most tone per unit of its own ink (a stroke over paper beats one over strokes), which
+  spreads strokes evenly (the thesis' appendix Figs. 7-9);
+- **nesting** (4.3.8): a darker tone starts from the lighter tone's images and only adds
+  strokes, so every stroke of a lighter tone is in every darker one;
+- **mip levels** (2.4.3, 4.3.8): a stroke spans the same fraction of the tile at every level but
+  is drawn at the same width in pixels, not downsampled; each coarser level follows the finest
+  level's tone, taking a stroke only where that brings it closer, so it holds fewer strokes
+  ("custom mipmaps which drop strokes", 4.3.8); a candidate's worth is averaged over the levels
+  that take it;
+- **tiling** (4.3.8, Figs. 4.21-4.22): a stroke crossing an edge continues from the opposite
+  edge, the thesis' hidden extra stroke; here every pixel index wraps, so the two are one.
+
+Tones are spread evenly in ink: the darkest tone holds ``strokes`` strokes at the finest level,
+shared among the tones by the expected coverage of strokes placed at random, so each tone adds
+about the same ink. Generation is deterministic for a seed and cached on disk
+(:func:`tonal_art_map`).
+
+For the GPU the TAM is one 2D texture, an atlas of the tones side by side, each cell padded by a
+wrapped gutter so that hardware filtering tiles seamlessly at every level
+(:meth:`ToneArtMap.atlas`, :func:`tam_texture`); ``shaders/techniques/hatching.glsl`` blends the
+two tones nearest a lit tone, on the surface (Praun et al.) or in screen space (Lake et al.,
+Fig. 4.20a). :func:`blend_tones` is the same blend in numpy.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import sys
+import tempfile
+import zipfile
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from deferred.api import InputError, read_image
+
+if TYPE_CHECKING:
+    import moderngl
+
+# Bumped whenever the generator's output for the same settings changes (part of the cache key).
+GENERATOR_VERSION = 1
+CACHE_SUBFOLDER = "hatching"
+DEFAULT_STROKE_SHAPE = (32, 256)  # samples across and along the default stroke
+WHERE = "hatching"
+
+
+@dataclass(frozen=True)
+class TamSettings:
+    """What a tonal art map is made of (the defaults: the thesis' Table 5.1 row, 512x512, 6
+    tones x 3 mips, 78 strokes, 10 candidates)."""
+
+    size: int = 512  # the finest level's side in pixels; a multiple of 2^(mips - 1)
+    tones: int = 6
+    mips: int = 3
+    strokes: int = 78  # strokes of the darkest tone at the finest level
+    candidates: int = 10  # random candidates per stroke, the best kept
+    seed: int = 0
+    stroke_length: float = 0.5  # fraction of the tile's side, the same at every level
+    stroke_width: float = 6.0  # pixels, the same at every level
+    angle: float = 0.0  # degrees from the texture's u axis
+    angle_jitter: float = 8.0  # degrees, uniform either side of ``angle``
+    length_jitter: float = 0.25  # relative, uniform either side of ``stroke_length``
+    cross_from: int | None = None  # tones from this index on hatch across (angle + 90 degrees)
+
+    def check(self) -> None:
+        """Raise :class:`InputError` naming the first setting out of range."""
+        def need(ok: bool, key: str, what: str) -> None:
+            if not ok:
+                raise InputError(f"{key} {what}, got {getattr(self, key)!r}", WHERE)
+
+        for key in ("size", "tones", "mips", "strokes", "candidates", "seed"):
+            value = getattr(self, key)
+            need(isinstance(value, int | np.integer) and not isinstance(value, bool),
+                 key, "must be an integer")
+        need(1 <= self.mips <= 8, "mips", "must be within [1, 8]")
+        need(16 <= self.size <= 4096, "size", "must be within [16, 4096]")
+        need(self.size % (1 << (self.mips - 1)) == 0, "size",
+             f"must be a multiple of 2^(mips - 1) = {1 << (self.mips - 1)}")
+        need(1 <= self.tones <= 64, "tones", "must be within [1, 64]")
+        need(self.tones <= self.strokes <= 100_000, "strokes",
+             f"must be within [tones = {self.tones}, 100000]")
+        need(1 <= self.candidates <= 1000, "candidates", "must be within [1, 1000]")
+        need(0.0 < self.stroke_length <= 0.9, "stroke_length", "must be within (0, 0.9]")
+        need(0.5 <= self.stroke_width <= 64.0, "stroke_width", "must be within [0.5, 64]")
+        need(0.0 <= self.angle_jitter <= 45.0, "angle_jitter", "must be within [0, 45]")
+        need(0.0 <= self.length_jitter < 1.0, "length_jitter", "must be within [0, 1)")
+        need(math.isfinite(self.angle), "angle", "must be finite")
+        need(self.cross_from is None or 0 <= self.cross_from < self.tones, "cross_from",
+             f"must be a tone index within [0, {self.tones - 1}] or None")
+        coarsest = self.size >> (self.mips - 1)
+        longest = self.stroke_length * (1.0 + self.length_jitter) * coarsest
+        need(longest + self.stroke_width + 4 < coarsest, "stroke_length",
+             f"with stroke_width, must fit the coarsest level ({coarsest} px)")
+
+
+@dataclass(frozen=True, eq=False)
+class ToneArtMap:
+    """A tonal art map: ``levels[m]`` is mip level m, (tones, size >> m, size >> m) uint8 ink
+    (0 paper, 255 full ink), tone 0 the lightest; row 0 lies at v = 0 (the GL convention)."""
+
+    levels: tuple[np.ndarray, ...]
+
+    @property
+    def tones(self) -> int:
+        return int(self.levels[0].shape[0])
+
+    @property
+    def size(self) -> int:
+        return int(self.levels[0].shape[1])
+
+    @property
+    def mips(self) -> int:
+        return len(self.levels)
+
+    @property
+    def gutter(self) -> int:
+        """The wrapped border of each atlas cell at level 0: one texel at the coarsest level."""
+        return 1 << (self.mips - 1)
+
+    def ink(self, level: int = 0) -> np.ndarray:
+        """Level ``level`` as float32 ink in [0, 1]."""
+        return self.levels[level].astype(np.float32) / 255.0
+
+    def atlas(self, level: int = 0) -> np.ndarray:
+        """Level ``level`` of the GPU atlas: the tones side by side in cells of side
+        ``(size + 2 gutter) >> level``, each tone padded by its own wrapped pixels, uint8
+        (rows, columns), row 0 at v = 0."""
+        pad = self.gutter >> level
+        cells = np.pad(self.levels[level], ((0, 0), (pad, pad), (pad, pad)), mode="wrap")
+        return np.ascontiguousarray(np.concatenate(list(cells), axis=1))
+
+
+# -- the stroke ---------------------------------------------------------------------------------
+
+def default_stroke(shape: tuple[int, int] = DEFAULT_STROKE_SHAPE) -> np.ndarray:
+    """A soft-ended dark line, (rows across, columns along) float32 ink in [0, 1]: full width in
+    the middle, thinning and fading toward both ends as a pen lifts (the role of the thesis'
+    Fig. 6)."""
+    rows, columns = shape
+    along = (np.arange(columns) + 0.5) / columns
+    across = np.abs((np.arange(rows) + 0.5) / rows * 2.0 - 1.0)
+    pressure = np.sin(np.pi * along) ** 0.5
+    edge = np.clip((pressure[None, :] - across[:, None]) / 0.3, 0.0, 1.0)
+    soft = edge * edge * (3.0 - 2.0 * edge)
+    return (soft * (0.8 + 0.15 * pressure[None, :])).astype(np.float32)
+
+
+def load_stroke(path: str | Path) -> np.ndarray:
+    """A stroke image file as ink, (rows across, columns along) float32 in [0, 1]: dark on
+    light, the stroke lying along the image's width; ink = (1 - luminance) x alpha."""
+    pixels = read_image(path, where=WHERE)
+    luminance = pixels[..., :3] @ np.array([0.2126, 0.7152, 0.0722], np.float32)
+    return check_stroke(np.clip((1.0 - luminance) * pixels[..., 3], 0.0, 1.0), str(path))
+
+
+def check_stroke(stroke: np.ndarray, where: str = WHERE) -> np.ndarray:
+    """``stroke`` as contiguous float32, or an :class:`InputError` saying what is wrong."""
+    array = np.asarray(stroke, dtype=np.float32)
+    if array.ndim != 2 or min(array.shape) < 2:
+        raise InputError(f"a stroke must be a 2D image of at least 2x2, got shape {array.shape}",
+                         where)
+    if not np.all(np.isfinite(array)) or array.min() < 0.0 or array.max() > 1.0:
+        raise InputError("a stroke's ink must lie within [0, 1]", where)
+    if array.max() <= 0.0:
+        raise InputError("the stroke holds no ink (a dark stroke on a light ground is needed)",
+                         where)
+    return np.ascontiguousarray(array)
+
+
+def resolve_stroke(stroke: np.ndarray | str | Path | None) -> np.ndarray:
+    if stroke is None:
+        return default_stroke()
+    if isinstance(stroke, str | Path):
+        return load_stroke(stroke)
+    return check_stroke(stroke)
+
+
+def resample(stroke: np.ndarray, rows: int, columns: int) -> np.ndarray:
+    """``stroke`` at (rows, columns), area-filtered (Pillow's bilinear widens its support when
+    shrinking), with one zero sample around it so that bilinear lookups fade out at its ends."""
+    from PIL import Image
+
+    image = Image.fromarray(stroke, mode="F").resize((columns, rows),
+                                                     Image.Resampling.BILINEAR)
+    return np.pad(np.asarray(image, np.float32), 1)
+
+
+# -- the generator ------------------------------------------------------------------------------
+
+@dataclass
+class _Level:
+    """One mip level while strokes are added."""
+
+    side: int
+    stroke: np.ndarray  # the stroke resampled for this level, zero-padded
+    ink: np.ndarray  # (side, side) float32
+
+    @property
+    def darkness(self) -> float:
+        return float(self.ink.mean())
+
+
+def tone_stroke_counts(settings: TamSettings, ink_per_stroke: float) -> list[int]:
+    """Strokes at the finest level after each tone (cumulative): the expected coverage
+    1 - (1 - a)^n of n strokes of coverage a each is split evenly among the tones, so each adds
+    about the same ink; every tone adds at least one stroke, the last ends at ``strokes``."""
+    n, tones = settings.strokes, settings.tones
+    a = min(max(ink_per_stroke, 1e-9), 0.5)
+    total = 1.0 - (1.0 - a) ** n
+    counts = []
+    for tone in range(tones):
+        coverage = total * (tone + 1) / tones
+        counts.append(round(math.log1p(-coverage) / math.log1p(-a)))
+    counts[-1] = n
+    for tone in range(tones):  # at least one stroke each, and room for the rest
+        low = counts[tone - 1] + 1 if tone else 1
+        counts[tone] = min(max(counts[tone], low), n - (tones - 1 - tone))
+    return counts
+
+
+def _candidate_strokes(level: _Level, settings: TamSettings, centres: np.ndarray,
+                       angles: np.ndarray, lengths: np.ndarray):
+    """The candidates' ink at one level: their (K, H, W) ink over a common box, the box's rows
+    (K, H) and columns (K, W), wrapped into the tile."""
+    side, width = level.side, settings.stroke_width
+    length_px = lengths * side
+    cos, sin = np.cos(angles), np.sin(angles)
+    half_x = np.abs(cos) * length_px / 2 + np.abs(sin) * width / 2
+    half_y = np.abs(sin) * length_px / 2 + np.abs(cos) * width / 2
+    box_w = 2 * math.ceil(half_x.max()) + 3
+    box_h = 2 * math.ceil(half_y.max()) + 3
+    centre = centres * side
+    x0 = np.floor(centre[:, 0]).astype(np.int64) - box_w // 2
+    y0 = np.floor(centre[:, 1]).astype(np.int64) - box_h // 2
+    columns = x0[:, None] + np.arange(box_w)
+    rows = y0[:, None] + np.arange(box_h)
+    dx = (columns + 0.5 - centre[:, :1]).astype(np.float32)[:, None, :]
+    dy = (rows + 0.5 - centre[:, 1:]).astype(np.float32)[:, :, None]
+    cos = cos.astype(np.float32)[:, None, None]
+    sin = sin.astype(np.float32)[:, None, None]
+    # stroke coordinates in samples of the level's resampled (and zero-padded) stroke: along
+    # the stroke scaled by the candidate's length, across at the fixed pixel width
+    stroke = level.stroke
+    along_samples = stroke.shape[1] - 2
+    across_samples = stroke.shape[0] - 2
+    scale_along = (along_samples / length_px).astype(np.float32)[:, None, None]
+    x = (dx * cos + dy * sin) * scale_along + (along_samples / 2 + 0.5)
+    y = (dy * cos - dx * sin) * np.float32(across_samples / width) + (across_samples / 2 + 0.5)
+    np.clip(x, 0.0, stroke.shape[1] - 1.001, out=x)
+    np.clip(y, 0.0, stroke.shape[0] - 1.001, out=y)
+    xi = x.astype(np.int32)
+    yi = y.astype(np.int32)
+    fx = x - xi
+    fy = y - yi
+    flat = stroke.ravel()
+    index = yi * stroke.shape[1] + xi
+    top = flat[index] + fx * (flat[index + 1] - flat[index])
+    index += stroke.shape[1]
+    bottom = flat[index] + fx * (flat[index + 1] - flat[index])
+    ink = top + fy * (bottom - top)
+    return ink, rows % side, columns % side
+
+
+def generate_tam(settings: TamSettings = TamSettings(),
+                 stroke: np.ndarray | str | Path | None = None) -> ToneArtMap:
+    """Make a tonal art map (no cache: :func:`tonal_art_map` is the cached one)."""
+    settings.check()
+    stroke = resolve_stroke(stroke)
+    rng = np.random.default_rng(settings.seed)
+    width = settings.stroke_width
+    levels = []
+    for m in range(settings.mips):
+        side = settings.size >> m
+        levels.append(_Level(side, resample(stroke, max(2, round(width)),
+                                            max(2, round(settings.stroke_length * side))),
+                             np.zeros((side, side), np.float32)))
+    # the ink one stroke leaves at the finest level, as a fraction of the tile
+    finest = levels[0]
+    sample_area = (width / (finest.stroke.shape[0] - 2)) \
+        * (settings.stroke_length * finest.side / (finest.stroke.shape[1] - 2))
+    ink_per_stroke = float(finest.stroke.sum()) * sample_area / finest.side ** 2
+    counts = tone_stroke_counts(settings, ink_per_stroke)
+    out = [np.empty((settings.tones, level.side, level.side), np.uint8) for level in levels]
+    placed = 0
+    jitter = math.radians(settings.angle_jitter)
+    k = settings.candidates
+    for tone, count in enumerate(counts):
+        base = math.radians(settings.angle)
+        if settings.cross_from is not None and tone >= settings.cross_from:
+            base += math.pi / 2
+        taken = np.zeros(settings.mips, bool)  # the levels this tone has added a stroke to
+        for index in range(placed, count):
+            centres = rng.random((k, 2))
+            angles = base + rng.uniform(-jitter, jitter, k)
+            lengths = settings.stroke_length * (1.0 + rng.uniform(-1.0, 1.0, k)
+                                                * settings.length_jitter)
+            strokes = [_candidate_strokes(level, settings, centres, angles, lengths)
+                       for level in levels]
+            gain = np.empty((k, settings.mips))  # tone each candidate adds at each level
+            alone = np.empty((k, settings.mips))  # ... and would add on blank paper
+            for m, (level, (ink, rows, columns)) in enumerate(zip(levels, strokes, strict=True)):
+                under = level.ink[rows[:, :, None], columns[:, None, :]]
+                area = float(level.side * level.side)
+                alone[:, m] = ink.sum(axis=(1, 2)) / area
+                gain[:, m] = (ink * (1.0 - under)).sum(axis=(1, 2)) / area
+            darkness = np.array([level.darkness for level in levels])
+            target = darkness[0] + gain[:, :1]  # the finest level's tone with the candidate
+            closer = (np.abs(darkness + gain - target) < np.abs(darkness - target))
+            closer[:, 0] = True
+            if index == count - 1:  # every level darkens with every tone
+                closer[:, ~taken] = True
+            share = np.where(closer, gain / np.maximum(alone, 1e-12), 0.0)
+            score = share.sum(axis=1) / closer.sum(axis=1)
+            best = int(np.argmax(score))
+            for m, (level, (ink, rows, columns)) in enumerate(zip(levels, strokes, strict=True)):
+                if closer[best, m]:
+                    block = np.ix_(rows[best], columns[best])
+                    level.ink[block] = 1.0 - (1.0 - level.ink[block]) * (1.0 - ink[best])
+                    taken[m] = True
+        placed = count
+        for m, level in enumerate(levels):
+            out[m][tone] = np.rint(np.clip(level.ink, 0.0, 1.0) * 255.0).astype(np.uint8)
+    return ToneArtMap(tuple(out))
+
+
+# -- the cache ----------------------------------------------------------------------------------
+
+def cache_folder() -> Path:
+    """Where cached TAMs live: ``$DEFERRED_CACHE_DIR``, else the user's cache folder
+    (``$XDG_CACHE_HOME`` or ~/.cache on Linux) under ``deferred``."""
+    folder = os.environ.get("DEFERRED_CACHE_DIR")
+    if folder:
+        return Path(folder)
+    if sys.platform == "win32":
+        local = os.environ.get("LOCALAPPDATA")
+        return (Path(local) if local else Path.home() / "AppData" / "Local") / "deferred" / "Cache"
+    if sys.platform == "darwin":
+        return Path.home() / "Library" / "Caches" / "deferred"
+    xdg = os.environ.get("XDG_CACHE_HOME")
+    return (Path(xdg) if xdg else Path.home() / ".cache") / "deferred"
+
+
+def cache_key(settings: TamSettings, stroke: np.ndarray) -> str:
+    """A hash of the generator's version, the settings and the stroke's pixels."""
+    digest = hashlib.sha256()
+    digest.update(json.dumps({"generator": GENERATOR_VERSION, **asdict(settings)},
+                             sort_keys=True).encode())
+    digest.update(repr(stroke.shape).encode())
+    digest.update(np.ascontiguousarray(stroke, np.float32).tobytes())
+    return digest.hexdigest()[:32]
+
+
+def cache_path(settings: TamSettings, stroke: np.ndarray | str | Path | None = None,
+               folder: Path | None = None) -> Path:
+    """The file a TAM of these settings and stroke is cached in."""
+    stroke = resolve_stroke(stroke)
+    folder = cache_folder() if folder is None else Path(folder)
+    return folder / CACHE_SUBFOLDER / f"tam-{cache_key(settings, stroke)}.npz"
+
+
+def _read_cached(path: Path, settings: TamSettings) -> ToneArtMap | None:
+    """The TAM in ``path``, or None where it is missing, unreadable or not what was asked."""
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            levels = tuple(np.array(data[f"level{m}"]) for m in range(settings.mips))
+    except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile):
+        return None
+    for m, level in enumerate(levels):
+        side = settings.size >> m
+        if level.dtype != np.uint8 or level.shape != (settings.tones, side, side):
+            return None
+    return ToneArtMap(levels)
+
+
+def _write_cached(path: Path, tam: ToneArtMap) -> None:
+    """Write ``tam`` to ``path`` atomically (a temporary file in the same folder, renamed); a
+    cache that cannot be written is skipped, not an error."""
+    temporary = None
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with tempfile.NamedTemporaryFile(dir=path.parent, prefix=".tam-", suffix=".tmp",
+                                         delete=False) as handle:
+            temporary = Path(handle.name)
+            np.savez(handle, **{f"level{m}": level for m, level in enumerate(tam.levels)})
+        os.replace(temporary, path)
+        temporary = None
+    except OSError:
+        pass
+    finally:
+        if temporary is not None:
+            temporary.unlink(missing_ok=True)
+
+
+def tonal_art_map(settings: TamSettings = TamSettings(),
+                  stroke: np.ndarray | str | Path | None = None,
+                  cache: Path | bool = True) -> ToneArtMap:
+    """The tonal art map of ``settings`` and ``stroke`` (None: :func:`default_stroke`; a path:
+    an image file; an array: ink), read from the cache where it holds one, else generated and
+    cached. ``cache``: True for :func:`cache_folder`, a folder, or False for none. A cache file
+    that cannot be read is regenerated and replaced."""
+    settings.check()
+    stroke = resolve_stroke(stroke)
+    if cache is False:
+        return generate_tam(settings, stroke)
+    path = cache_path(settings, stroke, None if cache is True else Path(cache))
+    tam = _read_cached(path, settings)
+    if tam is None:
+        tam = generate_tam(settings, stroke)
+        _write_cached(path, tam)
+    return tam
+
+
+# -- lookups ------------------------------------------------------------------------------------
+
+def sample_wrapped(image: np.ndarray, uv: np.ndarray) -> np.ndarray:
+    """Bilinear samples of a tiling ``image`` (rows, columns) at ``uv`` (..., 2), texel centres
+    at (i + 0.5) / side, wrapping at every edge (what GL_REPEAT with GL_LINEAR does)."""
+    rows, columns = image.shape
+    x = np.asarray(uv[..., 0], np.float64) * columns - 0.5
+    y = np.asarray(uv[..., 1], np.float64) * rows - 0.5
+    x0 = np.floor(x)
+    y0 = np.floor(y)
+    fx = x - x0
+    fy = y - y0
+    i0 = x0.astype(np.int64) % columns
+    j0 = y0.astype(np.int64) % rows
+    i1 = (i0 + 1) % columns
+    j1 = (j0 + 1) % rows
+    top = image[j0, i0] * (1 - fx) + image[j0, i1] * fx
+    bottom = image[j1, i0] * (1 - fx) + image[j1, i1] * fx
+    return top * (1 - fy) + bottom * fy
+
+
+def tone_blend(tone: np.ndarray, tones: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The two TAM tones nearest a lit tone in [0, 1] (1 lit: paper, 0: the darkest tone) and
+    the darker one's weight: s = (1 - tone) x tones runs over paper (s = 0) and the tones
+    (s = 1 ... tones); between two, their linear mix (-1 stands for paper)."""
+    s = np.clip(1.0 - np.asarray(tone, np.float64), 0.0, 1.0) * tones
+    darker = np.minimum(np.floor(s), tones - 1).astype(np.int64)
+    return darker - 1, darker, s - darker
+
+
+def blend_tones(tam: ToneArtMap, tone: np.ndarray, uv: np.ndarray, level: int = 0) -> np.ndarray:
+    """Ink of the TAM at lit ``tone`` (n,) and texture coordinates ``uv`` (n, 2) at mip level
+    ``level``: the two nearest tones, each sampled bilinearly with wrapping, mixed linearly
+    (the blend of ``hatching_ink`` in ``techniques/hatching.glsl``)."""
+    tone = np.asarray(tone, np.float64)
+    uv = np.asarray(uv, np.float64)
+    lighter, darker, weight = tone_blend(tone, tam.tones)
+    images = tam.ink(level).astype(np.float64)
+    samples = np.stack([sample_wrapped(image, uv) for image in images])  # (tones, n)
+    columns = np.arange(tone.shape[0])
+    dark = samples[darker, columns]
+    light = np.where(lighter >= 0, samples[np.maximum(lighter, 0), columns], 0.0)
+    return light + weight * (dark - light)
+
+
+def tam_texture(ctx: moderngl.Context, tam: ToneArtMap) -> moderngl.Texture:
+    """The TAM's atlas as a single-channel texture whose mip levels are the TAM's own
+    (trilinear filtering, clamped: the gutters do the wrapping). The GLSL takes it with
+    ``tam.tones`` and ``tam.gutter``."""
+    import moderngl
+
+    first = tam.atlas(0)
+    texture = ctx.texture((first.shape[1], first.shape[0]), 1, first.tobytes())
+    texture.build_mipmaps(0, tam.mips - 1)  # allocates the levels, replaced below
+    for m in range(1, tam.mips):
+        level = tam.atlas(m)
+        texture.write(level.tobytes(), level=m)
+    texture.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+    texture.repeat_x = texture.repeat_y = False
+    return texture
