@@ -1,6 +1,6 @@
 """The built-in meshes (``builtin:sphere``, ``builtin:torus``, ``builtin:plane``,
-``builtin:cube``) and their parameters as a query (``builtin:torus?segments=78&sides=60``),
-each checked before the shape is built."""
+``builtin:cube``, ``builtin:head``) and their parameters as a query
+(``builtin:torus?segments=78&sides=60``), each checked before the shape is built."""
 from __future__ import annotations
 
 import inspect
@@ -13,7 +13,7 @@ from deferred.gl.meshes import MeshData
 from deferred.scene.geometry import MAX_TRIANGLES, build_mesh
 
 BUILTIN_PREFIX = "builtin:"
-BUILTIN_MESHES = ("sphere", "torus", "plane", "cube")
+BUILTIN_MESHES = ("sphere", "torus", "plane", "cube", "head")
 
 
 def _grid_indices(rows: int, cols: int) -> np.ndarray:
@@ -85,8 +85,57 @@ def builtin_cube(size: float = 1.5) -> MeshData:
                       np.array(normals), np.array(uvs, dtype=np.float64))
 
 
+# builtin:head, in units of the cranium radius: the union of these spheres (x, y, z, radius):
+# cranium, face, chin; +y up, +z the face. They are also its collision shape for hair
+# (Costigan 4.1, appendix Fig. 1: a head as a group of spheres).
+HEAD_SPHERES = np.array([[0.0, 0.0, 0.0, 1.0], [0.0, -0.38, 0.22, 0.8],
+                         [0.0, -0.72, 0.34, 0.52]])
+_HEAD_CENTRE = np.array([0.0, -0.3, 0.12])  # inside every sphere: the surface is radial from it
+_HEAD_BLEND = 40.0  # sharpness of the smooth union (creases rounded by at most log(3)/40)
+
+
+def builtin_head_spheres(radius: float = 0.1) -> np.ndarray:
+    """``builtin:head``'s collision spheres ``(3, 4)`` (centre, radius) for a cranium
+    ``radius``: the mesh lies on or just outside their union."""
+    return HEAD_SPHERES * radius
+
+
+def builtin_head(segments: int = 64, rings: int = 48, radius: float = 0.1) -> MeshData:
+    """A head, 0.1 m cranium radius by default (about 0.22 m tall): the smooth union of
+    :data:`HEAD_SPHERES`, facing +z. Its vertex colours paint the scalp: alpha (the fur length
+    scale) 1 on the cranium above a hairline that runs from the forehead down to the nape, 0 on
+    the face; RGB comb the hair down and back."""
+    u = np.linspace(0.0, 1.0, segments + 1)
+    v = np.linspace(0.0, 1.0, rings + 1)
+    vv, uu = np.meshgrid(v, u, indexing="ij")
+    theta, phi = vv * math.pi, uu * 2.0 * math.pi
+    d = np.stack([np.sin(theta) * np.sin(phi), np.cos(theta),
+                  np.sin(theta) * np.cos(phi)], -1).reshape(-1, 3)
+    # each sphere's exit distance along d from the centre, and their smooth maximum
+    rel = HEAD_SPHERES[:, :3] - _HEAD_CENTRE
+    b = d @ rel.T
+    root = np.sqrt(b * b - (rel ** 2).sum(1) + HEAD_SPHERES[:, 3] ** 2)
+    exits = b + root
+    weight = np.exp(_HEAD_BLEND * (exits - exits.max(1, keepdims=True)))
+    r = exits.max(1) + np.log(weight.sum(1)) / _HEAD_BLEND
+    weight /= weight.sum(1, keepdims=True)
+    positions = _HEAD_CENTRE + d * r[:, None]
+    # the normal of a radial surface r(d) d is d - grad_s(r) / r (grad on the unit sphere)
+    grad = ((weight * exits / root)[:, :, None] * rel[None]).sum(1)
+    grad -= (grad * d).sum(1, keepdims=True) * d
+    normals = d - grad / r[:, None]
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    hairline = 0.05 + 0.45 * positions[:, 2]
+    scalp = np.clip((positions[:, 1] - hairline) / 0.15 + 0.5, 0.0, 1.0) * weight[:, 0]
+    scalp = np.where(scalp > 0.5, 1.0, 0.0)
+    comb = np.tile(np.array([0.5, 0.5 - 0.5 * 0.894, 0.5 - 0.5 * 0.447]), (len(d), 1))
+    uvs = np.stack([uu, 1.0 - vv], -1).reshape(-1, 2)
+    return build_mesh("builtin:head", positions * radius, _grid_indices(rings, segments),
+                      normals, uvs, colors=np.hstack([comb, scalp[:, None]]))
+
+
 BUILTIN_SHAPES = {"sphere": builtin_sphere, "torus": builtin_torus, "plane": builtin_plane,
-             "cube": builtin_cube}
+             "cube": builtin_cube, "head": builtin_head}
 
 
 
@@ -100,6 +149,7 @@ _BUILTIN_TRIANGLES = {
     "sphere": lambda a: 2 * a["segments"] * a["rings"],
     "torus": lambda a: 2 * a["segments"] * a["sides"],
     "plane": lambda a: 2 * a["divisions"] ** 2,
+    "head": lambda a: 2 * a["segments"] * a["rings"],
 }
 
 
