@@ -83,8 +83,9 @@ def test_a_random_scene_document_is_a_scene_or_one_input_error(document):
     try:
         scene = scene_from_dict(document, "random.toml")
     except InputError as exc:
-        message = str(exc)
-        assert message.startswith("random.toml") and "\n" not in message, message
+        for problem in exc.problems:  # every problem of the document, a line each
+            message = str(problem)
+            assert message.startswith("random.toml") and "\n" not in message, message
     else:
         assert scene.size[0] >= 1 and scene.size[1] >= 1
     assert time.perf_counter() - start < 10.0  # no hang (the unwrap and mesh checks bounded)
