@@ -25,6 +25,19 @@ from deferred.gl.targets import FrameTargets
 from deferred.gl.uniforms import gl_value
 
 
+class OfferedUniforms(dict):
+    """Uniforms a pass offers its program: set where the program declares them, and in strict
+    mode no error where it does not (an effect's parameters, offered to each of its passes:
+    :meth:`deferred.interfaces.effect.Effect.uniforms`). ``owner`` names who offers them: in
+    strict mode each must be declared by at least one program of the frame it is offered to."""
+
+    __slots__ = ("owner",)
+
+    def __init__(self, values: Mapping[str, Any] = (), owner: str = ""):
+        super().__init__(values)
+        self.owner = owner
+
+
 @dataclass(slots=True)
 class MaterialInputs:
     """A material's uniforms and textures for one frame, and which of them its programs
@@ -49,7 +62,10 @@ class Frame:
     In ``strict`` mode, a uniform or sampler a pass sets by name that its program does not
     declare is an error, and so is a material uniform that none of the material's programs
     declares: a misspelt name fails instead of being silently ignored. Uniforms every pass is
-    offered (camera, object transform, binding sources) are never errors.
+    offered (camera, object transform, binding sources, :class:`OfferedUniforms` for uniforms
+    or textures) are never errors. The other way round, an active uniform of a program (one
+    it uses) that nothing set in the frame when the program is bound is an error too (it
+    reads 0), unless its declaration gives it a value (an initializer, a layout binding).
 
     The device's state, framebuffer and draw calls are the frame's own methods (the same
     functions: a pass of many objects pays no extra call a draw).
@@ -112,6 +128,11 @@ class Frame:
         self.dispatch = device.dispatch
         self.barrier = device.barrier
         self.current_pass: PassLike | None = None
+        # strict mode: each owner of offered uniforms -> (names, what its programs declare)
+        self.offers: dict[str, tuple[set[str], set[str]]] = {}
+        if strict:  # the checks wrap the calls: the default path pays nothing for them
+            self.bind = self._bind_strict
+            self.bind_compute = self._bind_compute_strict
 
     # -- passes --------------------------------------------------------------------------------
     def run_pass(self, render_pass: PassLike, check_errors: bool = True) -> None:
@@ -194,9 +215,6 @@ class Frame:
         over the material's, and the material's over a source's. A value the program holds
         already is not written again; ``StableValues`` are planned once (``set_stable``).
         """
-        if self.strict:
-            self._check_declared(program, "program", [*(uniforms or {}), *(textures or {})],
-                                 material)
         program_uniforms = self.shaders.uniforms(program)
         program_uniforms.set_shared("camera", self.camera_values)
         # in order, a later value of a name winning (no merged copies: a pass of many objects
@@ -216,6 +234,53 @@ class Frame:
         if textures:
             program_uniforms.bind_samplers(textures, unit)
 
+    def _bind_strict(self, program: moderngl.Program, uniforms: dict[str, Any] | None = None,
+                     textures: dict[str, moderngl.Texture] | None = None, *,
+                     offered: dict[str, Any] | None = None,
+                     material: MaterialInputs | None = None) -> None:
+        """:meth:`bind` in strict mode: what the pass sets is declared, and what the program
+        uses is set."""
+        names = [*textures] if textures and textures.__class__ is not OfferedUniforms else []
+        if uniforms:
+            if uniforms.__class__ is not OfferedUniforms:
+                names[:0] = uniforms
+            elif uniforms.owner:
+                self._note_offer(program, uniforms)
+        self._check_declared(program, "program", names, material)
+        Frame.bind(self, program, uniforms, textures, offered=offered, material=material)
+        self._check_set(program)
+
+    def _bind_compute_strict(self, shader: moderngl.ComputeShader, uniforms: dict[str, Any],
+                             textures: dict[str, moderngl.Texture], *,
+                             offered: dict[str, Any] | None = None) -> None:
+        self._check_declared(shader, "compute shader", [*uniforms, *textures])
+        Frame.bind_compute(self, shader, uniforms, textures, offered=offered)
+        self._check_set(shader)
+
+    def _note_offer(self, program: moderngl.Program, values: OfferedUniforms) -> None:
+        names, declared = self.offers.setdefault(values.owner, (set(), set()))
+        names.update(values)
+        declared |= self.shaders.declared_uniforms(program)
+
+    def _check_set(self, program: moderngl.Program | moderngl.ComputeShader) -> None:
+        """Strict mode: every uniform ``program`` uses has a value (one nothing set reads 0:
+        a parameter, pass uniform, built-in or texture the GLSL expects and nobody gives)."""
+        unset = self.shaders.unset_uniforms(program)
+        if unset:
+            where = ", ".join(f"'{name}' ({self.shaders.declaration(program, name)})"
+                              for name in unset)
+            raise RenderError(f"program {self.shaders.describe(program)}: nothing sets uniform "
+                              f"{where}, which it uses (it reads 0)")
+
+    def check_offers(self) -> None:
+        """Strict mode, at the end of a frame: each offered uniform (an effect's parameter) is
+        declared by at least one program it was offered to."""
+        for owner, (names, declared) in self.offers.items():
+            unused = sorted(names - declared)
+            if unused:
+                raise RenderError(f"{owner}: no program of its passes declares uniform "
+                                  f"{', '.join(repr(n) for n in unused)}")
+
     def set_uniforms(self, program: moderngl.Program, values: dict[str, Any]) -> None:
         """Set the values ``program`` has (no strict check: :meth:`bind` does that); a value
         the program holds already is not written again."""
@@ -226,8 +291,6 @@ class Frame:
                      offered: dict[str, Any] | None = None) -> None:
         """Set a compute shader's uniforms and samplers (strict mode as :meth:`bind`); the
         binding sources are not offered (a compute pass binds what it reads itself)."""
-        if self.strict:
-            self._check_declared(shader, "compute shader", [*uniforms, *textures])
         shader_uniforms = self.shaders.uniforms(shader)
         shader_uniforms.set_shared("camera", self.camera_values)
         shader_uniforms.set({**(offered or {}), **uniforms})

@@ -7,18 +7,26 @@ which is how a generic pass pulls in a material's surface function. Each file is
 program (include-once), nesting is limited to ``MAX_INCLUDE_DEPTH``, and a cycle is an error.
 
 The assembled source keeps a line map, so a compile error reported by the driver as ``0:57(3)``
-(Mesa) or ``0(57)`` (NVIDIA) is reported as ``materials/standard/surface.glsl:12``.
+(Mesa) or ``0(57)`` (NVIDIA) is reported as ``materials/standard/surface.glsl:12``; a file a
+plugin's root holds is also named by the plugin's package (``... (plugin my_plugin)``).
 """
 
 from __future__ import annotations
 
 import re
+import sys
+from collections.abc import Callable
 from dataclasses import dataclass
-from importlib import resources
-from importlib.resources.abc import Traversable
+from functools import cache
+from importlib import metadata, resources
 from pathlib import Path
 
 import moderngl
+
+if sys.version_info >= (3, 11):
+    from importlib.resources.abc import Traversable
+else:  # Python 3.10
+    from importlib.abc import Traversable
 
 from deferred.errors import ShaderError
 from deferred.gl.uniforms import ProgramUniforms
@@ -27,7 +35,9 @@ MAX_INCLUDE_DEPTH = 16
 
 # Uniform declarations of assembled GLSL (strict mode checks names against them; blocks excluded).
 _QUALIFIERS = r"(?:(?:lowp|mediump|highp|coherent|volatile|restrict|readonly|writeonly)\s+)*"
-_UNIFORM = re.compile(r"^\s*(?:layout\s*\([^)]*\)\s*)?" + _QUALIFIERS + r"uniform\s+" +
+# Groups: the layout qualifier's arguments (a ``binding`` gives a sampler or image its unit), the
+# names (with any array sizes and initializers).
+_UNIFORM = re.compile(r"^\s*(?:layout\s*\(([^)]*)\)\s*)?" + _QUALIFIERS + r"uniform\s+" +
                       _QUALIFIERS + r"\w+\s+([^;{]+);", re.MULTILINE)
 _INCLUDE = re.compile(r'^\s*#\s*include\s+(?:"([^"]+)"|<([^>]+)>|([A-Za-z_]\w*))\s*$')
 # Mesa "0:57(3):", NVIDIA "0(57) :" - the location and the colon after it.
@@ -76,6 +86,11 @@ class ShaderLibrary:
         self.virtual_files: dict[str, str] = {}
         self._programs: dict[tuple, moderngl.Program] = {}
         self._declared: dict[int, frozenset[str]] = {}  # program glo -> declared uniform names
+        # program glo -> its uniforms' declarations, and its assembled stages (strict checks)
+        self._declarations: dict[int, dict[str, Declaration]] = {}
+        self._sources: dict[int, dict[str, Source]] = {}
+        self._required: dict[int, tuple[str, ...]] = {}  # glo -> what a pass must set (strict)
+        self._origins: dict[str, Traversable | Path] = {}  # file -> the added root holding it
         self._labels: dict[int, str] = {}  # program glo -> its files, for messages
         # program glo -> its active uniforms and the values last written to them
         self._uniforms: dict[int, ProgramUniforms] = {}
@@ -112,9 +127,11 @@ class ShaderLibrary:
     def read(self, name: str) -> str:
         if name in self.virtual_files:
             return self.virtual_files[name]
-        for root in self.roots:
+        for index, root in enumerate(self.roots):
             candidate = root.joinpath(*name.split("/"))
             if candidate.is_file():
+                if index:  # not the framework's own: errors name the plugin
+                    self._origins[name] = root
                 return candidate.read_text(encoding="utf-8")
         searched = ", ".join(str(root) for root in self.roots)
         raise ShaderError(f"shader file not found: {name} (searched: {searched})")
@@ -174,17 +191,48 @@ class ShaderLibrary:
         try:
             program = self.ctx.program(**{stage: src.text for stage, src in sources.items()})
         except moderngl.Error as exc:
-            raise ShaderError(self._map_error(str(exc), sources, stages)) from None
+            raise ShaderError(self._map_error(str(exc), sources, stages,
+                                              self._plugins_of)) from None
         self._programs[key] = program
-        self._declared[program.glo] = frozenset(
-            name for source in sources.values() for name in declared_uniforms(source.text))
-        self._labels[program.glo] = " + ".join(n for n in stages.values() if n is not None)
+        self._remember(program, sources, " + ".join(n for n in stages.values() if n is not None))
         self._uniforms[program.glo] = ProgramUniforms(program)
         return program
+
+    def _remember(self, program: moderngl.Program | moderngl.ComputeShader,
+                  sources: dict[str, Source], label: str) -> None:
+        declarations = uniform_declarations(list(sources.values()))
+        self._declarations[program.glo] = declarations
+        self._declared[program.glo] = frozenset(declarations)
+        self._sources[program.glo] = sources
+        self._labels[program.glo] = label
+        self._required.pop(program.glo, None)
 
     def declared_uniforms(self, program: moderngl.Program) -> frozenset[str]:
         """Names of the uniforms (and samplers) the program's sources declare, used or not."""
         return self._declared.get(program.glo, frozenset())
+
+    def declaration(self, program: moderngl.Program, name: str) -> str:
+        """``file:line`` declaring uniform ``name`` of ``program`` (its files where unknown)."""
+        found = self._declarations.get(program.glo, {}).get(name)
+        return found.where if found else self.describe(program)
+
+    def sources(self, program: moderngl.Program) -> dict[str, Source]:
+        """The assembled GLSL of each stage of ``program`` (``fragment_shader``...)."""
+        return self._sources.get(program.glo, {})
+
+    def unset_uniforms(self, program: moderngl.Program | moderngl.ComputeShader) -> list[str]:
+        """Strict mode: the active uniforms of ``program`` (those the linked program uses) that
+        no write gave a value since its values were last forgotten (a frame starts) and whose
+        declaration gives none (an initializer or a layout binding): they read 0."""
+        required = self._required.get(program.glo)
+        if required is None:
+            declarations = self._declarations.get(program.glo, {})
+            required = self._required[program.glo] = tuple(
+                name for name in program
+                if isinstance(program[name], moderngl.Uniform) and not name.startswith("gl_")
+                and not (name in declarations and declarations[name].preset))
+        written = self.uniforms(program).written
+        return [name for name in required if name not in written]
 
     def declared_in_folder(self, folder: str) -> frozenset[str]:
         """Uniforms declared by the shader files of ``folder`` (in any root) and the files they
@@ -237,17 +285,20 @@ class ShaderLibrary:
             shader = self.ctx.compute_shader(source.text)
         except moderngl.Error as exc:
             raise ShaderError(self._map_error(str(exc), {"compute_shader": source},
-                                              {"compute_shader": name})) from None
+                                              {"compute_shader": name},
+                                              self._plugins_of)) from None
         self._programs[key] = shader
-        self._declared[shader.glo] = frozenset(declared_uniforms(source.text))
-        self._labels[shader.glo] = name
+        self._remember(shader, {"compute_shader": source}, name)
         self._uniforms[shader.glo] = ProgramUniforms(shader, frozenset(
-            name for name in declared_uniforms(source.text) if name in shader))
+            name for name in self._declared[shader.glo] if name in shader))
         return shader
 
     @staticmethod
-    def _map_error(message: str, sources: dict[str, Source], stages: dict[str, str | None]) -> str:
-        """Rewrite driver line references to ``file:line`` of the stage that failed."""
+    def _map_error(message: str, sources: dict[str, Source], stages: dict[str, str | None],
+                   plugins_of: Callable[[list[str]], list[str]] | None = None) -> str:
+        """Rewrite driver line references to ``file:line`` of the stage that failed, naming the
+        plugin package of the file (or else of the program's files) where a plugin's root
+        holds it."""
         headers = {line.strip() for line in message.splitlines()}
         stage = next((s for s in sources if s in headers), None)
         if stage is None and len(sources) == 1:
@@ -274,7 +325,19 @@ class ShaderLibrary:
         head = first_location or (stages.get(stage) if stage else None) or "shader"
         detail = "; ".join(line for line in lines_out if "error" in line.lower()) or \
             "; ".join(lines_out)
-        return f"{head}: {detail}" if not detail.startswith(head) else detail
+        text = f"{head}: {detail}" if not detail.startswith(head) else detail
+        if plugins_of is None:
+            return text
+        failed = first_location.rpartition(":")[0] if first_location else None
+        plugins = plugins_of([failed]) if failed else []
+        plugins = plugins or plugins_of([file for source in sources.values()
+                                         for file, _ in source.line_map])
+        return f"{text} (plugin {', '.join(plugins)})" if plugins else text
+
+    def _plugins_of(self, files: list[str]) -> list[str]:
+        """The plugin packages (or shader folders) holding ``files``, as errors name them."""
+        roots = dict.fromkeys(self._origins[file] for file in files if file in self._origins)
+        return [root_package(root) or str(root) for root in roots]
 
     def release(self) -> None:
         self.generation += 1
@@ -282,6 +345,9 @@ class ShaderLibrary:
             program.release()
         self._programs.clear()
         self._declared.clear()
+        self._declarations.clear()
+        self._sources.clear()
+        self._required.clear()
         self._labels.clear()
         self._uniforms.clear()
 
@@ -293,14 +359,64 @@ def _folder_entries(root: Traversable | Path, folder: str) -> list[Traversable]:
     return [entry for entry in directory.iterdir() if entry.is_file()]
 
 
-def declared_uniforms(text: str) -> set[str]:
-    """Uniform names declared in GLSL ``text`` (``uniform vec3 a, b[4];`` gives a and b)."""
-    text = re.sub(r"/\*.*?\*/", " ", text, flags=re.DOTALL)
-    text = re.sub(r"//[^\n]*", "", text)
-    names = set()
+def _without_comments(text: str) -> str:
+    """``text`` with its comments blanked out, its lines where they were."""
+    text = re.sub(r"/\*.*?\*/", lambda m: "\n" * m.group(0).count("\n") or " ", text,
+                  flags=re.DOTALL)
+    return re.sub(r"//[^\n]*", "", text)
+
+
+def _declarations(text: str):
+    """(name, line of ``text`` (1-based), whether it is given a value) of each uniform
+    declaration; a value: an initializer, or a layout ``binding`` (a sampler's unit)."""
+    text = _without_comments(text)
     for match in _UNIFORM.finditer(text):
-        for part in match.group(1).split(","):
+        bound = bool(match.group(1)) and "binding" in match.group(1)
+        line = text.count("\n", 0, match.start(2)) + 1
+        for part in match.group(2).split(","):
             name = part.split("[")[0].split("=")[0].strip()
             if name:
-                names.add(name)
-    return names
+                yield name, line, bound or "=" in part
+
+
+def declared_uniforms(text: str) -> set[str]:
+    """Uniform names declared in GLSL ``text`` (``uniform vec3 a, b[4];`` gives a and b)."""
+    return {name for name, _, _ in _declarations(text)}
+
+
+@dataclass(frozen=True)
+class Declaration:
+    """Where a uniform is declared (``file:line``) and whether the declaration gives it a
+    value (an initializer or a layout binding): a pass need not set such a one."""
+
+    where: str
+    preset: bool
+
+
+def uniform_declarations(sources: list[Source]) -> dict[str, Declaration]:
+    """The uniforms the assembled ``sources`` (a program's stages) declare, by name."""
+    found: dict[str, Declaration] = {}
+    for source in sources:
+        for name, line, preset in _declarations(source.text):
+            file, file_line = source.locate(line)
+            known = found.get(name)
+            found[name] = Declaration(known.where if known else f"{file}:{file_line}",
+                                      preset or (known is not None and known.preset))
+    return found
+
+
+@cache
+def root_package(root: Traversable | Path) -> str | None:
+    """The Python package (and distribution, where one is installed) holding a shader root, as
+    errors name it: ``my_plugin (my-plugin-dist)``; None for a folder outside any package."""
+    path = Path(str(root))
+    package = None
+    for folder in (path, *path.parents):
+        if (folder / "__init__.py").is_file():
+            package = folder.name  # the outermost folder that is a package
+        elif package is not None:
+            break
+    if package is None:
+        return None
+    dists = metadata.packages_distributions().get(package, [])
+    return f"{package} ({', '.join(dists)})" if dists and dists != [package] else package

@@ -146,6 +146,12 @@ class ProgramUniforms:
         if name in self.members:
             self.set({name: gl_value(value)})
 
+    @property
+    def written(self) -> Any:
+        """The names written since the values were last forgotten (strict mode's check of
+        uniforms nothing sets: ``ShaderLibrary.unset_uniforms``)."""
+        return self._values.keys()
+
     def forget(self) -> None:
         """Drop the remembered values: the next write of each name reaches GL."""
         self._values.clear()

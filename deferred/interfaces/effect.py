@@ -4,8 +4,10 @@ An effect is a class with a unique ``name`` (the scene file's ``[[effect]] type`
 ``Params`` model and ``passes(scene, pipeline)``: the passes it adds, in any phase (typically
 ``screen``, over the clean G-buffer before any stipple, and ``post``, over the tone-mapped frame),
 ranked by ``Order`` within the phase. Parameters become ``u_<field>`` uniforms
-(:mod:`deferred.params`). ``pipelines`` names the pipelines it applies to (an effect reading the
-G-buffer has nothing to read in the forward pipeline). Register with
+(:mod:`deferred.params`), offered to each pass given ``uniforms=self.uniforms``: a pass's program
+gets those it declares (each of an effect's programs may use some of them; in strict mode each
+parameter must be declared by one of them). ``pipelines`` names the pipelines it applies to
+(an effect reading the G-buffer has nothing to read in the forward pipeline). Register with
 ``@deferred.api.effects.register`` or the entry-point group ``deferred.effects``.
 
 A screen effect that creates the target ``ssao`` (:data:`AMBIENT_OCCLUSION`) feeds the
@@ -14,12 +16,18 @@ ambient light, whichever effect it is.
 
 from __future__ import annotations
 
-from importlib.resources.abc import Traversable
+import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
 
+from deferred.core.frame import OfferedUniforms
 from deferred.names import Pipeline
 from deferred.params import Params, UniformOverrides, params_uniforms, validate_params
+
+if sys.version_info >= (3, 11):
+    from importlib.resources.abc import Traversable
+else:  # Python 3.10
+    from importlib.abc import Traversable
 
 if TYPE_CHECKING:
     from deferred.core.frame import Frame
@@ -54,8 +62,15 @@ class Effect:
         return cls(validate_params(cls.Params, values, where))
 
     def uniforms(self, frame: Frame) -> dict[str, Any]:
-        """``u_<field>`` for every parameter that is a uniform."""
-        return params_uniforms(self.params, self.uniform_overrides)
+        """``u_<field>`` for every parameter that is a uniform, offered to a pass's program
+        (:class:`~deferred.core.frame.OfferedUniforms`: set where the program declares them).
+        An override adding values keeps them offered with ``self.offer({...})``."""
+        return self.offer(params_uniforms(self.params, self.uniform_overrides))
+
+    def offer(self, values: dict[str, Any]) -> OfferedUniforms:
+        """``values`` offered to each pass of the effect: a pass's program gets the ones it
+        declares, not an error for the others in strict mode."""
+        return OfferedUniforms(values, f"effect {self.name}")
 
     def passes(self, scene: SceneLike, pipeline: str) -> list[RenderPass]:
         raise NotImplementedError

@@ -142,7 +142,9 @@ class FrameInputs:
 
     def check_material_uniforms(self) -> None:
         """Strict mode, at the end of a frame: every uniform a material sets is declared by at
-        least one of its programs."""
+        least one of its programs, and so is every uniform an effect offers its passes
+        (:meth:`Frame.check_offers`)."""
+        self.frame.check_offers()
         shaders = self.frame.shaders
         for inputs in self._materials.values():
             if not inputs.programs:

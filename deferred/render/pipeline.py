@@ -20,6 +20,7 @@ from dataclasses import replace
 import numpy as np
 
 from deferred import names
+from deferred.core.frame import OfferedUniforms
 from deferred.core.graph import PassGraph, compile_graph
 from deferred.core.passes import (
     ClearPass,
@@ -50,6 +51,7 @@ from deferred.interfaces.effect import AMBIENT_OCCLUSION
 from deferred.interfaces.material import ForwardLitPass
 from deferred.lighting.culling import LightCullPass, list_shading_pass
 from deferred.lighting.volumes import LightTypePass, surface_pass
+from deferred.memo import overrides
 from deferred.scene.model import Scene
 
 # what the pass graph checks beyond the core's rules: the G-buffer's
@@ -222,12 +224,38 @@ class ForwardPipeline(Pipeline):
         return {"FORWARD_PLUS": "1"} if self.light_path == names.LightPath.TILED else {}
 
 
+class DepthPrepass(ObjectPass):
+    """Forward+'s depth pre-pass twin of an object's lit pass ``lit``: the same vertex stage,
+    constants, uniforms and textures (a vertex stage displacing by a texture, shell_fur's
+    strands, puts the depth where the lit pass draws), depth and linear depth only."""
+
+    fragment = "forward/depth_prepass.frag"
+    colors = (LINEAR_DEPTH,)
+    order = Order.FIRST
+    lit: ForwardLitPass | None = None
+
+    def prepare(self, frame) -> None:
+        self.lit.prepare(frame)  # a twin of the graph's lit pass: what its hooks read
+
+    def uniforms(self, frame) -> dict:
+        return OfferedUniforms(self.lit.uniforms(frame))  # those of its stages
+
+    def textures(self, frame) -> dict:
+        # the lit pass's target reads are not the pre-pass's (it runs before their makers)
+        return {} if self.lit.extra_reads else OfferedUniforms(self.lit.textures(frame))
+
+
 def depth_prepass(lit: ForwardLitPass) -> RenderPass:
-    """Forward+'s depth pre-pass twin of an object's lit pass: the same vertex stage and
-    constants, depth and linear depth only."""
-    return ObjectPass(f"{lit.obj.label}.depth_prepass", Phase.FORWARD, lit.obj,
-                      vertex=lit.vertex, fragment="forward/depth_prepass.frag",
-                      colors=(LINEAR_DEPTH,), constants=lit.constants, order=Order.FIRST)
+    """Forward+'s depth pre-pass twin of ``lit``: a plain object pass of its vertex stage and
+    constants where those are all it sets (most materials: no hooks asked at each draw), else
+    a :class:`DepthPrepass`."""
+    name = f"{lit.obj.label}.depth_prepass"
+    if lit._hooks_unchanged and not overrides(type(lit), RenderPass, "prepare"):
+        return ObjectPass(name, Phase.FORWARD, lit.obj, vertex=lit.vertex,
+                          fragment=DepthPrepass.fragment, colors=DepthPrepass.colors,
+                          constants=lit.constants, order=Order.FIRST)
+    return DepthPrepass(name, Phase.FORWARD, lit.obj, vertex=lit.vertex,
+                        constants=lit.constants, lit=lit)
 
 
 PIPELINES: dict[str, type[Pipeline]] = {names.Pipeline.DEFERRED.value: DeferredPipeline,
