@@ -1,7 +1,9 @@
-"""The ``deferred`` command line (DESIGN.md, "Command line").
+"""The ``deferred`` command line (README.md, "Command line").
 
-Exit codes: 0 success, 1 a failure while rendering, 2 bad input. Bad input is one line on stderr
-naming the file/key and the problem; ``--debug`` shows the traceback instead.
+Exit codes: 0 success, 1 a failure while rendering (``dump --compare``: the dumps differ), 2 bad
+input. Bad input is one line on stderr naming the file/key and the problem; ``--debug`` shows the
+traceback instead. Progress goes to stderr (:mod:`deferred.io.progress`), so does a Python
+warning, as one line (``warning: ...``); results (tables, ``--json -``) go to stdout.
 """
 
 from __future__ import annotations
@@ -11,6 +13,7 @@ import os
 import sys
 import time
 import traceback
+import warnings
 from pathlib import Path
 
 import click
@@ -21,17 +24,22 @@ from deferred.errors import DeferredError, InputError, RenderError, ShaderError
 from deferred.interfaces import registry
 from deferred.io.images import write_image
 from deferred.io.paths import check_output_path
+from deferred.io.progress import Progress, duration
 from deferred.io.safety import (
     interrupt_exit_code,
     raise_if_stop_requested,
     termination_as_interrupt,
 )
-from deferred.names import Pipeline
+from deferred.names import LightPath, Pipeline
 from deferred.render.pipeline import PIPELINES
 from deferred.scene.loader import load_scene
 from deferred.scene.model import parse_size
 
 stderr = Console(stderr=True, soft_wrap=True)  # status lines never wrap on pipes
+LIGHT_PATH_CHOICE = click.Choice([path.value for path in LightPath])
+LIGHT_PATH_HELP = ("How lights reach the pixels: volumes, tiled or clustered (deferred); naive or "
+                   "tiled, i.e. Forward+ (forward). Default: the scene's light_path, else tiled "
+                   "where compute shaders exist.")
 
 
 MAX_PROBLEM_LINES = 50  # a scene file's problems shown; the rest are counted
@@ -79,18 +87,15 @@ def cli(debug: bool) -> None:
               show_default=True)
 @click.option("--size", help="WIDTHxHEIGHT, overrides the scene's size.")
 @click.option("--frames", type=click.IntRange(min=1, max=100_000), default=1, show_default=True,
-              help="Render this many frames, frame i at --time + i / --fps seconds: all of "
-                   "them go to a sequence or a video; an image gets the last (timing).")
+              help="Render this many frames, frame i at --time + i / --fps seconds, to a "
+                   "numbered sequence (a # pattern) or a video: one image holds one frame.")
 @click.option("--fps", type=FiniteFloat(min=0.0, min_open=True, max=1000.0), default=24.0,
               show_default=True, help="Frames per second: the time step and the video's rate.")
 @click.option("--time", "start_time", type=FiniteFloat(min=0.0, max=1e6), default=0.0,
               show_default=True, metavar="SECONDS",
               help="Time of the first frame (the scene's [[event]] timeline, animated "
                    "materials).")
-@click.option("--light-path", metavar="PATH",
-              help="How lights reach the pixels: volumes, tiled or clustered (deferred); naive "
-                   "or tiled, i.e. Forward+ (forward). Default: the scene's light_path, else "
-                   "tiled where compute shaders exist.")
+@click.option("--light-path", type=LIGHT_PATH_CHOICE, help=LIGHT_PATH_HELP)
 @click.option("--strict", is_flag=True,
               help="Fail on a uniform set by name that its program does not declare.")
 @click.option("--view", "view_name", metavar="BUFFER",
@@ -112,7 +117,12 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
         write_view,
     )
     from deferred.io.paths import output_kind
-    from deferred.io.video import check_animation_memory, check_video_size, frame_times
+    from deferred.io.video import (
+        check_animation_memory,
+        check_video_size,
+        check_video_writer,
+        frame_times,
+    )
     from deferred.lighting.paths import resolve_light_path
     from deferred.render.renderer import FULL_FEATURES, Renderer
 
@@ -130,41 +140,50 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
     if view_name is not None and kind != "image":
         raise InputError("writes one buffer to one .png or .exr image, not to a frame "
                          "pattern or a video", "--view")
-    loaded = _scene(scene)
-    _check_not_inputs(_render_outputs(out, kind, frames), loaded, scene, "-o")
-    size_override = _size_option(size)
+    if view_name is not None and frames > 1:
+        raise InputError("--view writes one buffer of one frame; pick the frame with --time",
+                         "--frames")
+    if kind == "image" and frames > 1:
+        raise InputError(f"{frames} frames cannot go to one image, {out.name}: use a # pattern "
+                         f"such as {out.stem}_####{out.suffix}, or .mp4/.gif", "--frames")
     if kind == "video":
-        check_video_size(out, size_override or loaded.size)
-        check_animation_memory(out, size_override or loaded.size, frames)
-    shown_name = view_name
-    if view_name is not None:
-        debug_scene = with_material_view(loaded, view_name)
-        if debug_scene is not None:  # the material draws the view: the frame shows it
-            loaded, view_name = debug_scene, None
-    with Renderer(loaded, pipeline, size_override, strict=strict or None,
-                  light_path=light_path) as renderer:
-        renderer.check_times(times)  # a simulation cannot reach the last frame: refuse now
-        if kind != "image":
-            written, frame_ms = _render_animation(renderer, out, times, fps)
-        else:
-            if view_name is not None:
-                view_pass, _ = resolve_view(view_name, renderer.passes)  # bad names fail here
-            frame_ms = []
-            for index, at in enumerate(times):
-                last = index == frames - 1
-                start = time.perf_counter()
-                if view_name is not None and last:
-                    capture = capture_frame(renderer, [view_pass] if view_pass else [],
-                                            warmup=False, time=at)
-                else:
-                    result = renderer.render(readback=last, time=at)
-                renderer.gl.ctx.finish()
-                frame_ms.append((time.perf_counter() - start) * 1000.0)
-    if kind == "image":
+        check_video_writer(out)  # a missing extra is said before the scene loads
+    with Progress("render", stderr) as progress:
+        progress.status(f"loading {scene or 'the demo scene'} (meshes, UV unwraps)")
+        loaded = _scene(scene)
+        _check_not_inputs(_render_outputs(out, kind, frames), loaded, scene, "-o")
+        size_override = _size_option(size)
+        if kind == "video":
+            check_video_size(out, size_override or loaded.size)
+            check_animation_memory(out, size_override or loaded.size, frames)
+        shown_name = view_name
         if view_name is not None:
-            write_view(out, view(capture, view_name))
-        else:
-            _write_result(out, result)
+            debug_scene = with_material_view(loaded, view_name)
+            if debug_scene is not None:  # the material draws the view: the frame shows it
+                loaded, view_name = debug_scene, None
+        progress.status("starting the renderer")
+        with Renderer(loaded, pipeline, size_override, strict=strict or None,
+                      light_path=light_path) as renderer:
+            renderer.check_times(times)  # a simulation cannot reach the last frame: refuse now
+            if kind != "image":
+                written, frame_ms = _render_animation(renderer, out, times, fps, progress)
+            else:
+                if view_name is not None:
+                    view_pass, _ = resolve_view(view_name, renderer.passes)  # bad names fail
+                progress.status("rendering the frame (shaders compile, simulations settle)")
+                start = time.perf_counter()
+                if view_name is not None:
+                    capture = capture_frame(renderer, [view_pass] if view_pass else [],
+                                            warmup=False, time=times[0])
+                else:
+                    result = renderer.render(readback=True, time=times[0])
+                renderer.gl.ctx.finish()
+                frame_ms = [(time.perf_counter() - start) * 1000.0]
+                # written while the renderer lives: the result may read its buffers lazily
+                if view_name is not None:
+                    write_view(out, view(capture, view_name))
+                else:
+                    _write_result(out, result)
     width, height = renderer.size
     timing = f"{min(frame_ms):.1f} ms" if frames == 1 else \
         f"median {sorted(frame_ms)[len(frame_ms) // 2]:.1f} ms over {frames} frames"
@@ -178,34 +197,24 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
                  f"{shown}{clock}, {timing})", markup=False, highlight=False)
 
 
-def _render_animation(renderer, out: Path, times: list[float],
-                      fps: float) -> tuple[str, list[float]]:
+def _render_animation(renderer, out: Path, times: list[float], fps: float,
+                      progress: Progress) -> tuple[str, list[float]]:
     """Every frame of ``times`` to the sequence or video ``out``: (what was written, the
     frame times in ms)."""
-    from rich.progress import (
-        BarColumn,
-        MofNCompleteColumn,
-        Progress,
-        TextColumn,
-        TimeRemainingColumn,
-    )
-
     from deferred.io.video import AnimationWriter, describe_written
 
     frame_ms = []
-    with AnimationWriter(out, fps) as writer, \
-            Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-                     TimeRemainingColumn(), console=stderr, transient=True,
-                     disable=len(times) <= 1 or not stderr.is_terminal) as progress:
-        task = progress.add_task(f"rendering {out.name}", total=len(times))
-        for at in times:
+    with AnimationWriter(out, fps) as writer:
+        progress.count(len(times), "frames", f"rendering {out.name} (the first compiles "
+                                             "shaders, settles simulations)")
+        for index, at in enumerate(times):
             start = time.perf_counter()
             renderer.render(readback=False, time=at)
             renderer.gl.ctx.finish()
             frame_ms.append((time.perf_counter() - start) * 1000.0)
             writer.write(renderer.read_hdr() if writer.wants_hdr else renderer.read_final())
-            progress.advance(task)
-        progress.update(task, description=f"writing {out.name}")
+            progress.advance(index + 1, f"rendering {out.name}")
+        progress.status(f"writing {out.name}")
         written = writer.close()
     return describe_written(written), frame_ms
 
@@ -224,21 +233,20 @@ def _render_animation(renderer, out: Path, times: list[float],
 @click.option("--pixel", metavar="X,Y",
               help="Print every pass that wrote this pixel (top-down coordinates) and what it "
                    "wrote; recorded in the manifest too.")
-@click.option("--light-path", metavar="PATH",
-              help="How lights reach the pixels: volumes, tiled or clustered (deferred); naive "
-                   "or tiled, i.e. Forward+ (forward). Default: the scene's light_path, else "
-                   "tiled where compute shaders exist.")
+@click.option("--light-path", type=LIGHT_PATH_CHOICE, help=LIGHT_PATH_HELP)
 @click.option("--strict", is_flag=True,
               help="Fail on a uniform set by name that its program does not declare.")
 @click.option("--compare", nargs=2, type=click.Path(), metavar="DIR_A DIR_B",
-              help="Compare two dumps: per-buffer max/mean differences and difference images.")
+              help="Compare two dumps: per-buffer max/mean differences and difference images. "
+                   "Exit status as diff's: 0 the same, 1 they differ, 2 bad input.")
 def dump(scene: str | None, output: str | None, pipeline: str, size: str | None,
          passes: str | None, pixel: str | None, light_path: str | None, strict: bool,
          compare: tuple[str, str] | None) -> None:
     """Write every buffer of every pass of one frame of SCENE as EXR, plus a contact sheet and
-    a manifest (DESIGN.md, "Dumps")."""
-    from rich.progress import Progress, SpinnerColumn, TextColumn
+    a manifest.json (README.md, "Debugging a frame", lists the files).
 
+    With --compare DIR_A DIR_B: print each buffer's max and mean difference, write difference
+    images, and exit 0 when the dumps are the same, 1 when they differ (as diff does)."""
     from deferred.debug.capture import select_passes
     from deferred.debug.dump import dump_scene
     from deferred.debug.dump_folder import check_dump_folder, check_dump_inputs
@@ -250,27 +258,29 @@ def dump(scene: str | None, output: str | None, pipeline: str, size: str | None,
         if scene or passes or pixel or size:
             raise InputError("compares two dump folders; give no scene, --size, --passes or "
                              "--pixel with it", "--compare")
-        _compare(*compare, output)
+        if _compare(*compare, output):
+            raise click.exceptions.Exit(1)  # as diff: the dumps differ
         return
     if not output:
         raise InputError("a dump needs an output folder", "-o")
     out_dir = check_dump_folder(output)  # not a folder of other files: a dump replaces it
-    loaded = _scene(scene)
-    check_dump_inputs(out_dir, scene_inputs(loaded, scene))
     patterns = [p.strip() for p in passes.split(",") if p.strip()] if passes is not None else None
     if patterns == []:
         raise InputError("names no pass (give names or globs, or leave --passes out)", "--passes")
-    with Renderer(loaded, pipeline, _size_option(size), strict=strict or None,
-                  light_path=light_path) as renderer:
-        chosen = select_passes(renderer.passes, patterns)  # bad input fails before any file
-        where = parse_pixel(pixel, renderer.size) if pixel is not None else None
-        with Progress(SpinnerColumn(), TextColumn("{task.description}"), console=stderr,
-                      transient=True, disable=not stderr.is_terminal) as progress:
-            task = progress.add_task("capturing")
+    with Progress("dump", stderr) as progress:
+        progress.status(f"loading {scene or 'the demo scene'} (meshes, UV unwraps)")
+        loaded = _scene(scene)
+        check_dump_inputs(out_dir, scene_inputs(loaded, scene))
+        progress.status("starting the renderer")
+        with Renderer(loaded, pipeline, _size_option(size), strict=strict or None,
+                      light_path=light_path) as renderer:
+            chosen = select_passes(renderer.passes, patterns)  # bad input fails before any file
+            where = parse_pixel(pixel, renderer.size) if pixel is not None else None
+            progress.status("capturing the frame (shaders compile, simulations settle)")
             manifest, history = dump_scene(
                 renderer, out_dir, patterns, where,
                 scene_file=str(Path(scene).resolve()) if scene else None,
-                progress=lambda name: progress.update(task, description=f"writing {name}"))
+                progress=lambda name: progress.status(f"writing {name}"))
     if history is not None and where is not None:
         for line in format_history(history, *where, renderer.size):
             click.echo(line)
@@ -279,7 +289,8 @@ def dump(scene: str | None, output: str | None, pipeline: str, size: str | None,
                  f"{len(manifest['passes'])} passes, frame {manifest['frame_ms']:.1f} ms)")
 
 
-def _compare(first: str, second: str, output: str | None) -> None:
+def _compare(first: str, second: str, output: str | None) -> bool:
+    """Compare two dumps, print the table; whether they differ."""
     from deferred.debug.compare import compare_dumps
 
     b = Path(second).resolve()  # "." has no name to build the default from
@@ -299,16 +310,18 @@ def _compare(first: str, second: str, output: str | None) -> None:
             table.add_row(r.buffer, str(len(r.channels)), f"{r.max:.6g}", f"{r.mean:.6g}",
                           str(r.pixels), "")
     console.print(table)
-    differing = sum(1 for r in results if r.problem or r.max > 0.0)
+    differing = sum(1 for r in results if r.differs)
     stderr.print(f"{differing} of {len(results)} buffers differ; difference images in {out}/")
+    return differing > 0
 
 
 @cli.command()
 @click.argument("scene", required=False, type=click.Path(dir_okay=False))
 @click.option("--lights", default="1,16,64,256,1024", show_default=True, metavar="N,...",
               help="Extra point lights added to the scene's own, one sweep point each.")
-@click.option("--shells", default="0,16,64", show_default=True, metavar="N,...",
-              help="Shell counts for every object whose material has 'shells'.")
+@click.option("--shells", metavar="N,...",
+              help="Shell counts for every object whose material has 'shells'. Default: the "
+                   "scene's own (0 where no object has shells).")
 @click.option("--size", help="WIDTHxHEIGHT, overrides the scene's size.")
 @click.option("--runs", type=click.IntRange(min=1, max=10_000), default=10, show_default=True,
               help="Rounds per point: in each, its frames timed back to back for 100 ms (1 to "
@@ -322,21 +335,25 @@ def _compare(first: str, second: str, output: str | None) -> None:
 @click.option("--interleave/--no-interleave", default=True, show_default=True,
               help="Time the points of a shell count together, their frames alternating (all "
                    "their renderers alive at once), or one after another (less memory).")
-@click.option("--json", "json_path", metavar="FILE.json", help="Results as JSON ('-': stdout).")
+@click.option("--json", "json_path", metavar="FILE.json",
+              help="Results as JSON ('-': to stdout, in place of the table).")
 @click.option("--csv", "csv_path", metavar="FILE.csv", help="Results as CSV.")
-@click.option("--plot", "plot_path", metavar="FILE.png", help="ms against light count.")
-def bench(scene: str | None, lights: str, shells: str, size: str | None, runs: int, warmup: int,
+@click.option("--plot", "plot_path", metavar="FILE.png",
+              help="ms against light count (needs the plot extra: pip install "
+                   "'deferred[plot]').")
+def bench(scene: str | None, lights: str, shells: str | None, size: str | None, runs: int,
+          warmup: int,
           pipelines: str, light_paths: str, interleave: bool, json_path: str | None,
           csv_path: str | None, plot_path: str | None) -> None:
     """Time SCENE (the built-in demo when omitted) in each pipeline over a sweep of light and
-    shell counts (DESIGN.md, "Benchmarks")."""
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
-
+    shell counts. The table goes to stdout, progress and the sweep's size and time to stderr;
+    benchmarks/README.md describes the method and the results."""
     from deferred import bench as benchmark
 
     # Every option is checked before the first frame: bad input never costs a sweep.
     sweep = benchmark.Sweep(lights=benchmark.parse_counts(lights, "--lights"),
-                            shells=benchmark.parse_counts(shells, "--shells"),
+                            shells=None if shells is None else
+                            benchmark.parse_counts(shells, "--shells"),
                             pipelines=benchmark.parse_pipelines(pipelines),
                             light_paths=benchmark.parse_light_paths(light_paths),
                             size=_size_option(size), runs=runs, warmup=warmup,
@@ -350,26 +367,32 @@ def bench(scene: str | None, lights: str, shells: str, size: str | None, runs: i
     loaded = _scene(scene)
     for where, path in outputs.items():
         _check_not_inputs([path], loaded, scene, where)
-    if not benchmark.shell_objects(loaded):
+    benchmark.check_sweep(loaded, sweep)
+    if shells is not None and not benchmark.shell_objects(loaded):
         stderr.print(f"{loaded.source}: no object has a 'shells' parameter; shell sweep "
                      "skipped (shells 0)")
-    total = benchmark.sweep_steps(loaded, sweep)
-    with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-                  console=stderr, transient=True, disable=not stderr.is_terminal) as progress:
-        task = progress.add_task("benchmark", total=total)
-        started = []
+    stderr.print(f"bench: {benchmark.describe_sweep(loaded, sweep)}; time: estimating",
+                 markup=False, highlight=False)
+    with Progress("bench", stderr) as progress:
+        progress.count(benchmark.sweep_runs(loaded, sweep), "runs", "starting")
+        estimated = []
 
-        def step(description: str) -> None:
-            progress.update(task, completed=len(started), description=description)
-            started.append(description)
+        def step(at: benchmark.SweepProgress) -> None:
+            progress.advance(at.runs_done, at.description, at.seconds_left)
+            if at.seconds_left is not None and not estimated:  # the first measured run
+                estimated.append(at.seconds_left)
+                progress.note(f"bench: about {duration(at.seconds_left)} left, from the "
+                              "first warm-up and run")
 
         report = benchmark.run_bench(loaded, sweep, progress=step)
-    # Not squeezed to 80 columns when stderr is a pipe or a file.
-    table_console = stderr if stderr.is_terminal else Console(stderr=True, width=160)
-    table_console.print(benchmark.results_table(report))
+    # The table and the comparisons are the results: on stdout, unless the JSON is there.
+    results = Console(stderr=json_path == "-")
+    if not results.is_terminal:
+        results = Console(stderr=json_path == "-", width=160)  # pipes: not 80 columns
+    results.print(benchmark.results_table(report))
     for line in [*benchmark.crossovers(report), *benchmark.speedups(report),
                  *benchmark.growth(report)]:
-        stderr.print(line)
+        results.print(line, markup=False, highlight=False, soft_wrap=True)
     if json_path == "-":
         try:  # a full disk or a closed pipe shows here, not as a warning at exit
             click.echo(report.to_json(), nl=False)
@@ -508,7 +531,8 @@ def info(scene: str | None) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     # SIGTERM unwinds like Ctrl-C, through the finally blocks that remove temporary files.
-    with termination_as_interrupt():
+    with termination_as_interrupt(), warnings.catch_warnings():
+        warnings.showwarning = _show_warning
         try:
             code = _main(argv)
             if code < 128:  # not ended by a signal already (said so once)
@@ -516,6 +540,12 @@ def main(argv: list[str] | None = None) -> int:
             return code
         except KeyboardInterrupt as exc:
             return _interrupted(exc)
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """A Python warning as one line, ``warning: ...``, without the source file and line."""
+    text = str(message).replace("\r", "\\r").replace("\n", "\\n")
+    click.echo(f"warning: {text}", err=True)
 
 
 def _interrupted(exc: KeyboardInterrupt) -> int:
@@ -528,8 +558,8 @@ def _main(argv: list[str] | None) -> int:
         click.echo(cli.get_help(cli.make_context("deferred", [], resilient_parsing=True)))
         return 0
     try:
-        cli.main(args=argv, prog_name="deferred", standalone_mode=False)
-        return 0
+        code = cli.main(args=argv, prog_name="deferred", standalone_mode=False)
+        return code if isinstance(code, int) else 0  # click returns an Exit's code
     except click.exceptions.Exit as exc:
         return exc.exit_code
     except click.exceptions.Abort as exc:

@@ -42,6 +42,12 @@ class BufferDiff:
     problem: str | None = None
     image: str | None = None  # difference image written, relative to the output folder
 
+    @property
+    def differs(self) -> bool:
+        """Whether the buffer differs between the dumps (or could not be compared): what
+        ``dump --compare``'s exit status 1 says."""
+        return self.problem is not None or self.max > 0.0 or self.pixels > 0
+
     def describe(self) -> dict[str, Any]:
         return {"buffer": self.buffer, "channels": self.channels, "max": self.max,
                 "mean": self.mean, "pixels": self.pixels, "per_channel_max": self.per_channel_max,
