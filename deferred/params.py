@@ -13,8 +13,7 @@ from typing import Any
 
 from pydantic import BaseModel, ConfigDict, ValidationError
 
-from deferred.errors import InputError
-from deferred.validation import StrictValues, format_validation_error
+from deferred.validation import StrictValues, validation_error
 
 UniformOverrides = dict[str, Callable[[Any], dict[str, Any]] | None]
 
@@ -44,11 +43,12 @@ class Params(StrictValues):
 
 
 def validate_params(model: type[Params], values: dict[str, Any], where: str | None) -> Params:
-    """``model(**values)``; a validation error is an ``InputError`` naming the key."""
+    """``model(**values)``; a validation error is an ``InputError`` naming the key (an
+    ``InputErrors`` naming each, for several), an unknown one with the closest known."""
     try:
         return model(**values)
     except ValidationError as exc:
-        raise InputError(*format_validation_error(exc, where)) from None
+        raise validation_error(exc, where, model) from None
 
 
 def uniform_value(value: Any) -> bool:

@@ -47,16 +47,6 @@ def location(loc: tuple) -> str:
     return out
 
 
-def format_validation_error(exc: ValidationError, where: str | None) -> tuple[str, str | None]:
-    """(message, where) for the first error; ``where`` is extended with the key's path. The
-    message counts the others: :func:`validation_problems` says each of them."""
-    problems = validation_problems(exc, where)
-    first = problems[0]
-    count = len(problems)
-    more = f" (and {count - 1} more problem{'s' if count > 2 else ''})" if count > 1 else ""
-    return first.message + more, first.where
-
-
 def validation_problems(exc: ValidationError, where: str | None,
                         model: type[BaseModel] | None = None) -> list[InputError]:
     """Every error of ``exc`` as an :class:`InputError` naming its key (``where`` extended
