@@ -1,16 +1,19 @@
-"""The benchmark harness (``deferred bench``, DESIGN.md "Benchmarks"): the sweep and its runner
+"""The benchmark harness (``deferred bench``, README.md "Benchmarks"): the sweep and its runner
 (:mod:`~deferred.bench.harness`), the scene variants it renders (:mod:`~deferred.bench.scenes`),
 how a frame is timed (:mod:`~deferred.bench.timing`) and what is written of the results
 (:mod:`~deferred.bench.report`)."""
 
 from deferred.bench.harness import (
     Sweep,
+    SweepProgress,
     check_output,
+    check_sweep,
+    describe_sweep,
     parse_counts,
     parse_light_paths,
     parse_pipelines,
     run_bench,
-    sweep_steps,
+    sweep_runs,
 )
 from deferred.bench.report import (
     BenchReport,
@@ -26,7 +29,8 @@ from deferred.bench.report import (
 from deferred.bench.scenes import shell_objects, with_extra_lights, with_shells
 from deferred.bench.timing import cpu_frame, time_cpu, time_passes
 
-__all__ = ["BenchReport", "BenchResult", "Sweep", "check_output", "cpu_frame", "crossovers",
-           "growth", "parse_counts", "parse_light_paths", "parse_pipelines", "results_table",
-           "run_bench", "shell_objects", "speedups", "sweep_steps", "time_cpu", "time_passes",
+__all__ = ["BenchReport", "BenchResult", "Sweep", "SweepProgress", "check_output", "check_sweep",
+           "cpu_frame", "crossovers", "describe_sweep", "growth", "parse_counts",
+           "parse_light_paths", "parse_pipelines", "results_table", "run_bench",
+           "shell_objects", "speedups", "sweep_runs", "time_cpu", "time_passes",
            "with_extra_lights", "with_shells", "write_csv", "write_json", "write_plot"]

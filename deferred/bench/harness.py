@@ -1,7 +1,8 @@
 """Benchmarks: the same scene through each pipeline over a sweep of light and shell counts.
 
-DESIGN.md, "Benchmarks". Every (pipeline, light path, lights, shells) point of a sweep gets its
-own renderer on one shared GL context: ``warmup`` untimed frames (shaders compile there), then
+README.md, "Benchmarks", and benchmarks/README.md. Every (pipeline, light path, lights, shells)
+point of a sweep gets its own renderer on one shared GL context: ``warmup`` untimed frames
+(shaders compile there), then
 ``runs`` rounds, each of frames timed by wall clock around ``render()`` plus ``ctx.finish()``
 (back to back for ``round_ms``, the first dropped: a 20 ms frame is timed four times a round, a
 3 s one once), one frame timing each pass the same way (kept apart so the per-pass
@@ -14,7 +15,8 @@ The light sweep adds ``L`` point lights to the scene's own, placed by a seeded g
 the objects' world bounds where the camera sees them, each with a radius covering a fixed share
 of the view at its depth, so every light touches the screen whatever the scene's scale. The
 lights of a smaller count are the first lights of a larger one. The shell sweep sets ``shells``
-on every object whose material has that parameter (``revie_fur``).
+on every object whose material has that parameter (``revie_fur``); without one the scene runs
+with its own shells (its largest count is the rows' ``shells``).
 
 Every light path of each pipeline runs (``light_path``: ``volumes``, ``tiled``, ``clustered``
 for deferred, ``naive`` and ``tiled`` (Forward+) for forward), unless ``--light-paths`` picks.
@@ -34,6 +36,7 @@ from __future__ import annotations
 
 import random
 import statistics
+import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -52,6 +55,7 @@ from deferred.bench.timing import (
 )
 from deferred.errors import InputError
 from deferred.gl.context import GLContext, create_context
+from deferred.io.extras import PLOT, require_extra
 from deferred.io.paths import check_output_path
 from deferred.names import LIGHT_PATHS, LightPath, Pipeline
 from deferred.render.pipeline import PIPELINES
@@ -59,7 +63,6 @@ from deferred.render.renderer import Renderer
 from deferred.scene.model import Scene
 
 DEFAULT_LIGHTS = (1, 16, 64, 256, 1024)
-DEFAULT_SHELLS = (0, 16, 64)
 ROUND_ORDER_SEED = 0  # run_bench: the order of the points in each round
 ROUND_FRAMES = 5  # the most frames a point renders back to back in a round (Sweep.round_ms)
 OUTPUT_SUFFIXES = {"--json": ".json", "--csv": ".csv", "--plot": ".png"}
@@ -115,8 +118,12 @@ def parse_pipelines(text: str, where: str = "--pipelines") -> list[str]:
 
 
 def check_output(path: str | Path, where: str) -> Path:
-    """An output file named by ``where`` (``--json``...) with that option's suffix."""
-    return check_output_path(path, where, (OUTPUT_SUFFIXES[where],), patterns=False)
+    """An output file named by ``where`` (``--json``...) with that option's suffix; a plot
+    needs the ``plot`` extra (matplotlib)."""
+    checked = check_output_path(path, where, (OUTPUT_SUFFIXES[where],), patterns=False)
+    if where == "--plot":
+        require_extra(PLOT, ("matplotlib",), "a plot", where)
+    return checked
 
 
 
@@ -124,7 +131,7 @@ def check_output(path: str | Path, where: str) -> Path:
 @dataclass(frozen=True)
 class Sweep:
     lights: Sequence[int] = DEFAULT_LIGHTS
-    shells: Sequence[int] = DEFAULT_SHELLS
+    shells: Sequence[int] | None = None  # None: the scene's own shells, as they are
     pipelines: Sequence[str] = tuple(Pipeline)
     light_paths: Sequence[str] | None = None  # None: every path of each pipeline
     size: tuple[int, int] | None = None  # None: the scene's size
@@ -136,9 +143,24 @@ class Sweep:
     round_ms: float = 100.0
 
 
-def sweep_shells(scene: Scene, shells: Sequence[int]) -> list[int]:
-    """The shell counts a sweep really runs: one value (0) when no object has shells."""
+def own_shells(scene: Scene) -> int:
+    """The scene's own shell count: its objects' largest (0 where none has shells)."""
+    return max((int(obj.material.params.shells) for obj in shell_objects(scene)), default=0)
+
+
+def sweep_shells(scene: Scene, shells: Sequence[int] | None) -> list[int]:
+    """The shell counts a sweep really runs: the scene's own where none are given, one value
+    (0) when no object has shells."""
+    if shells is None:
+        return [own_shells(scene)]
     return list(shells) if shell_objects(scene) else [0]
+
+
+def _shelled(scene: Scene, sweep: Sweep, shells: int) -> Scene:
+    """The scene at one of the sweep's shell counts (as it is without a shell sweep)."""
+    if sweep.shells is None or not shell_objects(scene):
+        return scene
+    return with_shells(scene, shells)
 
 
 @dataclass
@@ -186,16 +208,88 @@ def sweep_points(sweep: Sweep) -> list[tuple[int, str, str]]:
             for path in pipeline_paths(pipeline, sweep.light_paths)]
 
 
-def sweep_steps(scene: Scene, sweep: Sweep) -> int:
-    """How many times :func:`run_bench` calls ``progress``: a warm-up per point, a round of
-    frames per group of points timed together."""
-    points = len(sweep_points(sweep))
-    groups = 1 if sweep.interleave else points
-    return len(sweep_shells(scene, sweep.shells)) * (points + groups * sweep.runs)
+def sweep_runs(scene: Scene, sweep: Sweep) -> int:
+    """The runs of a sweep: a round of each configuration, ``sweep.runs`` each (a
+    configuration is a pipeline's light path at a light count and a shell count)."""
+    return len(sweep_shells(scene, sweep.shells)) * len(sweep_points(sweep)) * sweep.runs
+
+
+def describe_sweep(scene: Scene, sweep: Sweep) -> str:
+    """The sweep's size in words: ``24 configurations (4 light paths x 3 light counts x 2
+    shell counts) x 10 runs, after 2 warm-up frames each``."""
+    paths = len({(pipeline, path) for _, pipeline, path in sweep_points(sweep)})
+    shells = sweep_shells(scene, sweep.shells)
+    configurations = len(sweep_points(sweep)) * len(shells)
+
+    def counted(count: int, what: str) -> str:
+        return f"{count} {what}{'s' if count != 1 else ''}"
+
+    shell_part = (counted(len(shells), "shell count") if sweep.shells is not None
+                  else f"the scene's {shells[0]} shells")
+    return (f"{counted(configurations, 'configuration')} ({counted(paths, 'light path')} x "
+            f"{counted(len(sweep.lights), 'light count')} x {shell_part}) x "
+            f"{counted(sweep.runs, 'run')}, after {counted(sweep.warmup, 'warm-up frame')} each")
+
+
+def check_sweep(scene: Scene, sweep: Sweep) -> None:
+    """Everything :func:`run_bench` refuses, refused before any GL work (``InputError``)."""
+    if sweep.runs < 1:
+        raise InputError(f"runs must be 1 or more, got {sweep.runs}", "--runs")
+    if sweep.warmup < 0:
+        raise InputError(f"warmup must be 0 or more, got {sweep.warmup}", "--warmup")
+    if max(sweep.lights, default=0) + len(scene.lights) > MAX_LIGHTS:
+        raise InputError(f"at most {MAX_LIGHTS} lights in all, the scene has "
+                         f"{len(scene.lights)}", "--lights")
+    if not sweep_points(sweep):
+        raise InputError("no light path of the pipelines chosen is in --light-paths",
+                         "--light-paths")
+    for shells in sweep_shells(scene, sweep.shells):
+        _shelled(scene, sweep, shells)  # each material's range of shells
+
+
+@dataclass(frozen=True)
+class SweepProgress:
+    """Where a sweep stands when :func:`run_bench` starts a step (a warm-up or a run): what the
+    step is, the runs done of all, and the time left, estimated from the warm-ups and runs
+    measured so far (None until one of each was)."""
+
+    description: str
+    runs_done: int
+    runs_total: int
+    seconds_left: float | None
+
+
+class _SweepClock:
+    """The time a sweep has left: the warm-ups and runs still to come, each at the mean
+    duration of those measured so far."""
+
+    def __init__(self, warmups: int, runs: int):
+        self.warmups_left, self.runs_left = warmups, runs
+        self.runs_total = runs
+        self.warmup_s: list[float] = []
+        self.run_s: list[float] = []
+
+    def warmed_up(self, seconds: float) -> None:
+        self.warmup_s.append(seconds)
+        self.warmups_left -= 1
+
+    def ran(self, seconds: float) -> None:
+        self.run_s.append(seconds)
+        self.runs_left -= 1
+
+    def seconds_left(self) -> float | None:
+        if not self.run_s or (self.warmups_left and not self.warmup_s):
+            return None
+        warmup = statistics.fmean(self.warmup_s) if self.warmup_s else 0.0
+        return self.warmups_left * warmup + self.runs_left * statistics.fmean(self.run_s)
+
+    def at(self, description: str) -> SweepProgress:
+        return SweepProgress(description, self.runs_total - self.runs_left, self.runs_total,
+                             self.seconds_left())
 
 
 def run_bench(scene: Scene, sweep: Sweep, gl: GLContext | None = None,
-              progress: Callable[[str], None] | None = None) -> BenchReport:
+              progress: Callable[[SweepProgress], None] | None = None) -> BenchReport:
     """Render every (pipeline, light path, lights, shells) point of ``sweep`` and time it.
 
     With ``sweep.interleave`` (the default) the points of one shell count are timed together:
@@ -210,29 +304,27 @@ def run_bench(scene: Scene, sweep: Sweep, gl: GLContext | None = None,
     (a light count against another, a path against another) hold where timing one point after
     another moved them by 40%. The cost: all those renderers are alive at once (about 50-90 MB
     each at 1280x720 on lights.toml). Without it, one point is built, timed and released
-    after another. ``progress(description)`` is called before each warm-up and each round.
+    after another. ``progress`` is called with a :class:`SweepProgress` before each warm-up
+    and each run (a configuration's round).
     """
-    if sweep.runs < 1:
-        raise InputError(f"runs must be 1 or more, got {sweep.runs}", "--runs")
-    if sweep.warmup < 0:
-        raise InputError(f"warmup must be 0 or more, got {sweep.warmup}", "--warmup")
-    if max(sweep.lights, default=0) + len(scene.lights) > MAX_LIGHTS:
-        raise InputError(f"at most {MAX_LIGHTS} lights in all, the scene has "
-                         f"{len(scene.lights)}", "--lights")
+    check_sweep(scene, sweep)
     points = sweep_points(sweep)
-    if not points:
-        raise InputError("no light path of the pipelines chosen is in --light-paths",
-                         "--light-paths")
     size = sweep.size or scene.size
     aspect = size[0] / size[1]
-    report = progress or (lambda description: None)
+    clock = _SweepClock(len(points) * len(sweep_shells(scene, sweep.shells)),
+                        sweep_runs(scene, sweep))
+
+    def report(description: str) -> None:
+        if progress is not None:
+            progress(clock.at(description))
+
     owns = gl is None
     gl = gl or create_context()
     results = []
     try:
         timers = timer_queries_work(gl)
         for shells in sweep_shells(scene, sweep.shells):
-            shelled = with_shells(scene, shells) if shell_objects(scene) else scene
+            shelled = _shelled(scene, sweep, shells)
             lit = {lights: with_extra_lights(shelled, lights, aspect) for lights in sweep.lights}
             groups = [points] if sweep.interleave else [[point] for point in points]
             for group in groups:
@@ -241,19 +333,22 @@ def run_bench(scene: Scene, sweep: Sweep, gl: GLContext | None = None,
                 try:
                     for lights, pipeline, path in group:
                         report(f"warm-up: {pipeline} ({path}), {lights} lights, {shells} shells")
+                        start = time.perf_counter()
                         renderer = Renderer(lit[lights], pipeline, size, gl=gl, light_path=path)
                         timed.append(_TimedPoint(lights, pipeline, path, renderer,
                                                  timer_queries(renderer) if timers else None))
                         for _ in range(sweep.warmup):
                             renderer.render(readback=False)
+                        clock.warmed_up(time.perf_counter() - start)
                     for round_index in range(sweep.runs):
-                        what = (f"{len(timed)} points" if len(timed) > 1 else
-                                f"{timed[0].pipeline} ({timed[0].light_path}), "
-                                f"{timed[0].lights} lights")
-                        report(f"round {round_index + 1} of {sweep.runs}: {what}, "
-                               f"{shells} shells")
                         for k in order.sample(range(len(timed)), len(timed)):
-                            timed[k].time_round(sweep.round_ms)
+                            point = timed[k]
+                            report(f"round {round_index + 1} of {sweep.runs}: {point.pipeline} "
+                                   f"({point.light_path}), {point.lights} lights, "
+                                   f"{shells} shells")
+                            start = time.perf_counter()
+                            point.time_round(sweep.round_ms)
+                            clock.ran(time.perf_counter() - start)
                     results += [point.result(shells) for point in timed]
                 finally:
                     for point in timed:

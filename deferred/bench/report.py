@@ -124,7 +124,7 @@ def write_csv(report: BenchReport, path: str | Path) -> Path:
 
 def plot_image(report: BenchReport, title: str | None = None) -> np.ndarray:
     """The plot as RGBA pixels: median ms (min..max shaded) against extra lights, one line per
-    pipeline, one panel per shell count."""
+    pipeline, one panel per shell count (matplotlib: the ``plot`` extra)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
     from matplotlib.ticker import NullLocator, ScalarFormatter
@@ -174,7 +174,7 @@ def plot_title(report: BenchReport) -> str:
 
 
 def results_table(report: BenchReport):
-    """A rich table of the results (stderr in the CLI), the slowest pass of each row last."""
+    """A rich table of the results (stdout in the CLI), the slowest pass of each row last."""
     from rich.table import Table
 
     table = Table(title=plot_title(report), title_justify="left")

@@ -5,7 +5,8 @@ scene's ``[[event]]`` timeline and animated materials follow ``frame.time``) and
 
 - a numbered sequence for a name with a run of ``#`` (``out_####.png``, ``.exr`` too): the run
   becomes the frame number, zero-padded to its length (wider numbers keep every digit);
-- a video for ``.mp4`` (H.264, yuv420p, through imageio's ffmpeg plugin; even sizes only) or
+- a video for ``.mp4`` (H.264, yuv420p, through imageio's ffmpeg plugin, the ``video`` extra;
+  even sizes only) or
   ``.gif`` (Pillow, looping forever; Pillow merges identical consecutive frames into one longer
   frame, so a GIF's frames are held, a byte a pixel, until it is written at the end:
   :func:`check_animation_memory` refuses more than the memory budget before the first frame).
@@ -25,6 +26,7 @@ import numpy as np
 from PIL import Image
 
 from deferred.errors import InputError, RenderError
+from deferred.io.extras import VIDEO, require_extra
 from deferred.io.images import first_line, sync_file, write_image
 from deferred.io.memory import check_memory
 from deferred.io.paths import expand_pattern, output_kind, temporary_path
@@ -83,16 +85,24 @@ def gif_durations(frames: int, fps: float) -> list[int]:
     return [max(1, b - a) * GIF_TICK_MS for a, b in zip(ticks, ticks[1:], strict=False)]
 
 
-def ffmpeg_executable() -> str:
-    """The ffmpeg imageio uses (imageio-ffmpeg's own binary unless ``IMAGEIO_FFMPEG_EXE``
-    names another); ``RenderError`` when there is none."""
-    try:
-        import imageio_ffmpeg
+def check_video_writer(path: str | Path, where: str = "-o") -> None:
+    """An ``.mp4`` needs the ``video`` extra (imageio and imageio-ffmpeg): ``InputError`` naming
+    it when missing (a ``.gif`` needs Pillow alone)."""
+    if Path(path).suffix.lower() == ".mp4":
+        require_extra(VIDEO, ("imageio", "imageio_ffmpeg"), "writing .mp4", where)
 
+
+def ffmpeg_executable(where: str = "-o") -> str:
+    """The ffmpeg imageio uses (imageio-ffmpeg's own binary unless ``IMAGEIO_FFMPEG_EXE``
+    names another); ``InputError`` without the ``video`` extra, ``RenderError`` when it has
+    no ffmpeg for this machine."""
+    require_extra(VIDEO, ("imageio", "imageio_ffmpeg"), "writing .mp4", where)
+    import imageio_ffmpeg
+
+    try:
         return imageio_ffmpeg.get_ffmpeg_exe()
-    except (ImportError, RuntimeError) as exc:
-        raise RenderError(f"mp4 output needs ffmpeg (pip install imageio-ffmpeg): {exc}") \
-            from None
+    except RuntimeError as exc:
+        raise RenderError(f"mp4 output needs ffmpeg: {exc}") from None
 
 
 class AnimationWriter:
@@ -116,7 +126,7 @@ class AnimationWriter:
         if self.kind == "sequence":
             expand_pattern(self.path, 0, where)  # one run of '#', an image suffix
         elif self.suffix == ".mp4":
-            ffmpeg_executable()  # before any frame is rendered
+            ffmpeg_executable(where)  # before any frame is rendered
         self.written: list[Path] = []  # files completed
         self.frames = 0
         self._temporary: Path | None = None

@@ -44,8 +44,7 @@ def test_cli_sweep_writes_json_csv_plot(tmp_path, capsys):
                             "--json", str(out["json"]), "--csv", str(out["csv"]),
                             "--plot", str(out["png"]))
     assert code == 0, err
-    assert stdout == ""  # stdout stays clean for --json -
-    assert "median ms" in err  # the table goes to stderr
+    assert "median ms" in stdout and "median ms" not in err  # the results on stdout
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bench.csv", "bench.json",
                                                           "bench.png"]
 
@@ -65,7 +64,7 @@ def test_cli_sweep_writes_json_csv_plot(tmp_path, capsys):
     assert set(combos) == {(*p, lights, shells) for p in paths for lights in (0, 3)
                            for shells in (0, 4)}
     assert set(combos.values()) == {1}
-    assert "shells: deferred" in err  # the crossover lines
+    assert "shells: deferred" in stdout  # the crossover lines
 
     demo = load_scene(None)
     for r in results:
@@ -112,6 +111,7 @@ def test_json_dash_goes_to_stdout(tmp_path, capsys, monkeypatch):
     report = json.loads(stdout)
     assert [(r["pipeline"], r["light_path"], r["lights"], r["shells"])
             for r in report["results"]] == [("forward", "naive", 2, 0)]
+    assert "median ms" in err  # the table goes to stderr, out of the JSON's way
     assert list(tmp_path.iterdir()) == []
 
 
@@ -125,7 +125,7 @@ def test_scene_without_shells_sweeps_one_value(gl, capsys):
     assert all(r.runs == 1 and r.stddev_ms == 0.0 for r in report.results)
 
     code, _, err = run(capsys, "bench", str(LIGHTS_SCENE), *FAST, "--lights", "0",
-                       "--pipelines", "deferred")
+                       "--pipelines", "deferred", "--shells", "0,16")
     assert code == 0, err
     assert "no object has a 'shells' parameter; shell sweep skipped (shells 0)" in err
 
@@ -301,9 +301,14 @@ def test_interleaved_points_alternate_their_frames_round_by_round(gl, monkeypatc
     sweep = Sweep(lights=[0, 3], runs=3, warmup=1, light_paths=["tiled"],
                   interleave=interleave, round_ms=0.0)  # one timed frame a round
     report = run_bench(scene, sweep, gl=gl, progress=steps.append)
-    from deferred.bench.harness import sweep_steps
+    from deferred.bench.harness import sweep_runs
 
-    assert len(steps) == sweep_steps(scene, sweep)
+    # called before each of the 4 warm-ups and the 12 runs, the runs counted
+    assert sweep_runs(scene, sweep) == 12
+    assert len(steps) == 4 + 12 and {s.runs_total for s in steps} == {12}
+    assert [s.runs_done for s in steps if s.description.startswith("round")] == list(range(12))
+    assert steps[0].seconds_left is None  # nothing measured yet
+    assert steps[-1].seconds_left is not None and steps[-1].seconds_left >= 0.0
     assert report.renderer["interleaved"] is interleave
     own = len(scene.lights)
     points = [("deferred", "tiled", own), ("forward", "tiled", own),
