@@ -8,10 +8,10 @@ as categorical colours (0, the background, is black).
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import lru_cache
+from pathlib import Path
 
 import numpy as np
 
@@ -38,11 +38,20 @@ class Tile:
 
 
 # -- colour maps -------------------------------------------------------------------------------
-@lru_cache(maxsize=4)
-def _lut(name: str) -> np.ndarray:
-    from matplotlib import colormaps
+# Turbo (Mikhailov, Google, 2019; Apache-2.0) at 256 evenly spaced points, float32 RGB: the
+# table matplotlib's ``colormaps["turbo"]`` gives, stored so that no plotting library is needed.
+TURBO_FILE = Path(__file__).with_name("turbo.npy")
+# matplotlib's "tab10" (Tableau 10): categorical colours for ids
+TAB10 = np.array([[0x1F, 0x77, 0xB4], [0xFF, 0x7F, 0x0E], [0x2C, 0xA0, 0x2C], [0xD6, 0x27, 0x28],
+                  [0x94, 0x67, 0xBD], [0x8C, 0x56, 0x4B], [0xE3, 0x77, 0xC2], [0x7F, 0x7F, 0x7F],
+                  [0xBC, 0xBD, 0x22], [0x17, 0xBE, 0xCF]], dtype=np.float32) / 255.0
 
-    return np.asarray(colormaps[name](np.linspace(0.0, 1.0, 256))[:, :3], dtype=np.float32)
+
+@lru_cache(maxsize=1)
+def _turbo() -> np.ndarray:
+    table = np.load(TURBO_FILE)
+    table.setflags(write=False)
+    return table
 
 
 def tonemap(hdr: np.ndarray, method: str = "aces", exposure: float = 1.0) -> np.ndarray:
@@ -68,7 +77,7 @@ def depth_colors(depth: np.ndarray, covered: np.ndarray) -> np.ndarray:
         lo, hi = float(depth[covered].min()), float(depth[covered].max())
         t = (depth - lo) / (hi - lo) if hi > lo else np.zeros_like(depth)
         index = np.clip(np.nan_to_num(t) * 255.0, 0, 255).astype(np.int32)
-        rgb[covered] = _lut("turbo")[index[covered]]
+        rgb[covered] = _turbo()[index[covered]]
     return rgb
 
 
@@ -80,15 +89,13 @@ def heat_colors(values: np.ndarray, peak: float | None = None) -> np.ndarray:
     if peak is None:
         peak = float(values[finite].max()) if finite.any() else 0.0
     t = np.where(finite, values / peak if peak > 0.0 else 0.0, 1.0)
-    rgb = _lut("turbo")[np.clip(t * 255.0, 0, 255).astype(np.int32)]
+    rgb = _turbo()[np.clip(t * 255.0, 0, 255).astype(np.int32)]
     return np.where((values != 0.0)[..., None], rgb, 0.0).astype(np.float32)
 
 
 def id_colors(ids: np.ndarray) -> np.ndarray:
     """Categorical colours by integer id; 0 (background) black."""
-    from matplotlib import colormaps
-
-    palette = np.asarray(colormaps["tab10"].colors, dtype=np.float32)
+    palette = TAB10
     index = np.rint(np.nan_to_num(ids)).astype(np.int64)
     rgb = palette[(np.maximum(index, 1) - 1) % len(palette)]
     return np.where((index > 0)[..., None], rgb, 0.0).astype(np.float32)
@@ -146,32 +153,31 @@ def thumbnail(rgb: np.ndarray, width: int) -> np.ndarray:
     return blocks.mean(axis=(1, 3))
 
 
-@lru_cache(maxsize=1)
-def _font():
-    """matplotlib's bundled DejaVu Sans, so labels look the same on every machine."""
-    from pathlib import Path
+@lru_cache(maxsize=4)
+def _font(pixels: int):
+    """Pillow's bundled font (a scalable one where Pillow has FreeType), so labels look the
+    same on every machine."""
+    from PIL import ImageFont
 
-    import matplotlib
-    from matplotlib.ft2font import FT2Font
-
-    return FT2Font(str(Path(matplotlib.get_data_path()) / "fonts" / "ttf" / "DejaVuSans.ttf"))
+    return ImageFont.load_default(size=pixels)
 
 
 def text_mask(text: str, pixels: int = 12) -> np.ndarray | None:
-    """Coverage (H, W) in [0, 1] of ``text`` rendered ``pixels`` high; None if no font."""
+    """Coverage (H, W) in [0, 1] of ``text`` rendered ``pixels`` high; None if no font.
+    A glyph the font lacks (CJK in an object's name) is drawn as a box."""
     if not text:
         return None
+    from PIL import Image, ImageDraw
+
     try:
-        font = _font()
-        font.clear()
-        font.set_size(pixels * 0.75, 96)  # points at 96 dpi
-        with warnings.catch_warnings():
-            # a glyph the font lacks (CJK in an object's name) is drawn as a box; no warning
-            warnings.simplefilter("ignore")
-            font.set_text(text, 0.0)
-        font.draw_glyphs_to_bitmap(antialiased=True)
-        return np.asarray(font.get_image(), dtype=np.float32) / 255.0
-    except (ImportError, OSError, RuntimeError, ValueError):
+        font = _font(pixels)
+        left, top, right, bottom = font.getbbox(text)
+        if right <= 0 or bottom <= 0:
+            return None
+        image = Image.new("L", (right, bottom), 0)
+        ImageDraw.Draw(image).text((0, 0), text, fill=255, font=font)
+        return np.asarray(image, dtype=np.float32) / 255.0
+    except (OSError, ValueError):
         return None  # a sheet without labels beats no sheet
 
 

@@ -15,8 +15,8 @@ file, a define) or to a function giving the uniforms it becomes.
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Iterable
-from importlib.resources.abc import Traversable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
 
@@ -38,6 +38,11 @@ from deferred.interfaces import registry
 from deferred.memo import kept_while
 from deferred.params import Params, UniformOverrides, params_uniforms, validate_params
 from deferred.validation import require_regular_file
+
+if sys.version_info >= (3, 11):
+    from importlib.resources.abc import Traversable
+else:  # Python 3.10
+    from importlib.abc import Traversable
 
 if TYPE_CHECKING:
     from deferred.core.frame import Frame

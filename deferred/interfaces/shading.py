@@ -21,13 +21,18 @@ passes it straight through.
 
 from __future__ import annotations
 
-from importlib.resources.abc import Traversable
+import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, ClassVar
 
 import moderngl
 
 from deferred.gbuffer.layout import GBufferData
+
+if sys.version_info >= (3, 11):
+    from importlib.resources.abc import Traversable
+else:  # Python 3.10
+    from importlib.abc import Traversable
 
 if TYPE_CHECKING:
     from deferred.core.frame import Frame
