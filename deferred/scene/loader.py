@@ -36,7 +36,6 @@ from deferred.validation import (
     StrictValues,
     closest,
     require_regular_file,
-    validation_error,
     validation_problems,
 )
 
@@ -51,7 +50,6 @@ MAX_DEPTH_RANGE = 1e7  # far / near
 DEMO_SCENE = "demo.toml"
 T = TypeVar("T")
 M = TypeVar("M", bound=BaseModel)
-E = TypeVar("E")
 
 
 class _Strict(StrictValues):
@@ -226,8 +224,8 @@ def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
             material_cls = _collect(problems, registry.materials.get, obj.material,
                                     f"{where}.material")
             if material_cls is not None and "params" not in bad:
-                material = _collect(problems, _made, material_cls, material_cls.Params,
-                                    obj.params, f"{where}.params", base_dir)
+                material = _collect(problems, material_cls.from_dict, obj.params, base_dir,
+                                    f"{where}.params")
         mesh = None
         if "mesh" not in bad:
             if obj.mesh not in meshes:
@@ -256,8 +254,7 @@ def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
             continue
         light_cls = _collect(problems, registry.lights.get, light.type, f"{where}.type")
         if light_cls is not None:
-            made = _collect(problems, _made, light_cls, light_cls.Params,
-                            light.model_extra or {}, where)
+            made = _collect(problems, light_cls.from_dict, light.model_extra or {}, where)
             if made is not None:
                 scene.lights.append(made)
     effects = [(f"{name}: effect[{index}]", e.type, e.model_extra or {})
@@ -277,7 +274,7 @@ def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
         seen.add(kind)
         effect_cls = _collect(problems, registry.effects.get, kind, f"{where}.type")
         if effect_cls is not None:
-            made = _collect(problems, _made, effect_cls, effect_cls.Params, values, where)
+            made = _collect(problems, effect_cls.from_dict, values, where)
             if made is not None:
                 scene.effects.append(made)
     # each object's events added at once (in the file's order: it breaks ties of time)
@@ -296,9 +293,7 @@ def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
             grouped.setdefault(event.object, []).append((event.time, event.params, where))
         elif material_cls is not None and "params" not in bad:
             # the object is refused: the event's own keys and values are still checked
-            found = _every_problem(None, material_cls.Params, event.params, f"{where}.params")
-            if found is not None:
-                problems.append(found)
+            problems += _params_problems(material_cls.Params, event.params, f"{where}.params")
     for label, timeline in grouped.items():
         target = labels[label][0]
         try:
@@ -307,11 +302,11 @@ def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
             # the timeline stops at its first problem: every event's keys and values are
             # checked too, so each of their problems is said
             found = [problem for _, params, where in timeline
-                     for problem in _every_problem(
-                         exc, type(target.base_params),
-                         {**target.base_params.model_dump(), **params},
-                         f"{where}.params").problems if problem is not exc]
-            problems += found if any(p.where == exc.where for p in found) else [exc, *found]
+                     for problem in _params_problems(
+                         type(target.base_params),
+                         {**target.base_params.model_dump(), **params}, f"{where}.params")]
+            wheres = {problem.where for problem in found}
+            problems += [p for p in exc.problems if p.where not in wheres] + found
     if problems:
         order = {key: position for position, key in enumerate(data)}
         each = [one for problem in problems for one in problem.problems]
@@ -331,34 +326,14 @@ def _collect(problems: list[InputError], function: Callable[..., T], *args: Any)
         return None
 
 
-def _validated(model: type[BaseModel], values: dict[str, Any], where: str) -> BaseModel:
-    """``model(**values)``, or an ``InputError`` naming each of its problems."""
-    try:
-        return model(**values)
-    except ValidationError as exc:
-        raise validation_error(exc, where, model) from None
-
-
-def _made(cls: Any, params: type[BaseModel], values: dict[str, Any], where: str,
-          *base_dir: Path | None) -> Any:
-    """``cls.from_dict(values, *base_dir, where)`` (a material, light or effect); where its
-    parameters are what it refuses, every problem of them is said (``from_dict`` says the
-    first)."""
-    try:
-        return cls.from_dict(values, *base_dir, where)
-    except InputError as exc:
-        raise _every_problem(exc, params, values, where) from None
-
-
-def _every_problem(exc: E, model: type[BaseModel], values: dict[str, Any],
-                   where: str) -> InputError | E:
-    """Each problem ``model`` finds in ``values``, or ``exc`` where it finds none (the refusal
-    was another check's)."""
+def _params_problems(model: type[BaseModel], values: dict[str, Any],
+                     where: str) -> list[InputError]:
+    """Each problem ``model`` finds in ``values`` (none: ``[]``)."""
     try:
         model(**values)
     except ValidationError as error:
-        return validation_error(error, where, model)
-    return exc
+        return validation_problems(error, where, model)
+    return []
 
 
 def _mesh_name(spec: str) -> str:

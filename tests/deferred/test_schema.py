@@ -302,3 +302,27 @@ def test_a_newline_in_a_problem_stays_on_its_line(capsys):
     _fail(*(f"error: {p}" for p in problems.problems))
     assert capsys.readouterr().err.splitlines() == ["error: a.toml: x: bad\\nvalue",
                                                     "error: b: worse"]
+
+
+def test_each_event_of_a_timeline_says_its_problems():
+    scene = dict(SCENE, event=[
+        {"time": 1.0, "object": "ball", "params": {"specular_intensty": 0.2}},
+        {"time": 2.0, "object": "ball", "params": {"specular_intensity": 5.0}},
+        {"time": 2.0, "object": "fur", "params": {"shells": 2, "colour": [1.0, 1.0, 1.0]}}])
+    with pytest.raises(InputErrors) as info:
+        scene_from_dict(scene, "s.toml")
+    assert [str(p) for p in info.value.problems] == [
+        "s.toml: event[0].params.specular_intensty: unknown parameter "
+        "(did you mean 'specular_intensity'?)",
+        "s.toml: event[1].params.specular_intensity: Input should be less than or equal to 1 "
+        "(got 5.0)",
+        "s.toml: event[2].params.colour: unknown parameter"]
+
+
+def test_python_from_dict_says_every_problem_too():
+    material = registry.materials.get("standard")
+    with pytest.raises(InputErrors) as info:
+        material.from_dict({"colour": [1.0, 1.0, 1.0], "specular_exponent": 0.0}, None, "ball")
+    assert [str(p) for p in info.value.problems] == [
+        "ball: specular_exponent: Input should be greater than or equal to 1 (got 0.0)",
+        "ball: colour: unknown parameter (did you mean 'color'?)"]
