@@ -205,8 +205,7 @@ def _render_animation(renderer, out: Path, times: list[float], fps: float,
 
     frame_ms = []
     with AnimationWriter(out, fps) as writer:
-        progress.count(len(times), "frames", f"rendering {out.name} (the first compiles "
-                                             "shaders, settles simulations)")
+        progress.count(len(times), "frames", f"rendering {out.name}")
         for index, at in enumerate(times):
             start = time.perf_counter()
             renderer.render(readback=False, time=at)

@@ -113,7 +113,8 @@ class Progress:
         with self._lock:
             now = self.clock()
             if self._total is None:
-                return f"{self._text} ({duration(now - self._step_started)})"
+                taken = now - self._step_started
+                return f"{self._text} ({duration(taken)})" if taken >= 1.0 else self._text
             counts = f"{self._done}/{self._total} {self._unit}"
             left = self._time_left(now)
             counts += f", ~{duration(left)} left" if left is not None else ", estimating time"
