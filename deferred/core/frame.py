@@ -52,6 +52,8 @@ class MaterialInputs:
     kept: bool = False
     declared: set[str] = field(default_factory=set)
     programs: list[str] = field(default_factory=list)
+    # strict mode: the programs bound with these inputs this frame, by GL name
+    bound: dict[int, Any] = field(default_factory=dict)
 
 
 class Frame:
@@ -201,6 +203,7 @@ class Frame:
         if material is not None:
             material.declared |= declared
             material.programs.append(self.shaders.describe(program))
+            material.bound[program.glo] = program
 
     def bind(self, program: moderngl.Program, uniforms: dict[str, Any] | None = None,
              textures: dict[str, moderngl.Texture] | None = None, *,

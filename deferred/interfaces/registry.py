@@ -51,6 +51,8 @@ class Registry(Generic[T]):
         self._builtins_loaded = False
         self._importing = False  # the built-in package is being imported (by this thread)
         self._tried: dict[str, str | None] = {}  # entry point name -> error (None: loaded)
+        # entry point name -> (the class's ``name`` it registered, what it is): named otherwise
+        self._misnamed: dict[str, tuple[str, str]] = {}
         self._next_id = 1  # ids are never reused: 0 means "none" in GPU buffers
 
     def register(self, cls: type[T]) -> type[T]:
@@ -102,14 +104,25 @@ class Registry(Generic[T]):
         if entry.name in self._tried:
             return self._tried[entry.name]
         error = None
+        dist = f" ({entry.dist.name})" if entry.dist is not None else ""
         try:
-            self.register(entry.load())
+            cls = self.register(entry.load())
         except Exception as exc:  # noqa: BLE001 - plugins fail in many ways; say which
-            dist = f" ({entry.dist.name})" if entry.dist is not None else ""
             error = f"cannot load {self.what} plugin '{entry.name}'{dist}: " \
                     f"{type(exc).__name__}: {exc}"
+        else:
+            if cls.name != entry.name:
+                self._misnamed[entry.name] = (
+                    cls.name, f"{self.what} plugin entry point '{entry.name}'{dist} loads "
+                              f"{entry.value}, whose name is '{cls.name}'")
         self._tried[entry.name] = error
         return error
+
+    def _misnamed_hint(self, entry_name: str) -> str:
+        """What to do about an entry point named otherwise than its class."""
+        real, what = self._misnamed[entry_name]
+        return f"{what}: ask for '{real}', and name the entry point '{real}' so that it loads " \
+               "alone"
 
     def _load_all(self) -> None:
         self._load_builtins()
@@ -118,6 +131,8 @@ class Registry(Generic[T]):
             error = self._load_entry(entry)
             if error and first_time:
                 warnings.warn(f"{error} (skipped)", PluginWarning, stacklevel=3)
+            elif first_time and entry.name in self._misnamed:
+                warnings.warn(self._misnamed_hint(entry.name), PluginWarning, stacklevel=3)
 
     # -- lookup ------------------------------------------------------------------------------
     def get(self, name: str, where: str | None = None) -> type[T]:
@@ -130,9 +145,24 @@ class Registry(Generic[T]):
                 error = self._load_entry(entry)
                 if error:
                     raise InputError(error, where or f"entry point {self.group}")
+                if entry.name in self._misnamed:
+                    raise InputError(self._misnamed_hint(entry.name), where)
         cls = self._classes.get(name)
         if cls is None:
+            cls = self._from_misnamed_entry(name)
+        if cls is None:
             raise InputError(self.unknown(name), where)
+        return cls
+
+    def _from_misnamed_entry(self, name: str) -> type[T] | None:
+        """``name`` registered by an entry point named otherwise (every plugin loads to find
+        it), with a warning saying so; None where no plugin has it."""
+        self._load_all()
+        cls = self._classes.get(name)
+        entry = next((entry for entry, (real, _) in self._misnamed.items() if real == name),
+                     None)
+        if cls is not None and entry is not None:
+            warnings.warn(self._misnamed_hint(entry), PluginWarning, stacklevel=3)
         return cls
 
     def unknown(self, name: object) -> str:

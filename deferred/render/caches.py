@@ -5,12 +5,14 @@ object's inputs, and the shading models' samplers as a binding source.
 :class:`KeptMaterialInputs` a material's uniforms and textures while its params hold;
 :class:`FrameInputs` gives a frame's passes both (:class:`deferred.core.protocols.ObjectInputs`)
 and, in strict mode, checks at the end of the frame that every uniform a material sets is
-declared by one of its programs; :class:`ShadingTextures` binds the scene's shading models'
+declared by one of its programs and that its surface code writes the G-buffer data it
+declares; :class:`ShadingTextures` binds the scene's shading models'
 samplers to every program.
 """
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterable
 from typing import TYPE_CHECKING, Any
 
@@ -19,10 +21,12 @@ import numpy as np
 
 from deferred.core.frame import MaterialInputs
 from deferred.errors import DeferredError, RenderError
+from deferred.gbuffer.layout import data_write_file
 from deferred.gl.uniforms import StableValues
 
 if TYPE_CHECKING:
     from deferred.core.frame import Frame
+    from deferred.gl.shaderlib import Source
     from deferred.gl.uniforms import ProgramUniforms
     from deferred.interfaces.material import Material
     from deferred.interfaces.shading import ShadingModel
@@ -145,6 +149,7 @@ class FrameInputs:
         least one of its programs, and so is every uniform an effect offers its passes
         (:meth:`Frame.check_offers`)."""
         self.frame.check_offers()
+        self.check_gbuffer_data()
         shaders = self.frame.shaders
         for inputs in self._materials.values():
             if not inputs.programs:
@@ -159,6 +164,56 @@ class FrameInputs:
                     f"material {inputs.material.name}: no program of it declares uniform "
                     f"{', '.join(repr(n) for n in unused)} (programs: "
                     f"{', '.join(dict.fromkeys(inputs.programs))})")
+
+
+    def check_gbuffer_data(self) -> None:
+        """Strict mode, at the end of a frame: each material's programs that write its
+        G-buffer data (the generated ``gbuffer_write_data``) assign every datum it declares
+        somewhere in their own GLSL: a datum left unassigned is written undefined (black on
+        one driver, speckled on another)."""
+        shaders = self.frame.shaders
+        for inputs in self._materials.values():
+            names = [data.name for data in inputs.material.written_data()]
+            if not names:
+                continue
+            for program in inputs.bound.values():
+                fragment = shaders.sources(program).get("fragment_shader")
+                if fragment is None or not any(file.startswith(_DATA_WRITE_FOLDER)
+                                               for file, _ in fragment.line_map):
+                    continue
+                unwritten = unwritten_data(fragment, names)
+                if unwritten:
+                    material = inputs.material
+                    raise RenderError(
+                        f"material {material.name}: its surface code "
+                        f"({material.surface_shader or shaders.describe(program)}) never "
+                        f"writes the G-buffer data {', '.join(repr(n) for n in unwritten)} it "
+                        f"declares (set s.data.{unwritten[0]} in material_surface; unset, it "
+                        f"is undefined); program {shaders.describe(program)}")
+
+
+_DATA_WRITE_FOLDER = data_write_file(["x"]).rpartition("/")[0] + "/"
+_COMMENTS = re.compile(r"/\*.*?\*/|//[^\n]*", re.DOTALL)
+# an assignment (or a compound one) to a field, a swizzle or an element of it: ".sheen.rgb ="
+_ASSIGNED = r"\.\s*{name}\b(?:\s*\.\s*\w+|\s*\[[^\]]*\])*\s*(?:[-+*/%&|^]|<<|>>)?=(?!=)"
+# the whole data assigned or constructed, or a field passed where a function may write it
+_WHOLE = re.compile(r"\.\s*data\s*=(?!=)|\bSurfaceData\s*\(")
+_PASSED = r"[(,]\s*[\w.\[\]]*\.\s*{name}\s*[,)]"
+_WRITING_PARAMETER = re.compile(r"\b(?:out|inout)\s+\w+\s+\w+")
+
+
+def unwritten_data(source: Source, names: list[str]) -> list[str]:
+    """Which of the G-buffer data ``names`` the GLSL of ``source`` never assigns (its own
+    files: the generated ones declare, fetch and copy the data, they do not make it)."""
+    text = _COMMENTS.sub(" ", "\n".join(
+        line for line, (file, _) in zip(source.text.splitlines(), source.line_map, strict=False)
+        if not file.startswith(("generated/", "<"))))
+    if _WHOLE.search(text):
+        return []
+    writers = bool(_WRITING_PARAMETER.search(text))
+    return [name for name in names
+            if not re.search(_ASSIGNED.format(name=re.escape(name)), text)
+            and not (writers and re.search(_PASSED.format(name=re.escape(name)), text))]
 
 
 class ShadingTextures:
