@@ -1,7 +1,8 @@
 #!/bin/sh
 # Re-run the sweeps whose results benchmarks/README.md reports, with the commands it gives
 # (about 30 minutes on two cores: naive forward with 1024 lights is the slow part).
-# Run from the repository root with the package installed (`pip install -e .`).
+# Run from the repository root with the package installed with its plot extra
+# (`pip install -e '.[plot]'`: the --plot images need matplotlib).
 set -e
 out=benchmarks/results
 

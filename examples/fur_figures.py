@@ -1,6 +1,7 @@
 """The fur technique's figures in docs/figures/fur_*.png: Revie's Figures 2.20 and 2.21 before and
 after the fur technique, fins off and on at a silhouette, three distances with their shell counts,
-and the fur debug views. Run from the repository root: python examples/fur_figures.py"""
+and the fur debug views. Run from the repository root: python examples/fur_figures.py (matplotlib:
+pip install -e '.[plot]')"""
 
 from __future__ import annotations
 
