@@ -102,6 +102,8 @@ class TamSettings:
         need(self.cross_from is None or 0 <= self.cross_from < self.tones, "cross_from",
              f"must be a tone index within [0, {self.tones - 1}] or None")
         coarsest = self.size >> (self.mips - 1)
+        need(1.5 * self.stroke_width + 8 < coarsest, "stroke_width",
+             f"must fit the coarsest level ({coarsest} px) across")
         longest = self.stroke_length * (1.0 + self.length_jitter) * coarsest
         need(longest + self.stroke_width + 4 < coarsest, "stroke_length",
              f"with stroke_width, must fit the coarsest level ({coarsest} px)")
@@ -209,10 +211,6 @@ class _Level:
     stroke: np.ndarray  # the stroke resampled for this level, zero-padded
     ink: np.ndarray  # (side, side) float32
 
-    @property
-    def darkness(self) -> float:
-        return float(self.ink.mean())
-
 
 def tone_stroke_counts(settings: TamSettings, ink_per_stroke: float) -> list[int]:
     """Strokes at the finest level after each tone (cumulative): the expected coverage
@@ -233,46 +231,62 @@ def tone_stroke_counts(settings: TamSettings, ink_per_stroke: float) -> list[int
 
 
 def _candidate_strokes(level: _Level, settings: TamSettings, centres: np.ndarray,
-                       angles: np.ndarray, lengths: np.ndarray):
-    """The candidates' ink at one level: their (K, H, W) ink over a common box, the box's rows
-    (K, H) and columns (K, W), wrapped into the tile."""
+                       angles: np.ndarray, lengths: np.ndarray, along_u: bool):
+    """The candidates' ink at one level, over the pixels near each: for each pixel column
+    (``along_u``; rows otherwise) the stroke crosses, a band of pixels about its centre line.
+    Returns the ink (K, P, B) and the pixels' rows and columns, wrapped into the tile
+    (broadcasting to (K, P, B)); every pixel index wraps, so a stroke leaving one edge enters
+    from the opposite one (4.3.8, Fig. 4.22)."""
     side, width = level.side, settings.stroke_width
     length_px = lengths * side
     cos, sin = np.cos(angles), np.sin(angles)
-    half_x = np.abs(cos) * length_px / 2 + np.abs(sin) * width / 2
-    half_y = np.abs(sin) * length_px / 2 + np.abs(cos) * width / 2
-    box_w = 2 * math.ceil(half_x.max()) + 3
-    box_h = 2 * math.ceil(half_y.max()) + 3
+    # the main axis: columns for strokes nearer u, rows for those nearer v
+    main_cos, cross_sin = (cos, sin) if along_u else (sin, cos)
+    half_main = np.abs(main_cos) * length_px / 2 + np.abs(cross_sin) * width / 2
+    main_count = 2 * math.ceil(half_main.max()) + 3
+    # a stroke of width w spans w / |cos| across a column; +1.5 px for its filtered edge
+    band = 2 * math.ceil((width / 2 / np.abs(main_cos)).max() + 1.5) + 1
     centre = centres * side
-    x0 = np.floor(centre[:, 0]).astype(np.int64) - box_w // 2
-    y0 = np.floor(centre[:, 1]).astype(np.int64) - box_h // 2
-    columns = x0[:, None] + np.arange(box_w)
-    rows = y0[:, None] + np.arange(box_h)
-    dx = (columns + 0.5 - centre[:, :1]).astype(np.float32)[:, None, :]
-    dy = (rows + 0.5 - centre[:, 1:]).astype(np.float32)[:, :, None]
-    cos = cos.astype(np.float32)[:, None, None]
-    sin = sin.astype(np.float32)[:, None, None]
+    main_centre, cross_centre = (centre[:, 0], centre[:, 1]) if along_u \
+        else (centre[:, 1], centre[:, 0])
+    main = np.floor(main_centre).astype(np.int64)[:, None] - main_count // 2 \
+        + np.arange(main_count)  # (K, P)
+    d_main = main + 0.5 - main_centre[:, None]
+    line = cross_centre[:, None] + d_main * (cross_sin / main_cos)[:, None]  # centre line
+    cross = np.floor(line).astype(np.int64)[:, :, None] - band // 2 + np.arange(band)
+    d_main = d_main.astype(np.float32)[:, :, None]  # (K, P, 1)
+    d_cross = (cross + 0.5 - cross_centre[:, None, None]).astype(np.float32)  # (K, P, B)
+    dx, dy = (d_main, d_cross) if along_u else (d_cross, d_main)
     # stroke coordinates in samples of the level's resampled (and zero-padded) stroke: along
     # the stroke scaled by the candidate's length, across at the fixed pixel width
     stroke = level.stroke
     along_samples = stroke.shape[1] - 2
     across_samples = stroke.shape[0] - 2
+    cos = cos.astype(np.float32)[:, None, None]
+    sin = sin.astype(np.float32)[:, None, None]
     scale_along = (along_samples / length_px).astype(np.float32)[:, None, None]
-    x = (dx * cos + dy * sin) * scale_along + (along_samples / 2 + 0.5)
-    y = (dy * cos - dx * sin) * np.float32(across_samples / width) + (across_samples / 2 + 0.5)
+    x = (dx * cos + dy * sin) * scale_along + np.float32(along_samples / 2 + 0.5)
+    y = (dy * cos - dx * sin) * np.float32(across_samples / width) \
+        + np.float32(across_samples / 2 + 0.5)
     np.clip(x, 0.0, stroke.shape[1] - 1.001, out=x)
     np.clip(y, 0.0, stroke.shape[0] - 1.001, out=y)
     xi = x.astype(np.int32)
     yi = y.astype(np.int32)
-    fx = x - xi
-    fy = y - yi
+    x -= xi
+    y -= yi
     flat = stroke.ravel()
     index = yi * stroke.shape[1] + xi
-    top = flat[index] + fx * (flat[index + 1] - flat[index])
+    top = np.take(flat, index)
+    top += x * (np.take(flat, index + 1) - top)
     index += stroke.shape[1]
-    bottom = flat[index] + fx * (flat[index + 1] - flat[index])
-    ink = top + fy * (bottom - top)
-    return ink, rows % side, columns % side
+    bottom = np.take(flat, index)
+    bottom += x * (np.take(flat, index + 1) - bottom)
+    top += y * (bottom - top)
+    main %= side
+    cross %= side
+    if along_u:
+        return top, cross, main[:, :, None]
+    return top, main[:, :, None], cross
 
 
 def generate_tam(settings: TamSettings = TamSettings(),
@@ -298,6 +312,8 @@ def generate_tam(settings: TamSettings = TamSettings(),
     placed = 0
     jitter = math.radians(settings.angle_jitter)
     k = settings.candidates
+    darkness = np.zeros(settings.mips)  # each level's mean ink
+    areas = np.array([float(level.side) ** 2 for level in levels])
     for tone, count in enumerate(counts):
         base = math.radians(settings.angle)
         if settings.cross_from is not None and tone >= settings.cross_from:
@@ -308,28 +324,41 @@ def generate_tam(settings: TamSettings = TamSettings(),
             angles = base + rng.uniform(-jitter, jitter, k)
             lengths = settings.stroke_length * (1.0 + rng.uniform(-1.0, 1.0, k)
                                                 * settings.length_jitter)
-            strokes = [_candidate_strokes(level, settings, centres, angles, lengths)
-                       for level in levels]
             gain = np.empty((k, settings.mips))  # tone each candidate adds at each level
             alone = np.empty((k, settings.mips))  # ... and would add on blank paper
-            for m, (level, (ink, rows, columns)) in enumerate(zip(levels, strokes, strict=True)):
-                under = level.ink[rows[:, :, None], columns[:, None, :]]
-                area = float(level.side * level.side)
-                alone[:, m] = ink.sum(axis=(1, 2)) / area
-                gain[:, m] = (ink * (1.0 - under)).sum(axis=(1, 2)) / area
-            darkness = np.array([level.darkness for level in levels])
+            # candidates nearer u and nearer v are rasterised in bands of their own axis
+            along_u = np.abs(np.cos(angles)) >= np.abs(np.sin(angles))
+            groups = []
+            for members, axis_u in ((np.flatnonzero(along_u), True),
+                                    (np.flatnonzero(~along_u), False)):
+                if not members.size:
+                    continue
+                strokes = [_candidate_strokes(level, settings, centres[members],
+                                              angles[members], lengths[members], axis_u)
+                           for level in levels]
+                for m, (level, (ink, rows, columns)) in enumerate(zip(levels, strokes,
+                                                                      strict=True)):
+                    under = np.take(level.ink, rows * level.side + columns)
+                    alone[members, m] = ink.sum(axis=(1, 2), dtype=np.float64) / areas[m]
+                    gain[members, m] = np.einsum("kpb,kpb->k", ink, 1.0 - under,
+                                                 dtype=np.float64) / areas[m]
+                groups.append((members, strokes))
             target = darkness[0] + gain[:, :1]  # the finest level's tone with the candidate
-            closer = (np.abs(darkness + gain - target) < np.abs(darkness - target))
+            closer = np.abs(darkness + gain - target) < np.abs(darkness - target)
             closer[:, 0] = True
             if index == count - 1:  # every level darkens with every tone
                 closer[:, ~taken] = True
             share = np.where(closer, gain / np.maximum(alone, 1e-12), 0.0)
             score = share.sum(axis=1) / closer.sum(axis=1)
             best = int(np.argmax(score))
+            members, strokes = next(group for group in groups if best in group[0])
+            within = int(np.flatnonzero(members == best)[0])
             for m, (level, (ink, rows, columns)) in enumerate(zip(levels, strokes, strict=True)):
                 if closer[best, m]:
-                    block = np.ix_(rows[best], columns[best])
-                    level.ink[block] = 1.0 - (1.0 - level.ink[block]) * (1.0 - ink[best])
+                    pixels = rows[within] * level.side + columns[within]  # unique
+                    flat = level.ink.reshape(-1)
+                    flat[pixels] = 1.0 - (1.0 - np.take(flat, pixels)) * (1.0 - ink[within])
+                    darkness[m] += gain[best, m]
                     taken[m] = True
         placed = count
         for m, level in enumerate(levels):

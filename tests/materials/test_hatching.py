@@ -61,15 +61,12 @@ def test_lighter_tones_strokes_lie_inside_the_darker_ones(tam):
         assert np.all((ink[1:] - ink[:-1] > 64).any(axis=(1, 2))), m
 
 
-def seam_and_inside(image: np.ndarray) -> tuple[float, np.ndarray, float]:
-    """Mean |difference| across the wrap (last column to first), between each pair of
-    neighbouring columns inside, and between two unrelated columns (half a tile apart)."""
+def seam_and_inside(image: np.ndarray) -> tuple[float, np.ndarray]:
+    """Mean |difference| across the wrap (last column to first) and between each pair of
+    neighbouring columns inside."""
     image = image.astype(np.float64)
     inside = np.abs(np.diff(image, axis=1)).mean(axis=0)
-    seam = float(np.abs(image[:, -1] - image[:, 0]).mean())
-    half = image.shape[1] // 2
-    unrelated = float(np.abs(image[:, half - 1] - image[:, 0]).mean())
-    return seam, inside, unrelated
+    return float(np.abs(image[:, -1] - image[:, 0]).mean()), inside
 
 
 @pytest.fixture(scope="module")
@@ -80,26 +77,33 @@ def upright(tam) -> ToneArtMap:
 
 @pytest.mark.parametrize("axis", ["columns", "rows"])
 def test_tiles_wrap_seamlessly(tam, upright, axis):
-    """The last column (row) continues into the first as any column (row) does into the next
-    (Figs. 4.21-4.22); strokes along u cross the left and right edges, along v the others."""
+    """The last column (row) continues into the first as columns (rows) inside do into the
+    next (Figs. 4.21-4.22); strokes along u cross the left and right edges, along v the others.
+    The seam is one sample of the neighbours' differences, so it may top their largest by
+    chance, never by much (a cut tile's seam is over 10x: next test)."""
     along = tam if axis == "columns" else upright
+    seams, insides = [], []
     for m in range(along.mips):
         for tone in range(along.tones):
             image = along.ink(m)[tone]
             if axis == "rows":
                 image = image.T
-            seam, inside, _ = seam_and_inside(image)
-            assert seam <= inside.max() + 1e-9, (m, tone, seam, inside.max())
+            seam, inside = seam_and_inside(image)
+            assert seam <= 1.5 * inside.max(), (m, tone, seam, inside.max())
+            seams.append(seam)
+            insides.append(inside.mean())
+    assert np.mean(seams) <= 1.5 * np.mean(insides)
 
 
-def test_the_seam_measure_tells_a_cut_tile():
-    """Strokes cut at the edges (a corner of a larger tile) make a seam across them that no
-    neighbouring columns inside show; two unrelated columns differ as much."""
-    larger = generate_tam(replace(SMALL, size=256, mips=1, strokes=96))
-    seam, inside, unrelated = seam_and_inside(larger.ink(0)[-1][:128, :128])
-    assert seam > inside.max()
-    seam, inside, unrelated = seam_and_inside(larger.ink(0)[-1])
-    assert unrelated > 2.0 * inside.max() > 2.0 * seam
+@pytest.mark.parametrize("angle", [0.0, 90.0])
+def test_the_seam_measure_tells_a_cut_tile(angle):
+    """Strokes cut at the edges (a corner of a larger tile) leave a seam far above any
+    neighbouring columns' (rows') difference inside."""
+    larger = generate_tam(replace(SMALL, size=256, mips=1, strokes=96, angle=angle))
+    for image in larger.ink(0):
+        corner = image[:128, :128] if angle == 0.0 else image[:128, :128].T
+        seam, inside = seam_and_inside(corner)
+        assert seam > 3.0 * inside.max()
 
 
 def test_cross_hatching_turns_the_darker_tones_strokes(tam):
