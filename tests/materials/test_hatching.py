@@ -283,6 +283,8 @@ def glsl_tam():
 
 def render_ink(gl, tam, tones, uniforms):
     ctx = gl.ctx
+    gl.make_current()  # a CLI test may have made and released a context of its own
+    gl.park()  # creating a framebuffer re-binds the last one used: ours, not a released one
     height, width = tones.shape
     lib = ShaderLibrary(ctx, 330)
     lib.set_virtual_file("hatching_harness.vert", HARNESS_VERT)
