@@ -56,6 +56,7 @@ GENERATOR_VERSION = 1
 CACHE_SUBFOLDER = "hatching"
 DEFAULT_STROKE_SHAPE = (32, 256)  # samples across and along the default stroke
 WHERE = "hatching"
+FLOAT_SETTINGS = ("stroke_length", "stroke_width", "angle", "angle_jitter", "length_jitter")
 
 
 @dataclass(frozen=True)
@@ -101,7 +102,7 @@ class TamSettings:
         need(math.isfinite(self.angle), "angle", "must be finite")
         need(self.cross_from is None or 0 <= self.cross_from < self.tones, "cross_from",
              f"must be a tone index within [0, {self.tones - 1}] or None")
-        coarsest = self.size >> (self.mips - 1)
+        coarsest = int(self.size) >> (int(self.mips) - 1)
         need(1.5 * self.stroke_width + 8 < coarsest, "stroke_width",
              f"must fit the coarsest level ({coarsest} px) across")
         longest = self.stroke_length * (1.0 + self.length_jitter) * coarsest
@@ -385,8 +386,12 @@ def cache_folder() -> Path:
 
 def cache_key(settings: TamSettings, stroke: np.ndarray) -> str:
     """A hash of the generator's version, the settings and the stroke's pixels."""
+    # numbers as Python's own, so 6 and 6.0 (or a numpy integer) name the same map
+    values = {key: value if value is None else (float(value) if key in FLOAT_SETTINGS
+                                                else int(value))
+              for key, value in asdict(settings).items()}
     digest = hashlib.sha256()
-    digest.update(json.dumps({"generator": GENERATOR_VERSION, **asdict(settings)},
+    digest.update(json.dumps({"generator": GENERATOR_VERSION, **values},
                              sort_keys=True).encode())
     digest.update(repr(stroke.shape).encode())
     digest.update(np.ascontiguousarray(stroke, np.float32).tobytes())

@@ -4,6 +4,7 @@ across mip levels, the disk cache, and the GLSL blend against the numpy referenc
 from __future__ import annotations
 
 from dataclasses import replace
+from pathlib import Path
 
 import moderngl
 import numpy as np
@@ -207,6 +208,13 @@ def test_a_changed_setting_or_stroke_makes_a_new_file(tmp_path, counted):
     assert len(counted) == 3
     assert len(list((tmp_path / "hatching").glob("tam-*.npz"))) == 3
     assert not list((tmp_path / "hatching").glob(".tam-*"))  # no temporary left behind
+
+
+def test_equal_settings_written_differently_share_a_file():
+    same = replace(CACHED, size=np.int64(CACHED.size), stroke_width=int(CACHED.stroke_width))
+    assert cache_path(same, None, Path("c")) == cache_path(CACHED, None, Path("c"))
+    assert cache_path(replace(CACHED, stroke_width=3.5), None, Path("c")) \
+        != cache_path(CACHED, None, Path("c"))
 
 
 @pytest.mark.parametrize("damage", ["garbage", "truncated", "empty", "wrong_shape"])
