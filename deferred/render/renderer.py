@@ -6,6 +6,7 @@ import math
 import numbers
 import os
 import warnings
+import weakref
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -53,9 +54,10 @@ FULL_FEATURES = Features(storage_buffers=True, compute_shaders=True)
 class RenderResult:
     """One frame: ``image`` (H, W, 4) uint8 sRGB, top row first (None: rendered with
     ``readback=False``); ``hdr`` the linear float composite (H, W, 4), read from the GPU when
-    first asked for, which must be before the renderer's next frame (or ask for it at once
-    with ``render(hdr=True)``); the draw calls, in all and by pass. ``save(path)`` writes the
-    frame (.png the image, .exr the composite); in a notebook the result shows as its image."""
+    first asked for, or before the renderer draws its next frame or is released while the
+    result is still held (a result dropped unread costs no read; ``render(hdr=True)`` reads it
+    at once); the draw calls, in all and by pass. ``save(path)`` writes the frame (.png the
+    image, .exr the composite); in a notebook the result shows as its image."""
 
     image: np.ndarray | None
     draw_calls: int
@@ -193,6 +195,7 @@ class Renderer:
             self._release_partial()
             raise
         self._frame_number = 0
+        self._pending_hdr: weakref.ref[RenderResult] | None = None
         self._note_scene()
 
     # -- following the scene -------------------------------------------------------------------
@@ -343,6 +346,7 @@ class Renderer:
             raise InputError(f"frame time must be a finite number of seconds >= 0, got {time!r}",
                              "time")
         time = float(time)
+        self._keep_pending_hdr()
         self._follow_scene()
         self.check_times([time], "time")
         self.scene.apply_timeline(time)
@@ -416,7 +420,18 @@ class Renderer:
                 result._hdr = self.read_hdr()
             else:
                 result._read_hdr = self._hdr_reader(self._frame_number)
+                self._pending_hdr = weakref.ref(result)
         return result
+
+    def _keep_pending_hdr(self) -> None:
+        """Read the last frame's HDR composite into its result before the targets are drawn
+        over or released, where the caller still holds the result and has not read it (a
+        result no one holds costs nothing)."""
+        pending, self._pending_hdr = self._pending_hdr, None
+        result = pending() if pending is not None else None
+        if result is not None and result._read_hdr is not None:
+            result._hdr = self.read_hdr()
+            result._read_hdr = None
 
     def _hdr_reader(self, frame_number: int) -> Callable[[], np.ndarray]:
         def read() -> np.ndarray:
@@ -462,6 +477,10 @@ class Renderer:
         again does nothing."""
         if self._released:
             return
+        try:
+            self._keep_pending_hdr()
+        except Exception:  # noqa: BLE001 - a context already lost: the result says so if read
+            pass
         self._released = True
         try:
             self._release_parts()

@@ -201,7 +201,10 @@ def test_an_object_with_a_timeline_keeps_parameters_assigned_to_it(renderer):
 
 # -- results --------------------------------------------------------------------------------------
 
-def test_the_hdr_composite_is_read_when_asked_for(renderer, monkeypatch):
+def test_the_hdr_composite_is_read_when_asked_for(renderer, gl, monkeypatch):
+    """A frame reads back its 8-bit image; the float composite is read when result.hdr is
+    first asked for, or before the renderer draws over it or is released while the result is
+    held; a result dropped unread costs no read."""
     scene = small_scene()
     r = renderer(scene)
     reads = []
@@ -211,16 +214,23 @@ def test_the_hdr_composite_is_read_when_asked_for(renderer, monkeypatch):
     assert reads == []  # the 8-bit image only
     hdr = result.hdr
     assert reads == [1] and hdr.shape == (64, 96, 4) and hdr.dtype == np.float32
-    assert result.hdr is hdr
-    stale = r.render()
-    r.render()
-    with pytest.raises(RenderError, match="rendered again or been released"):
-        _ = stale.hdr
+    assert result.hdr is hdr and reads == [1]
+    for _ in range(3):
+        r.render()  # each result dropped at once: none read
+    assert reads == [1]
+    held = r.render()
+    r.render()  # held and unread: read before this frame draws over it
+    assert reads == [1, 1]
+    np.testing.assert_array_equal(held.hdr, hdr)
+    assert reads == [1, 1]
     eager = r.render(hdr=True)
-    r.render()
     np.testing.assert_array_equal(eager.hdr, hdr)
     with pytest.raises(RenderError, match="readback=False"):
         _ = r.render(readback=False).hdr
+    # released with a result held: the composite is kept for it
+    with Renderer(scene, gl=gl) as other:
+        last = other.render()
+    np.testing.assert_array_equal(last.hdr, hdr)
 
 
 def test_a_result_saves_and_shows_in_a_notebook(renderer, tmp_path):
