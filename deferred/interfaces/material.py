@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
 
 import moderngl
-from pydantic import BaseModel, Field
+from pydantic import Field
 
 from deferred.core.passes import ObjectPass, Phase, RenderPass
 from deferred.errors import InputError
@@ -263,28 +263,6 @@ class Material:
                  Phase.STIPPLE: self.stipple_passes, Phase.MATERIAL: self.material_passes,
                  Phase.FORWARD: self.forward_passes}
         return hooks[phase](obj) if phase in hooks else []
-
-    @classmethod
-    def describe_params(cls) -> list[dict[str, Any]]:
-        """Name, type, default, range and doc of each parameter (for ``deferred materials``)."""
-        return describe_model(cls.Params)
-
-
-def describe_model(model: type[BaseModel]) -> list[dict[str, Any]]:
-    rows = []
-    for name, field in model.model_fields.items():
-        bounds = []
-        for meta in field.metadata:
-            for attr, symbol in (("ge", ">="), ("gt", ">"), ("le", "<="), ("lt", "<")):
-                value = getattr(meta, attr, None)
-                if value is not None:
-                    bounds.append(f"{symbol} {value}")
-        annotation = field.annotation
-        type_name = getattr(annotation, "__name__", None) or str(annotation).replace(
-            "typing.", "")
-        rows.append({"name": name, "type": type_name, "default": field.default,
-                     "range": ", ".join(bounds), "doc": field.description or ""})
-    return rows
 
 
 def compose_layout(materials: Iterable[Material]) -> GBufferLayout:
