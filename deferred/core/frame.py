@@ -25,6 +25,17 @@ from deferred.gl.targets import FrameTargets
 from deferred.gl.uniforms import gl_value
 
 
+def plugin_note(render_pass: PassLike) -> str:
+    """`` (plugin <package>)`` where the pass, or its object's material, is a plugin's class
+    (not the framework's), for its errors; else nothing."""
+    material = getattr(getattr(render_pass, "obj", None), "material", None)
+    for cls in (type(render_pass), type(material) if material is not None else None):
+        module = getattr(cls, "__module__", "") or ""
+        if cls is not None and module.partition(".")[0] not in ("deferred", "builtins"):
+            return f" (plugin {module.partition('.')[0]})"
+    return ""
+
+
 class OfferedUniforms(dict):
     """Uniforms a pass offers its program: set where the program declares them, and in strict
     mode no error where it does not (an effect's parameters, offered to each of its passes:
@@ -154,7 +165,8 @@ class Frame:
                 raise
             raise type(exc)(f"pass {render_pass.name}: {exc}") from exc
         except Exception as exc:  # noqa: BLE001 - whatever a plugin's pass raises, say which
-            raise RenderError(f"pass {render_pass.name}: {type(exc).__name__}: {exc}") from exc
+            raise RenderError(f"pass {render_pass.name}: {type(exc).__name__}: {exc}"
+                              f"{plugin_note(render_pass)}") from exc
         if check_errors:
             error = self.ctx.error
             if error != "GL_NO_ERROR":

@@ -9,6 +9,7 @@ from strict_plugin import (
     BrokenMaterial,
     MaskedMaterial,
     PresetTintMaterial,
+    RaisingMaterial,
     TintedMaterial,
     TwoPassEffect,
     UnmaskedMaterial,
@@ -22,7 +23,7 @@ from deferred.render.renderer import Renderer
 from deferred.scene.loader import scene_from_dict
 
 MATERIALS = (TintedMaterial, PresetTintMaterial, MaskedMaterial, UnmaskedMaterial,
-             BrokenMaterial)
+             BrokenMaterial, RaisingMaterial)
 EFFECTS = (TwoPassEffect, UnusedParameterEffect)
 SIZE = (64, 48)
 
@@ -134,6 +135,12 @@ def test_a_plugin_glsl_error_names_the_package_file_and_line(gl):
     message = str(info.value)
     assert message.startswith("pass sphere0.gbuffer: materials/test_strict/broken.glsl:9:")
     assert message.endswith("(plugin strict_plugin)")
+
+
+def test_a_plugin_pass_raising_names_the_pass_and_the_package(gl):
+    with pytest.raises(RenderError, match=r"^pass sphere0\.gbuffer: ValueError: the plugin's own "
+                                          r"bug \(plugin strict_plugin\)$"):
+        render(gl, scene("test_strict_raising"), strict=False)
 
 
 def misnamed_distribution(tmp_path, monkeypatch, group):
