@@ -25,6 +25,8 @@ from deferred.api import (
 EDGES_RAW = "edges_raw"
 EDGES = "edges"
 EDGES_SPEC = TargetSpec(1, "f1", "edge mask (1 = line)")
+EDGE_ROW_OFFSETS = "edge_row_offsets"
+EDGE_ROW_OFFSETS_SPEC = TargetSpec(1, "f2", "least squared offset to an edge along the row")
 
 
 class EdgesParams(EffectParams):
@@ -54,8 +56,16 @@ class Edges(Effect):
                                "u_depth_threshold": self.params.depth_threshold,
                                "u_normal_threshold": self.params.normal_threshold,
                                "u_ids": self.params.ids}),
-            FullscreenPass("screen.edges_dilate", Phase.SCREEN, "screen/edges_dilate.frag",
-                           {"u_edges_raw": EDGES_RAW}, (EDGES,), creates={EDGES: EDGES_SPEC},
+            # the disc of the line's width in two passes, a row then a column: the cost grows
+            # with the width, not its square
+            FullscreenPass("screen.edges_dilate_rows", Phase.SCREEN,
+                           "screen/edges_dilate_rows.frag", {"u_edges_raw": EDGES_RAW},
+                           (EDGE_ROW_OFFSETS,), creates={EDGE_ROW_OFFSETS: EDGE_ROW_OFFSETS_SPEC},
+                           uniforms=lambda frame: {"u_width": self.params.width}),
+            FullscreenPass("screen.edges_dilate_columns", Phase.SCREEN,
+                           "screen/edges_dilate_columns.frag",
+                           {"u_row_offsets": EDGE_ROW_OFFSETS}, (EDGES,),
+                           creates={EDGES: EDGES_SPEC},
                            uniforms=lambda frame: {"u_width": self.params.width}),
             FullscreenPass("post.edges", Phase.POST, "post/edges_composite.frag",
                            {"u_edges": EDGES}, (FINAL,), blend="alpha", order=Order.TRANSPARENT,
