@@ -178,3 +178,27 @@ def test_listing_plugins_warns_of_an_entry_point_named_otherwise(tmp_path, monke
     materials = misnamed_distribution(tmp_path, monkeypatch, "deferred.test_misnamed3")
     with pytest.warns(registry.PluginWarning, match="whose name is 'test_strict_misnamed'"):
         assert list(materials) == ["test_strict_misnamed"]
+
+
+def test_a_glsl_error_names_an_installed_plugin_by_package_and_distribution(
+        gl, tmp_path, monkeypatch):
+    package = tmp_path / "my_shader_plugin"
+    (package / "shaders").mkdir(parents=True)
+    (package / "__init__.py").write_text("")
+    (package / "shaders" / "bad.frag").write_text("out vec4 c;\nvoid main() { c = 1; }\n")
+    info = tmp_path / "my_shader_plugin-0.1.dist-info"
+    info.mkdir()
+    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: my-shader-plugin\n"
+                                   "Version: 0.1\n")
+    (info / "top_level.txt").write_text("my_shader_plugin\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    library = ShaderLibrary(gl.ctx, 330)
+    library.add_root(package / "shaders")
+    try:
+        with pytest.raises(ShaderError) as raised:
+            library.program("post/fullscreen.vert", "bad.frag")
+    finally:
+        library.release()
+    message = str(raised.value)
+    assert message.startswith("bad.frag:2:")
+    assert message.endswith("(plugin my_shader_plugin (my-shader-plugin))")
