@@ -571,7 +571,7 @@ def _main(argv: list[str] | None) -> int:
         return 2
     except InputError as exc:  # a line per problem (a scene file's are said at once)
         problems = exc.problems
-        shown = [f"error: {problem}" for problem in problems[:MAX_PROBLEM_LINES]]
+        shown = [f"error: {_as_option(problem)}" for problem in problems[:MAX_PROBLEM_LINES]]
         if len(problems) > MAX_PROBLEM_LINES:
             shown.append(f"error: ... and {len(problems) - MAX_PROBLEM_LINES} more problems")
         _fail(*shown)
@@ -582,6 +582,17 @@ def _main(argv: list[str] | None) -> int:
     except Exception as exc:  # noqa: BLE001 - the last line of defence of a CLI
         _fail(f"render failed: {type(exc).__name__}: {exc}")
         return 1
+
+
+# The Python API names its arguments in errors; the command line's options carry them
+PYTHON_ARGUMENTS = {"light_path": "--light-path", "pipeline": "--pipeline", "size": "--size",
+                    "time": "--time"}
+
+
+def _as_option(problem: InputError) -> str:
+    """A problem as the command line says it: a Python argument by the option that set it."""
+    option = PYTHON_ARGUMENTS.get(problem.where or "")
+    return f"{option}: {problem.message}" if option else str(problem)
 
 
 def _fail(*messages: str) -> None:

@@ -100,3 +100,22 @@ def test_console_script_exit_code(tmp_path):
                             capture_output=True, text=True, cwd=tmp_path)
     assert result.returncode == 2
     assert result.stderr.strip() == "error: nope.toml: scene file not found"
+
+
+def test_python_argument_names_read_as_the_options_that_set_them(tmp_path, capsys, monkeypatch):
+    """The Python API names its arguments (light_path, size, time, pipeline); through the
+    command line the same problems name the options."""
+    import deferred.render.renderer as renderer_module
+    from deferred.errors import InputError
+
+    def refuse(*args, **kwargs):
+        raise InputError("light path 'tiled' needs compute shaders (GL 4.3)", "light_path")
+
+    monkeypatch.setattr(renderer_module, "resolve_light_path", refuse)
+    code, _, err = run(capsys, "render", "-o", str(tmp_path / "x.png"), "--size", "32x18")
+    assert code == 2 and err.strip() == \
+        "error: --light-path: light path 'tiled' needs compute shaders (GL 4.3)", err
+    monkeypatch.undo()
+    code, _, err = run(capsys, "dump", "-o", str(tmp_path / "d"), "--size", "4096x4096")
+    assert code == 2 and err.startswith("error: --size: "), err
+    assert list(tmp_path.iterdir()) == []

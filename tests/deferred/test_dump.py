@@ -647,7 +647,7 @@ def test_a_dump_past_the_memory_budget_is_refused_before_the_frame(tmp_path, cap
     and refused past the budget, naming the size; --passes captures less and fits."""
     out = tmp_path / "dump"
     code, _, err = run(capsys, "dump", "-o", out, "--size", "4096x4096")
-    assert code == 2 and err.startswith("error: size: a dump of 4096x4096 holds ") and \
+    assert code == 2 and err.startswith("error: --size: a dump of 4096x4096 holds ") and \
         err.strip().endswith("the budget is 4.0 GiB (DEFERRED_TARGET_MEMORY): a smaller "
                              "--size, or --passes to capture fewer passes"), err
     assert not out.exists()

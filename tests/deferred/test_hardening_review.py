@@ -110,7 +110,7 @@ CASES = [
                                              "x.gif"], None,
      ["--frames", "100,000 frames of 4096x4096 held for a GIF take 3.1 TiB"]),
     ("dump-past-the-budget", scene(), ["dump", "s.toml", "-o", "dump", "--size", "4096x4096"],
-     None, ["size: a dump of 4096x4096 holds", "--passes to capture fewer passes"]),
+     None, ["--size: a dump of 4096x4096 holds", "--passes to capture fewer passes"]),
     ("size-with-underscores", scene(), ["--size", "1_60x9_0"], None, ["--size"]),
     ("fps-whose-last-frame-overflows", scene(), ["--fps", "5e-324", "--frames", "3"], None,
      ["--fps", "no finite time"]),
