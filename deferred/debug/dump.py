@@ -1,6 +1,6 @@
-"""Writing a dump folder (DESIGN.md, "Dumps"; ``deferred dump``): every buffer of every pass of
-a captured frame as float EXR with named channels, the frame's decoded buffers, a contact sheet
-and a manifest; :func:`write_dump` describes the files.
+"""Writing a dump folder (``deferred dump``; README.md, "Debugging a frame"): every buffer of
+every pass of a captured frame as float EXR with named channels, the frame's decoded buffers, a
+contact sheet and a manifest; :func:`write_dump` describes the files.
 """
 
 from __future__ import annotations
