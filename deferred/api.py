@@ -112,6 +112,8 @@ GLSL_INCLUDES: dict[str, str] = {
                                          "(Revie 2.4.4, Listing 2.2)",
     "techniques/fur_light.glsl": "a fur layer's light from a fur_light gather",
     "techniques/strand_tangent.glsl": "a strand tangent as G-buffer data (Kajiya-Kay)",
+    "techniques/hatching.glsl": "tonal-art-map hatching, on the surface (Praun et al.) or "
+                                "projected on the screen (Lake et al.; Costigan 4.3.8)",
 }
 
 __all__ = [
