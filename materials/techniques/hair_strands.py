@@ -106,6 +106,35 @@ def interpolate_keyframes(keyframes: np.ndarray, key_times: np.ndarray, time: fl
             + (-2 * u ** 3 + 3 * u * u) * end + (u ** 3 - u * u) * m1)
 
 
+def rotation_minimising_frames(points: np.ndarray, tangents: np.ndarray,
+                               reference: np.ndarray | None = None) -> np.ndarray:
+    """Unit normals ``(S, N, 3)`` of rotation-minimising frames along ``points`` ``(S, N, 3)``
+    with unit ``tangents``, by double reflection (Wang, Juttler, Zheng and Liu 2008), the first
+    normal being ``reference`` ``(S, 3)`` made perpendicular to the first tangent (default: the
+    world axis least along it). Sequential along the strand, vectorised over strands."""
+    count, samples = points.shape[:2]
+    t0 = tangents[:, 0]
+    if reference is None:
+        reference = np.eye(3, dtype=points.dtype)[np.abs(t0).argmin(axis=1)]
+    r = reference - (reference * t0).sum(-1, keepdims=True) * t0
+    r = r / np.maximum(np.linalg.norm(r, axis=-1, keepdims=True), 1e-12)
+    normals = np.empty_like(points)
+    normals[:, 0] = r
+    eps = np.finfo(points.dtype).tiny * 1e6
+    for i in range(samples - 1):
+        v1 = points[:, i + 1] - points[:, i]
+        c1 = (v1 * v1).sum(-1, keepdims=True)
+        k1 = np.where(c1 > eps, 2.0 / np.maximum(c1, eps), 0.0)
+        r_l = r - (k1 * (v1 * r).sum(-1, keepdims=True)) * v1
+        t_l = tangents[:, i] - (k1 * (v1 * tangents[:, i]).sum(-1, keepdims=True)) * v1
+        v2 = tangents[:, i + 1] - t_l
+        c2 = (v2 * v2).sum(-1, keepdims=True)
+        k2 = np.where(c2 > eps, 2.0 / np.maximum(c2, eps), 0.0)
+        r = r_l - (k2 * (v2 * r_l).sum(-1, keepdims=True)) * v2
+        normals[:, i + 1] = r
+    return normals
+
+
 # --------------------------------------------------------------------------- files (4.1-4.2.1)
 
 def load_strands(path: str | Path, where: str | None = None) -> np.ndarray:
