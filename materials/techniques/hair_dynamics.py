@@ -63,6 +63,7 @@ import numpy as np
 from .hair_strands import interpolate_keyframes, quadratic, rotation_minimising_frames
 
 PINNED = 3  # chain particles p_-1, q_-1, p_0
+COLLISION_ROUNDS = 8
 
 
 @dataclass(frozen=True)
@@ -301,17 +302,23 @@ class HairSimulation:
         centres = transform_points(model, self._spheres[:, :3])
         radii = self._spheres[:, 3] * axis_scale + self.physics.collision_margin
         free = self._x[:, PINNED + 1::2]  # the strand particles p_1 .. p_(P-1)
-        for centre, radius in zip(centres.astype(np.float32), radii, strict=True):
-            offset = free - centre[:, None, None]
-            distance = np.sqrt(offset[0] ** 2 + offset[1] ** 2 + offset[2] ** 2)
-            inside = distance < radius
-            if inside.any():
-                # radially out to the surface (a particle at the very centre goes up), a
-                # millionth beyond it so float32 rounding cannot leave it inside
-                away = np.float32(radius * (1.0 + 1e-6)) / np.maximum(distance, 1e-30)
-                pushed = centre[:, None, None] + offset * away
-                pushed[1] += np.where(distance > 0.0, 0.0, np.float32(radius * (1.0 + 1e-6)))
-                np.copyto(free, pushed, where=inside[None])
+        # out of one sphere may be into an overlapping one: rounds until none is inside
+        for _ in range(COLLISION_ROUNDS):
+            moved = False
+            for centre, radius in zip(centres.astype(np.float32), radii, strict=True):
+                offset = free - centre[:, None, None]
+                distance = np.sqrt(offset[0] ** 2 + offset[1] ** 2 + offset[2] ** 2)
+                inside = distance < radius
+                if inside.any():
+                    # radially out to the surface (a particle at the very centre goes up), a
+                    # millionth beyond it so float32 rounding cannot leave it inside
+                    away = np.float32(radius * (1.0 + 1e-6)) / np.maximum(distance, 1e-30)
+                    pushed = centre[:, None, None] + offset * away
+                    pushed[1] += np.where(distance > 0.0, 0.0, np.float32(radius * (1 + 1e-6)))
+                    np.copyto(free, pushed, where=inside[None])
+                    moved = True
+            if not moved:
+                break
 
     def advance(self, until: float, model_at: Callable[[float], np.ndarray]) -> None:
         """Step until the simulated time is ``until`` (rounded to a whole step), ``model_at(t)``

@@ -1,0 +1,169 @@
+"""Cartoon hair dynamics (Costigan 4.2.2-4.2.4): stiff strands hold their style, loose ones
+hang, roots follow the object, no particle ends inside a collision sphere, anchors pull onto the
+keyframed pose, and the same inputs give the same bits."""
+
+import numpy as np
+import pytest
+
+from deferred.materials.techniques.hair_dynamics import (
+    HairPhysics,
+    HairSimulation,
+    transform_points,
+)
+
+LENGTH = 0.1
+
+
+def horizontal_strands(count=3, points=8):
+    """Strands sticking out sideways along +x from roots spread along z: cantilevers."""
+    strands = np.zeros((count, points, 3))
+    strands[:, :, 0] = np.linspace(0.0, LENGTH, points)
+    strands[:, :, 2] = np.linspace(0.0, 0.05, count)[:, None]
+    return strands
+
+
+def run(sim, seconds):
+    sim.advance(seconds, lambda t: np.eye(4))
+    return sim.strands.astype(np.float64)
+
+
+def test_a_stiff_strand_settles_near_its_rest_shape():
+    rest = horizontal_strands()
+    sim = HairSimulation(rest, HairPhysics(edge_stiffness=1.0, bend_stiffness=1.0,
+                                           torsion_stiffness=1.0))
+    strands = run(sim, 3.0)
+    assert sim.kinetic_energy() < 1e-10
+    assert np.abs(strands - rest).max() < 0.01 * LENGTH
+
+
+def test_a_loose_strand_hangs():
+    rest = horizontal_strands()
+    sim = HairSimulation(rest, HairPhysics(bend_stiffness=0.0, torsion_stiffness=0.0))
+    strands = run(sim, 6.0)  # a pendulum, damped by the air's drag
+    assert sim.kinetic_energy() < 1e-6
+    drop = strands[:, 0] - strands[:, -1]
+    np.testing.assert_allclose(drop[:, 1], LENGTH, rtol=0.02)  # straight down, full length
+    assert np.abs(drop[:, [0, 2]]).max() < 0.02 * LENGTH
+
+
+def test_stiffness_grades_the_sag():
+    rest = horizontal_strands(1)
+    sags = []
+    for stiffness in (1.0, 0.9, 0.5, 0.0):
+        sim = HairSimulation(rest, HairPhysics(bend_stiffness=stiffness,
+                                               torsion_stiffness=stiffness))
+        sags.append(-run(sim, 3.0)[0, -1, 1])
+    assert sags == sorted(sags) and sags[0] < 1e-6 and sags[-1] > 0.09
+
+
+def moving_model(t):
+    angle = 1.3 * np.sin(3.0 * t)
+    c, s = np.cos(angle), np.sin(angle)
+    model = np.eye(4)
+    model[:3, :3] = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) * 1.5
+    model[:3, 3] = [0.2 * t, np.sin(5.0 * t) * 0.1, -0.3]
+    return model
+
+
+def test_roots_follow_the_object_transform_exactly():
+    rest = horizontal_strands(4)
+    sim = HairSimulation(rest, HairPhysics(bend_stiffness=0.3), model=moving_model(0.0))
+    for frame in range(1, 40):
+        sim.advance(frame / 30.0, moving_model)
+        want = transform_points(moving_model(sim.time), rest[:, 0])
+        np.testing.assert_allclose(sim.strands[:, 0], want, atol=2e-7)
+
+
+def test_no_particle_ends_inside_a_collision_sphere():
+    # loose strands rooted on top of a ball fall onto it while the ball swings
+    count = 40
+    rng = np.random.default_rng(3)
+    direction = rng.normal(size=(count, 3)) * [1.0, 0.3, 1.0] + [0.0, 1.0, 0.0]
+    direction /= np.linalg.norm(direction, axis=1, keepdims=True)
+    radius = 0.1
+    t = np.linspace(0.0, 1.0, 8)[None, :, None]
+    sideways = np.cross(direction, [0.0, 0.0, 1.0])
+    rest = direction[:, None] * radius + t * 0.15 * (direction + sideways)[:, None]
+    spheres = np.array([[0.0, 0.0, 0.0, radius], [0.0, -0.12, 0.05, 0.07]])
+    sim = HairSimulation(rest, HairPhysics(bend_stiffness=0.05, torsion_stiffness=0.05,
+                                           wind=(1.0, 0.0, 0.0)), spheres=spheres)
+
+    def model_at(time):
+        model = np.eye(4)
+        model[0, 3] = 0.1 * np.sin(4.0 * time)
+        return model
+
+    touched = False
+    for frame in range(1, 61):
+        sim.advance(frame / 30.0, model_at)
+        local = sim.strands[:, 1:].astype(np.float64) - model_at(sim.time)[:3, 3]
+        gap = np.linalg.norm(local[:, :, None] - spheres[:, :3], axis=-1) - spheres[:, 3]
+        assert gap.min() >= -1e-6 * radius, (frame, gap.min())
+        touched |= gap.min() < 1e-3
+    assert touched  # the strands did reach the ball
+
+
+def test_anchors_pull_a_loose_strand_onto_the_keyframe_pose():
+    rest = horizontal_strands(3)
+    pose = rest.copy()
+    pose[:, :, 1] = np.linspace(0.0, 0.06, 8)  # the keyframe: raised toward the tip
+    distances = []
+    for stiffness in (0.0, 0.1, 0.5, 0.9, 1.0):
+        sim = HairSimulation(rest, HairPhysics(bend_stiffness=0.0, torsion_stiffness=0.0,
+                                               anchor_stiffness=stiffness),
+                             keyframes=pose[None])
+        distances.append(np.abs(run(sim, 3.0) - pose).max())
+    assert distances == sorted(distances, reverse=True)
+    assert distances[0] > 0.05 and distances[-1] < 1e-6
+
+
+def test_anchor_stiffness_follows_the_quadratic_along_the_strand():
+    rest = horizontal_strands(1)
+    pose = rest.copy()
+    pose[:, :, 1] = 0.03
+    pose[:, 0, 1] = 0.0
+    physics = HairPhysics(bend_stiffness=0.0, torsion_stiffness=0.0, anchor_stiffness=1.0,
+                          anchor_curve=(1.0, 0.0, 0.0))  # 0 at the root, 1 at the tip
+    strands = run(HairSimulation(rest, physics, keyframes=pose[None]), 2.0)
+    np.testing.assert_allclose(strands[0, -1], pose[0, -1], atol=1e-6)  # held at the tip
+    assert np.abs(strands[0, 1] - pose[0, 1]).max() > 1e-3  # free near the root
+
+
+def test_anchors_move_along_the_keyframes_over_time():
+    rest = horizontal_strands(2)
+    keys = np.stack([rest + [0.0, dy, 0.0] for dy in (0.0, 0.05, -0.02)])
+    keys[:, :, 0] = rest[:, 0]  # the roots stay
+    times = [0.0, 0.5, 1.0]
+    sim = HairSimulation(rest, HairPhysics(anchor_stiffness=1.0, bend_stiffness=0.0,
+                                           torsion_stiffness=0.0), keyframes=keys,
+                         key_times=times)
+    for key, time in zip(keys, times, strict=True):
+        np.testing.assert_allclose(run(sim, time), key, atol=1e-6)
+
+
+def test_the_same_inputs_give_the_same_bits():
+    rest = horizontal_strands(5)
+    pose = rest + [0.0, 0.02, 0.0]
+    physics = HairPhysics(bend_stiffness=0.4, torsion_stiffness=0.7, anchor_stiffness=0.2,
+                          wind=(0.5, 0.0, -1.0), iterations=3)
+    spheres = np.array([[0.05, -0.05, 0.0, 0.04]])
+
+    def simulate():
+        sim = HairSimulation(rest, physics, spheres=spheres, keyframes=np.stack([rest, pose]),
+                             model=moving_model(0.0))
+        sim.advance(1.0, moving_model)
+        return sim
+
+    first, second = simulate(), simulate()
+    assert first.strands.tobytes() == second.strands.tobytes()
+    # going back in time restarts: the state at a time does not depend on the frames before
+    first.advance(1.5, moving_model)
+    first.advance(1.0, moving_model)
+    assert first.strands.tobytes() == second.strands.tobytes()
+
+
+@pytest.mark.parametrize("field", ["edge_stiffness", "bend_stiffness", "torsion_stiffness",
+                                   "anchor_stiffness"])
+def test_stiffness_outside_0_1_is_refused(field):
+    with pytest.raises(ValueError, match=field):
+        HairPhysics(**{field: 1.5})
