@@ -12,6 +12,9 @@
 - :mod:`.strands`: one-particle mass-spring strands and their curl (Silva et al. 3.2.1, Eq. 2-4)
 - :mod:`.wetness`: the wetness mask of droplets and clumps (Silva et al. 3.1, Algorithm 1)
 - :mod:`.topology`: vertices welded by position across UV seams (fins, strands, clumps)
+- :mod:`.hair_strands`, :mod:`.hair_dynamics`, :mod:`.hair_tubes`: cartoon hair's guide strands
+  (files, scalp, styles, Catmull-Rom), tetrahedral mass-spring dynamics and tube meshes
+  (Costigan 4.1-4.3.2)
 - :mod:`.xtoon`: X-toon 2D ramps for the toon shading model: depth, backlight and specular
   metrics (Costigan 4.3.3-4.3.6, after Barla et al.)
 - :mod:`.hatching`: tonal art maps and their tone blend (Costigan 4.3.8, after Praun et al.)

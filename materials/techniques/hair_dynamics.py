@@ -79,7 +79,7 @@ class HairPhysics:
     wind: tuple[float, float, float] = (0.0, 0.0, 0.0)  # the air's velocity
     drag: float = 2.0  # 1/s: how fast a particle takes the air's velocity
     time_step: float = 1.0 / 60.0
-    iterations: int = 4
+    iterations: int = 1  # sweeps a step: one holds k = 1 exactly; more only soften k < 1 less
     collision_margin: float = 0.0  # added to every collision sphere's radius
     structure_offset: float = 0.5  # structural particles' distance, in segment lengths
 

@@ -117,10 +117,12 @@ def build_tubes(strands: np.ndarray, samples: int = 8, sides: int = 8, radius: f
         raise ValueError(f"normals must be 'averaged' or 'swept', got {normals!r}")
     strands = np.asarray(strands, dtype=np.float32)
     count, points = strands.shape[:2]
-    spline = np.einsum("ip,spc->sic", catmull_rom_weights(points, samples).astype(np.float32),
-                       strands)
-    slope = np.einsum("ip,spc->sic",
-                      catmull_rom_weights(points, samples, True).astype(np.float32), strands)
+    # the spline and its slope at every sample: one matrix product each over all strands
+    flat = strands.transpose(1, 0, 2).reshape(points, -1)
+    spline, slope = (
+        np.ascontiguousarray((catmull_rom_weights(points, samples, derivative).astype(np.float32)
+                              @ flat).reshape(samples, count, 3).transpose(1, 0, 2))
+        for derivative in (False, True))
     speed = np.maximum(np.linalg.norm(slope, axis=-1, keepdims=True), 1e-20)
     tangents = slope / speed
     ref = None if reference is None else np.asarray(reference, dtype=np.float32)
