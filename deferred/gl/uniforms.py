@@ -73,7 +73,7 @@ class ProgramUniforms:
         """Write the values the program has and does not hold already; names it lacks are
         skipped (:meth:`Frame.bind` checks them in strict mode)."""
         # the comparisons inline: a pass of many objects sets a few values a draw, and a call
-        # a value was most of the cost (3 values: 4.2 -> 2.0 us); a call a write remains
+        # a value was most of the cost (benchmarks/README.md); a call a write remains
         held = self._values
         members = self.members
         for name, value in values.items():  # a few values: cheaper than a set intersection

@@ -70,8 +70,8 @@ class ObjectTransforms:
     """Every object's transform uniforms (``u_model`` and ``u_model_normal_matrix``, the
     inverse transpose of the model's 3x3, as GL bytes; ``u_surface_id``), made for all objects
     at once and kept while the objects hold. The camera's view is apart (``u_view``,
-    ``shaders/common/object_transform.glsl``), so a camera that moves remakes none of them: the
-    batched inverse and the conversions cost about 3 us an object when they are remade."""
+    ``shaders/common/object_transform.glsl``), so a camera that moves remakes none of them (the
+    batched inverse and the conversions are most of an object's CPU time when remade)."""
 
     def __init__(self) -> None:
         self._key: tuple | None = None
