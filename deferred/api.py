@@ -87,6 +87,7 @@ from deferred.io.images import check_image, read_channels, read_image
 from deferred.names import LightPath, LightVolume, Pipeline
 from deferred.params import Params, UniformOverrides
 from deferred.scene import Scene, SceneObject
+from deferred.scene.builtin_meshes import builtin_head_spheres
 from deferred.validation import Albedo, NonZeroVec3, Radiance, require_regular_file
 
 # The framework's GLSL a plugin may include (``#include "<file>"``), and what each gives.
@@ -125,8 +126,8 @@ __all__ = [
     "LightParams", "LightPath", "LightVolume", "Material", "MaterialParams", "MeshData",
     "NonZeroVec3", "ObjectPass", "Order", "Params", "Phase", "Pipeline", "Radiance",
     "RenderError", "RenderPass", "Scene", "SceneObject", "ShadingModel", "TargetSpec",
-    "UniformOverrides", "check_image", "copy_pass", "effects", "image_texture_bytes", "lights",
-    "materials",
+    "UniformOverrides", "builtin_head_spheres", "check_image", "copy_pass", "effects",
+    "image_texture_bytes", "lights", "materials",
     "radiances", "read_channels", "read_image", "register_shader_root", "require_regular_file",
     "shading_models",
     "view_direction", "view_directions", "view_point", "view_points",

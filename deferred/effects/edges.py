@@ -25,6 +25,7 @@ from deferred.api import (
 EDGES_RAW = "edges_raw"
 EDGES = "edges"
 EDGES_SPEC = TargetSpec(1, "f1", "edge mask (1 = line)")
+STRAND_ID = "strand_id"  # G-buffer datum: a strand's id where materials declare it
 EDGE_ROW_OFFSETS = "edge_row_offsets"
 EDGE_ROW_OFFSETS_SPEC = TargetSpec(1, "f2", "least squared offset to an edge along the row")
 
@@ -47,11 +48,16 @@ class Edges(Effect):
     pipelines = (Pipeline.DEFERRED,)  # reads the G-buffer
 
     def passes(self, scene, pipeline: str) -> list[RenderPass]:
+        inputs = {"u_linear_depth": LINEAR_DEPTH, "u_normal_exponent_id": NORMAL_EXPONENT_ID}
+        defines = {}
+        if STRAND_ID in scene.gbuffer_layout().data:
+            # strands of one object (cartoon_hair) are told apart by the datum strand_id, so
+            # overlapping strands of one colour are outlined too (Costigan 4.3.7)
+            inputs["u_strand_id"] = STRAND_ID
+            defines["STRAND_IDS"] = "1"
         return [
-            FullscreenPass("screen.edges", Phase.SCREEN, "screen/edges.frag",
-                           {"u_linear_depth": LINEAR_DEPTH,
-                            "u_normal_exponent_id": NORMAL_EXPONENT_ID},
-                           (EDGES_RAW,), creates={EDGES_RAW: EDGES_SPEC},
+            FullscreenPass("screen.edges", Phase.SCREEN, "screen/edges.frag", inputs,
+                           (EDGES_RAW,), creates={EDGES_RAW: EDGES_SPEC}, defines=defines,
                            uniforms=lambda frame: {
                                "u_depth_threshold": self.params.depth_threshold,
                                "u_normal_threshold": self.params.normal_threshold,

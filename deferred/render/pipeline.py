@@ -244,13 +244,20 @@ class DepthPrepass(ObjectPass):
         # the lit pass's target reads are not the pre-pass's (it runs before their makers)
         return {} if self.lit.extra_reads else OfferedUniforms(self.lit.textures(frame))
 
+    def draw(self, frame, program) -> None:
+        self.lit.draw(frame, program)  # what the lit pass draws (a material's own geometry)
+
 
 def depth_prepass(lit: ForwardLitPass) -> RenderPass:
     """Forward+'s depth pre-pass twin of ``lit``: a plain object pass of its vertex stage and
     constants where those are all it sets (most materials: no hooks asked at each draw), else
     a :class:`DepthPrepass`."""
-    name = f"{lit.obj.label}.depth_prepass"
-    if lit._hooks_unchanged and not overrides(type(lit), RenderPass, "prepare"):
+    # an object's lit pass is <label>.forward; a material's other lit passes keep their names
+    stem = lit.name.removesuffix(".forward") if lit.name == f"{lit.obj.label}.forward" \
+        else lit.name
+    name = f"{stem}.depth_prepass"
+    if lit._hooks_unchanged and not overrides(type(lit), RenderPass, "prepare") and \
+            not overrides(type(lit), ObjectPass, "draw"):
         return ObjectPass(name, Phase.FORWARD, lit.obj, vertex=lit.vertex,
                           fragment=DepthPrepass.fragment, colors=DepthPrepass.colors,
                           constants=lit.constants, order=Order.FIRST)

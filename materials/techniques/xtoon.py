@@ -65,9 +65,10 @@ class XToonParams(MaterialParams):
     """The X-toon parameters of a material shaded by the ``toon`` model (a mixin)."""
 
     ramp: tuple[Stop, ...] = Field(
-        ((0.0, "#2e2440"), (0.35, "#6a4f8c"), (0.75, "#b49ad6")),
+        ((0.0, "#4a4a4a"), (0.35, "#9a9a9a"), (0.75, "#ffffff")),
         description="colour stops [[x, \"#rrggbb\"], ...] along max(N.L, 0), x ascending "
-                    "from 0: each colour holds until the next stop (a quantised ramp)")
+                    "from 0: each colour holds until the next stop (a quantised ramp); it "
+                    "multiplies the albedo (4.3.3), so greys keep the material's colour")
     ramp_image: str | None = Field(None, description="a 2D ramp image instead of the stops "
                                                      "(x: max(N.L, 0); y, up: the metric)")
     ramp_metric: Metric = Field("none", description="the ramp's y axis: none, depth (4.3.4), "

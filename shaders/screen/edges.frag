@@ -2,7 +2,7 @@
 // side of each discontinuity so a line is one pixel wide before dilation:
 //  - normals: Sobel on the decoded view-space normal (creases);
 //  - ids: a 4-neighbour of another surface id that lies farther away (silhouettes, material
-//    boundaries);
+//    boundaries), or of another strand where the scene's materials write strand_id;
 //  - depth: the second difference of inverse linear depth along rows, columns and diagonals.
 //    Inverse depth is affine in screen space over any plane, so a flat surface gives exactly
 //    zero whatever its slope (a Sobel of raw depth would flag every tilted plane); a depth
@@ -15,6 +15,9 @@ uniform sampler2D u_normal_exponent_id;
 uniform float u_depth_threshold;   // relative second difference of inverse depth
 uniform float u_normal_threshold;  // normal change across the pixel (Sobel / 4)
 uniform bool u_ids;                // use surface ids
+#ifdef STRAND_IDS
+uniform sampler2D u_strand_id;     // G-buffer datum strand_id: 1 + a strand's index, 0 none
+#endif
 
 out float out_edge;
 
@@ -27,6 +30,12 @@ float depth_at(ivec2 p) {
 vec4 normal_id_at(ivec2 p) {
     return texelFetch(u_normal_exponent_id, clamp(p, ivec2(0), g_size - 1), 0);
 }
+
+#ifdef STRAND_IDS
+float strand_at(ivec2 p) {
+    return texelFetch(u_strand_id, clamp(p, ivec2(0), g_size - 1), 0).r;
+}
+#endif
 
 void main() {
     g_size = textureSize(u_linear_depth, 0);
@@ -45,6 +54,10 @@ void main() {
         for (int k = 0; k < 4; ++k) {
             float other_depth = depth_at(p + sides[k]);
             bool other = !same_surface(normal_id_at(p + sides[k]).w, id);
+#ifdef STRAND_IDS
+            // another strand of the same surface (cartoon hair: one colour, many strands)
+            other = other || abs(strand_at(p + sides[k]) - strand_at(p)) > 0.5;
+#endif
             if (other && (other_depth <= 0.0 || other_depth > d)) edge = 1.0;
         }
     }

@@ -1,0 +1,285 @@
+"""Cartoon hair (Costigan, "Cartoon Hair Simulation", chapters 3-4): guide strands on the
+object's scalp, simulated as mass-spring chains, swept into tapered tube meshes every frame and
+shaded by the ``toon`` model through the material's X-toon ramp; the object's own mesh (the
+head) is drawn too, in ``skin_color``.
+
+- strands (4.1-4.2.1): from ``strands_file`` (JSON or OBJ polylines, object space) or grown on
+  the scalp (the mesh's vertex-colour alpha: ``builtin:head`` paints one) in a ``style``;
+- dynamics (4.2.2-4.2.4): :mod:`.techniques.hair_dynamics`, the roots pinned to the object,
+  colliding with ``collision_spheres`` (``builtin:head``'s own by default), anchored to
+  ``keyframes`` (strand files at ``key_times``, Catmull-Rom in time) by ``anchor_stiffness``;
+  stepped from t = 0 at ``time_step``, so a frame's hair depends only on its time;
+- tubes (4.3.1-4.3.2): :mod:`.techniques.hair_tubes`, ``hair_samples`` spline samples swept by a
+  ``sides``-gon tapered by the quadratic ``taper``;
+- shading (4.3.3-4.3.6): X-toon (:mod:`.techniques.xtoon`), the G-buffer datum ``strand_id``
+  (0 on the head, 1 + the strand's index on the hair) lets the ``edges`` effect outline
+  strands of one colour where they overlap (4.3.7).
+
+The tubes carry each vertex's strand in the vertex format's comb slot (the hair has no comb):
+``comb.x`` the strand's index, ``comb.y`` the parameter along it; ``uv`` is (along, around).
+"""
+
+from __future__ import annotations
+
+import weakref
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Literal
+
+import moderngl
+import numpy as np
+from pydantic import Field, model_validator
+
+from deferred.api import (
+    BlinnPhongParams,
+    ForwardLitPass,
+    GBufferData,
+    GBufferPass,
+    GpuMesh,
+    InputError,
+    Material,
+    MeshData,
+    Phase,
+    builtin_head_spheres,
+    materials,
+)
+
+from .shading_models import Toon
+from .techniques.hair_dynamics import HairPhysics, HairSimulation
+from .techniques.hair_strands import grow_strands, load_strands, resample_strand, scalp_roots
+from .techniques.hair_tubes import build_tubes
+from .techniques.xtoon import XTOON_UNIFORM_OVERRIDES, XToonParams, XToonRamp
+
+if TYPE_CHECKING:
+    from deferred.api import Frame, SceneObject
+
+Vec3 = tuple[float, float, float]
+SURFACE = "materials/cartoon_hair/surface.glsl"
+STRAND_ID = GBufferData("strand_id", "R32F", ("id",),
+                        "cartoon_hair: 1 + the strand's index on hair, 0 elsewhere")
+MAX_STRANDS = 20000
+
+
+class CartoonHairParams(BlinnPhongParams, XToonParams):
+    color: Vec3 = Field((0.55, 0.35, 0.85), description="hair albedo, linear RGB")
+    skin_color: Vec3 = Field((0.95, 0.78, 0.66), description="the head's albedo, linear RGB")
+    specular_intensity: float = Field(0.0, ge=0.0, le=1.0,
+                                      description="the toon model's hard specular band")
+    # strands in (4.1-4.2.1)
+    strands_file: str | None = Field(None, description="guide strands: JSON {\"strands\": "
+                                                       "[[[x, y, z], ...], ...]} or OBJ l lines")
+    strands: int = Field(200, ge=1, le=MAX_STRANDS, description="strands grown on the scalp")
+    length: float = Field(0.18, gt=0.0, le=10.0, description="strand length, object units")
+    segments: int = Field(7, ge=1, le=32, description="simulated segments a strand")
+    style: Literal["combed", "spiky"] = Field("spiky", description="how grown strands lie")
+    parting: float = Field(0.0, ge=-1.0, le=1.0, description="combed: the parting's x")
+    seed: int = Field(1, ge=0, le=2**31 - 1, description="roots and styles")
+    # dynamics (4.2.2-4.2.4)
+    edge_stiffness: float = Field(1.0, ge=0.0, le=1.0, description="edge springs")
+    bend_stiffness: float = Field(0.8, ge=0.0, le=1.0, description="bend springs")
+    torsion_stiffness: float = Field(0.8, ge=0.0, le=1.0, description="torsion springs")
+    anchor_stiffness: float = Field(0.0, ge=0.0, le=1.0,
+                                    description="pull toward the keyframed pose")
+    anchor_curve: Vec3 = Field((0.0, 0.0, 1.0),
+                               description="anchor stiffness along the strand: a x^2 + b x + c")
+    keyframes: tuple[str, ...] = Field((), description="strand files of the anchors' poses")
+    key_times: tuple[float, ...] = Field((), description="seconds of each keyframe")
+    gravity: Vec3 = Field((0.0, -9.81, 0.0), description="world acceleration")
+    wind: Vec3 = Field((0.0, 0.0, 0.0), description="the air's velocity, world units/s")
+    time_step: float = Field(1.0 / 60.0, gt=0.0, le=0.1, description="simulation step, s")
+    collision_spheres: tuple[tuple[float, float, float, float], ...] | None = Field(
+        None, description="object-space (x, y, z, radius); default: builtin:head's own")
+    # tubes (4.3.1-4.3.2)
+    hair_samples: int = Field(8, ge=2, le=64, description="spline samples a strand")
+    sides: int = Field(6, ge=3, le=16, description="sides of a tube")
+    radius: float = Field(0.012, gt=0.0, le=1.0, description="tube radius at the root")
+    taper: Vec3 = Field((0.0, -1.0, 1.0), description="radius along the strand: a x^2 + b x + c")
+
+    @model_validator(mode="after")
+    def _keys(self) -> CartoonHairParams:
+        if len(self.key_times) != len(self.keyframes):
+            raise ValueError("key_times needs a time for each keyframe")
+        if any(b <= a for a, b in zip(self.key_times, self.key_times[1:], strict=False)):
+            raise ValueError("key_times must increase")
+        return self
+
+
+class HairState:
+    """One object's hair in one renderer: the simulation and the tube mesh's GPU buffers,
+    brought to a frame's time by :meth:`advance`."""
+
+    def __init__(self, ctx: moderngl.Context, obj: SceneObject):
+        self.obj = obj
+        material: CartoonHairMaterial = obj.material
+        params = material.params
+        self.params = params
+        rest = material.rest_strands(obj)
+        keyframes = material.keyframe_strands(rest.shape) if params.keyframes else None
+        physics = HairPhysics(
+            edge_stiffness=params.edge_stiffness, bend_stiffness=params.bend_stiffness,
+            torsion_stiffness=params.torsion_stiffness,
+            anchor_stiffness=params.anchor_stiffness, anchor_curve=params.anchor_curve,
+            gravity=params.gravity, wind=params.wind, time_step=params.time_step)
+        self.simulation = HairSimulation(rest, physics, material.spheres(obj), keyframes,
+                                         params.key_times or None, obj.model)
+        self.inverse_model = np.linalg.inv(obj.model)
+        tubes = self._tubes()
+        self.mesh = MeshData("cartoon_hair tubes", tubes[0], tubes[1],
+                             *self._constant_attributes(tubes[2]), tubes[3])
+        self.gpu = GpuMesh(ctx, self.mesh)
+        self.time: float | None = None
+
+    def _tubes(self):
+        p = self.params
+        tubes = build_tubes(self.simulation.strands, p.hair_samples, p.sides, p.radius,
+                            p.taper, reference=self.simulation.root_references())
+        # the simulation is in world space; the object's passes draw in object space
+        linear, offset = self.inverse_model[:3, :3], self.inverse_model[:3, 3]
+        positions = tubes.positions @ linear.T + offset
+        normals = tubes.normals @ np.linalg.inv(linear)  # the inverse transpose, applied
+        normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-12)
+        return positions.astype(np.float32), normals.astype(np.float32), tubes, tubes.indices
+
+    @staticmethod
+    def _constant_attributes(tubes) -> tuple[np.ndarray, ...]:
+        count = len(tubes.positions)
+        uvs = np.stack([tubes.along, tubes.around], axis=1).astype(np.float32)
+        zeros = np.zeros((count, 3), np.float32)
+        comb = np.zeros((count, 4), np.float32)
+        comb[:, 0] = tubes.strand_ids
+        comb[:, 1] = tubes.along
+        return uvs, zeros, zeros.copy(), comb
+
+    def advance(self, time: float) -> None:
+        """The hair at ``time`` (seconds): stepped from where it is (or from 0, for an earlier
+        time), the tubes rebuilt and uploaded."""
+        if self.time == time:
+            return
+        model = self.obj.model
+        self.simulation.advance(time, lambda _: model)
+        positions, normals, _, _ = self._tubes()
+        self.mesh.positions, self.mesh.normals = positions, normals
+        self.gpu.vbo.write(self.mesh.interleaved().tobytes())
+        self.time = time
+
+    def release(self) -> None:
+        self.gpu.release()
+
+
+def hair_state(frame: Frame, obj: SceneObject) -> HairState:
+    """``obj``'s hair in the frame's renderer, made the first time it is asked for."""
+    return frame.resources.cached(("cartoon_hair_state", obj), lambda ctx: HairState(ctx, obj))
+
+
+class HairInputs:
+    """The hair passes: ``prepare`` brings the object's hair to the frame's time (every pass is
+    prepared before any draws); the pass draws the tubes instead of the object's mesh."""
+
+    obj: SceneObject
+    name: str
+    _prepared: tuple[weakref.ref, HairState] | None = None
+
+    def prepare(self, frame: Frame) -> None:
+        state = hair_state(frame, self.obj)
+        state.advance(frame.time)
+        self._prepared = (weakref.ref(frame), state)
+
+    def state(self, frame: Frame) -> HairState:
+        if self._prepared is None or self._prepared[0]() is not frame:
+            raise RuntimeError(f"{self.name}: drawn in a frame it was not prepared for")
+        return self._prepared[1]
+
+    def uniforms(self, frame: Frame) -> dict[str, Any]:
+        return {**super().uniforms(frame), "u_hair": True,
+                "u_color": self.obj.material.params.color}
+
+    def draw(self, frame: Frame, program: moderngl.Program) -> None:
+        self.state(frame).gpu.render(program)
+
+
+class HairGBufferPass(HairInputs, GBufferPass):
+    """The tubes into the G-buffer."""
+
+
+class HairForwardPass(HairInputs, ForwardLitPass):
+    """The tubes lit in the forward pipeline."""
+
+
+@materials.register
+class CartoonHairMaterial(Material):
+    name = "cartoon_hair"
+    Params = CartoonHairParams
+    surface_shader = SURFACE
+    shading_model = "toon"
+    gbuffer_data = (STRAND_ID,)
+    uniform_overrides = {
+        **XTOON_UNIFORM_OVERRIDES,
+        **{name: None for name in (
+            "skin_color", "strands_file", "strands", "length", "segments", "style", "parting",
+            "seed", "edge_stiffness", "bend_stiffness", "torsion_stiffness",
+            "anchor_stiffness", "anchor_curve", "keyframes", "key_times", "gravity", "wind",
+            "time_step", "collision_spheres", "hair_samples", "sides", "radius", "taper")},
+        "color": lambda value: {},  # the head's pass takes skin_color, the hair's color
+    }
+    # read once, at t = 0: the strands, their simulation and the tubes' topology
+    timeline_fixed = ("strands_file", "strands", "length", "segments", "style", "parting",
+                      "seed", "keyframes", "key_times", "hair_samples", "sides",
+                      "collision_spheres", "time_step")
+
+    def check_files(self, where: str | None) -> None:
+        super().check_files(where)
+        for key, names in (("strands_file", [self.params.strands_file]),
+                           ("keyframes", list(self.params.keyframes))):
+            for index, name in enumerate(names):
+                if name is None:
+                    continue
+                at = f"{where}.{key}" if where else key
+                at = at if key == "strands_file" else f"{at}[{index}]"
+                load_strands(self.file_parameter(name, "strand file", at), at)
+
+    def xtoon_ramp(self) -> XToonRamp:
+        image = None if self.params.ramp_image is None else \
+            self.resolve_path(self.params.ramp_image)
+        return XToonRamp.from_params(self.params, image)
+
+    def uniforms(self, frame: Frame) -> dict[str, Any]:  # the ramp's layer: the scene's
+        return {**super().uniforms(frame), "u_hair": False,
+                "u_color": self.params.skin_color,
+                "u_ramp_row": Toon.xtoon_row(frame.scene, self.xtoon_ramp())}
+
+    # -- the strands ----------------------------------------------------------------------
+    def spheres(self, obj: SceneObject) -> np.ndarray:
+        """Object-space collision spheres: the params', or builtin:head's, or none."""
+        if self.params.collision_spheres is not None:
+            return np.asarray(self.params.collision_spheres, np.float64).reshape(-1, 4)
+        if obj.mesh.name == "builtin:head":
+            return builtin_head_spheres()
+        return np.zeros((0, 4))
+
+    def rest_strands(self, obj: SceneObject) -> np.ndarray:
+        """The style: ``(S, P, 3)`` object-space strands, root first."""
+        p = self.params
+        if p.strands_file is not None:
+            return load_strands(self.resolve_path(p.strands_file), "strands_file")
+        roots = scalp_roots(obj.mesh, p.strands, p.seed)
+        return grow_strands(roots, p.length, p.segments, p.style, p.seed, self.spheres(obj),
+                            p.parting)
+
+    def keyframe_strands(self, shape: tuple[int, ...]) -> np.ndarray:
+        """The keyframes' strands, each resampled to the rest strands' points."""
+        poses = []
+        for index, name in enumerate(self.params.keyframes):
+            strands = load_strands(self.resolve_path(name), f"keyframes[{index}]")
+            if len(strands) != shape[0]:
+                raise InputError(f"{Path(name).name} has {len(strands)} strands; the hair "
+                                 f"has {shape[0]}", f"keyframes[{index}]")
+            poses.append(np.stack([resample_strand(s, shape[1]) for s in strands]))
+        return np.stack(poses)
+
+    # -- passes ---------------------------------------------------------------------------
+    def geometry_passes(self, obj: SceneObject) -> list:
+        return [*super().geometry_passes(obj),
+                HairGBufferPass(f"{obj.label}.hair", Phase.GEOMETRY, obj)]
+
+    def forward_passes(self, obj: SceneObject) -> list:
+        return [*super().forward_passes(obj),
+                HairForwardPass(f"{obj.label}.hair", Phase.FORWARD, obj)]

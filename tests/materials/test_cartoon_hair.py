@@ -1,0 +1,103 @@
+"""cartoon_hair (Costigan, "Cartoon Hair Simulation"): strands on the head's scalp simulated,
+swept into tubes and toon shaded in both pipelines, with strand ids in the G-buffer that the
+edges effect outlines overlapping strands by (4.3.7)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from deferred.cli import main
+from deferred.render.renderer import Renderer
+from deferred.scene.loader import scene_from_dict
+
+
+def head_scene(params: dict | None = None, effects=None, size=(128, 128)) -> object:
+    return scene_from_dict({
+        "size": list(size), "tonemap": "none", "background": [0.9, 0.9, 0.9],
+        "camera": {"position": [0.0, 0.05, 0.55], "target": [0.0, 0.0, 0.0], "fov": 40.0},
+        "object": [{"name": "head", "mesh": "builtin:head?segments=48&rings=32",
+                    "material": "cartoon_hair",
+                    "params": {"strands": 60, "style": "spiky", **(params or {})}}],
+        "light": [{"type": "directional", "direction": [-0.5, -0.6, -0.6]}],
+        "effect": effects or []})
+
+
+def capture(gl, scene, pipeline="deferred", time=0.0):
+    with Renderer(scene, pipeline, gl=gl) as renderer:
+        result = renderer.render(time=time, hdr=True)
+        targets = {name: renderer.targets.read(name)[::-1] for name in renderer.targets.specs}
+        return result, targets
+
+
+def test_the_hair_is_drawn_over_the_head_with_strand_ids(gl):
+    result, targets = capture(gl, head_scene())
+    ids = targets["strand_id"][..., 0]
+    hair = ids > 0.5
+    assert 0.1 < hair.mean() < 0.7
+    assert len(np.unique(ids[hair])) > 20  # many strands seen
+    assert np.all(ids[hair] == np.round(ids[hair]))  # whole indices, 1 + the strand's
+    assert ids[hair].max() <= 60
+    # the hair is on top: most hair pixels lie in the upper half of the frame
+    rows = np.nonzero(hair)[0]
+    assert np.mean(rows < 64) > 0.6
+    assert np.isfinite(result.hdr).all()
+
+
+def test_forward_and_deferred_agree_without_outlines(gl):
+    from conftest import psnr
+
+    scene = head_scene()
+    deferred, _ = capture(gl, scene, "deferred")
+    forward, _ = capture(gl, scene, "forward")
+    assert psnr(deferred.hdr[..., :3], forward.hdr[..., :3]) > 35.0
+
+
+def test_overlapping_strands_of_one_colour_are_outlined(gl):
+    """Where two strands meet (4-neighbours of different strand ids, one nearer), the nearer
+    side is an edge: the surface id alone (one material) would draw nothing there."""
+    _, targets = capture(gl, head_scene(effects=[{"type": "edges", "width": 1}]))
+    ids = targets["strand_id"][..., 0]
+    depth = targets["linear_depth"][..., 0]
+    edges = targets["edges_raw"][..., 0] > 0.5
+    near_side = np.zeros_like(edges)
+    for axis, shift in ((0, 1), (0, -1), (1, 1), (1, -1)):
+        other_id, other_depth = np.roll(ids, shift, axis), np.roll(depth, shift, axis)
+        near_side |= (ids > 0.5) & (other_id > 0.5) & (np.abs(other_id - ids) > 0.5) & \
+            (other_depth > depth)
+    near_side[[0, -1], :] = near_side[:, [0, -1]] = False
+    assert near_side.sum() > 100
+    assert edges[near_side].all()
+
+
+def test_a_frame_depends_only_on_its_time(gl):
+    """The simulation steps from t = 0: the hair at t = 0.5 is the same whether frames before
+    it were rendered or not, and differs from t = 0 (the strands fall and swing)."""
+    scene = head_scene({"bend_stiffness": 0.3, "torsion_stiffness": 0.3})
+    with Renderer(scene, gl=gl) as renderer:
+        first = renderer.render(time=0.0).image
+        for t in (0.1, 0.2, 0.3):
+            renderer.render(time=t)
+        stepped = renderer.render(time=0.5).image
+    with Renderer(scene, gl=gl) as renderer:
+        direct = renderer.render(time=0.5).image
+    np.testing.assert_array_equal(stepped, direct)
+    assert not np.array_equal(first, direct)
+
+
+@pytest.mark.parametrize("params, message", [
+    ({"strands_file": "missing.json"}, "object[0].params.strands_file: strand file not found"),
+    ({"keyframes": ["a.json"]}, "key_times needs a time for each keyframe"),
+    ({"sides": 2}, "object[0].params.sides"),
+    ({"taper": [0.0, 0.0]}, "object[0].params.taper"),
+])
+def test_bad_parameters_are_one_line_errors(tmp_path, capsys, params, message):
+    import json
+
+    (tmp_path / "s.toml").write_text(
+        "[[object]]\nmesh = \"builtin:head\"\nmaterial = \"cartoon_hair\"\n[object.params]\n" +
+        "".join(f"{key} = {json.dumps(value)}\n" for key, value in params.items()))
+    code = main(["render", str(tmp_path / "s.toml"), "-o", str(tmp_path / "out.png")])
+    err = capsys.readouterr().err
+    assert code == 2 and len(err.strip().splitlines()) == 1 and message in err, err
+    assert not (tmp_path / "out.png").exists()
