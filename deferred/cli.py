@@ -165,6 +165,9 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
         with Renderer(loaded, pipeline, size_override, strict=strict or None,
                       light_path=light_path) as renderer:
             renderer.check_times(times)  # a simulation cannot reach the last frame: refuse now
+            if kind == "video":  # the frames a GIF holds with what the renderer holds
+                check_animation_memory(out, renderer.size, frames,
+                                       renderer_bytes=renderer.memory_bytes())
             if kind != "image":
                 written, frame_ms = _render_animation(renderer, out, times, fps, progress)
             else:
@@ -184,6 +187,7 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
                     write_view(out, view(capture, view_name))
                 else:
                     _write_result(out, result)
+                    result = None  # held past release, its HDR composite would be read back
     width, height = renderer.size
     timing = f"{min(frame_ms):.1f} ms" if frames == 1 else \
         f"median {sorted(frame_ms)[len(frame_ms) // 2]:.1f} ms over {frames} frames"

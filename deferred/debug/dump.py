@@ -38,7 +38,7 @@ from deferred.debug.preview import Tile, contact_sheet, target_views
 from deferred.debug.views import view
 from deferred.errors import RenderError
 from deferred.gbuffer.layout import GBUFFER_COLOR_TARGETS
-from deferred.gl.target_spec import TargetSpec, targets_bytes
+from deferred.gl.target_spec import TargetSpec
 from deferred.gl.targets import COMPOSITE, LIGHT_ACCUMULATION
 from deferred.io.images import write_image, write_text
 from deferred.io.memory import check_memory
@@ -269,7 +269,8 @@ def build_manifest(capture: FrameCapture, files: dict[str, str],
 
 
 def dump_memory(renderer: Renderer, passes: Sequence[str] | None = None) -> int:
-    """Bytes a dump of ``renderer``'s frame holds at most: the render targets, the capture
+    """Bytes a dump of ``renderer``'s frame holds at most: the render targets and the
+    materials' textures and state (``Renderer.memory_bytes``), the capture
     (:func:`~deferred.debug.capture.capture_bytes`), and while files are written the float
     buffers of a pass file prepared for each writer and one more, and the decoded G-buffer
     (its channels, their stack and the decoder's temporaries)."""
@@ -281,7 +282,7 @@ def dump_memory(renderer: Renderer, passes: Sequence[str] | None = None) -> int:
     gbuffer_channels = len(GBUFFER_CHANNELS) + sum(
         len(data.channels) for data in renderer.scene.gbuffer_layout().data.values())
     float_bytes = 4 * width * height
-    return (targets_bytes(specs.values(), width, height) + capture_bytes(renderer, passes)
+    return (renderer.memory_bytes() + capture_bytes(renderer, passes)
             + (WRITERS + 1) * max(pass_channels, default=0) * float_bytes
             + 3 * gbuffer_channels * float_bytes)
 

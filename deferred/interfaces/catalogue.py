@@ -56,7 +56,7 @@ def selected(kind: str | None = None, name: str | None = None
     if name is not None:
         known = KINDS[kinds[0]]
         if name not in known:
-            raise InputError(known.unknown(name))
+            raise InputError(known.unknown(name), "NAME")
         return [(kinds[0], name, known.get(name))]
     return [(k, n, cls) for k in kinds for n, cls in KINDS[k].items()]
 

@@ -67,14 +67,17 @@ GIF_BYTES_PER_PIXEL = 2
 
 
 def check_animation_memory(path: str | Path, size: tuple[int, int], frames: int,
-                           where: str = "--frames") -> None:
+                           where: str = "--frames", renderer_bytes: int = 0) -> None:
     """Refuse, before a frame is rendered, a GIF whose frames would take more than the memory
-    budget (a sequence or an .mp4 holds none: each frame goes to its file or to ffmpeg)."""
+    budget, with ``renderer_bytes`` (the renderer's targets and textures, once it is made) (a
+    sequence or an .mp4 holds none: each frame goes to its file or to ffmpeg)."""
     if Path(path).suffix.lower() != ".gif":
         return
     width, height = size
-    check_memory(frames * width * height * GIF_BYTES_PER_PIXEL,
-                 f"{frames:,} frames of {width}x{height} held for a GIF take {{}}", where,
+    held = f"{frames:,} frames of {width}x{height} held for a GIF"
+    check_memory(frames * width * height * GIF_BYTES_PER_PIXEL + renderer_bytes,
+                 f"{held}, with the render targets and textures, take {{}}" if renderer_bytes
+                 else f"{held} take {{}}", where,
                  "fewer frames, a smaller size, an .mp4 or a frame pattern")
 
 

@@ -36,6 +36,7 @@ from deferred.lighting.lists import (
 from deferred.lighting.paths import resolve_light_path
 from deferred.memo import overrides
 from deferred.names import LightVolume, Pipeline
+from deferred.params import validate_params
 from deferred.render.caches import (
     FrameInputs,
     KeptMaterialInputs,
@@ -43,7 +44,7 @@ from deferred.render.caches import (
     ShadingTextures,
 )
 from deferred.render.generated import generated_glsl
-from deferred.render.pipeline import PIPELINES, check_passes
+from deferred.render.pipeline import PIPELINES, TONEMAPS, check_passes
 from deferred.scene.model import Scene, SceneObject, check_size
 
 PassCallback = Callable[[RenderPass, Frame], None]
@@ -133,6 +134,34 @@ def held_memory(scene: Scene) -> dict[str, int]:
     return held
 
 
+def check_scene_values(scene: Scene) -> None:
+    """The scene's own values as a scene file's are checked (a scene built or changed in
+    Python skips the loader): the camera, the tone mapping operator, the background and the
+    exposure; ``InputError`` naming the attribute."""
+    from dataclasses import asdict
+
+    from deferred.scene.loader import CameraModel
+
+    validate_params(CameraModel, asdict(scene.camera), "camera")
+    if scene.tonemap not in TONEMAPS:
+        raise InputError(f"unknown tone mapping operator {scene.tonemap!r} (choose from "
+                         f"{', '.join(TONEMAPS)})", "tonemap")
+    background = np.asarray(scene.background, dtype=np.float64)
+    if background.shape != (3,) or not np.all(np.isfinite(background)) or np.any(background < 0):
+        raise InputError(f"expected three finite numbers >= 0, got {scene.background!r}",
+                         "background")
+    if not (math.isfinite(scene.exposure) and scene.exposure > 0.0):
+        raise InputError(f"expected a finite number > 0, got {scene.exposure!r}", "exposure")
+
+
+def _restarts(material_cls: type[Material], before: object, after: object) -> bool:
+    """Whether new parameters need the material's state made again: one it reads once
+    (``timeline_fixed``) changed, or a count that only rises (``timeline_growing``) fell."""
+    return any(getattr(before, key) != getattr(after, key)
+               for key in material_cls.timeline_fixed) or \
+        any(getattr(after, key) < getattr(before, key) for key in material_cls.timeline_growing)
+
+
 class Renderer:
     """Renders one scene with one pipeline; reuse it for many frames, then ``release()``.
 
@@ -157,9 +186,12 @@ class Renderer:
         if pipeline not in PIPELINES:
             raise InputError(f"unknown pipeline '{pipeline}' (choose from "
                              f"{', '.join(PIPELINES)})", "pipeline")
+        check_scene_values(scene)
         self.scene = scene
+        self._camera_checked = scene.camera
         self.pipeline_name = pipeline
         self._size_arg, self._light_path_arg = size, light_path  # for a rebuild
+        self._times_checked: tuple[float, tuple] | None = None  # check_times' last pass
         self._inserted: list[tuple[RenderPass, str | None, str | None]] = []  # insert_pass's
         self.strict = strict_default() if strict is None else strict
         given = size is not None
@@ -206,7 +238,8 @@ class Renderer:
         scene = self.scene
         return (tuple((id(obj), id(obj.mesh), type(obj.material)) for obj in scene.objects),
                 tuple(map(type, scene.lights)), tuple(map(id, scene.effects)),
-                tuple(scene.background), scene.tonemap, scene.light_path,
+                tuple(scene.background), scene.tonemap,
+                scene.light_path if self._light_path_arg is None else None,
                 scene.size if self._size_arg is None else None)
 
     @staticmethod
@@ -224,13 +257,21 @@ class Renderer:
         """Rebuild before a frame where the scene changed in what the passes are built from;
         parameters that only change values (uniforms, defines) need nothing here."""
         changed = self._scene_structure() != self._structure
+        exposure = self.scene.exposure
+        if changed or self.scene.camera is not self._camera_checked or \
+                not (isinstance(exposure, float | int) and math.isfinite(exposure) and
+                     exposure > 0.0):
+            check_scene_values(self.scene)
+            self._camera_checked = self.scene.camera
         if not changed:
             for obj in self.scene.objects:
                 params = obj.material.params
                 if params is self._params_seen.get(id(obj)):
                     continue
                 passes = self._object_passes(obj)
-                if passes != self._passes_seen.get(id(obj)):
+                seen = self._params_seen.get(id(obj))
+                if passes != self._passes_seen.get(id(obj)) or \
+                        (seen is not None and _restarts(type(obj.material), seen, params)):
                     changed = True
                     break
                 self._params_seen[id(obj)] = params
@@ -241,11 +282,15 @@ class Renderer:
         """A renderer built afresh for the scene on this one's context takes this one's place
         (this one is left as it was if that fails); passes inserted with insert_pass are
         inserted again."""
-        replacement = Renderer(self.scene, self.pipeline_name, self._size_arg, gl=self.gl,
-                               strict=self.strict, light_path=self._light_path_arg)
+        replacement = type(self)(self.scene, self.pipeline_name, self._size_arg, gl=self.gl,
+                                 strict=self.strict, light_path=self._light_path_arg)
         try:
             for render_pass, before, after in self._inserted:
-                replacement.insert_pass(render_pass, before=before, after=after)
+                try:
+                    replacement.insert_pass(render_pass, before=before, after=after)
+                except PassGraphError as exc:
+                    raise PassGraphError(f"pass {render_pass.name}, inserted with insert_pass, "
+                                         f"no longer fits the changed scene: {exc}") from None
         except BaseException:
             replacement.release()
             raise
@@ -296,6 +341,12 @@ class Renderer:
         if not self._owns_context:
             _ = self.gl.ctx.error  # reading clears it: the caller's next renderer starts clean
 
+    def memory_bytes(self) -> int:
+        """What the renderer holds as the memory budget counts it: its render targets and the
+        materials' textures and state (:func:`held_memory`)."""
+        return targets_bytes(self.graph.targets.values(), *self.size) + \
+            sum(held_memory(self.scene).values())
+
     @property
     def passes(self) -> list[RenderPass]:
         return self.graph.passes
@@ -341,6 +392,8 @@ class Renderer:
         targets (recompiling programs; simulations start over) on the same context."""
         self._check_alive()
         raise_if_stop_requested()  # a signal a library swallowed ends the command here
+        if hdr and not readback:
+            raise ValueError("hdr=True reads the composite back: not with readback=False")
         if isinstance(time, bool) or not isinstance(time, numbers.Real) or \
                 not math.isfinite(time) or time < 0.0:
             raise InputError(f"frame time must be a finite number of seconds >= 0, got {time!r}",
@@ -444,15 +497,26 @@ class Renderer:
 
     def check_times(self, times: list[float], where: str = "--time") -> None:
         """Every material's :meth:`~deferred.interfaces.material.Material.check_time` for the
-        latest of ``times``: an animation is refused before its first frame, not part way."""
-        if times:
-            latest = max(times)
-            objects = self.scene.objects
-            checking = {cls for cls in {type(obj.material) for obj in objects}
-                        if overrides(cls, Material, "check_time", "check_time_for")}
-            for obj in objects:  # most materials have no check
-                if type(obj.material) in checking:
-                    obj.material.check_time_for(obj, latest, where)
+        latest of ``times``: an animation is refused before its first frame, not part way.
+        The work a check weighs grows with the time (steps from 0, droplets fallen by then),
+        so a time passed covers every earlier one while the checked objects' parameters and
+        events are the same: a frame at such a time checks nothing again."""
+        if not times:
+            return
+        latest = max(times)
+        objects = self.scene.objects
+        checking = {cls for cls in {type(obj.material) for obj in objects}
+                    if overrides(cls, Material, "check_time", "check_time_for")}
+        checked = [obj for obj in objects if type(obj.material) in checking]
+        state = tuple((id(obj), id(obj.material), id(obj.material.params),
+                       id(getattr(obj, "base_params", None)), id(getattr(obj, "events", None)))
+                      for obj in checked)
+        if self._times_checked is not None and self._times_checked[1] == state and \
+                latest <= self._times_checked[0]:
+            return
+        for obj in checked:  # most materials have no check
+            obj.material.check_time_for(obj, latest, where)
+        self._times_checked = (latest, state)
 
     def _check_gl(self, stage: str) -> None:
         error = self.gl.ctx.error
@@ -461,11 +525,13 @@ class Renderer:
 
     def read_final(self) -> np.ndarray:
         self._check_alive()
+        self.gl.make_current()  # another renderer's context may be current
         data = np.frombuffer(self.targets[FINAL].read(alignment=1), dtype=np.uint8)
         return data.reshape(self.size[1], self.size[0], 4)[::-1].copy()
 
     def read_hdr(self) -> np.ndarray:
         self._check_alive()
+        self.gl.make_current()  # another renderer's context may be current
         return self.targets.read(COMPOSITE)[::-1].copy()
 
     def _check_alive(self) -> None:
@@ -509,6 +575,7 @@ class Renderer:
 def render_scene(scene: Scene, pipeline: str = Pipeline.DEFERRED,
                  size: tuple[int, int] | None = None, gl: GLContext | None = None,
                  time: float = 0.0) -> RenderResult:
-    """Render one frame of ``scene`` at ``time`` with a renderer made and released for it."""
+    """Render one frame of ``scene`` at ``time`` with a renderer made and released for it (the
+    result holds the image and the HDR composite both)."""
     with Renderer(scene, pipeline, size, gl) as renderer:
-        return renderer.render(time=time)
+        return renderer.render(time=time, hdr=True)

@@ -246,6 +246,10 @@ class SceneObject:
         self._states.clear()
         self._values.clear()
         try:
+            # each event again over the new base: what a timeline may not change
+            # (timeline_fixed, the passes), then every state and what may only rise
+            for event in self.events:
+                self._checked_event(event.time, event.params, event.where)
             for time in sorted(set(self._times)):
                 self.params_at(time)
             self._check_growing()
@@ -264,8 +268,10 @@ class SceneObject:
         assigned to ``material.params`` since the last time become the base, as
         :meth:`set_params` makes them, rather than being overwritten by the timeline."""
         if self._applied is not None and self.material.params is not self._applied:
-            assigned = self.material.params
-            self.set_params(**assigned.model_dump())
+            # what the assignment changed from the timeline's state, not that state itself
+            assigned, applied = self.material.params.model_dump(), self._applied.model_dump()
+            self.set_params(**{key: value for key, value in assigned.items()
+                               if value != applied.get(key)})
         self._applied_time = time
         self.material.params = self._applied = self.params_at(time)
 

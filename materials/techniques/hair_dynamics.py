@@ -47,8 +47,10 @@ default). At 1 the strand is its keyframe pose.
 
 **Collisions.** After the iterations every strand particle inside a collision sphere (object-space
 centre and radius plus ``collision_margin``, moved by the model matrix; a scaled matrix scales
-the radius by its largest axis scale) is pushed radially to its surface, so no particle ends a
-step inside one (4.1: the head as a group of spheres; no hair-hair collisions, as in 3.1).
+the radius by its largest axis scale) is pushed radially to its surface, for up to
+``COLLISION_ROUNDS`` rounds where spheres overlap (a particle pushed out of one into another),
+so particles end a step outside them (4.1: the head as a group of spheres; no hair-hair
+collisions, as in 3.1).
 Structural particles are not hair and do not collide: pushing one would twist the strand's
 frame and bend the strand.
 """

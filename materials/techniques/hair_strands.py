@@ -36,6 +36,7 @@ from deferred.api import InputError, MeshData, require_regular_file
 STRAND_SUFFIXES = (".json", ".obj")
 MAX_STRAND_FILE_BYTES = 256 << 20
 MAX_STRANDS = 1_000_000
+MAX_STRAND_POINTS = 20_000_000  # strands x points, after resampling to the longest
 MAX_STRAND_POINTS = 4096
 HairStyle = Literal["combed", "spiky"]
 HAIR_STYLES: tuple[str, ...] = ("combed", "spiky")
@@ -165,7 +166,7 @@ def load_strands(path: str | Path, where: str | None = None) -> np.ndarray:
     except OSError as exc:
         raise InputError(f"cannot read strand file: {exc.strerror or exc}", where) from None
     strands = _json_strands(text, where) if suffix == ".json" else _obj_strands(text, where)
-    return _common_points(strands)
+    return _common_points(strands, where)
 
 
 def _json_strands(text: str, where: str) -> list[np.ndarray]:
@@ -190,6 +191,7 @@ def _json_strands(text: str, where: str) -> list[np.ndarray]:
         for index, point in enumerate(strand):
             if (not isinstance(point, list) or len(point) != 3
                     or not all(isinstance(c, int | float) and not isinstance(c, bool)
+                               and not (isinstance(c, int) and abs(c) > 1e300)
                                for c in point)):
                 raise InputError(f"strand {number} point {index} must be 3 numbers [x, y, z], "
                                  f"got {json.dumps(point)[:40]}", where)
@@ -255,9 +257,15 @@ def _checked_strand(strand: np.ndarray, number: int, where: str) -> np.ndarray:
     return strand
 
 
-def _common_points(strands: list[np.ndarray]) -> np.ndarray:
-    """The strands as one array, each resampled by arc length to the largest point count."""
+def _common_points(strands: list[np.ndarray], where: str | None = None) -> np.ndarray:
+    """The strands as one array, each resampled by arc length to the largest point count;
+    ``InputError`` where that array would pass ``MAX_STRAND_POINTS`` (a million two-point
+    strands and one long one would ask for tens of gigabytes)."""
     count = max(len(s) for s in strands)
+    if len(strands) * count > MAX_STRAND_POINTS:
+        raise InputError(f"{len(strands):,} strands of {count:,} points (each resampled to the "
+                         f"longest) are more than the {MAX_STRAND_POINTS:,} points allowed",
+                         where)
     return np.stack([s if len(s) == count else resample_strand(s, count) for s in strands])
 
 

@@ -75,7 +75,9 @@ class XToonParams(MaterialParams):
                                                     "backlight (4.3.5) or specular (4.3.6)")
     depth_range: tuple[float, float] = Field(
         (2.0, 20.0), description="z_min, z_max of the depth metric (view-space units)")
-    backlight_power: float = Field(1.0, ge=0.0, le=64.0, description="r of |N.V|^r")
+    backlight_power: float = Field(1.0, gt=0.0, le=64.0, description="r of |N.V|^r (> 0: "
+                                                                        "GLSL's pow(0, 0) is "
+                                                                        "undefined)")
     backlight_color: tuple[float, float, float] = Field(
         (0.9, 0.8, 0.6), description="rim light added to the diffuse where |N.V|^r is small")
     ramp_shininess: float = Field(40.0, ge=1.0, le=2048.0,
@@ -181,8 +183,12 @@ def scene_ramps(scene: Scene) -> list[XToonRamp]:
 
 
 def ramp_layer(scene: Scene, ramp: XToonRamp, first_layer: int) -> int:
-    """The texture-array layer of ``ramp`` in ``scene``."""
+    """The texture-array layer of ``ramp`` in ``scene`` (the G-buffer datum toon_ramp holds
+    it in 8 bits: at most 256 layers)."""
     ramps = scene_ramps(scene)
+    if first_layer + len(ramps) > 256:
+        raise InputError(f"the scene's materials have {len(ramps)} different X-toon ramps; the "
+                         f"toon model holds {256 - first_layer}")
     if ramp not in ramps:
         raise InputError("the material's X-toon ramp is not among the scene's (it was changed "
                          "outside its params)")

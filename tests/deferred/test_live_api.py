@@ -246,3 +246,128 @@ def test_a_result_saves_and_shows_in_a_notebook(renderer, tmp_path):
     with pytest.raises(InputError, match=r"^path: saves \.png .* or \.exr"):
         result.save(tmp_path / "f.jpg")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["f.exr", "f.png"]
+
+
+# -- review fixes ----------------------------------------------------------------------------------
+
+def coloured_scene(color) -> Scene:
+    scene = small_scene()
+    scene.objects[0].set_params(color=color)
+    return scene
+
+
+def test_a_result_reads_its_own_renderers_composite(gl):
+    """Each renderer owns a pooled context: a result read after another renderer drew reads
+    its own frame, not the context that is current."""
+    red, blue = Renderer(coloured_scene((0.9, 0.05, 0.05))), \
+        Renderer(coloured_scene((0.05, 0.05, 0.9)))
+    try:
+        a = red.render()
+        b = blue.render()
+        # the ball at the frame's centre: red in the first renderer's, blue in the second's
+        assert a.hdr[32, 48, 0] > 2 * a.hdr[32, 48, 2]
+        assert b.hdr[32, 48, 2] > 2 * b.hdr[32, 48, 0]
+    finally:
+        red.release()
+        blue.release()
+
+
+def test_set_params_is_refused_where_the_timeline_could_not_follow():
+    """A new base is checked against every event as an event is: passes the timeline cannot
+    change (shells 0 with an event of 8) and parameters it reads once."""
+    scene = small_scene()
+    fur = scene.add_object("builtin:sphere", "revie_fur", label="fur", params={"shells": 4})
+    scene.add_event(fur, 1.0, {"shells": 8})
+    with pytest.raises(InputError, match="would change the object's passes"):
+        fur.set_params(shells=0)
+    assert fur.base_params.shells == 4
+    fur.set_params(shells=6)  # allowed: the event's 8 still has shells
+    assert fur.base_params.shells == 6
+
+
+def test_assigned_params_move_only_what_they_change_into_the_base(renderer):
+    scene = small_scene()
+    ball = scene.objects[0]
+    ball.set_params(specular_intensity=0.9)
+    scene.add_event(ball, 1.0, {"specular_intensity": 0.1})
+    r = renderer(scene)
+    r.render(time=2.0)
+    ball.material.params = ball.params.model_copy(update={"color": (0.1, 0.9, 0.1)})
+    r.render(time=0.0)
+    assert ball.params.specular_intensity == 0.9 and ball.params.color == (0.1, 0.9, 0.1)
+
+
+def test_parameters_read_once_remake_the_state_of_a_live_renderer(gl, renderer):
+    """shell_fur reads its seed and mask size once: changed with set_params, a live renderer
+    starts the simulation over and draws what a fresh renderer draws."""
+    scene = small_scene()
+    fur = scene.add_object("builtin:sphere", "shell_fur", label="fur", position=(1.2, 0, 0),
+                           params={"shells": 4, "seed": 1})
+    live = renderer(scene)
+    live.render()
+    fur.set_params(seed=7, fur_length=0.3)
+    changed = live.render().image
+    with Renderer(scene, gl=gl) as fresh:
+        np.testing.assert_array_equal(changed, fresh.render().image)
+
+
+def test_scene_values_set_in_python_are_checked_at_the_next_frame(renderer):
+    from deferred import Camera
+
+    scene = small_scene()
+    r = renderer(scene)
+    first = r.render().image
+    for attribute, value, message in [
+            ("tonemap", "filmic", "^tonemap: unknown tone mapping operator 'filmic'"),
+            ("background", (float("nan"), 0.0, 0.0), "^background: expected three finite"),
+            ("camera", Camera(position=(0, 0, 0), target=(0, 0, 0)),
+             "^camera: position and target are the same point"),
+            ("exposure", -1.0, "^exposure: expected a finite number > 0")]:
+        kept = getattr(scene, attribute)
+        setattr(scene, attribute, value)
+        with pytest.raises(InputError, match=message):
+            r.render()
+        setattr(scene, attribute, kept)
+    np.testing.assert_array_equal(r.render().image, first)
+
+
+def test_a_frame_at_a_time_already_checked_checks_nothing_again(renderer, monkeypatch):
+    """check_times passes for the latest time cover every earlier one while the parameters
+    stay (the droplet count was weighed again each frame: 30-50 ms at 10,000 droplets)."""
+    import deferred.materials.shell_fur as shell_fur
+
+    scene = small_scene()
+    fur = scene.add_object("builtin:sphere", "shell_fur", label="fur", position=(1.2, 0, 0),
+                           params={"shells": 2, "droplets": 5})
+    calls = []
+    real = shell_fur.ShellFurMaterial.check_time_for
+    monkeypatch.setattr(shell_fur.ShellFurMaterial, "check_time_for",
+                        lambda self, *a: calls.append(a[1]) or real(self, *a))
+    r = renderer(scene)
+    r.check_times([0.5])
+    for t in (0.0, 0.25, 0.5):
+        r.render(time=t)
+    assert calls == [0.5]
+    r.render(time=0.75)
+    fur.set_params(droplets=6)
+    r.render(time=0.75)
+    assert calls == [0.5, 0.75, 0.75]
+
+
+def test_hdr_without_readback_is_refused(renderer):
+    with pytest.raises(ValueError, match="readback=False"):
+        renderer(small_scene()).render(readback=False, hdr=True)
+
+
+def test_a_plain_png_render_reads_no_composite(tmp_path, capsys, monkeypatch):
+    import deferred.render.renderer as renderer_module
+    from deferred.cli import main
+
+    reads = []
+    real = renderer_module.Renderer.read_hdr
+    monkeypatch.setattr(renderer_module.Renderer, "read_hdr",
+                        lambda self: reads.append(1) or real(self))
+    assert main(["render", "-o", str(tmp_path / "x.png"), "--size", "32x18"]) == 0
+    assert reads == []
+    assert main(["render", "-o", str(tmp_path / "x.exr"), "--size", "32x18"]) == 0
+    assert reads == [1]

@@ -103,8 +103,9 @@ def test_a_kind_or_a_type_alone(capsys, args, listed):
 @pytest.mark.parametrize("args, expected", [
     (["lihgt"], "error: unknown kind 'lihgt' (did you mean 'light'? choose from material, "
                 "light, effect, shading_model)"),
-    (["light", "pointt"], "error: unknown light 'pointt' (did you mean 'point'? choose from "),
-    (["material", "velvett"], "error: unknown material 'velvett' (choose from "),
+    (["light", "pointt"],
+     "error: NAME: unknown light 'pointt' (did you mean 'point'? choose from "),
+    (["material", "velvett"], "error: NAME: unknown material 'velvett' (choose from "),
     (["teapot"], "error: unknown kind 'teapot' (choose from material, light, effect, "
                  "shading_model)"),
 ])

@@ -237,3 +237,22 @@ def test_bad_strand_files_are_one_line_errors_naming_the_file(tmp_path, name, te
 def test_a_missing_strand_file_is_named(tmp_path):
     with pytest.raises(InputError, match="nowhere.json: strand file not found"):
         load_strands(tmp_path / "nowhere.json")
+
+
+def test_strand_files_asking_for_too_much_are_refused(tmp_path, monkeypatch):
+    """Strands are resampled to the longest one's points: a file whose strands times that count
+    pass MAX_STRAND_POINTS is refused before the array is made; an integer too large for a
+    float is a bad point, not an OverflowError."""
+    import json
+
+    from deferred.errors import InputError
+    from deferred.materials.techniques import hair_strands
+
+    monkeypatch.setattr(hair_strands, "MAX_STRAND_POINTS", 100)
+    many = [[[0, 0, 0], [0, 1, 0]]] * 10 + [[[0, 0, k] for k in range(20)]]
+    (tmp_path / "many.json").write_text(json.dumps({"strands": many}))
+    with pytest.raises(InputError, match=r"11 strands of 20 points .* more than the 100 points"):
+        hair_strands.load_strands(tmp_path / "many.json")
+    (tmp_path / "huge.json").write_text('{"strands": [[[0, 0, 0], [' + "9" * 400 + ', 0, 0]]]}')
+    with pytest.raises(InputError, match="point 1 must be 3 numbers"):
+        hair_strands.load_strands(tmp_path / "huge.json")
