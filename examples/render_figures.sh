@@ -11,3 +11,7 @@ python examples/fur_figures.py
 # Silva et al., curling and clumping fur (the shell_fur material): Figs. 7, 9, 11, 12 (c), Table 1's
 # torus and the wet-in-the-wind GIF (examples/shell_fur/README.md)
 python examples/shell_fur/figures.py
+# Costigan's cartoon hair: X-toon shading (Figs. 4.7-4.10, the depth metric), outlines (4.11-4.13)
+# and the tonal art map (4.21-4.22) in docs/figures/cartoon_hair/
+python examples/cartoon_hair/figures.py
+deferred render examples/cartoon_hair/spiky_head.toml -o docs/figures/cartoon_hair_spiky.png
