@@ -109,9 +109,10 @@ class Toon(ShadingModel):
             texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
             return texture
 
-        return {"u_toon_ramps": frame.resources.texture(key, create),
-                "u_toon_ramp_constants": frame.resources.texture(
-                    ("toon_ramp_constants", tuple(ramps)), create_constants)}
+        # one array at a time: a ramp edited between frames replaces it
+        return {"u_toon_ramps": frame.resources.current("toon_ramps", key, create),
+                "u_toon_ramp_constants": frame.resources.current(
+                    "toon_ramp_constants", key, create_constants)}
 
     @staticmethod
     def ramp_row(name: str) -> float:

@@ -22,6 +22,16 @@ def image_texture_bytes(width: int, height: int) -> int:
     return width * height * 8 * 4 // 3
 
 
+class _Slot(tuple):
+    """(key, object) of :meth:`Resources.current`: released with the resources."""
+
+    def __new__(cls, key: Any, made: Any) -> _Slot:
+        return super().__new__(cls, (key, made))
+
+    def release(self) -> None:
+        self[1].release()
+
+
 class Resources:
     """GPU objects that outlive one frame: meshes, textures loaded from files, helper geometry."""
 
@@ -47,6 +57,20 @@ class Resources:
         if made is None:
             made = create(self.ctx)
             self._cached[key] = made
+        return made
+
+    def current(self, slot: Any, key: Any, create: Callable[[moderngl.Context], Any]) -> Any:
+        """A GPU object in ``slot`` made for ``key`` (anything with ``release()``): asked for
+        with another key, the slot's object is released and ``create(ctx)`` makes the new
+        one (what follows a value that changes between frames: a cached object a value would
+        outlive its use)."""
+        held = self._cached.get(("slot", slot))
+        if held is not None and held[0] == key:
+            return held[1]
+        made = create(self.ctx)
+        if held is not None:
+            held[1].release()
+        self._cached[("slot", slot)] = _Slot(key, made)
         return made
 
     def texture(self, key: Any, create: Callable[[moderngl.Context], moderngl.Texture]

@@ -278,3 +278,19 @@ def test_xtoon_params_are_refused_with_the_key():
             from deferred.params import validate_params
 
             validate_params(XToonParams, values, None)
+
+
+def test_an_edited_ramp_replaces_the_toon_textures(gl, xtoon_material):
+    """A ramp changed between frames makes new toon textures and releases the old ones (each
+    edit kept another texture array for the renderer's life)."""
+    scene = sphere_scene({"ramp": XTOON_STOPS})
+    with Renderer(scene, gl=gl) as renderer:
+        renderer.render()
+        before = renderer.resources._cached[("slot", "toon_ramps")][1]
+        count = len(renderer.resources._cached)
+        scene.objects[0].set_params(ramp=[[0.0, "#000000"], [0.5, "#ffffff"]])
+        image = renderer.render(hdr=True).hdr
+        after = renderer.resources._cached[("slot", "toon_ramps")][1]
+        assert after is not before and len(renderer.resources._cached) == count
+        covered = image[..., 3] > 0.999
+        assert np.unique(np.round(image[covered][:, 0], 3)).size == 2  # the new two tones
