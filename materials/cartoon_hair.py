@@ -13,7 +13,12 @@ head) is drawn too, in ``skin_color``.
   ``sides``-gon tapered by the quadratic ``taper``;
 - shading (4.3.3-4.3.6): X-toon (:mod:`.techniques.xtoon`), the G-buffer datum ``strand_id``
   (0 on the head, 1 + the strand's index on the hair) lets the ``edges`` effect outline
-  strands of one colour where they overlap (4.3.7).
+  strands of one colour where they overlap (4.3.7);
+- silhouette strokes (4.3.7, object space): :mod:`.techniques.hair_silhouettes` with
+  ``silhouettes = true``, strokes ``stroke_width`` pixels wide in ``stroke_color`` along the
+  tubes' silhouette edges, faded toward the roots by the quadratic ``stroke_fade``; drawn over
+  the lit image (deferred: the material phase, visible by the G-buffer's strand ids; forward:
+  after the lit hair, by the depth buffer).
 
 The tubes carry each vertex's strand in the vertex format's comb slot (the hair has no comb):
 ``comb.x`` the strand's index, ``comb.y`` the parameter along it; ``uv`` is (along, around).
@@ -45,8 +50,9 @@ from deferred.api import (
 
 from .shading_models import Toon
 from .techniques.hair_dynamics import HairPhysics, HairSimulation
+from .techniques.hair_silhouettes import SilhouetteGeometry, SilhouettePass, tube_adjacency
 from .techniques.hair_strands import grow_strands, load_strands, resample_strand, scalp_roots
-from .techniques.hair_tubes import build_tubes
+from .techniques.hair_tubes import build_tubes, tube_radii
 from .techniques.xtoon import XTOON_UNIFORM_OVERRIDES, XToonParams, XToonRamp
 
 if TYPE_CHECKING:
@@ -93,6 +99,13 @@ class CartoonHairParams(BlinnPhongParams, XToonParams):
     sides: int = Field(6, ge=3, le=16, description="sides of a tube")
     radius: float = Field(0.012, gt=0.0, le=1.0, description="tube radius at the root")
     taper: Vec3 = Field((0.0, -1.0, 1.0), description="radius along the strand: a x^2 + b x + c")
+    # silhouette strokes (4.3.7, object space)
+    silhouettes: bool = Field(False, description="strokes along the tubes' silhouette edges")
+    stroke_width: float = Field(3.0, gt=0.0, le=64.0, description="silhouette strokes, pixels")
+    stroke_color: Vec3 = Field((0.08, 0.05, 0.12), description="silhouette strokes, linear RGB")
+    stroke_fade: Vec3 = Field((-1.0, 2.0, 0.0),
+                              description="stroke alpha along the strand (0 root, 1 tip): "
+                                          "a x^2 + b x + c, clamped to [0, 1]")
 
     @model_validator(mode="after")
     def _keys(self) -> CartoonHairParams:
@@ -126,7 +139,18 @@ class HairState:
         self.mesh = MeshData("cartoon_hair tubes", tubes[0], tubes[1],
                              *self._constant_attributes(tubes[2]), tubes[3])
         self.gpu = GpuMesh(ctx, self.mesh)
+        self.ctx = ctx
+        self._silhouettes: SilhouetteGeometry | None = None
         self.time: float | None = None
+
+    @property
+    def silhouettes(self) -> SilhouetteGeometry:
+        """The tubes with each triangle's neighbours (made the first time it is asked for)."""
+        if self._silhouettes is None:
+            p = self.params
+            topology = (self.simulation.strands.shape[0], p.hair_samples, p.sides)
+            self._silhouettes = SilhouetteGeometry(self.ctx, self.gpu, tube_adjacency(*topology))
+        return self._silhouettes
 
     def _tubes(self):
         p = self.params
@@ -162,6 +186,8 @@ class HairState:
         self.time = time
 
     def release(self) -> None:
+        if self._silhouettes is not None:
+            self._silhouettes.release()
         self.gpu.release()
 
 
@@ -204,6 +230,28 @@ class HairForwardPass(HairInputs, ForwardLitPass):
     """The tubes lit in the forward pipeline."""
 
 
+class HairSilhouettePass(SilhouettePass):
+    """The tubes' silhouette strokes over the lit image."""
+
+    _prepared: tuple[weakref.ref, HairState] | None = None
+
+    def prepare(self, frame: Frame) -> None:
+        state = hair_state(frame, self.obj)
+        state.advance(frame.time)
+        self._prepared = (weakref.ref(frame), state)
+
+    def silhouette_geometry(self, frame: Frame) -> SilhouetteGeometry:
+        if self._prepared is None or self._prepared[0]() is not frame:
+            raise RuntimeError(f"{self.name}: drawn in a frame it was not prepared for")
+        return self._prepared[1].silhouettes
+
+    def stroke_settings(self) -> dict[str, Any]:
+        p = self.obj.material.params
+        # a tube's own front surface lies up to its radius nearer than its silhouette
+        return {"width": p.stroke_width, "color": p.stroke_color, "fade": p.stroke_fade,
+                "tolerance": float(tube_radii(p.hair_samples, p.radius, p.taper).max())}
+
+
 @materials.register
 class CartoonHairMaterial(Material):
     name = "cartoon_hair"
@@ -217,7 +265,8 @@ class CartoonHairMaterial(Material):
             "skin_color", "strands_file", "strands", "length", "segments", "style", "parting",
             "seed", "edge_stiffness", "bend_stiffness", "torsion_stiffness",
             "anchor_stiffness", "anchor_curve", "keyframes", "key_times", "gravity", "wind",
-            "time_step", "collision_spheres", "hair_samples", "sides", "radius", "taper")},
+            "time_step", "collision_spheres", "hair_samples", "sides", "radius", "taper",
+            "silhouettes", "stroke_width", "stroke_color", "stroke_fade")},
         "color": lambda value: {},  # the head's pass takes skin_color, the hair's color
     }
     # read once, at t = 0: the strands, their simulation and the tubes' topology
@@ -280,6 +329,17 @@ class CartoonHairMaterial(Material):
         return [*super().geometry_passes(obj),
                 HairGBufferPass(f"{obj.label}.hair", Phase.GEOMETRY, obj)]
 
+    def material_passes(self, obj: SceneObject) -> list:
+        if not self.params.silhouettes:
+            return [*super().material_passes(obj)]
+        return [*super().material_passes(obj),
+                HairSilhouettePass(f"{obj.label}.silhouettes", Phase.MATERIAL, obj,
+                                   id_buffer=True)]
+
     def forward_passes(self, obj: SceneObject) -> list:
-        return [*super().forward_passes(obj),
-                HairForwardPass(f"{obj.label}.hair", Phase.FORWARD, obj)]
+        passes = [*super().forward_passes(obj),
+                  HairForwardPass(f"{obj.label}.hair", Phase.FORWARD, obj)]
+        if self.params.silhouettes:
+            passes.append(HairSilhouettePass(f"{obj.label}.forward_silhouettes", Phase.FORWARD,
+                                             obj))
+        return passes
