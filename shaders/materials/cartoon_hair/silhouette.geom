@@ -2,9 +2,10 @@
 // al.). Input: a triangle with its neighbours (triangles_adjacency: 0, 2, 4 the triangle; 1, 3,
 // 5 the vertices opposite its edges 0-2, 2-4, 4-0 across them). An edge between a front- and a
 // back-facing triangle is a silhouette edge; the front-facing triangle emits it (each edge
-// once) as a quad u_stroke_width pixels wide, extruded in screen space about the edge and
-// lengthened by half its width at each end, so the quads of neighbouring edges overlap at the
-// joints. Without STROKE_ID_BUFFER the quad is pulled u_stroke_tolerance toward the eye (the
+// once) as a quad u_stroke_width pixels wide, extruded in screen space either side of the edge
+// along its vertices' normals as they project on screen, so the quads of neighbouring edges
+// meet at their shared vertices (the thesis' strip joints, Fig. 4.16, without chaining the
+// edges). Without STROKE_ID_BUFFER the quad is pulled u_stroke_tolerance toward the eye (the
 // forward pipeline's depth test; its position on screen does not change).
 layout(triangles_adjacency) in;
 layout(triangle_strip, max_vertices = 12) out;
@@ -54,6 +55,19 @@ void emit_corner(vec4 clip, vec2 offset_pixels, vec2 uv, float view_depth) {
     EmitVertex();
 }
 
+// The screen direction (pixels, unit) the vertex normal points in at clip position c; the
+// edge's own normal ``across`` where the vertex normal looks along the edge or at the eye.
+vec2 extrusion(int i, vec4 c, vec2 across) {
+    vec4 cn = u_projection * vec4(vs_normal[i], 0.0);
+    vec2 d = (cn.xy * c.w - c.xy * cn.w) * u_resolution;  // d(c.xy / c.w), times c.w^2 > 0
+    float len = length(d);
+    if (len < 1e-6) return across;
+    d /= len;
+    float along_across = dot(d, across);
+    if (abs(along_across) < 0.3) return across;
+    return along_across < 0.0 ? -d : d;
+}
+
 void stroke(int i, int j) {
     vec4 c0 = pulled_clip(vs_position[i]);
     vec4 c1 = pulled_clip(vs_position[j]);
@@ -63,19 +77,18 @@ void stroke(int i, int j) {
     vec2 d = s1 - s0;
     float len = length(d);
     if (len < 1e-3) return;  // an edge seen end-on
-    vec2 along = d / len;
+    vec2 across = vec2(-d.y, d.x) / len;
+    // Each end is pushed along its vertex's normal on screen: the edges meeting at a vertex
+    // push it alike, so neighbouring quads join without gaps or overlaps (no chaining).
     float half_width = 0.5 * u_stroke_width;
-    vec2 across = vec2(-along.y, along.x) * half_width;
-    vec2 extend = along * half_width;
-    float du = (vs_along[j] - vs_along[i]) * half_width / len;
-    float u0 = vs_along[i] - du;
-    float u1 = vs_along[j] + du;
+    vec2 e0 = extrusion(i, c0, across) * half_width;
+    vec2 e1 = extrusion(j, c1, across) * half_width;
     float z0 = -vs_position[i].z;
     float z1 = -vs_position[j].z;
-    emit_corner(c0, -extend - across, vec2(u0, 0.0), z0);
-    emit_corner(c0, -extend + across, vec2(u0, 1.0), z0);
-    emit_corner(c1, extend - across, vec2(u1, 0.0), z1);
-    emit_corner(c1, extend + across, vec2(u1, 1.0), z1);
+    emit_corner(c0, -e0, vec2(vs_along[i], 0.0), z0);
+    emit_corner(c0, e0, vec2(vs_along[i], 1.0), z0);
+    emit_corner(c1, -e1, vec2(vs_along[j], 0.0), z1);
+    emit_corner(c1, e1, vec2(vs_along[j], 1.0), z1);
     EndPrimitive();
 }
 
