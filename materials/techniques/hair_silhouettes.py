@@ -13,8 +13,12 @@ and Northrup et al.).
   tapered to a point) face as the sum of their vertices' normals.
 - **Strokes** (Figs. 4.16-4.17): each silhouette edge becomes a quad ``stroke_width`` pixels
   wide, extruded in screen space. Edges are not chained into strips (the thesis' insertion
-  sort): each quad is lengthened by half the width at both ends, so neighbouring quads overlap
-  at the joints (square caps, no mitres) and a bend shows no gap. The stroke image runs along
+  sort): each end of a quad is pushed either side along its vertex's normal as it projects on
+  screen (the edge's own normal where that looks along the edge), so the quads of two edges
+  meeting at a vertex share their corners there: joints neither overlap (no doubled ink) nor
+  gap at bends, the role of the thesis' extrusion along the sum of neighbouring edges
+  (Fig. 4.16); the stroke keeps ``stroke_width`` across a straight strand and thins a little
+  where the normal leans along the edge. The stroke image runs along
   the whole strand (its ``u`` is the parameter along the strand, 0 root to 1 tip) and across
   the quad, so strokes are coherent from frame to frame without chaining; it is the hatching
   generator's soft-ended stroke (:func:`.hatching.default_stroke`).
