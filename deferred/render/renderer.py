@@ -403,6 +403,9 @@ class Renderer:
         self._follow_scene()
         self.check_times([time], "time")
         self.scene.apply_timeline(time)
+        # a camera the tracks moved was checked as they made it (Scene.camera_at): a track's
+        # camera is not checked again, and no move of the camera, a light or an object rebuilds
+        self._camera_checked = self.scene.camera
         self.gl.make_current()
         ctx = self.gl.ctx
         stale = ctx.error  # reading clears it: errors from here on are this frame's

@@ -30,7 +30,15 @@ from deferred.interfaces.material import Material
 from deferred.names import LightPath
 from deferred.scene.camera import Camera, model_matrix
 from deferred.scene.meshes import load_mesh
-from deferred.scene.model import Scene, SceneObject, check_size, unique_label
+from deferred.scene.model import (
+    Scene,
+    SceneObject,
+    Transform,
+    check_light_name,
+    check_size,
+    unique_label,
+)
+from deferred.scene.tracks import INTERPOLATIONS, make_track, parse_target
 from deferred.validation import (
     Radiance,
     StrictValues,
@@ -120,6 +128,20 @@ class EventModel(_Strict):
     params: dict[str, Any] = Field(description="material parameters, merged over the object's")
 
 
+class TrackModel(_Strict):
+    """A ``[[track]]`` table: keys moving the camera, a light or an object
+    (:mod:`deferred.scene.tracks`)."""
+
+    target: str = Field(description="what moves: 'camera', 'object:NAME', 'light:INDEX' (0 is "
+                                    "the first [[light]]) or 'light:NAME'")
+    interpolation: Literal[INTERPOLATIONS] = Field(
+        "linear", description="between keys: step (hold), linear, or smooth (cubic Hermite, "
+                              "Catmull-Rom tangents, zero at the first and last keys)")
+    keys: list[dict[str, Any]] = Field(
+        min_length=1, description="{ time = seconds, and the properties set then }, in rising "
+                                  "time")
+
+
 class TypedModel(BaseModel):
     """A ``[[light]]`` or ``[[effect]]`` table: its type, then that type's parameters."""
 
@@ -143,6 +165,7 @@ class SceneModel(_Strict):
     light: list[TypedModel] = Field(default_factory=list)
     effect: list[TypedModel] = Field(default_factory=list)
     event: list[EventModel] = Field(default_factory=list)
+    track: list[TrackModel] = Field(default_factory=list)
 
 
 def builtin_scenes() -> list[str]:
@@ -193,17 +216,19 @@ def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
     problems: list[InputError] = []
     try:
         model = SceneModel(**data)
-        objects, lights, effects_, events = ([(item, set()) for item in items] for items in (
-            model.object, model.light, model.effect, model.event))
+        objects, lights, effects_, events, tracks = (
+            [(item, set()) for item in items] for items in (
+                model.object, model.light, model.effect, model.event, model.track))
     except ValidationError as exc:
         problems += validation_problems(exc, name, SceneModel)
         # the parts valid alone are checked further: all problems are said at once
         bad = {error["loc"][0] for error in exc.errors() if error["loc"]}
         model = _valid_alone(SceneModel, {k: v for k, v in data.items()
                                           if k not in bad and k not in _LISTS})[0]
-        objects, lights, effects_, events = (_each(cls, data.get(key)) for key, cls in (
-            ("object", ObjectModel), ("light", TypedModel), ("effect", TypedModel),
-            ("event", EventModel)))
+        objects, lights, effects_, events, tracks = (
+            _each(cls, data.get(key)) for key, cls in (
+                ("object", ObjectModel), ("light", TypedModel), ("effect", TypedModel),
+                ("event", EventModel), ("track", TrackModel)))
     _collect(problems, check_size, model.size, f"{name}: size")
     c = model.camera
     scene = Scene(camera=Camera(c.position, c.target, c.up, c.fov, c.near, c.far),
@@ -244,19 +269,38 @@ def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
         made = None
         if not bad and material is not None and mesh is not None:
             made = SceneObject(label, mesh, material,
-                               model_matrix(obj.position, obj.rotation, obj.scale), where=where)
+                               model_matrix(obj.position, obj.rotation, obj.scale), where=where,
+                               transform=Transform.model_construct(
+                                   position=obj.position, rotation=obj.rotation,
+                                   scale=obj.scale))
             scene.objects.append(made)
         labels[label] = (made, material_cls)
         taken.add(label)
+    # each [[light]] by its index in the file (None where refused), and its name
+    file_lights: list = []
+    light_names: set[str] = set()
     for index, (light, bad) in enumerate(lights):
         where = f"{name}: light[{index}]"
+        file_lights.append(None)
+        values = dict(light.model_extra or {}) if light is not None else {}
+        light_name = values.pop("name", None)
+        if light_name is not None:
+            try:
+                check_light_name(light_name, light_names, f"{where}.name")
+                light_names.add(light_name)
+            except InputError as exc:
+                problems.append(exc)
+                light_name = None
         if light is None or "type" in bad:
             continue
         light_cls = _collect(problems, registry.lights.get, light.type, f"{where}.type")
         if light_cls is not None:
-            made = _collect(problems, light_cls.from_dict, light.model_extra or {}, where)
+            made = _collect(problems, light_cls.from_dict, values, where)
             if made is not None:
                 scene.lights.append(made)
+                file_lights[index] = made
+                if light_name is not None:
+                    scene.light_names[light_name] = made
     effects = [(f"{name}: effect[{index}]", e.type, e.model_extra or {})
                for index, (e, bad) in enumerate(effects_) if e is not None and "type" not in bad]
     if model.ssao is not None:  # the [ssao] table of earlier scene files
@@ -307,6 +351,7 @@ def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
                          {**target.base_params.model_dump(), **params}, f"{where}.params")]
             wheres = {problem.where for problem in found}
             problems += [p for p in exc.problems if p.where not in wheres] + found
+    _load_tracks(scene, name, tracks, labels, unlabelled, file_lights, light_names, problems)
     if problems:
         order = {key: position for position, key in enumerate(data)}
         each = [one for problem in problems for one in problem.problems]
@@ -314,7 +359,44 @@ def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
     return scene
 
 
-_LISTS = ("object", "light", "effect", "event")  # lists of tables, checked item by item
+def _load_tracks(scene: Scene, name: str, tracks: list, labels: dict, unlabelled: bool,
+                 file_lights: list, light_names: set[str], problems: list[InputError]) -> None:
+    """Each ``[[track]]`` checked and added to what it moves (its keys checked alone where that
+    object or light was refused)."""
+    for index, (track, bad) in enumerate(tracks):
+        where = f"{name}: track[{index}]"
+        if track is None or bad & {"target", "interpolation", "keys", ""}:
+            continue
+        target_where = f"{where}.target"
+        kind, target = _collect(problems, parse_target, track.target, target_where) or \
+            (None, None)
+        subject: Any = "camera" if kind == "camera" else None
+        if kind == "object":
+            if target in labels:
+                subject = labels[target][0]
+            elif not unlabelled:
+                problems.append(InputError(_no_object(target, list(labels)), target_where))
+        elif kind == "light":
+            if target in light_names:  # None where that light was refused
+                subject = scene.light_names.get(target)
+            elif target.isdigit() and int(target) < len(file_lights):
+                subject = file_lights[int(target)]
+            else:
+                have = f"light:0 to light:{len(file_lights) - 1}" if file_lights else "none"
+                named = f", or by name: {', '.join(sorted(light_names)[:10])}" \
+                    if light_names else ""
+                problems.append(InputError(f"no light '{target[:80]}' (lights: {have}{named})",
+                                           target_where))
+        if subject is None:  # nothing to move: the keys are still checked
+            if kind is not None:
+                _collect(problems, make_track, track.target, track.keys, track.interpolation,
+                         where)
+            continue
+        _collect(problems, scene.add_track, track.target if subject == "camera" else subject,
+                 track.keys, track.interpolation, where)
+
+
+_LISTS = ("object", "light", "effect", "event", "track")  # lists of tables, checked item by item
 
 
 def _collect(problems: list[InputError], function: Callable[..., T], *args: Any) -> T | None:

@@ -2,10 +2,13 @@
 timeline.
 
 A scene may carry a timeline: ``[[event]]`` tables (``time``, ``object``, ``params``) that change
-an object's material parameters from their time on. :meth:`SceneObject.params_at` gives an
-object's parameters at a time and :meth:`Scene.apply_timeline` sets them on every object with
-events (the renderer does so before each frame). Scene files are read by
-:mod:`deferred.scene.loader`.
+an object's material parameters from their time on, and keyframe tracks (``[[track]]``,
+:mod:`deferred.scene.tracks`) that move the camera, lights and objects.
+:meth:`SceneObject.params_at` gives an object's parameters at a time,
+:meth:`SceneObject.model_at` its model matrix, :meth:`Scene.camera_at` and
+:meth:`Scene.light_params_at` the camera and a light's parameters, and
+:meth:`Scene.apply_timeline` sets them all (the renderer does so before each frame). Scene files
+are read by :mod:`deferred.scene.loader`.
 """
 from __future__ import annotations
 
@@ -36,11 +39,11 @@ from deferred.interfaces.shading import ShadingModel
 from deferred.params import validate_params
 from deferred.scene.camera import Camera, model_matrix
 from deferred.scene.meshes import load_mesh
-from deferred.validation import StrictValues
+from deferred.scene.tracks import MIN_SCALE, Track, Turntable, decompose, make_track
+from deferred.validation import StrictValues, join_where
 
 Vec3 = tuple[float, float, float]
 MAX_SIZE = 16384
-MIN_SCALE = 1e-6  # an object smaller is a mistake of units; 1/scale must fit float32
 SIZE_TEXT = re.compile(r"([0-9]+)\s*[xX]\s*([0-9]+)")
 
 
@@ -87,6 +90,10 @@ class SceneObject:
     base_params: MaterialParams | None = None
     events: tuple[TimelineEvent, ...] = ()
     where: str | None = None  # names the object in errors (``scene.toml: object[2]``)
+    # the placement ``model`` was made from, where known: the base of the object's tracks
+    # (for a model given as a matrix alone, it is found from the matrix when first needed)
+    transform: Transform | None = None
+    tracks: tuple[Track, ...] = ()  # keyframe tracks of the transform (Scene.add_track)
     # params_at's validated states and the merged values they came from, by count of events
     # applied (cleared when the events change)
     _states: dict[int, MaterialParams] = field(default_factory=dict, init=False, repr=False)
@@ -95,11 +102,43 @@ class SceneObject:
     # the parameters the timeline set last, and at what time (apply_time)
     _applied: MaterialParams | None = field(default=None, init=False, repr=False)
     _applied_time: float = field(default=0.0, init=False, repr=False)
+    # the model matrix ``transform`` is the base of, and the one the tracks set last
+    _base_model: np.ndarray | None = field(default=None, init=False, repr=False)
+    _applied_model: np.ndarray | None = field(default=None, init=False, repr=False)
 
     def __post_init__(self) -> None:
         if self.base_params is None:
             self.base_params = self.material.params
         self._set_events(self.events)
+        self._base_model = self.model
+
+    def _base_placement(self) -> Transform:
+        """The placement the tracks animate: ``transform``, or, where ``model`` was set since
+        the tracks last set it (or no placement is known), the placement of ``model``."""
+        model = self.model
+        if model is not self._applied_model and model is not self._base_model:
+            self._base_model, self.transform = model, None
+        if self.transform is None:
+            position, rotation, scale = decompose(model)
+            self.transform = Transform.model_construct(position=position, rotation=rotation,
+                                                       scale=scale)
+        return self.transform
+
+    def model_at(self, time: float) -> np.ndarray:
+        """The model matrix at ``time`` (seconds): the placement with the tracks' values at
+        ``time`` over it; ``model`` itself for an object without tracks."""
+        if not self.tracks:
+            return self.model
+        base = self._base_placement()
+        values = {"position": base.position, "rotation": base.rotation, "scale": base.scale}
+        for track in self.tracks:
+            values.update(track.at(time))
+        return model_matrix(values["position"], values["rotation"], values["scale"])
+
+    def apply_tracks(self, time: float) -> None:
+        """Set ``model`` to :meth:`model_at` ``time`` (objects with tracks)."""
+        if self.tracks:
+            self.model = self._applied_model = self.model_at(time)
 
     def _set_events(self, events) -> None:
         self.events = tuple(sorted(events, key=lambda event: event.time))  # stable
@@ -299,16 +338,32 @@ class Scene:
     light_path: str | None = None
     effects: list[Effect] = field(default_factory=list)
     source: str = "<memory>"
+    # the camera's and lights' keyframe tracks (add_track; objects keep theirs), the
+    # turntable (set_turntable), and the lights' names (add_light, [[light]] name)
+    tracks: list[Track] = field(default_factory=list)
+    turntable: Turntable | None = None
+    light_names: dict[str, Light] = field(default_factory=dict)
+    # the camera and the lights' params the tracks animate, and what they set last
+    _camera_base: Camera | None = field(default=None, init=False, repr=False, compare=False)
+    _camera_applied: Camera | None = field(default=None, init=False, repr=False, compare=False)
+    _light_bases: dict[int, tuple[Any, Any]] = field(default_factory=dict, init=False,
+                                                     repr=False, compare=False)
 
     def apply_timeline(self, time: float) -> None:
-        """Set each object's material parameters to those of ``time`` (seconds): objects
-        with events only; the others keep theirs. An object with events that shares its
+        """Set everything the timeline moves to its state at ``time`` (seconds): each
+        object's material parameters (objects with events; the others keep theirs) and model
+        matrix (objects with tracks), the camera (camera tracks, the turntable) and the lights'
+        parameters (lights with tracks). An object with events that shares its
         material instance with another object (``Scene.add`` takes an instance) is given a copy
         of its own first (``copy.copy``: so ``obj.material`` is another object from the first
         frame on, and state a material keeps in containers is shared by the copies), so its
         events never change the other."""
+        if self.tracks or self.turntable is not None:
+            self._apply_tracks(time)
         users: dict[int, int] | None = None
         for obj in self.objects:
+            if obj.tracks:
+                obj.apply_tracks(time)
             if not obj.events:
                 continue
             if users is None:
@@ -332,6 +387,172 @@ class Scene:
                                  f"{where}.object" if where else "object")
             obj = found[0]
         return obj.add_event(time, params, where)
+
+    # -- keyframe tracks -----------------------------------------------------------------------
+    def add_track(self, target: str | SceneObject | Light, keys: Sequence[Mapping[str, Any]],
+                  interpolation: str = "linear", where: str | None = None) -> Track:
+        """Add a keyframe track (:mod:`deferred.scene.tracks`): ``target`` is ``"camera"``,
+        ``"object:NAME"``, ``"light:INDEX"`` or ``"light:NAME"`` (or the object or light
+        itself); ``keys`` a list of ``{"time": t, property: value, ...}`` in rising time;
+        ``interpolation`` ``step``, ``linear`` or ``smooth``. Checked at once (``InputError``
+        naming ``where``, default ``<source>: track[N]``, and the key): the keys, the
+        properties the target has (a light's type), a property already moved by another
+        track, and the camera and a light at every key's time. A renderer drawing the scene
+        moves the target from its next frame."""
+        where = where or f"{self.source}: track[{self._track_count()}]"
+        subject: SceneObject | Light | None
+        if isinstance(target, SceneObject):
+            subject, target = target, f"object:{target.label}"
+        elif isinstance(target, Light):
+            subject = target
+            index = next((i for i, light in enumerate(self.lights) if light is target), None)
+            if index is None:
+                raise InputError("the scene holds no such light", join_where(where, "target"))
+            target = f"light:{index}"
+        else:
+            subject = None
+        track = make_track(target, keys, interpolation, where)
+        if subject is None and track.kind != "camera":
+            subject = self._track_subject(track, join_where(where, "target"))
+        if isinstance(subject, SceneObject):
+            self._check_free(track, subject.tracks)
+            subject.tracks = (*subject.tracks, track)
+            try:
+                for time in track.key_times:
+                    subject.model_at(time)
+            except BaseException:
+                subject.tracks = subject.tracks[:-1]
+                raise
+            return track
+        track = replace(track, subject=subject)
+        if isinstance(subject, Light):
+            fields = type(subject.params).model_fields
+            for prop, curve in track.curves.items():
+                if prop not in fields:
+                    have = [p for p in ("position", "direction", "color", "intensity")
+                            if p in fields]
+                    raise InputError(f"a {type(subject).name} light has no {prop} (its keys may "
+                                     f"set {', '.join(have)})",
+                                     join_where(where, f"keys[{curve.keys[0]}].{prop}"))
+        self._check_free(track, [t for t in self.tracks if t.subject is subject])
+        self.tracks.append(track)
+        try:  # the camera and the light as each key leaves them
+            for time in track.key_times:
+                if subject is None:
+                    self.camera_at(time)
+                else:
+                    self.light_params_at(subject, time)
+        except BaseException:
+            self.tracks.remove(track)
+            raise
+        return track
+
+    def _track_count(self) -> int:
+        return len(self.tracks) + sum(len(obj.tracks) for obj in self.objects)
+
+    def _track_subject(self, track: Track, where: str) -> SceneObject | Light:
+        """The object or light ``track.name`` names."""
+        name = track.name
+        if track.kind == "object":
+            found = [o for o in self.objects if o.label == name]
+            if not found:
+                names = ", ".join(o.label[:40] for o in self.objects[:10]) or "none"
+                raise InputError(f"no object named '{name[:80]}' (objects: {names})", where)
+            return found[0]
+        light = self.light_names.get(name)
+        if light is not None and any(held is light for held in self.lights):
+            return light
+        if name.isdigit() and int(name) < len(self.lights):
+            return self.lights[int(name)]
+        names = [n for n, held in self.light_names.items() if any(held is h for h in self.lights)]
+        have = ("no lights" if not self.lights else "light:0" if len(self.lights) == 1
+                else f"light:0 to light:{len(self.lights) - 1}")
+        if names:
+            have += ", or by name: " + ", ".join(n[:40] for n in names[:10])
+        raise InputError(f"no light '{name[:80]}' (the scene has {have})", where)
+
+    @staticmethod
+    def _check_free(track: Track, others: Sequence[Track]) -> None:
+        """No property of ``track`` is moved by another track of its target already."""
+        for other in others:
+            for prop in track.curves:
+                if prop in other.curves:
+                    raise InputError(f"{track.target}'s {prop} is moved by {other.where} "
+                                     "already (one track a property)",
+                                     join_where(track.where,
+                                                f"keys[{track.curves[prop].keys[0]}].{prop}"))
+
+    def set_turntable(self, period: float | None, start: float = 0.0) -> Turntable | None:
+        """Orbit the camera about the vertical through its target once every ``period``
+        seconds from ``start`` (over camera tracks, which move what it orbits); ``None``
+        stops it. Frames ``start + i * period / n`` for i in 0..n-1 are an n-frame loop."""
+        self.turntable = None if period is None else Turntable(period, start)
+        return self.turntable
+
+    def camera_at(self, time: float) -> Camera:
+        """The camera at ``time``: the scene's camera with the camera tracks' values at
+        ``time`` over it, orbited by the turntable; checked as a scene file's camera is
+        (``InputError`` naming the track and the time)."""
+        camera = self.camera
+        if camera is not self._camera_applied or self._camera_base is None:
+            self._camera_base = camera  # set by hand since the tracks set it: the base now
+        base = self._camera_base
+        values: dict[str, Any] = {}
+        where = "camera"
+        for track in self.tracks:
+            if track.kind == "camera":
+                values.update(track.at(time))
+                where = track.where
+        if self.turntable is not None:
+            values["position"] = self.turntable.orbit(values.get("position", base.position),
+                                                      values.get("target", base.target), time)
+            where = where if where != "camera" else "turntable"
+        if not values:
+            return base
+        moved = replace(base, **values)
+        from dataclasses import asdict
+
+        from deferred.scene.loader import CameraModel  # the scene file's checks
+
+        try:
+            validate_params(CameraModel, asdict(moved), None)
+        except InputError as exc:
+            raise InputError(f"the camera at t = {time:g} s: {exc}", where) from None
+        return moved
+
+    def light_params_at(self, light: Light, time: float) -> Any:
+        """``light``'s parameters at ``time``: its own with its tracks' values at ``time``
+        over them, validated (``InputError`` naming the track and the time)."""
+        base = self._light_base(light)
+        values: dict[str, Any] = {}
+        where = None
+        for track in self.tracks:
+            if track.subject is light:
+                values.update(track.at(time))
+                where = track.where
+        if not values:
+            return base
+        try:
+            return validate_params(type(base), {**base.model_dump(), **values}, None)
+        except InputError as exc:
+            raise InputError(f"the light at t = {time:g} s: {exc}", where) from None
+
+    def _light_base(self, light: Light) -> Any:
+        kept = self._light_bases.get(id(light))
+        if kept is None or (light.params is not kept[1] and light.params is not kept[0]):
+            kept = (light.params, None)  # set by hand since the tracks set them: the base
+            self._light_bases[id(light)] = kept
+        return kept[0]
+
+    def _apply_tracks(self, time: float) -> None:
+        """The camera's and the lights' tracks (and the turntable) at ``time``."""
+        if self.turntable is not None or any(t.kind == "camera" for t in self.tracks):
+            self.camera = self._camera_applied = self.camera_at(time)
+        lights = {id(t.subject): t.subject for t in self.tracks if t.kind == "light"}
+        for light in lights.values():
+            params = self.light_params_at(light, time)
+            self._light_bases[id(light)] = (self._light_bases[id(light)][0], params)
+            light.params = params
 
     def gbuffer_layout(self) -> GBufferLayout:
         """The G-buffer of this scene: the core plus the data its materials declare."""
@@ -381,20 +602,25 @@ class Scene:
         place = validate_params(Transform, {"position": position, "rotation": rotation,
                                             "scale": scale}, None)
         obj = SceneObject(label, mesh, material,
-                          model_matrix(place.position, place.rotation, place.scale))
+                          model_matrix(place.position, place.rotation, place.scale),
+                          transform=place)
         self.objects.append(obj)
         return obj
 
     add = add_object  # the shorter name of earlier versions
 
-    def add_light(self, type: str, **params: Any) -> Light:
+    def add_light(self, type: str, name: str | None = None, **params: Any) -> Light:
         """Add a light of a registered ``type`` (``point``, ``spot``, ``directional``,
         ``ambient``, a plugin's) with its parameters, validated as a scene file's are
-        (``InputError`` naming the light and the key). A renderer drawing the scene lights
-        with it from its next frame."""
+        (``InputError`` naming the light and the key); ``name`` lets tracks say
+        ``light:NAME``. A renderer drawing the scene lights with it from its next frame."""
+        if name is not None:
+            check_light_name(name, self.light_names, "name")
         light = registry.lights.get(type, "type").from_dict(
             params, f"light[{len(self.lights)}] ({type})")
         self.lights.append(light)
+        if name is not None:
+            self.light_names[name] = light
         return light
 
     def remove(self, item: SceneObject | Light | Effect | str) -> None:
@@ -411,8 +637,23 @@ class Scene:
             for index, held in enumerate(collection):
                 if held is item:
                     del collection[index]
+                    if isinstance(item, Light):  # its tracks and name go with it
+                        self.tracks = [t for t in self.tracks if t.subject is not item]
+                        self.light_names = {n: light for n, light in self.light_names.items()
+                                            if light is not item}
                     return
         raise InputError(f"the scene holds no {type(item).__name__} {item!r:.80}", "item")
+
+
+def check_light_name(name: Any, taken: Mapping[str, Any], where: str) -> None:
+    """A light's name: printable text, not a number (``light:0`` is the first light's
+    index), not taken."""
+    if not isinstance(name, str) or not name or name.isdigit() or \
+            any(ord(c) < 32 or ord(c) == 127 for c in name) or len(name) > 1000:
+        raise InputError(f"a light's name is printable text and not a number (light:0 is the "
+                         f"first light), got {name!r:.80}", where)
+    if name in taken:
+        raise InputError(f"a light is named '{name[:80]}' already", where)
 
 
 def unique_label(taken: set[str], mesh_name: str, next_index: dict[str, int] | None = None

@@ -4,7 +4,8 @@ descriptions and checks as a scene is written. ``deferred schema`` writes it.
 It is built from the scene model (:class:`~deferred.scene.loader.SceneModel`) and the registries
 (plugins included): each ``[[object]]``'s ``material`` selects its ``params`` model, each
 ``[[light]]``'s and ``[[effect]]``'s ``type`` its parameters, through ``if``/``then`` on a
-``const`` (an editor's message names the one type that failed, not every alternative). Keys the
+``const`` (an editor's message names the one type that failed, not every alternative); each
+``[[track]]``'s ``target`` (camera, ``object:``, ``light:``) its keys' properties. Keys the
 loader refuses are refused here too (``additionalProperties: false``). The loader stays the
 authority: what a schema cannot say (a file that must exist, checks across keys, an event's
 parameters, which depend on its object's material) it checks when the scene loads.
@@ -23,6 +24,7 @@ from pydantic.json_schema import GenerateJsonSchema, models_json_schema
 
 from deferred.interfaces import registry
 from deferred.scene.loader import ObjectModel, SceneModel
+from deferred.scene.tracks import KEY_MODELS
 
 DRAFT = "http://json-schema.org/draft-07/schema#"
 DEFAULT_MATERIAL = ObjectModel.model_fields["material"].default
@@ -41,7 +43,7 @@ def scene_schema() -> dict[str, Any]:
     effect."""
     kinds = {"material": registry.materials.items(), "light": registry.lights.items(),
              "effect": registry.effects.items()}
-    models: list[type[BaseModel]] = [SceneModel]
+    models: list[type[BaseModel]] = [SceneModel, *KEY_MODELS.values()]
     for types in kinds.values():
         for _, cls in types:
             if cls.Params not in models:
@@ -82,6 +84,10 @@ def scene_schema() -> dict[str, Any]:
         for name, cls in kinds[kind]:
             params = copy.deepcopy(definition(cls.Params))
             params["properties"] = {"type": {"const": name}, **params.get("properties", {})}
+            if kind == "light":  # what tracks may call it (light:NAME)
+                params["properties"]["name"] = {
+                    "type": "string", "minLength": 1, "pattern": "^.*[^0-9].*$",
+                    "description": "a name for tracks (target = 'light:NAME'); not a number"}
             params["required"] = ["type", *params.get("required", [])]
             params["additionalProperties"] = False
             definitions[f"{kind}.{name}"] = params
@@ -104,6 +110,15 @@ def scene_schema() -> dict[str, Any]:
     events["properties"]["params"] = {
         "type": "object",
         "description": "parameters of the object's material, merged over the object's"}
+    # [[track]]: the target's form, and its kind's key properties
+    tracks = definitions[properties["track"]["items"]["$ref"].rsplit("/", 1)[1]]
+    tracks["properties"]["target"]["pattern"] = "^(camera|object:.+|light:.+)$"
+    tracks["properties"]["keys"]["items"] = {"type": "object", "required": ["time"]}
+    tracks["allOf"] = [
+        {"if": {"properties": {"target": {"pattern": pattern}}, "required": ["target"]},
+         "then": {"properties": {"keys": {"items": {"$ref": ref(KEY_MODELS[kind])}}}}}
+        for kind, pattern in (("camera", "^camera$"), ("object", "^object:"),
+                              ("light", "^light:"))]
     schema = {"$schema": DRAFT, "title": "deferred scene file",
               "description": "A scene for deferred (TOML); written by `deferred schema` for the "
                              "materials, lights and effects registered where it ran.",
