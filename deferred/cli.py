@@ -95,6 +95,10 @@ def cli(debug: bool) -> None:
               show_default=True, metavar="SECONDS",
               help="Time of the first frame (the scene's [[event]] timeline, animated "
                    "materials).")
+@click.option("--turntable", type=click.IntRange(min=1, max=100_000), metavar="N",
+              help="Orbit the camera once about the vertical through its target over N frames "
+                   "(the times --frames N gives; frame N would be frame 0 again), to a # "
+                   "pattern or a video.")
 @click.option("--light-path", type=LIGHT_PATH_CHOICE, help=LIGHT_PATH_HELP)
 @click.option("--strict", is_flag=True,
               help="Fail on a uniform set by name that its program does not declare.")
@@ -104,8 +108,8 @@ def cli(debug: bool) -> None:
                    "PASS:TARGET) or a material's debug view (MATERIAL.VIEW, e.g. "
                    "revie_fur.samples). '--view help' lists them.")
 def render(scene: str | None, output: str, pipeline: str, size: str | None, frames: int,
-           fps: float, start_time: float, light_path: str | None, strict: bool,
-           view_name: str | None) -> None:
+           fps: float, start_time: float, turntable: int | None, light_path: str | None,
+           strict: bool, view_name: str | None) -> None:
     """Render SCENE (a TOML file; the built-in demo when omitted) to an image, a numbered
     image sequence or a video."""
     from deferred.debug.capture import capture_frame
@@ -136,6 +140,16 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
         return
     out = check_output_path(output)
     kind = output_kind(out)
+    if turntable is not None:
+        source = click.get_current_context().get_parameter_source("frames")
+        if source != click.core.ParameterSource.DEFAULT and frames != turntable:
+            raise InputError(f"--turntable {turntable} renders {turntable} frames; leave "
+                             "--frames out", "--frames")
+        if kind == "image":
+            raise InputError(f"a turntable is {turntable} frames and {out.name} holds one "
+                             f"image: use a # pattern such as {out.stem}_####{out.suffix}, or "
+                             ".mp4/.gif", "--turntable")
+        frames = turntable
     times = frame_times(frames, fps, start_time)
     if view_name is not None and kind != "image":
         raise InputError("writes one buffer to one .png or .exr image, not to a frame "
@@ -151,6 +165,8 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
     with Progress("render", stderr) as progress:
         progress.status(f"loading {scene or 'the demo scene'} (meshes, UV unwraps)")
         loaded = _scene(scene)
+        if turntable is not None:
+            loaded.set_turntable(turntable / fps, start_time)
         _check_not_inputs(_render_outputs(out, kind, frames), loaded, scene, "-o")
         size_override = _size_option(size)
         if kind == "video":
