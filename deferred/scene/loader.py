@@ -31,6 +31,7 @@ from deferred.names import LightPath
 from deferred.scene.camera import Camera, model_matrix
 from deferred.scene.meshes import load_mesh
 from deferred.scene.model import (
+    CameraModel,
     Scene,
     SceneObject,
     Transform,
@@ -54,7 +55,6 @@ else:  # pragma: no cover
 
 Vec3 = tuple[float, float, float]
 MIN_SCALE = 1e-6  # an object smaller is a mistake of units; 1/scale must fit float32
-MAX_DEPTH_RANGE = 1e7  # far / near
 DEMO_SCENE = "demo.toml"
 T = TypeVar("T")
 M = TypeVar("M", bound=BaseModel)
@@ -62,33 +62,6 @@ M = TypeVar("M", bound=BaseModel)
 
 class _Strict(StrictValues):
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
-
-
-class CameraModel(_Strict):
-    position: Vec3 = (0.0, 1.0, 4.0)
-    target: Vec3 = (0.0, 0.5, 0.0)
-    up: Vec3 = (0.0, 1.0, 0.0)
-    fov: float = Field(45.0, gt=1.0, lt=179.0, description="vertical field of view, degrees")
-    near: float = Field(0.05, gt=0.0)
-    far: float = Field(100.0, gt=0.0)
-
-    @model_validator(mode="after")
-    def _check(self) -> CameraModel:
-        if self.far <= self.near:
-            raise ValueError("far must be greater than near")
-        if self.far / self.near > MAX_DEPTH_RANGE:
-            # measured: at 1e8 the deferred pipeline's depth reconstruction loses the scene
-            raise ValueError(f"far / near is {self.far / self.near:.3g}; at most "
-                             f"{MAX_DEPTH_RANGE:g} (the depth buffer's precision): raise near "
-                             "or lower far")
-        if np.allclose(self.position, self.target):
-            raise ValueError("position and target are the same point")
-        forward = np.subtract(self.target, self.position, dtype=float)
-        side = np.cross(forward / np.linalg.norm(forward), np.asarray(self.up, dtype=float))
-        if np.linalg.norm(side) < 1e-6:
-            raise ValueError("up is parallel to the view direction (or zero); "
-                             "choose another up vector")
-        return self
 
 
 class ObjectModel(_Strict):
@@ -385,7 +358,7 @@ def _load_tracks(scene: Scene, name: str, tracks: list, labels: dict, unlabelled
                 have = f"light:0 to light:{len(file_lights) - 1}" if file_lights else "none"
                 named = f", or by name: {', '.join(sorted(light_names)[:10])}" \
                     if light_names else ""
-                problems.append(InputError(f"no light '{target[:80]}' (lights: {have}{named})",
+                problems.append(InputError(f"no light {target[:80]!r} (lights: {have}{named})",
                                            target_where))
         if subject is None:  # nothing to move: the keys are still checked
             if kind is not None:
@@ -453,7 +426,7 @@ def _no_object(label: str, labels: list[str]) -> str:
     names = ", ".join(name[:40] for name in labels[:10]) or "none"
     if len(labels) > 10:
         names += f", ... ({len(labels)} in all)"
-    return f"no object named '{label[:80]}' ({hint}objects: {names})"
+    return f"no object named {label[:80]!r} ({hint}objects: {names})"
 
 
 def _file_order(where: str | None, name: str, order: dict[str, int]) -> tuple[int, int]:

@@ -19,13 +19,13 @@ import re
 from bisect import bisect_right
 from collections import Counter
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
 import numpy as np
-from pydantic import ConfigDict, field_validator
+from pydantic import ConfigDict, Field, field_validator, model_validator
 
 from deferred.core.passes import Phase
 from deferred.errors import InputError
@@ -44,6 +44,7 @@ from deferred.validation import StrictValues, join_where
 
 Vec3 = tuple[float, float, float]
 MAX_SIZE = 16384
+MAX_DEPTH_RANGE = 1e7  # far / near
 SIZE_TEXT = re.compile(r"([0-9]+)\s*[xX]\s*([0-9]+)")
 
 
@@ -62,6 +63,36 @@ class Transform(StrictValues):
         if np.any(np.abs(np.broadcast_to(np.asarray(scale, dtype=float), (3,))) < MIN_SCALE):
             raise ValueError(f"must be at least {MIN_SCALE:g} in size")
         return scale
+
+
+class CameraModel(StrictValues):
+    """A scene file's ``[camera]``, checked (the loader's, and every camera the tracks make)."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+    position: Vec3 = (0.0, 1.0, 4.0)
+    target: Vec3 = (0.0, 0.5, 0.0)
+    up: Vec3 = (0.0, 1.0, 0.0)
+    fov: float = Field(45.0, gt=1.0, lt=179.0, description="vertical field of view, degrees")
+    near: float = Field(0.05, gt=0.0)
+    far: float = Field(100.0, gt=0.0)
+
+    @model_validator(mode="after")
+    def _check(self) -> CameraModel:
+        if self.far <= self.near:
+            raise ValueError("far must be greater than near")
+        if self.far / self.near > MAX_DEPTH_RANGE:
+            # measured: at 1e8 the deferred pipeline's depth reconstruction loses the scene
+            raise ValueError(f"far / near is {self.far / self.near:.3g}; at most "
+                             f"{MAX_DEPTH_RANGE:g} (the depth buffer's precision): raise near "
+                             "or lower far")
+        if np.allclose(self.position, self.target):
+            raise ValueError("position and target are the same point")
+        forward = np.subtract(self.target, self.position, dtype=float)
+        side = np.cross(forward / np.linalg.norm(forward), np.asarray(self.up, dtype=float))
+        if np.linalg.norm(side) < 1e-6:
+            raise ValueError("up is parallel to the view direction (or zero); "
+                             "choose another up vector")
+        return self
 
 
 @dataclass(frozen=True)
@@ -383,7 +414,7 @@ class Scene:
                 names = ", ".join(o.label[:40] for o in self.objects[:10]) or "none"
                 if len(self.objects) > 10:
                     names += f", ... ({len(self.objects)} in all)"
-                raise InputError(f"no object named '{obj[:80]}' (objects: {names})",
+                raise InputError(f"no object named {obj[:80]!r} (objects: {names})",
                                  f"{where}.object" if where else "object")
             obj = found[0]
         return obj.add_event(time, params, where)
@@ -457,7 +488,7 @@ class Scene:
             found = [o for o in self.objects if o.label == name]
             if not found:
                 names = ", ".join(o.label[:40] for o in self.objects[:10]) or "none"
-                raise InputError(f"no object named '{name[:80]}' (objects: {names})", where)
+                raise InputError(f"no object named {name[:80]!r} (objects: {names})", where)
             return found[0]
         light = self.light_names.get(name)
         if light is not None and any(held is light for held in self.lights):
@@ -469,7 +500,7 @@ class Scene:
                 else f"light:0 to light:{len(self.lights) - 1}")
         if names:
             have += ", or by name: " + ", ".join(n[:40] for n in names[:10])
-        raise InputError(f"no light '{name[:80]}' (the scene has {have})", where)
+        raise InputError(f"no light {name[:80]!r} (the scene has {have})", where)
 
     @staticmethod
     def _check_free(track: Track, others: Sequence[Track]) -> None:
@@ -510,10 +541,6 @@ class Scene:
         if not values:
             return base
         moved = replace(base, **values)
-        from dataclasses import asdict
-
-        from deferred.scene.loader import CameraModel  # the scene file's checks
-
         try:
             validate_params(CameraModel, asdict(moved), None)
         except InputError as exc:
@@ -631,7 +658,7 @@ class Scene:
             found = [o for o in self.objects if o.label == item]
             if not found:
                 names = ", ".join(o.label for o in self.objects[:10]) or "none"
-                raise InputError(f"no object named '{item[:80]}' (objects: {names})", "item")
+                raise InputError(f"no object named {item[:80]!r} (objects: {names})", "item")
             item = found[0]
         for collection in (self.objects, self.lights, self.effects):
             for index, held in enumerate(collection):
