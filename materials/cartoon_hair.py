@@ -133,8 +133,8 @@ class HairState:
             anchor_stiffness=params.anchor_stiffness, anchor_curve=params.anchor_curve,
             gravity=params.gravity, wind=params.wind, time_step=params.time_step)
         self.simulation = HairSimulation(rest, physics, material.spheres(obj), keyframes,
-                                         params.key_times or None, obj.model)
-        self.inverse_model = np.linalg.inv(obj.model)
+                                         params.key_times or None, self.model_at(0.0))
+        self.inverse_model = np.linalg.inv(self.model_at(0.0))
         tubes = self._tubes()
         self.mesh = MeshData("cartoon_hair tubes", tubes[0], tubes[1],
                              *self._constant_attributes(tubes[2]), tubes[3])
@@ -142,6 +142,12 @@ class HairState:
         self.ctx = ctx
         self._silhouettes: SilhouetteGeometry | None = None
         self.time: float | None = None
+
+    def model_at(self, time: float) -> np.ndarray:
+        """The object's model matrix at ``time``: its tracks' (SceneObject.model_at), else
+        its model."""
+        model_at = getattr(self.obj, "model_at", None)
+        return model_at(time) if model_at is not None else self.obj.model
 
     @property
     def silhouettes(self) -> SilhouetteGeometry:
@@ -178,8 +184,9 @@ class HairState:
         time), the tubes rebuilt and uploaded."""
         if self.time == time:
             return
-        model = self.obj.model
-        self.simulation.advance(time, lambda _: model)
+        # the roots follow the object's transform at each step (its tracks move it)
+        self.simulation.advance(time, self.model_at)
+        self.inverse_model = np.linalg.inv(self.model_at(time))
         positions, normals, _, _ = self._tubes()
         self.mesh.positions, self.mesh.normals = positions, normals
         self.gpu.vbo.write(self.mesh.interleaved().tobytes())

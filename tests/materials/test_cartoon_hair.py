@@ -101,3 +101,25 @@ def test_bad_parameters_are_one_line_errors(tmp_path, capsys, params, message):
     err = capsys.readouterr().err
     assert code == 2 and len(err.strip().splitlines()) == 1 and message in err, err
     assert not (tmp_path / "out.png").exists()
+
+
+def test_the_hair_follows_the_head_along_its_track(gl):
+    """The strands' roots are pinned to the object's transform at each step (its tracks move
+    it): a head moved to the right by a track carries its hair with it."""
+    scene = head_scene({"edge_stiffness": 1.0, "bend_stiffness": 1.0, "torsion_stiffness": 1.0})
+    scene.add_track(scene.objects[0], [{"time": 0.0, "position": [0.0, 0.0, 0.0]},
+                                       {"time": 0.5, "position": [0.08, 0.0, 0.0]}])
+    hair_x, head_x = [], []
+    for time in (0.0, 1.0):
+        _, targets = capture(gl, scene, time=time)
+        ids = targets["strand_id"][..., 0]
+        covered = targets["linear_depth"][..., 0] > 0.0
+        hair_x.append(np.nonzero(ids > 0.5)[1].mean())
+        # the head's own pixels, in the rows under the hair (its face and chin)
+        head = covered & (ids < 0.5)
+        head[:64] = False
+        head_x.append(np.nonzero(head)[1].mean())
+    head_shift, hair_shift = head_x[1] - head_x[0], hair_x[1] - hair_x[0]
+    assert head_shift > 15.0  # the track moved the head right
+    # the hair went with it (less where strands swing out of the frame's right edge)
+    assert 0.4 * head_shift < hair_shift < 1.3 * head_shift
