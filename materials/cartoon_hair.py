@@ -35,6 +35,8 @@ import numpy as np
 from pydantic import Field, model_validator
 
 from deferred.api import (
+    COMPOSITE,
+    DEPTH,
     BlinnPhongParams,
     ForwardLitPass,
     GBufferData,
@@ -43,6 +45,8 @@ from deferred.api import (
     InputError,
     Material,
     MeshData,
+    ObjectPass,
+    Order,
     Phase,
     builtin_head_spheres,
     materials,
@@ -53,6 +57,7 @@ from .techniques.hair_dynamics import HairPhysics, HairSimulation
 from .techniques.hair_silhouettes import SilhouetteGeometry, SilhouettePass, tube_adjacency
 from .techniques.hair_strands import grow_strands, load_strands, resample_strand, scalp_roots
 from .techniques.hair_tubes import build_tubes, tube_radii
+from .techniques.hatching import TamSettings, tam_texture, tonal_art_map
 from .techniques.xtoon import XTOON_UNIFORM_OVERRIDES, XToonParams, XToonRamp
 
 if TYPE_CHECKING:
@@ -106,6 +111,15 @@ class CartoonHairParams(BlinnPhongParams, XToonParams):
     stroke_fade: Vec3 = Field((-1.0, 2.0, 0.0),
                               description="stroke alpha along the strand (0 root, 1 tip): "
                                           "a x^2 + b x + c, clamped to [0, 1]")
+
+    # hatching (4.3.8)
+    hatching: Literal["none", "surface", "screen"] = Field(
+        "none", description="tonal-art-map strokes darkening the hair by its lit tone: along "
+                            "the tubes (Praun, Fig. 4.20b) or over the screen (Lake, 4.20a)")
+    hatching_strength: float = Field(0.8, ge=0.0, le=1.0, description="ink at full tone")
+    hatching_scale: float = Field(3.0, gt=0.0, le=64.0,
+                                  description="surface hatching: the map's repeats along a "
+                                              "strand (screen hatching: a map texel a pixel)")
 
     @model_validator(mode="after")
     def _keys(self) -> CartoonHairParams:
@@ -229,6 +243,40 @@ class HairInputs:
         self.state(frame).gpu.render(program)
 
 
+class HairHatchingPass(HairInputs, ObjectPass):
+    """The tubes again, their lit tone's hatching multiplied over the lit hair (4.3.8): the
+    lighting evaluated here (every light of the frame, as the forward pipeline does), the ink
+    from the tonal art map (:mod:`.techniques.hatching`, made once and cached on disk)."""
+
+    fragment = "materials/cartoon_hair/hatching.frag"
+    colors = (COMPOSITE,)
+    depth = DEPTH
+    depth_func = "lequal"
+    depth_write = False
+    blend = "multiply"
+    order = Order.OPAQUE  # the material's own pixels, before its strokes
+
+    def uniforms(self, frame: Frame) -> dict[str, Any]:
+        params = self.obj.material.params
+        tam = hatching_map()
+        return {**super().uniforms(frame), "u_tam_tones": tam.tones,
+                "u_tam_gutter": tam.gutter, "u_hatching_strength": params.hatching_strength,
+                # screen hatching keeps the map's strokes at their width in pixels
+                "u_hatching_scale": 1.0 if params.hatching == "screen" else params.hatching_scale,
+                "u_hatching_screen": params.hatching == "screen"}
+
+    def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
+        texture = frame.resources.cached("cartoon_hair_tam",
+                                         lambda ctx: tam_texture(ctx, hatching_map()))
+        return {**super().textures(frame), "u_tam": texture}
+
+
+def hatching_map():
+    """The hatching's tonal art map: the thesis' 6 tones x 3 mips of 78 strokes at 256^2
+    (cached on disk by :func:`.techniques.hatching.tonal_art_map`)."""
+    return tonal_art_map(TamSettings(size=256, tones=6, mips=3, strokes=78, candidates=10))
+
+
 class HairGBufferPass(HairInputs, GBufferPass):
     """The tubes into the G-buffer."""
 
@@ -273,7 +321,8 @@ class CartoonHairMaterial(Material):
             "seed", "edge_stiffness", "bend_stiffness", "torsion_stiffness",
             "anchor_stiffness", "anchor_curve", "keyframes", "key_times", "gravity", "wind",
             "time_step", "collision_spheres", "hair_samples", "sides", "radius", "taper",
-            "silhouettes", "stroke_width", "stroke_color", "stroke_fade")},
+            "silhouettes", "stroke_width", "stroke_color", "stroke_fade", "hatching",
+            "hatching_strength", "hatching_scale")},
         "color": lambda value: {},  # the head's pass takes skin_color, the hair's color
     }
     # read once, at t = 0: the strands, their simulation and the tubes' topology
@@ -337,15 +386,20 @@ class CartoonHairMaterial(Material):
                 HairGBufferPass(f"{obj.label}.hair", Phase.GEOMETRY, obj)]
 
     def material_passes(self, obj: SceneObject) -> list:
-        if not self.params.silhouettes:
-            return [*super().material_passes(obj)]
-        return [*super().material_passes(obj),
-                HairSilhouettePass(f"{obj.label}.silhouettes", Phase.MATERIAL, obj,
-                                   id_buffer=True)]
+        passes = [*super().material_passes(obj)]
+        if self.params.hatching != "none":
+            passes.append(HairHatchingPass(f"{obj.label}.hatching", Phase.MATERIAL, obj))
+        if self.params.silhouettes:
+            passes.append(HairSilhouettePass(f"{obj.label}.silhouettes", Phase.MATERIAL, obj,
+                                             id_buffer=True))
+        return passes
 
     def forward_passes(self, obj: SceneObject) -> list:
         passes = [*super().forward_passes(obj),
                   HairForwardPass(f"{obj.label}.hair", Phase.FORWARD, obj)]
+        if self.params.hatching != "none":  # blended after the opaque lit passes
+            passes.append(HairHatchingPass(f"{obj.label}.forward_hatching", Phase.FORWARD, obj,
+                                           order=Order.VOLUME))
         if self.params.silhouettes:
             passes.append(HairSilhouettePass(f"{obj.label}.forward_silhouettes", Phase.FORWARD,
                                              obj))

@@ -123,3 +123,26 @@ def test_the_hair_follows_the_head_along_its_track(gl):
     assert head_shift > 15.0  # the track moved the head right
     # the hair went with it (less where strands swing out of the frame's right edge)
     assert 0.4 * head_shift < hair_shift < 1.3 * head_shift
+
+
+@pytest.mark.parametrize("mode", ["surface", "screen"])
+def test_hatching_inks_the_hair_by_its_lit_tone(gl, mode):
+    """Hatching (4.3.8) multiplies the lit hair by the tonal art map's ink for its tone: the
+    head is untouched, the hair only darkens, and its darker bands take more ink than its lit
+    ones; forward and deferred agree."""
+    from conftest import psnr
+
+    plain, targets = capture(gl, head_scene(size=(192, 192)))
+    hatched, _ = capture(gl, head_scene({"hatching": mode}, size=(192, 192)))
+    hair = targets["strand_id"][..., 0] > 0.5
+    base, inked = plain.hdr[..., :3], hatched.hdr[..., :3]
+    np.testing.assert_array_equal(inked[~hair], base[~hair])
+    assert np.all(inked[hair] <= base[hair] + 1e-6)
+    darkening = 1.0 - inked[hair].mean(axis=-1) / np.maximum(base[hair].mean(axis=-1), 1e-6)
+    assert (darkening > 0.05).mean() > 0.05  # strokes on the hair
+    brightness = base[hair].mean(axis=-1)
+    # the ramp's bands: its darkest against its lightest
+    dark, light = brightness <= brightness.min() + 1e-3, brightness >= brightness.max() - 1e-3
+    assert darkening[dark].mean() > 2.0 * darkening[light].mean()
+    forward, _ = capture(gl, head_scene({"hatching": mode}, size=(192, 192)), "forward")
+    assert psnr(hatched.hdr[..., :3], forward.hdr[..., :3]) > 30.0
