@@ -2,8 +2,9 @@
 4.7-4.10 (the 1D ramp, back lighting, the Blinn band, the ramp's specular) and the depth
 metric, the outline steps of Fig. 4.11 (edges, then dilated), Fig. 4.12's comparison (a Sobel of
 the lit image against the deferred G-buffer's edges, where the thesis re-rendered the scene
-solid shaded) and the result of Fig. 4.13, and the tonal art map's tones and tiling of Figs.
-4.21-4.22. Run from the repository root: python examples/cartoon_hair/figures.py
+solid shaded) and the result of Fig. 4.13, the hatching of Fig. 4.20 (screen and surface), and
+the tonal art map's tones and tiling of Figs. 4.21-4.22. Run from the repository root:
+python examples/cartoon_hair/figures.py
 """
 
 from __future__ import annotations
@@ -112,7 +113,13 @@ def outline_figures() -> None:
 
 
 def hatching_figures() -> None:
-    """Figs. 4.21-4.22: the tones of a tonal art map, and one tone tiled 2 x 2."""
+    """Fig. 4.20: the hair hatched over the screen (a, Lake) and along its tubes (b, Praun);
+    Figs. 4.21-4.22: the tones of a tonal art map, and one tone tiled 2 x 2."""
+    screen, _ = render(head({"hatching": "screen"}))
+    surface, _ = render(head({"hatching": "surface"}))
+    write_image(FIGURES / "fig4_20_hatching_screen_and_surface.png",
+                row(labelled(screen, "4.20a screen hatching"),
+                    labelled(surface, "4.20b surface hatching")))
     tam = tonal_art_map(TamSettings(size=256, tones=6, mips=3, strokes=78, candidates=10))
     ink = tam.levels[0]  # (tones, size, size) uint8 ink
     paper = 255 - ink
