@@ -15,5 +15,6 @@ python examples/shell_fur/figures.py
 # and the tonal art map (4.21-4.22) in docs/figures/cartoon_hair/
 python examples/cartoon_hair/figures.py
 deferred render examples/cartoon_hair/spiky_head.toml -o docs/figures/cartoon_hair_spiky.png
+deferred render examples/cartoon_hair/silhouettes.toml -o docs/figures/cartoon_hair_silhouettes.png
 deferred render examples/cartoon_hair/moving_head.toml --frames 48 --fps 24 \
     -o docs/figures/cartoon_hair_moving.gif

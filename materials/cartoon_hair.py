@@ -156,6 +156,12 @@ class HairState:
         self.ctx = ctx
         self._silhouettes: SilhouetteGeometry | None = None
         self.time: float | None = None
+        self._placed = self._placement()
+
+    def _placement(self) -> tuple:
+        """What the object's motion is made of: its tracks and its placement at t = 0."""
+        return (tuple(map(id, getattr(self.obj, "tracks", ()))),
+                self.model_at(0.0).tobytes())
 
     def model_at(self, time: float) -> np.ndarray:
         """The object's model matrix at ``time``: its tracks' (SceneObject.model_at), else
@@ -196,11 +202,16 @@ class HairState:
     def advance(self, time: float) -> None:
         """The hair at ``time`` (seconds): stepped from where it is (or from 0, for an earlier
         time), the tubes rebuilt and uploaded."""
+        placement = self._placement()
+        if placement != self._placed:  # new tracks or a new model: the motion starts over
+            self.simulation.reset(self.model_at(0.0))
+            self._placed, self.time = placement, None
         if self.time == time:
             return
-        # the roots follow the object's transform at each step (its tracks move it)
+        # the roots follow the object's transform at each step (its tracks move it); the
+        # tubes go back to object space through the transform at the simulated step
         self.simulation.advance(time, self.model_at)
-        self.inverse_model = np.linalg.inv(self.model_at(time))
+        self.inverse_model = np.linalg.inv(self.model_at(self.simulation.time))
         positions, normals, _, _ = self._tubes()
         self.mesh.positions, self.mesh.normals = positions, normals
         self.gpu.vbo.write(self.mesh.interleaved().tobytes())
@@ -326,9 +337,13 @@ class CartoonHairMaterial(Material):
         "color": lambda value: {},  # the head's pass takes skin_color, the hair's color
     }
     # read once, at t = 0: the strands, their simulation and the tubes' topology
+    # (and the simulation's and tubes' parameters: a timeline changing them part way would
+    # make a frame depend on the frames before it)
     timeline_fixed = ("strands_file", "strands", "length", "segments", "style", "parting",
                       "seed", "keyframes", "key_times", "hair_samples", "sides",
-                      "collision_spheres", "time_step")
+                      "collision_spheres", "time_step", "edge_stiffness", "bend_stiffness",
+                      "torsion_stiffness", "anchor_stiffness", "anchor_curve", "gravity",
+                      "wind", "radius", "taper")
 
     def check_files(self, where: str | None) -> None:
         super().check_files(where)

@@ -31,7 +31,7 @@ from types import MappingProxyType
 from typing import Any
 
 import numpy as np
-from pydantic import ConfigDict, Field, ValidationError
+from pydantic import ConfigDict, Field, ValidationError, field_validator
 
 from deferred.errors import InputError, input_error
 from deferred.validation import (
@@ -79,6 +79,13 @@ class ObjectKey(_Key):
     position: Vec3 | None = None
     rotation: Vec3 | None = Field(None, description="degrees, applied X, then Y, then Z")
     scale: float | Vec3 | None = None
+
+    @field_validator("scale")
+    @classmethod
+    def _scale(cls, scale: float | Vec3 | None) -> float | Vec3 | None:
+        if scale is not None and np.any(np.abs(np.asarray(scale, dtype=float)) < MIN_SCALE):
+            raise ValueError(f"must be at least {MIN_SCALE:g} in size")
+        return scale
 
 
 KEY_MODELS: dict[str, type[_Key]] = {"camera": CameraKey, "light": LightKey,
@@ -289,6 +296,12 @@ def make_track(target: str, keys: Any, interpolation: Any = "linear",
 def _check_range(kind: str, prop: str, curve: Curve, where: str) -> None:
     """The curve stays in the property's range between its keys (a smooth one may not)."""
     if kind == "object" and prop == "scale":
+        if curve.interpolation == "step":  # held key by key: each key's own value counts
+            for k, value in enumerate(curve.values):
+                if np.any(np.abs(value) < MIN_SCALE):
+                    raise InputError(f"a scale must be at least {MIN_SCALE:g} in size",
+                                     join_where(where, f"keys[{curve.keys[k]}].scale"))
+            return
         for k, low, high in curve.segment_extremes():
             if np.any((low < MIN_SCALE) & (high > -MIN_SCALE)):
                 first, last = curve.keys[k], curve.keys[k + 1]

@@ -355,3 +355,19 @@ def test_the_schema_accepts_tracks_and_refuses_a_typo():
         with pytest.raises(InputError):  # the loader refuses it too
             from deferred.scene.loader import scene_from_dict
             scene_from_dict(bad, "s.toml")
+
+
+def test_scales_are_checked_key_by_key():
+    """A single key's scale of 0 is refused (it rendered a singular matrix); a step track may
+    flip the sign at a key, which a linear one may not pass through."""
+    from deferred import InputError, Scene
+
+    scene = Scene()
+    ball = scene.add_object("builtin:sphere", label="ball")
+    with pytest.raises(InputError, match="scale: must be at least 1e-06"):
+        scene.add_track(ball, [{"time": 0.0, "scale": 0.0}])
+    scene.add_track(ball, [{"time": 0.0, "scale": 1.0}, {"time": 1.0, "scale": -1.0}],
+                    interpolation="step")
+    other = scene.add_object("builtin:sphere", label="other")
+    with pytest.raises(InputError, match="passes through 0"):
+        scene.add_track(other, [{"time": 0.0, "scale": 1.0}, {"time": 1.0, "scale": -1.0}])

@@ -146,3 +146,18 @@ def test_hatching_inks_the_hair_by_its_lit_tone(gl, mode):
     assert darkening[dark].mean() > 2.0 * darkening[light].mean()
     forward, _ = capture(gl, head_scene({"hatching": mode}, size=(192, 192)), "forward")
     assert psnr(hatched.hdr[..., :3], forward.hdr[..., :3]) > 30.0
+
+
+def test_the_hair_starts_over_when_its_head_gets_a_track(gl):
+    """A track added after some frames changes the head's whole motion: the hair is simulated
+    again from t = 0 and draws what a fresh renderer draws (its roots jumped in one step), at
+    a frame time between simulation steps too."""
+    scene = head_scene({"bend_stiffness": 0.5, "torsion_stiffness": 0.5})
+    with Renderer(scene, gl=gl) as renderer:
+        renderer.render(time=0.5)
+        scene.add_track(scene.objects[0], [{"time": 0.0, "rotation": [0.0, 0.0, 0.0]},
+                                           {"time": 0.5, "rotation": [0.0, 40.0, 0.0]}],
+                        interpolation="smooth")
+        late = renderer.render(time=0.55).image
+    with Renderer(scene, gl=gl) as fresh:
+        np.testing.assert_array_equal(late, fresh.render(time=0.55).image)
