@@ -506,6 +506,7 @@ class Renderer:
         events are the same: a frame at such a time checks nothing again."""
         if not times:
             return
+        self.scene.check_tracks(times)  # every frame's camera and lights, not just the last
         latest = max(times)
         objects = self.scene.objects
         checking = {cls for cls in {type(obj.material) for obj in objects}

@@ -571,6 +571,21 @@ class Scene:
             self._light_bases[id(light)] = kept
         return kept[0]
 
+    def check_tracks(self, times: Sequence[float]) -> None:
+        """The camera's and the lights' tracks at each of ``times``, checked before any frame
+        is drawn (a camera passing through its target between keys, a light's direction
+        through zero): ``InputError`` naming the track and the time."""
+        moving_camera = self.turntable is not None or \
+            any(t.kind == "camera" for t in self.tracks)
+        lights = {id(t.subject): t.subject for t in self.tracks if t.kind == "light"}
+        if not (moving_camera or lights):
+            return
+        for time in times:
+            if moving_camera:
+                self.camera_at(time)
+            for light in lights.values():
+                self.light_params_at(light, time)
+
     def _apply_tracks(self, time: float) -> None:
         """The camera's and the lights' tracks (and the turntable) at ``time``."""
         if self.turntable is not None or any(t.kind == "camera" for t in self.tracks):

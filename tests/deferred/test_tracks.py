@@ -371,3 +371,25 @@ def test_scales_are_checked_key_by_key():
     other = scene.add_object("builtin:sphere", label="other")
     with pytest.raises(InputError, match="passes through 0"):
         scene.add_track(other, [{"time": 0.0, "scale": 1.0}, {"time": 1.0, "scale": -1.0}])
+
+
+def test_a_track_bad_between_keys_is_refused_before_the_first_frame(tmp_path, capsys):
+    """A light direction turning through zero between its keys is refused before any frame of
+    the animation is written (frames 0 and 1 were written, then exit 2 at t = 0.5)."""
+    from deferred.cli import main
+
+    (tmp_path / "s.toml").write_text("""size = [32, 18]
+[[object]]
+mesh = "builtin:sphere"
+[[light]]
+type = "directional"
+direction = [1.0, 0.0, 0.0]
+[[track]]
+target = "light:0"
+keys = [{ time = 0.0, direction = [1.0, 0.0, 0.0] }, { time = 1.0, direction = [-1.0, 0.0, 0.0] }]
+""")
+    code = main(["render", str(tmp_path / "s.toml"), "--frames", "5", "--fps", "4",
+                 "-o", str(tmp_path / "f_##.png")])
+    err = capsys.readouterr().err
+    assert code == 2 and "the light at t = 0.5 s" in err, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]
