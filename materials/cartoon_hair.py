@@ -12,8 +12,8 @@ head) is drawn too, in ``skin_color``.
 - tubes (4.3.1-4.3.2): :mod:`.techniques.hair_tubes`, ``hair_samples`` spline samples swept by a
   ``sides``-gon tapered by the quadratic ``taper``;
 - shading (4.3.3-4.3.6): X-toon (:mod:`.techniques.xtoon`), the G-buffer datum ``strand_id``
-  (0 on the head, 1 + the strand's index on the hair) lets the ``edges`` effect outline
-  strands of one colour where they overlap (4.3.7);
+  (0 on the head; on the hair 1 + the object's first id + the strand's index) lets the
+  ``edges`` effect outline strands of one colour where they overlap (4.3.7);
 - silhouette strokes (4.3.7, object space): :mod:`.techniques.hair_silhouettes` with
   ``silhouettes = true``, strokes ``stroke_width`` pixels wide in ``stroke_color`` along the
   tubes' silhouette edges, faded toward the roots by the quadratic ``stroke_fade``; drawn over
@@ -66,8 +66,11 @@ if TYPE_CHECKING:
 Vec3 = tuple[float, float, float]
 SURFACE = "materials/cartoon_hair/surface.glsl"
 STRAND_ID = GBufferData("strand_id", "R32F", ("id",),
-                        "cartoon_hair: 1 + the strand's index on hair, 0 elsewhere")
+                        "cartoon_hair: 1 + the object's first id + the strand's index on "
+                        "hair, 0 elsewhere")
 MAX_STRANDS = 20000
+STRAND_IDS = 32768  # ids a hair object's strands take (more than MAX_STRANDS)
+MAX_HAIR_OBJECTS = (1 << 24) // STRAND_IDS  # ids stay whole numbers in the R32F datum
 
 
 class CartoonHairParams(BlinnPhongParams, XToonParams):
@@ -223,6 +226,17 @@ class HairState:
         self.gpu.release()
 
 
+def strand_base(scene, obj: SceneObject) -> float:
+    """The first strand id of ``obj``'s hair: each cartoon_hair object of the scene has its own
+    range of ``STRAND_IDS`` ids, so strands of two heads are told apart too."""
+    hairs = [other for other in scene.objects if isinstance(other.material, CartoonHairMaterial)]
+    index = next((k for k, other in enumerate(hairs) if other is obj), 0)
+    if index >= MAX_HAIR_OBJECTS:
+        raise InputError(f"a scene holds at most {MAX_HAIR_OBJECTS} cartoon_hair objects (their "
+                         "strand ids share one float channel)", obj.label)
+    return float(index * STRAND_IDS)
+
+
 def hair_state(frame: Frame, obj: SceneObject) -> HairState:
     """``obj``'s hair in the frame's renderer, made the first time it is asked for."""
     return frame.resources.cached(("cartoon_hair_state", obj), lambda ctx: HairState(ctx, obj))
@@ -248,7 +262,8 @@ class HairInputs:
 
     def uniforms(self, frame: Frame) -> dict[str, Any]:
         return {**super().uniforms(frame), "u_hair": True,
-                "u_color": self.obj.material.params.color}
+                "u_color": self.obj.material.params.color,
+                "u_strand_base": strand_base(frame.scene, self.obj)}
 
     def draw(self, frame: Frame, program: moderngl.Program) -> None:
         self.state(frame).gpu.render(program)
@@ -311,6 +326,12 @@ class HairSilhouettePass(SilhouettePass):
             raise RuntimeError(f"{self.name}: drawn in a frame it was not prepared for")
         return self._prepared[1].silhouettes
 
+    def uniforms(self, frame: Frame) -> dict[str, Any]:
+        uniforms = super().uniforms(frame)
+        if self.id_buffer:  # the stroke's own strand's id in the G-buffer
+            uniforms["u_strand_base"] = strand_base(frame.scene, self.obj)
+        return uniforms
+
     def stroke_settings(self) -> dict[str, Any]:
         p = self.obj.material.params
         # a tube's own front surface lies up to its radius nearer than its silhouette
@@ -362,7 +383,7 @@ class CartoonHairMaterial(Material):
         return XToonRamp.from_params(self.params, image)
 
     def uniforms(self, frame: Frame) -> dict[str, Any]:  # the ramp's layer: the scene's
-        return {**super().uniforms(frame), "u_hair": False,
+        return {**super().uniforms(frame), "u_hair": False, "u_strand_base": 0.0,
                 "u_color": self.params.skin_color,
                 "u_ramp_row": Toon.xtoon_row(frame.scene, self.xtoon_ramp())}
 
@@ -379,7 +400,11 @@ class CartoonHairMaterial(Material):
         """The style: ``(S, P, 3)`` object-space strands, root first."""
         p = self.params
         if p.strands_file is not None:
-            return load_strands(self.resolve_path(p.strands_file), "strands_file")
+            strands = load_strands(self.resolve_path(p.strands_file), "strands_file")
+            if len(strands) >= STRAND_IDS:
+                raise InputError(f"{len(strands):,} strands; a hair object holds fewer than "
+                                 f"{STRAND_IDS:,}", "strands_file")
+            return strands
         roots = scalp_roots(obj.mesh, p.strands, p.seed)
         return grow_strands(roots, p.length, p.segments, p.style, p.seed, self.spheres(obj),
                             p.parting)

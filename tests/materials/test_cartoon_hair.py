@@ -161,3 +161,21 @@ def test_the_hair_starts_over_when_its_head_gets_a_track(gl):
         late = renderer.render(time=0.55).image
     with Renderer(scene, gl=gl) as fresh:
         np.testing.assert_array_equal(late, fresh.render(time=0.55).image)
+
+
+def test_two_heads_have_their_own_strand_ids(gl):
+    """Each hair object takes its own range of strand ids, so strands of two heads are told
+    apart (outlines, silhouette visibility): both heads share indices 1..N otherwise."""
+    scene = scene_from_dict({
+        "size": [160, 96], "camera": {"position": [0.0, 0.05, 0.8], "target": [0, 0, 0]},
+        "object": [{"name": name, "mesh": "builtin:head?segments=32&rings=24",
+                    "material": "cartoon_hair", "position": [x, 0.0, 0.0],
+                    "params": {"strands": 30}}
+                   for name, x in (("left", -0.13), ("right", 0.13))],
+        "light": [{"type": "directional"}]})
+    _, targets = capture(gl, scene)
+    ids = np.unique(targets["strand_id"][..., 0])
+    ids = ids[ids > 0.5]
+    first, second = ids[ids <= 30], ids[ids > 32768]
+    assert len(first) > 5 and len(second) > 5 and len(first) + len(second) == len(ids)
+    assert second.max() <= 32768 + 30

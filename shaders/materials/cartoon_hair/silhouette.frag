@@ -10,6 +10,7 @@ uniform vec3 u_stroke_fade;
 uniform sampler2D u_strand_id;
 uniform sampler2D u_linear_depth;
 uniform float u_stroke_tolerance;
+uniform float u_strand_base;  // the object's first strand id (cartoon_hair.strand_base)
 #endif
 
 in vec2 g_stroke_uv;
@@ -23,7 +24,7 @@ void main() {
     ivec2 pixel = ivec2(gl_FragCoord.xy);
     float id = texelFetch(u_strand_id, pixel, 0).r;
     float scene_depth = texelFetch(u_linear_depth, pixel, 0).r;  // 0: background
-    bool own = abs(id - (g_strand + 1.0)) < 0.5;
+    bool own = abs(id - (u_strand_base + g_strand + 1.0)) < 0.5;
     bool in_front = scene_depth <= 0.0 || g_view_depth - u_stroke_tolerance <= scene_depth;
     if (!own && !in_front) discard;
 #endif
