@@ -389,7 +389,7 @@ class Scene:
         of its own first (``copy.copy``: so ``obj.material`` is another object from the first
         frame on, and state a material keeps in containers is shared by the copies), so its
         events never change the other."""
-        if self.tracks or self.turntable is not None:
+        if self.tracks or self.turntable is not None or self._camera_applied is not None:
             self._apply_tracks(time)
         users: dict[int, int] | None = None
         for obj in self.objects:
@@ -433,6 +433,8 @@ class Scene:
         where = where or f"{self.source}: track[{self._track_count()}]"
         subject: SceneObject | Light | None
         if isinstance(target, SceneObject):
+            if not any(obj is target for obj in self.objects):
+                raise InputError(f"the object {target.label!r} is not in the scene", "target")
             subject, target = target, f"object:{target.label}"
         elif isinstance(target, Light):
             subject = target
@@ -590,6 +592,10 @@ class Scene:
         """The camera's and the lights' tracks (and the turntable) at ``time``."""
         if self.turntable is not None or any(t.kind == "camera" for t in self.tracks):
             self.camera = self._camera_applied = self.camera_at(time)
+        elif self._camera_applied is not None:
+            if self.camera is self._camera_applied:  # what moved it is gone: back to its base
+                self.camera = self._camera_base
+            self._camera_applied = None
         lights = {id(t.subject): t.subject for t in self.tracks if t.kind == "light"}
         for light in lights.values():
             params = self.light_params_at(light, time)

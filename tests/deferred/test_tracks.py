@@ -393,3 +393,21 @@ keys = [{ time = 0.0, direction = [1.0, 0.0, 0.0] }, { time = 1.0, direction = [
     err = capsys.readouterr().err
     assert code == 2 and "the light at t = 0.5 s" in err, err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]
+
+
+def test_the_camera_returns_to_its_base_when_what_moved_it_goes():
+    """A turntable turned off (or the last camera track removed) leaves the camera where the
+    scene has it, not at the last orbited pose; an object not in the scene takes no track."""
+    from deferred import Camera, InputError, Scene
+
+    scene = Scene(camera=Camera(position=(0.0, 1.0, 4.0), target=(0.0, 0.0, 0.0)))
+    base = scene.camera
+    scene.set_turntable(8)
+    scene.apply_timeline(0.25)
+    assert scene.camera is not base
+    scene.set_turntable(None)
+    scene.apply_timeline(0.0)
+    assert scene.camera is base
+    stranger = Scene().add_object("builtin:sphere", label="elsewhere")
+    with pytest.raises(InputError, match="^target: the object 'elsewhere' is not in the scene"):
+        scene.add_track(stranger, [{"time": 0.0, "position": [0.0, 0.0, 0.0]}])
