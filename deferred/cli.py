@@ -99,6 +99,10 @@ def cli(debug: bool) -> None:
               help="Orbit the camera once about the vertical through its target over N frames "
                    "(the times --frames N gives; frame N would be frame 0 again), to a # "
                    "pattern or a video.")
+@click.option("--samples", type=click.IntRange(min=1, max=1024), default=1, show_default=True,
+              help="Average each frame over this many renders moved by sub-pixel offsets "
+                   "(Halton 2, 3), in linear light: anti-aliasing that converges to a "
+                   "supersampled frame.")
 @click.option("--light-path", type=LIGHT_PATH_CHOICE, help=LIGHT_PATH_HELP)
 @click.option("--strict", is_flag=True,
               help="Fail on a uniform set by name that its program does not declare.")
@@ -108,8 +112,8 @@ def cli(debug: bool) -> None:
                    "PASS:TARGET) or a material's debug view (MATERIAL.VIEW, e.g. "
                    "revie_fur.samples). '--view help' lists them.")
 def render(scene: str | None, output: str, pipeline: str, size: str | None, frames: int,
-           fps: float, start_time: float, turntable: int | None, light_path: str | None,
-           strict: bool, view_name: str | None) -> None:
+           fps: float, start_time: float, turntable: int | None, samples: int,
+           light_path: str | None, strict: bool, view_name: str | None) -> None:
     """Render SCENE (a TOML file; the built-in demo when omitted) to an image, a numbered
     image sequence or a video."""
     from deferred.debug.capture import capture_frame
@@ -154,6 +158,9 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
     if view_name is not None and kind != "image":
         raise InputError("writes one buffer to one .png or .exr image, not to a frame "
                          "pattern or a video", "--view")
+    if view_name is not None and samples > 1:
+        raise InputError("--view shows one buffer of one render; --samples averages frames",
+                         "--samples")
     if view_name is not None and frames > 1:
         raise InputError("--view writes one buffer of one frame; pick the frame with --time",
                          "--frames")
@@ -185,7 +192,8 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
                 check_animation_memory(out, renderer.size, frames,
                                        renderer_bytes=renderer.memory_bytes())
             if kind != "image":
-                written, frame_ms = _render_animation(renderer, out, times, fps, progress)
+                written, frame_ms = _render_animation(renderer, out, times, fps, progress,
+                                                      samples)
             else:
                 if view_name is not None:
                     view_pass, _ = resolve_view(view_name, renderer.passes)  # bad names fail
@@ -194,6 +202,8 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
                 if view_name is not None:
                     capture = capture_frame(renderer, [view_pass] if view_pass else [],
                                             warmup=False, time=times[0])
+                elif samples > 1:
+                    result = renderer.render_samples(samples, times[0])
                 else:
                     result = renderer.render(readback=True, time=times[0])
                 renderer.gl.ctx.finish()
@@ -218,9 +228,9 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
 
 
 def _render_animation(renderer, out: Path, times: list[float], fps: float,
-                      progress: Progress) -> tuple[str, list[float]]:
-    """Every frame of ``times`` to the sequence or video ``out``: (what was written, the
-    frame times in ms)."""
+                      progress: Progress, samples: int = 1) -> tuple[str, list[float]]:
+    """Every frame of ``times`` to the sequence or video ``out``, each averaged over
+    ``samples`` sub-pixel renders: (what was written, the frame times in ms)."""
     from deferred.io.video import AnimationWriter, describe_written
 
     frame_ms = []
@@ -228,10 +238,15 @@ def _render_animation(renderer, out: Path, times: list[float], fps: float,
         progress.count(len(times), "frames", f"rendering {out.name}")
         for index, at in enumerate(times):
             start = time.perf_counter()
-            renderer.render(readback=False, time=at)
-            renderer.gl.ctx.finish()
-            frame_ms.append((time.perf_counter() - start) * 1000.0)
-            writer.write(renderer.read_hdr() if writer.wants_hdr else renderer.read_final())
+            if samples > 1:
+                averaged = renderer.render_samples(samples, at)
+                frame_ms.append((time.perf_counter() - start) * 1000.0)
+                writer.write(averaged.hdr if writer.wants_hdr else averaged.image)
+            else:
+                renderer.render(readback=False, time=at)
+                renderer.gl.ctx.finish()
+                frame_ms.append((time.perf_counter() - start) * 1000.0)
+                writer.write(renderer.read_hdr() if writer.wants_hdr else renderer.read_final())
             progress.advance(index + 1, f"rendering {out.name}")
         progress.status(f"writing {out.name}")
         written = writer.close()

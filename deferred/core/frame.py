@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import moderngl
+import numpy as np
 
 from deferred.core.protocols import BindingSource, ObjectInputs, PassLike, SceneLike
 from deferred.errors import DeferredError, InputError, RenderError, gl_error
@@ -102,7 +103,8 @@ class Frame:
                  strict: bool = False, time: float = 0.0, time_gl_calls: bool = False,
                  blackboard: Mapping[str, Any] | None = None,
                  binding_sources: Sequence[BindingSource] = (),
-                 checked_framebuffers: dict[tuple, Any] | None = None):
+                 checked_framebuffers: dict[tuple, Any] | None = None,
+                 jitter: tuple[float, float] = (0.0, 0.0)):
         self.gl = gl
         self.ctx = gl.ctx
         self.time = float(time)  # seconds: the scene's timeline is applied at this time
@@ -127,6 +129,15 @@ class Frame:
         self.view = scene.camera.view()
         self.projection = scene.camera.projection(aspect)
         self.inverse_projection = scene.camera.inverse_projection(aspect)
+        self.jitter = jitter  # pixels: the image moved by a fraction of a pixel (samples)
+        if jitter != (0.0, 0.0):
+            # clip x gains P02 z and w is -z, so NDC x moves by -P02 everywhere: a sub-pixel
+            # shift of the whole image (P12 likewise in y)
+            projection = np.array(self.projection)
+            projection[0, 2] -= 2.0 * jitter[0] / self.width
+            projection[1, 2] -= 2.0 * jitter[1] / self.height
+            self.projection = projection
+            self.inverse_projection = np.linalg.inv(projection)
         # the camera's uniforms as GL takes them: one dict for every pass of the frame
         self.camera_values = {name: gl_value(value)
                               for name, value in self.camera_uniforms().items()}

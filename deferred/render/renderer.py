@@ -23,7 +23,7 @@ from deferred.gl.shaderlib import ShaderLibrary
 from deferred.gl.target_spec import targets_bytes
 from deferred.gl.targets import COMPOSITE, FINAL, FrameTargets
 from deferred.interfaces.material import Material
-from deferred.io.images import amount, write_image
+from deferred.io.images import amount, srgb_decode, srgb_encode, write_image
 from deferred.io.memory import check_memory
 from deferred.io.safety import raise_if_stop_requested
 from deferred.lighting.buffer import LIGHT_BUFFER, LightBuffer
@@ -132,6 +132,24 @@ def held_memory(scene: Scene) -> dict[str, int]:
     for obj in scene.objects:
         held.update(obj.material.held_memory(obj))
     return held
+
+
+MAX_SAMPLES = 1024  # sub-pixel samples a frame (render_samples)
+
+
+def halton(index: int, base: int) -> float:
+    """The radical inverse of ``index`` in ``base`` (the Halton sequence's term)."""
+    result, fraction = 0.0, 1.0 / base
+    while index > 0:
+        result += fraction * (index % base)
+        index //= base
+        fraction /= base
+    return result
+
+
+def halton_offsets(count: int) -> list[tuple[float, float]]:
+    """``count`` sub-pixel offsets in [-0.5, 0.5)^2: Halton (2, 3) from index 1, centred."""
+    return [(halton(k, 2) - 0.5, halton(k, 3) - 0.5) for k in range(1, count + 1)]
 
 
 def check_scene_values(scene: Scene) -> None:
@@ -378,12 +396,13 @@ class Renderer:
     def render(self, on_pass: PassCallback | None = None,
                before_pass: PassCallback | None = None, readback: bool = True,
                time: float = 0.0, time_gl_calls: bool = False,
-               hdr: bool = False) -> RenderResult:
+               hdr: bool = False, jitter: tuple[float, float] = (0.0, 0.0)) -> RenderResult:
         """Run every pass once for the frame at ``time`` (seconds: the scene's timeline is
         applied first, and passes see it as ``frame.time``). ``on_pass``/``before_pass`` are
         called around each pass; ``readback=False`` skips reading the images back (timing
         loops); ``hdr=True`` reads the float composite now (else when ``result.hdr`` is first
-        asked for); ``time_gl_calls`` measures the CPU time of the drawing GL calls
+        asked for); ``jitter`` moves the image by a fraction of a pixel (x, y; see
+        :meth:`render_samples`); ``time_gl_calls`` measures the CPU time of the drawing GL calls
         (``RenderResult.gl_call_seconds``, for the bench: two clock reads per call).
 
         Changes to the scene since the last frame are picked up first: objects, lights and
@@ -417,7 +436,8 @@ class Renderer:
         frame = Frame(self.gl, self.shaders, self.targets, self.resources, self.scene, inputs,
                       strict=self.strict, time=time, time_gl_calls=time_gl_calls,
                       blackboard=self.blackboard, binding_sources=self.binding_sources,
-                      checked_framebuffers=self.checked_framebuffers)
+                      checked_framebuffers=self.checked_framebuffers,
+                      jitter=(float(jitter[0]), float(jitter[1])))
         shading = ShadingTextures.of(self.shading_models, frame)  # the models' samplers, if any
         if shading is not None:
             frame.binding_sources.insert(0, shading)
@@ -478,6 +498,29 @@ class Renderer:
                 result._read_hdr = self._hdr_reader(self._frame_number)
                 self._pending_hdr = weakref.ref(result)
         return result
+
+    def render_samples(self, samples: int, time: float = 0.0) -> RenderResult:
+        """The frame at ``time`` averaged over ``samples`` renders, each moved by a sub-pixel
+        offset of the Halton (2, 3) sequence: the image averaged in linear light (its sRGB
+        decoded, then encoded again) and the float composite averaged, converging to a
+        supersampled frame (a box filter over the pixel). One sample is :meth:`render`."""
+        if isinstance(samples, bool) or not isinstance(samples, numbers.Integral) or \
+                not 1 <= samples <= MAX_SAMPLES:
+            raise InputError(f"must be a whole number 1..{MAX_SAMPLES}, got {samples!r}",
+                             "samples")
+        if samples == 1:
+            return self.render(time=time, hdr=True)
+        light = composite = None
+        for jitter in halton_offsets(samples):
+            result = self.render(time=time, hdr=True, jitter=jitter)
+            decoded = srgb_decode(result.image.astype(np.float64) / 255.0)
+            light = decoded if light is None else light + decoded
+            composite = result.hdr.astype(np.float64) if composite is None \
+                else composite + result.hdr
+        image = np.clip(np.rint(srgb_encode(light / samples) * 255.0), 0, 255).astype(np.uint8)
+        return RenderResult(image, result.draw_calls * samples,
+                            {name: count * samples for name, count in result.draws_by_pass.items()},
+                            _hdr=(composite / samples).astype(np.float32))
 
     def _keep_pending_hdr(self) -> None:
         """Read the last frame's HDR composite into its result before the targets are drawn
