@@ -242,9 +242,10 @@ def hair_state(frame: Frame, obj: SceneObject) -> HairState:
     return frame.resources.cached(("cartoon_hair_state", obj), lambda ctx: HairState(ctx, obj))
 
 
-class HairInputs:
-    """The hair passes: ``prepare`` brings the object's hair to the frame's time (every pass is
-    prepared before any draws); the pass draws the tubes instead of the object's mesh."""
+class PreparedHair:
+    """A pass of an object's hair: ``prepare`` brings the hair to the frame's time (every pass
+    is prepared before any draws, so all of them see the same hair) and :meth:`state` gives it
+    to the pass's hooks."""
 
     obj: SceneObject
     name: str
@@ -259,6 +260,10 @@ class HairInputs:
         if self._prepared is None or self._prepared[0]() is not frame:
             raise RuntimeError(f"{self.name}: drawn in a frame it was not prepared for")
         return self._prepared[1]
+
+
+class HairInputs(PreparedHair):
+    """The hair's surface passes: they draw the tubes instead of the object's mesh."""
 
     def uniforms(self, frame: Frame) -> dict[str, Any]:
         return {**super().uniforms(frame), "u_hair": True,
@@ -311,20 +316,11 @@ class HairForwardPass(HairInputs, ForwardLitPass):
     """The tubes lit in the forward pipeline."""
 
 
-class HairSilhouettePass(SilhouettePass):
+class HairSilhouettePass(PreparedHair, SilhouettePass):
     """The tubes' silhouette strokes over the lit image."""
 
-    _prepared: tuple[weakref.ref, HairState] | None = None
-
-    def prepare(self, frame: Frame) -> None:
-        state = hair_state(frame, self.obj)
-        state.advance(frame.time)
-        self._prepared = (weakref.ref(frame), state)
-
     def silhouette_geometry(self, frame: Frame) -> SilhouetteGeometry:
-        if self._prepared is None or self._prepared[0]() is not frame:
-            raise RuntimeError(f"{self.name}: drawn in a frame it was not prepared for")
-        return self._prepared[1].silhouettes
+        return self.state(frame).silhouettes
 
     def uniforms(self, frame: Frame) -> dict[str, Any]:
         uniforms = super().uniforms(frame)
