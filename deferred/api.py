@@ -52,7 +52,7 @@ from deferred.gbuffer import (
     NORMAL_EXPONENT_ID,
     GBufferData,
 )
-from deferred.gl.meshes import GpuMesh, MeshData
+from deferred.gl.meshes import GpuMesh, MeshData, MeshPrimitives
 from deferred.gl.resources import image_texture_bytes
 from deferred.gl.shaderlib import register_shader_root
 from deferred.gl.target_spec import TargetSpec
@@ -124,6 +124,7 @@ __all__ = [
     "BlinnPhongParams", "ClearPass", "Effect", "EffectParams", "ForwardLitPass", "Frame",
     "FullscreenPass", "GBufferData", "GBufferPass", "GpuMesh", "InputError", "Light",
     "LightParams", "LightPath", "LightVolume", "Material", "MaterialParams", "MeshData",
+    "MeshPrimitives",
     "NonZeroVec3", "ObjectPass", "Order", "Params", "Phase", "Pipeline", "Radiance",
     "RenderError", "RenderPass", "Scene", "SceneObject", "ShadingModel", "TargetSpec",
     "UniformOverrides", "builtin_head_spheres", "check_image", "copy_pass", "effects",

@@ -45,6 +45,7 @@ from deferred.api import (
     InputError,
     Material,
     MeshData,
+    MeshPrimitives,
     ObjectPass,
     Order,
     Phase,
@@ -54,7 +55,7 @@ from deferred.api import (
 
 from .shading_models import Toon
 from .techniques.hair_dynamics import HairPhysics, HairSimulation
-from .techniques.hair_silhouettes import SilhouetteGeometry, SilhouettePass, tube_adjacency
+from .techniques.hair_silhouettes import SilhouettePass, silhouette_geometry, tube_adjacency
 from .techniques.hair_strands import grow_strands, load_strands, resample_strand, scalp_roots
 from .techniques.hair_tubes import build_tubes, tube_radii
 from .techniques.hatching import TamSettings, tam_texture, tonal_art_map
@@ -157,7 +158,7 @@ class HairState:
                              *self._constant_attributes(tubes[2]), tubes[3])
         self.gpu = GpuMesh(ctx, self.mesh)
         self.ctx = ctx
-        self._silhouettes: SilhouetteGeometry | None = None
+        self._silhouettes: MeshPrimitives | None = None
         self.time: float | None = None
         self._placed = self._placement()
 
@@ -173,12 +174,13 @@ class HairState:
         return model_at(time) if model_at is not None else self.obj.model
 
     @property
-    def silhouettes(self) -> SilhouetteGeometry:
+    def silhouettes(self) -> MeshPrimitives:
         """The tubes with each triangle's neighbours (made the first time it is asked for)."""
         if self._silhouettes is None:
             p = self.params
             topology = (self.simulation.strands.shape[0], p.hair_samples, p.sides)
-            self._silhouettes = SilhouetteGeometry(self.ctx, self.gpu, tube_adjacency(*topology))
+            self._silhouettes = silhouette_geometry(self.ctx, self.gpu,
+                                                    tube_adjacency(*topology))
         return self._silhouettes
 
     def _tubes(self):
@@ -319,7 +321,7 @@ class HairForwardPass(HairInputs, ForwardLitPass):
 class HairSilhouettePass(PreparedHair, SilhouettePass):
     """The tubes' silhouette strokes over the lit image."""
 
-    def silhouette_geometry(self, frame: Frame) -> SilhouetteGeometry:
+    def silhouette_geometry(self, frame: Frame) -> MeshPrimitives:
         return self.state(frame).silhouettes
 
     def uniforms(self, frame: Frame) -> dict[str, Any]:

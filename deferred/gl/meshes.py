@@ -99,3 +99,32 @@ class GpuMesh:
         self._arrays.clear()
         self.vbo.release()
         self.ibo.release()
+
+
+class MeshPrimitives:
+    """A mesh's vertex buffer drawn through another index buffer as other primitives (lines or
+    triangles with adjacency for a geometry shader: fins, silhouette strokes); one vertex array
+    per program, released with it. The mesh's buffers stay the mesh's."""
+
+    def __init__(self, ctx: moderngl.Context, gpu_mesh: GpuMesh, indices: np.ndarray,
+                 mode: int):
+        self.ctx = ctx
+        self.gpu_mesh = gpu_mesh  # holds its MeshData: a cache key's id() stays unique
+        self.mode = mode
+        self.count = int(indices.size)
+        self.ibo = ctx.buffer(np.ascontiguousarray(indices, dtype=np.uint32).tobytes())
+        self._arrays: dict[int, moderngl.VertexArray] = {}
+
+    def render(self, program: moderngl.Program) -> None:
+        vao = self._arrays.get(program.glo)
+        if vao is None:
+            vao = self.ctx.vertex_array(program, [self.gpu_mesh.vertex_buffer(program)],
+                                        index_buffer=self.ibo, index_element_size=4)
+            self._arrays[program.glo] = vao
+        vao.render(self.mode, vertices=self.count)
+
+    def release(self) -> None:
+        for vao in self._arrays.values():
+            vao.release()
+        self._arrays.clear()
+        self.ibo.release()

@@ -11,7 +11,7 @@ from typing import Any
 import moderngl
 import numpy as np
 
-from deferred.api import DEPTH, GpuMesh, MeshData, ObjectPass, Order
+from deferred.api import DEPTH, GpuMesh, MeshData, MeshPrimitives, ObjectPass, Order
 
 from .topology import weld
 
@@ -53,29 +53,10 @@ def edge_adjacency(mesh: MeshData, tolerance: float = 1e-6) -> np.ndarray:
                     axis=1).astype(np.uint32)
 
 
-class FinGeometry:
+def fin_geometry(ctx: moderngl.Context, gpu_mesh: GpuMesh,
+                 edges: np.ndarray) -> MeshPrimitives:
     """The edges of a mesh as lines-with-adjacency over the mesh's own vertex buffer."""
-
-    def __init__(self, ctx: moderngl.Context, gpu_mesh: GpuMesh, edges: np.ndarray):
-        self.ctx = ctx
-        self.gpu_mesh = gpu_mesh  # holds its MeshData: the cache key's id() stays unique
-        self.count = int(edges.size)
-        self.ibo = ctx.buffer(np.ascontiguousarray(edges).tobytes())
-        self._arrays: dict[int, moderngl.VertexArray] = {}
-
-    def render(self, program: moderngl.Program) -> None:
-        vao = self._arrays.get(program.glo)
-        if vao is None:
-            vao = self.ctx.vertex_array(program, [self.gpu_mesh.vertex_buffer(program)],
-                                        index_buffer=self.ibo, index_element_size=4)
-            self._arrays[program.glo] = vao
-        vao.render(moderngl.LINES_ADJACENCY, vertices=self.count)
-
-    def release(self) -> None:
-        for vao in self._arrays.values():
-            vao.release()
-        self._arrays.clear()
-        self.ibo.release()
+    return MeshPrimitives(ctx, gpu_mesh, edges, moderngl.LINES_ADJACENCY)
 
 
 class FinPass(ObjectPass):
@@ -108,6 +89,6 @@ class FinPass(ObjectPass):
         mesh = self.obj.mesh
         geometry = frame.resources.cached(
             ("fins", id(mesh)),
-            lambda ctx: FinGeometry(ctx, frame.resources.gpu_mesh(mesh), edge_adjacency(mesh)))
+            lambda ctx: fin_geometry(ctx, frame.resources.gpu_mesh(mesh), edge_adjacency(mesh)))
         frame.gl_call(lambda: geometry.render(program))
         frame.count_draw()

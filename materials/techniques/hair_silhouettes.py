@@ -43,7 +43,15 @@ from typing import Any
 import moderngl
 import numpy as np
 
-from deferred.api import COMPOSITE, DEPTH, LINEAR_DEPTH, GpuMesh, ObjectPass, Order
+from deferred.api import (
+    COMPOSITE,
+    DEPTH,
+    LINEAR_DEPTH,
+    GpuMesh,
+    MeshPrimitives,
+    ObjectPass,
+    Order,
+)
 
 from .hair_tubes import tube_indices
 from .hatching import default_stroke
@@ -111,29 +119,11 @@ def stroke_texture(ctx: moderngl.Context) -> moderngl.Texture:
     return texture
 
 
-class SilhouetteGeometry:
-    """A tube mesh's triangles with their neighbours, over the mesh's own vertex buffer."""
-
-    def __init__(self, ctx: moderngl.Context, gpu_mesh: GpuMesh, adjacency: np.ndarray):
-        self.ctx = ctx
-        self.gpu_mesh = gpu_mesh
-        self.count = int(adjacency.size)
-        self.ibo = ctx.buffer(np.ascontiguousarray(adjacency, dtype=np.uint32).tobytes())
-        self._arrays: dict[int, moderngl.VertexArray] = {}
-
-    def render(self, program: moderngl.Program) -> None:
-        vao = self._arrays.get(program.glo)
-        if vao is None:
-            vao = self.ctx.vertex_array(program, [self.gpu_mesh.vertex_buffer(program)],
-                                        index_buffer=self.ibo, index_element_size=4)
-            self._arrays[program.glo] = vao
-        vao.render(moderngl.TRIANGLES_ADJACENCY, vertices=self.count)
-
-    def release(self) -> None:
-        for vao in self._arrays.values():
-            vao.release()
-        self._arrays.clear()
-        self.ibo.release()
+def silhouette_geometry(ctx: moderngl.Context, gpu_mesh: GpuMesh,
+                        adjacency: np.ndarray) -> MeshPrimitives:
+    """A tube mesh's triangles with their neighbours (:func:`tube_adjacency`), over the mesh's
+    own vertex buffer."""
+    return MeshPrimitives(ctx, gpu_mesh, adjacency, moderngl.TRIANGLES_ADJACENCY)
 
 
 class SilhouettePass(ObjectPass):
@@ -165,7 +155,7 @@ class SilhouettePass(ObjectPass):
             options.setdefault("extra_reads", (STRAND_ID, LINEAR_DEPTH))
         super().__init__(name, phase, obj, **options)
 
-    def silhouette_geometry(self, frame) -> SilhouetteGeometry:
+    def silhouette_geometry(self, frame) -> MeshPrimitives:
         """The tubes with their neighbours this frame."""
         raise NotImplementedError
 
