@@ -136,19 +136,26 @@ class SceneObject:
     # the model matrix ``transform`` is the base of, and the one the tracks set last
     _base_model: np.ndarray | None = field(default=None, init=False, repr=False)
     _applied_model: np.ndarray | None = field(default=None, init=False, repr=False)
+    # the contents of the model last seen as the base or set by the tracks (an in-place edit)
+    _model_seen: np.ndarray | None = field(default=None, init=False, repr=False)
 
     def __post_init__(self) -> None:
         if self.base_params is None:
             self.base_params = self.material.params
         self._set_events(self.events)
         self._base_model = self.model
+        self._model_seen = np.array(self.model)
 
     def _base_placement(self) -> Transform:
         """The placement the tracks animate: ``transform``, or, where ``model`` was set since
         the tracks last set it (or no placement is known), the placement of ``model``."""
         model = self.model
-        if model is not self._applied_model and model is not self._base_model:
+        # set by hand since: another array, or the tracks' or the base's array edited in place
+        kept = (model is self._applied_model or model is self._base_model) and \
+            self._model_seen is not None and np.array_equal(model, self._model_seen)
+        if not kept:
             self._base_model, self.transform = model, None
+            self._model_seen = np.array(model)
         if self.transform is None:
             position, rotation, scale = decompose(model)
             self.transform = Transform.model_construct(position=position, rotation=rotation,
@@ -170,6 +177,7 @@ class SceneObject:
         """Set ``model`` to :meth:`model_at` ``time`` (objects with tracks)."""
         if self.tracks:
             self.model = self._applied_model = self.model_at(time)
+            self._model_seen = np.array(self.model)
 
     def _set_events(self, events) -> None:
         self.events = tuple(sorted(events, key=lambda event: event.time))  # stable

@@ -411,3 +411,21 @@ def test_the_camera_returns_to_its_base_when_what_moved_it_goes():
     stranger = Scene().add_object("builtin:sphere", label="elsewhere")
     with pytest.raises(InputError, match="^target: the object 'elsewhere' is not in the scene"):
         scene.add_track(stranger, [{"time": 0.0, "position": [0.0, 0.0, 0.0]}])
+
+
+def test_a_model_edited_in_place_becomes_the_base_the_tracks_animate():
+    """Writing into obj.model (ObjectTransforms notices in-place writes too) moves the base a
+    rotation track animates, whether the array is the scene's own or the one the tracks set."""
+    from deferred import Scene
+
+    scene = Scene()
+    ball = scene.add_object("builtin:sphere", label="ball")
+    scene.add_track(ball, [{"time": 0.0, "rotation": [0.0, 0.0, 0.0]},
+                           {"time": 1.0, "rotation": [0.0, 90.0, 0.0]}])
+    scene.apply_timeline(0.5)
+    ball.model[:3, 3] = (1.0, 2.0, 3.0)  # the array the tracks set
+    scene.apply_timeline(1.0)
+    np.testing.assert_allclose(ball.model[:3, 3], (1.0, 2.0, 3.0), atol=1e-12)
+    ball.model[:3, 3] = (-1.0, 0.0, 0.5)
+    scene.apply_timeline(0.25)
+    np.testing.assert_allclose(ball.model[:3, 3], (-1.0, 0.0, 0.5), atol=1e-12)
