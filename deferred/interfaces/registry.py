@@ -168,7 +168,9 @@ class Registry(Generic[T]):
     def unknown(self, name: object) -> str:
         """The message for an unknown ``name``: the closest registered name, else them all."""
         match = closest(name, self)
-        shown = repr(name) if not isinstance(name, str) else f"'{name[:80]}'"
+        # quoted as Python would where the name holds a quote or a control character (a
+        # newline would split the one-line error)
+        shown = repr(name[:80] if isinstance(name, str) else name)
         hint = f"did you mean '{match}'? " if match is not None else ""
         return f"unknown {self.what} {shown} ({hint}choose from {', '.join(self)})"
 

@@ -58,3 +58,11 @@ def test_type_ids_are_never_reused():
     assert len(set(ids.values())) == 3
     with pytest.raises(InputError, match="unknown material 'x'"):
         registry.get("x")
+
+
+def test_an_unknown_name_with_a_newline_stays_on_one_line():
+    """A property test found a light type holding a newline split the one-line error."""
+    from deferred.interfaces import registry
+
+    message = registry.lights.unknown("la\nser")
+    assert "\n" not in message and message.startswith("unknown light 'la\\nser'")
