@@ -18,3 +18,5 @@ deferred render examples/cartoon_hair/spiky_head.toml -o docs/figures/cartoon_ha
 deferred render examples/cartoon_hair/silhouettes.toml -o docs/figures/cartoon_hair_silhouettes.png
 deferred render examples/cartoon_hair/moving_head.toml --frames 48 --fps 24 \
     -o docs/figures/cartoon_hair_moving.gif
+deferred render examples/cartoon_hair/anchored_head.toml --frames 48 --fps 24 \
+    -o docs/figures/cartoon_hair_anchored.gif

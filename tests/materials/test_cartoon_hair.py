@@ -4,6 +4,8 @@ edges effect outlines overlapping strands by (4.3.7)."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -179,3 +181,17 @@ def test_two_heads_have_their_own_strand_ids(gl):
     first, second = ids[ids <= 30], ids[ids > 32768]
     assert len(first) > 5 and len(second) > 5 and len(first) + len(second) == len(ids)
     assert second.max() <= 32768 + 30
+
+
+EXAMPLES = sorted((Path(__file__).parents[2] / "examples" / "cartoon_hair").glob("*.toml"))
+
+
+@pytest.mark.parametrize("path", EXAMPLES, ids=[p.stem for p in EXAMPLES])
+def test_the_cartoon_hair_examples_render(gl, path):
+    from deferred.scene.loader import load_scene
+
+    assert len(EXAMPLES) >= 4
+    with Renderer(load_scene(path), size=(64, 64), gl=gl) as renderer:
+        result = renderer.render(time=0.5, hdr=True)
+        ids = renderer.targets.read("strand_id")[..., 0]
+    assert np.isfinite(result.hdr).all() and (ids > 0.5).mean() > 0.05
