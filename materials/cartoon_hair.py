@@ -72,6 +72,10 @@ STRAND_ID = GBufferData("strand_id", "R32F", ("id",),
 MAX_STRANDS = 20000
 STRAND_IDS = 32768  # ids a hair object's strands take (more than MAX_STRANDS)
 MAX_HAIR_OBJECTS = (1 << 24) // STRAND_IDS  # ids stay whole numbers in the R32F datum
+# The hair at time t is t / time_step steps from 0 (benchmarks/README.md has what a step
+# costs): more is refused rather than left to run for hours
+MAX_HAIR_STEPS = 20_000
+MAX_HAIR_STRAND_STEPS = 50_000_000
 
 
 class CartoonHairParams(BlinnPhongParams, XToonParams):
@@ -363,6 +367,20 @@ class CartoonHairMaterial(Material):
                       "collision_spheres", "time_step", "edge_stiffness", "bend_stiffness",
                       "torsion_stiffness", "anchor_stiffness", "anchor_curve", "gravity",
                       "wind", "radius", "taper")
+
+    def check_time_for(self, obj: SceneObject, time: float, where: str) -> None:
+        """The hair is stepped from t = 0 at ``time_step``: the steps, and the steps times the
+        strands, are bounded (``MAX_HAIR_STEPS``, ``MAX_HAIR_STRAND_STEPS``), so a late frame
+        is refused before any frame instead of running for hours."""
+        steps = round(time / self.params.time_step)
+        strands = self.params.strands if self.params.strands_file is None else \
+            len(load_strands(self.resolve_path(self.params.strands_file), "strands_file"))
+        if steps > MAX_HAIR_STEPS or steps * strands > MAX_HAIR_STRAND_STEPS:
+            raise InputError(f"t = {time:g} s needs {steps:,} simulation steps of "
+                             f"{self.params.time_step:g} s for {strands:,} strands "
+                             f"({obj.label}); the most is {MAX_HAIR_STEPS:,} steps and "
+                             f"{MAX_HAIR_STRAND_STEPS:,} strand steps: render an earlier time, "
+                             "raise time_step or grow fewer strands", where)
 
     def check_files(self, where: str | None) -> None:
         super().check_files(where)

@@ -195,3 +195,16 @@ def test_the_cartoon_hair_examples_render(gl, path):
         result = renderer.render(time=0.5, hdr=True)
         ids = renderer.targets.read("strand_id")[..., 0]
     assert np.isfinite(result.hdr).all() and (ids > 0.5).mean() > 0.05
+
+
+def test_a_time_too_far_for_the_simulation_is_refused_before_a_frame(tmp_path, capsys):
+    """The hair steps from t = 0: a frame at 10,000 s (600,000 steps) is refused in one line
+    naming --time before anything is drawn, instead of running for hours."""
+    (tmp_path / "s.toml").write_text(
+        "[[object]]\nmesh = \"builtin:head\"\nmaterial = \"cartoon_hair\"\n")
+    code = main(["render", str(tmp_path / "s.toml"), "-o", str(tmp_path / "out.png"),
+                 "--time", "10000"])
+    err = capsys.readouterr().err
+    assert code == 2 and err.startswith("error: --time: t = 10000 s needs 600,000 simulation "
+                                        "steps"), err
+    assert not (tmp_path / "out.png").exists()
