@@ -39,7 +39,13 @@ from deferred.scene.model import (
     check_size,
     unique_label,
 )
-from deferred.scene.tracks import INTERPOLATIONS, make_track, parse_target
+from deferred.scene.tracks import (
+    INTERPOLATIONS,
+    MIN_SCALE,
+    make_track,
+    parse_target,
+    scale_too_small,
+)
 from deferred.validation import (
     Radiance,
     StrictValues,
@@ -54,7 +60,6 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 Vec3 = tuple[float, float, float]
-MIN_SCALE = 1e-6  # an object smaller is a mistake of units; 1/scale must fit float32
 DEMO_SCENE = "demo.toml"
 T = TypeVar("T")
 M = TypeVar("M", bound=BaseModel)
@@ -88,7 +93,7 @@ class ObjectModel(_Strict):
         scale = np.broadcast_to(np.asarray(self.scale, dtype=float), (3,))
         if np.any(scale == 0.0):
             raise ValueError("scale must not be zero")
-        if np.any(np.abs(scale) < MIN_SCALE):  # its normal matrix would overflow float32
+        if scale_too_small(scale):  # its normal matrix would overflow float32
             raise ValueError(f"scale must be at least {MIN_SCALE:g} in size")
         return self
 

@@ -39,7 +39,14 @@ from deferred.interfaces.shading import ShadingModel
 from deferred.params import validate_params
 from deferred.scene.camera import Camera, model_matrix
 from deferred.scene.meshes import load_mesh
-from deferred.scene.tracks import MIN_SCALE, Track, Turntable, decompose, make_track
+from deferred.scene.tracks import (
+    MIN_SCALE,
+    Track,
+    Turntable,
+    decompose,
+    make_track,
+    scale_too_small,
+)
 from deferred.validation import StrictValues, join_where
 
 Vec3 = tuple[float, float, float]
@@ -60,7 +67,7 @@ class Transform(StrictValues):
     @field_validator("scale")
     @classmethod
     def _check_scale(cls, scale: float | tuple[float, float, float]):
-        if np.any(np.abs(np.broadcast_to(np.asarray(scale, dtype=float), (3,))) < MIN_SCALE):
+        if scale_too_small(scale):
             raise ValueError(f"must be at least {MIN_SCALE:g} in size")
         return scale
 

@@ -46,6 +46,12 @@ from deferred.validation import (
 Vec3 = tuple[float, float, float]
 INTERPOLATIONS = ("step", "linear", "smooth")
 MIN_SCALE = 1e-6  # an object smaller is a mistake of units; 1/scale must fit float32
+
+
+def scale_too_small(scale: float | Sequence[float]) -> bool:
+    """Whether a scale (one number or one per axis) is under ``MIN_SCALE`` in size on an axis:
+    the one rule for a scene file's, a track key's and Python's placements."""
+    return bool(np.any(np.abs(np.asarray(scale, dtype=float)) < MIN_SCALE))
 KINDS = ("camera", "light", "object")
 MAX_KEYS = 100_000
 
@@ -83,7 +89,7 @@ class ObjectKey(_Key):
     @field_validator("scale")
     @classmethod
     def _scale(cls, scale: float | Vec3 | None) -> float | Vec3 | None:
-        if scale is not None and np.any(np.abs(np.asarray(scale, dtype=float)) < MIN_SCALE):
+        if scale is not None and scale_too_small(scale):
             raise ValueError(f"must be at least {MIN_SCALE:g} in size")
         return scale
 
