@@ -83,7 +83,7 @@ from deferred.interfaces.material import (
 )
 from deferred.interfaces.registry import effects, lights, materials, shading_models
 from deferred.interfaces.shading import ShadingModel
-from deferred.io.images import check_image, read_channels, read_image
+from deferred.io.images import check_image, read_channels, read_image, srgb_decode
 from deferred.names import LightPath, LightVolume, Pipeline
 from deferred.params import Params, UniformOverrides
 from deferred.scene import Scene, SceneObject
@@ -130,6 +130,7 @@ __all__ = [
     "UniformOverrides", "builtin_head_spheres", "check_image", "copy_pass", "effects",
     "image_texture_bytes", "lights", "materials",
     "radiances", "read_channels", "read_image", "register_shader_root", "require_regular_file",
+    "srgb_decode",
     "shading_models",
     "view_direction", "view_directions", "view_point", "view_points",
 ]

@@ -22,12 +22,14 @@ from deferred.io.safety import raise_if_stop_requested
 
 
 def srgb_encode(linear: np.ndarray) -> np.ndarray:
+    """Linear values in [0, 1] (clipped) as sRGB-encoded ones."""
     linear = np.clip(linear, 0.0, 1.0)
     return np.where(linear <= 0.0031308, linear * 12.92,
                     1.055 * np.power(linear, 1.0 / 2.4) - 0.055)
 
 
 def srgb_decode(encoded: np.ndarray) -> np.ndarray:
+    """sRGB-encoded values in [0, 1] as linear ones (float64)."""
     encoded = np.asarray(encoded, dtype=np.float64)
     return np.where(encoded <= 0.04045, encoded / 12.92, np.power((encoded + 0.055) / 1.055, 2.4))
 

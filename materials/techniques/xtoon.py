@@ -10,7 +10,7 @@ chosen per material:
 - ``specular``: y = (N.H)^c (4.3.6, Barla's texture specular): the top rows add a highlight.
 
 A ramp is generated from colour stops (``[[0.0, "#3a2a5a"], [0.5, "#8a6ac0"]]``: each colour
-holds from its position to the next stop's, a quantised gradient) or read from an image (x to
+holds from its position up to the following one's, a quantised gradient) or read from an image (x to
 the right, y up: the image's top row is y = 1). The toon shading model
 (:mod:`deferred.materials.shading_models`) gathers every ramp of the scene's materials into one
 texture array; a material writes its ramp's layer (:func:`ramp_layer`) into the G-buffer datum
@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 from pydantic import Field, field_validator
 
-from deferred.api import InputError, MaterialParams, read_image
+from deferred.api import InputError, MaterialParams, read_image, srgb_decode
 
 if TYPE_CHECKING:
     from deferred.api import Scene
@@ -56,8 +56,7 @@ def hex_to_linear(text: str, where: str = "colour") -> tuple[float, float, float
     if match is None:
         raise InputError(f"expected a colour as #rrggbb, got {text!r}", where)
     code = match.group(1)
-    srgb = np.array([int(code[k:k + 2], 16) / 255.0 for k in (0, 2, 4)])
-    linear = np.where(srgb <= 0.04045, srgb / 12.92, ((srgb + 0.055) / 1.055) ** 2.4)
+    linear = srgb_decode(np.array([int(code[k:k + 2], 16) / 255.0 for k in (0, 2, 4)]))
     return tuple(float(c) for c in linear)
 
 
@@ -67,7 +66,7 @@ class XToonParams(MaterialParams):
     ramp: tuple[Stop, ...] = Field(
         ((0.0, "#4a4a4a"), (0.35, "#9a9a9a"), (0.75, "#ffffff")),
         description="colour stops [[x, \"#rrggbb\"], ...] along max(N.L, 0), x ascending "
-                    "from 0: each colour holds until the next stop (a quantised ramp); it "
+                    "from 0: each colour holds until the following one (a quantised ramp); it "
                     "multiplies the albedo (4.3.3), so greys keep the material's colour")
     ramp_image: str | None = Field(None, description="a 2D ramp image instead of the stops "
                                                      "(x: max(N.L, 0); y, up: the metric)")
