@@ -224,8 +224,9 @@ class Renderer:
         self.graph: PassGraph = check_passes(PIPELINES[pipeline](provisional).build(scene))
         # where the frame size came from, for errors about it
         self.size_where = "size" if given else f"{scene.source}: size"
-        check_target_memory(self.graph, self.size, self.size_where, held_memory(scene),
-                            scene.source)
+        held = held_memory(scene)  # counted once: the scene's files are read for it
+        self._held_bytes = sum(held.values())
+        check_target_memory(self.graph, self.size, self.size_where, held, scene.source)
         light_types = scene.light_types()
         shading_models = self.shading_models = scene.shading_models()
         self.object_transforms = ObjectTransforms()  # kept across frames
@@ -361,9 +362,9 @@ class Renderer:
 
     def memory_bytes(self) -> int:
         """What the renderer holds as the memory budget counts it: its render targets and the
-        materials' textures and state (:func:`held_memory`)."""
-        return targets_bytes(self.graph.targets.values(), *self.size) + \
-            sum(held_memory(self.scene).values())
+        materials' textures and state (:func:`held_memory`, as counted when the renderer was
+        built)."""
+        return targets_bytes(self.graph.targets.values(), *self.size) + self._held_bytes
 
     @property
     def passes(self) -> list[RenderPass]:
