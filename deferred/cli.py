@@ -20,7 +20,7 @@ import click
 from rich.console import Console
 from rich.table import Table
 
-from deferred.errors import DeferredError, InputError, RenderError, ShaderError
+from deferred.errors import DeferredError, InputError, RenderError, ShaderError, one_line
 from deferred.interfaces import registry
 from deferred.io.images import write_image
 from deferred.io.paths import check_output_path
@@ -578,8 +578,7 @@ def main(argv: list[str] | None = None) -> int:
 
 def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
     """A Python warning as one line, ``warning: ...``, without the source file and line."""
-    text = str(message).replace("\r", "\\r").replace("\n", "\\n")
-    click.echo(f"warning: {text}", err=True)
+    click.echo(f"warning: {one_line(str(message))}", err=True)
 
 
 def _interrupted(exc: KeyboardInterrupt) -> int:
@@ -635,7 +634,7 @@ def _fail(*messages: str) -> None:
         traceback.print_exc()
     # one line each, whatever a file name holds: a newline in one is shown as \n
     for message in messages:
-        click.echo(message.replace("\r", "\\r").replace("\n", "\\n"), err=True)
+        click.echo(one_line(message), err=True)
 
 
 def entry() -> None:

@@ -5,6 +5,11 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 
+def one_line(text: str) -> str:
+    """``text`` with its line breaks written as ``\\n`` / ``\\r``: an error is one line."""
+    return text.replace("\r", "\\r").replace("\n", "\\n")
+
+
 class DeferredError(Exception):
     """Base class of the framework's own errors."""
 
@@ -18,9 +23,10 @@ class InputError(DeferredError):
     """
 
     def __init__(self, message: str, where: str | None = None):
-        self.where = where
-        self.message = message
-        super().__init__(f"{where}: {message}" if where else message)
+        # A file name may hold a line break; the message stays one line whatever it quotes.
+        self.where = None if where is None else one_line(where)
+        self.message = one_line(message)
+        super().__init__(f"{self.where}: {self.message}" if where else self.message)
 
     @property
     def problems(self) -> tuple[InputError, ...]:
@@ -34,7 +40,9 @@ class InputErrors(InputError):
 
     def __init__(self, problems: Sequence[InputError]):
         self._problems = tuple(one for problem in problems for one in problem.problems)
-        super().__init__("\n".join(map(str, self._problems)))
+        self.where = None
+        self.message = "\n".join(map(str, self._problems))
+        DeferredError.__init__(self, self.message)
 
     @property
     def problems(self) -> tuple[InputError, ...]:

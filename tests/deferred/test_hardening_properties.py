@@ -1,5 +1,8 @@
 """Issue #11, property tests: random scene documents are either a scene or one InputError (never
-another exception), quickly; what is accepted renders an image without NaN or inf."""
+another exception), quickly; what is accepted renders an image without NaN or inf.
+
+The examples are derandomized so a run on a clean checkout tries the same documents as the
+last run here; to explore further, drop ``derandomize`` and raise ``max_examples`` locally."""
 
 from __future__ import annotations
 
@@ -75,7 +78,7 @@ scene_documents = st.fixed_dictionaries({}, optional={
 })
 
 
-@settings(max_examples=300, deadline=None,
+@settings(max_examples=300, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 @given(scene_documents)
 def test_a_random_scene_document_is_a_scene_or_one_input_error(document):
@@ -91,7 +94,7 @@ def test_a_random_scene_document_is_a_scene_or_one_input_error(document):
     assert time.perf_counter() - start < 10.0  # no hang (the unwrap and mesh checks bounded)
 
 
-@settings(max_examples=30, deadline=None,
+@settings(max_examples=30, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 @given(document=scene_documents)
 def test_an_accepted_random_scene_renders_a_finite_image(gl, document):
@@ -138,7 +141,7 @@ def obj_documents(draw) -> str:
     return "\n".join(lines) + "\n"
 
 
-@settings(max_examples=120, deadline=None,
+@settings(max_examples=120, deadline=None, derandomize=True,
           suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large,
                                  HealthCheck.function_scoped_fixture])
 @given(text=obj_documents())

@@ -74,6 +74,8 @@ CASES = [
      ["object[0].mesh", "'radius' must be greater than 0 and at most"]),
     ("control-character-name", scene().replace('name = "ball"', 'name = "a\\nb"'), None, None,
      ["object[0].name", "no control characters"]),
+    ("line-break-mesh-name", scene(mesh="a\\nb.obj"), None, None,
+     ["object[0].mesh", "mesh file not found", "a\\nb.obj"]),
     ("depth-range", scene(extra="[camera]\nnear = 1e-9\nfar = 100.0"), None, None,
      ["s.toml: camera", "far / near is 1e+11"]),
     ("revie-fins-event", scene(material="revie_fur", params="shells = 4\nfins = true",
@@ -175,3 +177,4 @@ def test_hostile_options_exit_2(tmp_path, capsys, monkeypatch, args, fragment):
     err = capsys.readouterr().err
     assert fragment in err and len(err.strip().splitlines()) == 1, err
     assert list(tmp_path.iterdir()) == []
+

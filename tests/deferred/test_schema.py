@@ -297,7 +297,9 @@ def test_past_the_most_lines_the_rest_are_counted(tmp_path, capsys, monkeypatch)
 
 def test_a_newline_in_a_problem_stays_on_its_line(capsys):
     problems = InputErrors([InputError("bad\nvalue", "a.toml: x"), InputError("worse", "b")])
-    assert [str(p) for p in problems.problems] == ["a.toml: x: bad\nvalue", "b: worse"]
+    # the error itself is one line, from Python as from the command line
+    assert [str(p) for p in problems.problems] == ["a.toml: x: bad\\nvalue", "b: worse"]
+    assert str(problems).splitlines() == ["a.toml: x: bad\\nvalue", "b: worse"]
     from deferred.cli import _fail
     _fail(*(f"error: {p}" for p in problems.problems))
     assert capsys.readouterr().err.splitlines() == ["error: a.toml: x: bad\\nvalue",
