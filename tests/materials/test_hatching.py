@@ -255,33 +255,7 @@ def test_the_cache_folder_follows_the_environment(tmp_path, monkeypatch, counted
 GLSL_TAM = TamSettings(size=64, tones=4, mips=3, strokes=24, candidates=4, seed=7,
                        stroke_length=0.3, stroke_width=2.0)
 
-HARNESS_FRAG = """
-#include "techniques/hatching.glsl"
-uniform sampler2D u_tam;
-uniform sampler2D u_tones;  // the lit tone of each pixel
-uniform int u_tam_tones;
-uniform int u_gutter;
-uniform int u_screen;       // 0: hatching_ink at uv = frag * u_uv_scale + u_uv_offset; 1: screen
-uniform float u_uv_scale;
-uniform vec2 u_uv_offset;
-uniform float u_scale;
-out vec4 out_ink;
-
-void main() {
-    float tone = texelFetch(u_tones, ivec2(gl_FragCoord.xy), 0).r;
-    vec2 uv = gl_FragCoord.xy * u_uv_scale + u_uv_offset;
-    float surface = hatching_ink(u_tam, u_tam_tones, u_gutter, tone, uv);
-    float screen = hatching_screen_ink(u_tam, u_tam_tones, u_gutter, tone, gl_FragCoord.xy,
-                                       u_scale);
-    out_ink = vec4(u_screen == 1 ? screen : surface, 0.0, 0.0, 1.0);
-}
-"""
-HARNESS_VERT = """
-void main() {  // one triangle over the viewport
-    vec2 corner = vec2((gl_VertexID & 1) * 4 - 1, (gl_VertexID >> 1) * 4 - 1);
-    gl_Position = vec4(corner, 0.0, 1.0);
-}
-"""
+HARNESS = Path(__file__).parents[1] / "fixtures" / "hatching_harness"
 
 
 @pytest.fixture(scope="module")
@@ -295,8 +269,7 @@ def render_ink(gl, tam, tones, uniforms):
     gl.park()  # creating a framebuffer re-binds the last one used: ours, not a released one
     height, width = tones.shape
     lib = ShaderLibrary(ctx, 330)
-    lib.set_virtual_file("hatching_harness.vert", HARNESS_VERT)
-    lib.set_virtual_file("hatching_harness.frag", HARNESS_FRAG)
+    lib.add_root(HARNESS)
     program = lib.program("hatching_harness.vert", "hatching_harness.frag")
     texture = tam_texture(ctx, tam)
     tone_texture = ctx.texture((width, height), 1, tones.astype(np.float32).tobytes(), dtype="f4")
