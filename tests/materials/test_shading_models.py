@@ -292,5 +292,6 @@ def test_an_edited_ramp_replaces_the_toon_textures(gl, xtoon_material):
         image = renderer.render(hdr=True).hdr
         after = renderer.resources._cached[("slot", "toon_ramps")][1]
         assert after is not before and len(renderer.resources._cached) == count
+        assert type(before.mglo).__name__ == "InvalidObject"  # the old array was released
         covered = image[..., 3] > 0.999
         assert np.unique(np.round(image[covered][:, 0], 3)).size == 2  # the new two tones
