@@ -283,6 +283,7 @@ class Renderer:
             check_scene_values(self.scene)
             self._camera_checked = self.scene.camera
         if not changed:
+            edited = {}
             for obj in self.scene.objects:
                 params = obj.material.params
                 if params is self._params_seen.get(id(obj)):
@@ -293,9 +294,18 @@ class Renderer:
                         (seen is not None and _restarts(type(obj.material), seen, params)):
                     changed = True
                     break
-                self._params_seen[id(obj)] = params
+                edited[id(obj)] = params
+            if edited and not changed:
+                self._count_held_memory()  # an edited texture or mask size may not fit
+                self._params_seen.update(edited)  # seen once they are known to fit
         if changed:
             self._rebuild()
+
+    def _count_held_memory(self) -> None:
+        """Count what the materials hold again and check it against the budget."""
+        held = held_memory(self.scene)
+        check_target_memory(self.graph, self.size, self.size_where, held, self.scene.source)
+        self._held_bytes = sum(held.values())
 
     def _rebuild(self) -> None:
         """A renderer built afresh for the scene on this one's context takes this one's place
@@ -362,8 +372,8 @@ class Renderer:
 
     def memory_bytes(self) -> int:
         """What the renderer holds as the memory budget counts it: its render targets and the
-        materials' textures and state (:func:`held_memory`, as counted when the renderer was
-        built)."""
+        materials' textures and state (:func:`held_memory`, counted again when parameters
+        change)."""
         return targets_bytes(self.graph.targets.values(), *self.size) + self._held_bytes
 
     @property

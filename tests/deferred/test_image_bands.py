@@ -149,3 +149,28 @@ def test_textures_and_material_state_count_against_the_memory_budget(tmp_path, c
     assert not (tmp_path / "out.png").exists()
     monkeypatch.setenv("DEFERRED_TARGET_MEMORY", str(16 << 20))
     assert main(["render", str(scene_file), "-o", str(tmp_path / "out.png")]) == 0
+
+
+def test_a_texture_set_in_python_counts_against_the_memory_budget(gl, tmp_path, monkeypatch):
+    """``set_params`` with a larger texture between frames is counted again before the next
+    frame: refused past the budget (the renderer keeps its last frame), counted when it fits."""
+    from deferred.errors import InputError
+    from deferred.gl.resources import image_texture_bytes
+    from deferred.render.renderer import Renderer
+    from deferred.scene.model import Scene
+
+    write_image(tmp_path / "small.png", np.zeros((8, 8, 3), np.uint8))
+    write_image(tmp_path / "large.png", np.zeros((512, 1024, 3), np.uint8))
+    scene = Scene(size=(32, 18))
+    ball = scene.add_object("builtin:sphere", material="standard",
+                            params={"texture": str(tmp_path / "small.png")})
+    with Renderer(scene, gl=gl) as renderer:
+        renderer.render()
+        targets = renderer.memory_bytes() - image_texture_bytes(8, 8)
+        monkeypatch.setenv("DEFERRED_TARGET_MEMORY", str(targets + (1 << 20)))
+        ball.set_params(texture=str(tmp_path / "large.png"))  # 5.3 MiB with its mipmaps
+        with pytest.raises(InputError, match=r"the largest texture .*large\.png"):
+            renderer.render()
+        monkeypatch.setenv("DEFERRED_TARGET_MEMORY", str(targets + (8 << 20)))
+        renderer.render()
+        assert renderer.memory_bytes() == targets + image_texture_bytes(1024, 512)
