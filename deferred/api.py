@@ -49,6 +49,8 @@ from deferred.gbuffer import (
     DEPTH,
     GBUFFER_COLOR_TARGETS,
     LINEAR_DEPTH,
+    MOTION,
+    MOTION_SPEC,
     NORMAL_EXPONENT_ID,
     GBufferData,
 )
@@ -64,7 +66,13 @@ from deferred.gl.targets import (
     LIGHT_ACCUMULATION,
     LIGHT_ACCUMULATION_SPEC,
 )
-from deferred.interfaces.effect import AMBIENT_OCCLUSION, Effect, EffectParams
+from deferred.interfaces.effect import (
+    AMBIENT_OCCLUSION,
+    Effect,
+    EffectParams,
+    FrameMoment,
+    halton,
+)
 from deferred.interfaces.light import (
     Light,
     LightParams,
@@ -98,6 +106,8 @@ GLSL_INCLUDES: dict[str, str] = {
                                  "and the framework's completion of a Surface",
     "common/object_transform.glsl": "the object's model and normal matrices and the camera's "
                                     "view (vertex shaders)",
+    "common/motion.glsl": "this frame's and the last frame's unjittered clip positions of an "
+                          "object-space point (motion vectors; vertex shaders)",
     "common/lighting.glsl": "struct LightRecord and the shading-model interface (a light's "
                             "GLSL function)",
     "common/forward_lighting.glsl": "every light of the frame at one surface point (forward "
@@ -119,15 +129,16 @@ GLSL_INCLUDES: dict[str, str] = {
 
 __all__ = [
     "ALBEDO_SPECULAR", "AMBIENT_OCCLUSION", "COMPOSITE", "COMPOSITE_SPEC", "DEPTH", "FINAL",
-    "FINAL_SPEC", "GBUFFER_COLOR_TARGETS", "GLSL_INCLUDES", "LIGHT_ACCUMULATION",
-    "LIGHT_ACCUMULATION_SPEC", "LINEAR_DEPTH", "NORMAL_EXPONENT_ID", "Albedo",
+    "FINAL_SPEC", "FrameMoment", "GBUFFER_COLOR_TARGETS", "GLSL_INCLUDES", "LIGHT_ACCUMULATION",
+    "LIGHT_ACCUMULATION_SPEC", "LINEAR_DEPTH", "MOTION", "MOTION_SPEC", "NORMAL_EXPONENT_ID",
+    "Albedo",
     "BlinnPhongParams", "ClearPass", "Effect", "EffectParams", "ForwardLitPass", "Frame",
     "FullscreenPass", "GBufferData", "GBufferPass", "GpuMesh", "InputError", "Light",
     "LightParams", "LightPath", "LightVolume", "Material", "MaterialParams", "MeshData",
     "MeshPrimitives",
     "NonZeroVec3", "ObjectPass", "Order", "Params", "Phase", "Pipeline", "Radiance",
     "RenderError", "RenderPass", "Scene", "SceneObject", "ShadingModel", "TargetSpec",
-    "UniformOverrides", "builtin_head_spheres", "check_image", "copy_pass", "effects",
+    "UniformOverrides", "builtin_head_spheres", "check_image", "copy_pass", "effects", "halton",
     "image_texture_bytes", "lights", "materials",
     "radiances", "read_channels", "read_image", "register_shader_root", "require_regular_file",
     "srgb_decode",

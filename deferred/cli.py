@@ -133,6 +133,7 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
     )
     from deferred.lighting.paths import resolve_light_path
     from deferred.render.renderer import FULL_FEATURES, Renderer
+    from deferred.render.temporal import temporal_effect
 
     if view_name == "help":
         loaded = _scene(scene)
@@ -200,6 +201,10 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
                 progress.status("rendering the frame (shaders compile, simulations settle)")
                 start = time.perf_counter()
                 if view_name is not None:
+                    if temporal_effect(loaded) is not None and times[0] >= 1.0 / fps:
+                        # the frame before, so a temporal effect's buffers (the motion
+                        # vectors, the history) show this frame's motion from it
+                        renderer.render(readback=False, time=times[0] - 1.0 / fps)
                     capture = capture_frame(renderer, [view_pass] if view_pass else [],
                                             warmup=False, time=times[0])
                 elif samples > 1:

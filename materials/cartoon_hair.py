@@ -368,6 +368,10 @@ class CartoonHairMaterial(Material):
                       "torsion_stiffness", "anchor_stiffness", "anchor_curve", "gravity",
                       "wind", "radius", "taper")
 
+    def motion_extent(self, obj: SceneObject) -> float:
+        """The strands reach up to their length beyond the head."""
+        return float(self.params.length)
+
     def check_time_for(self, obj: SceneObject, time: float, where: str) -> None:
         """The hair is stepped from t = 0 at ``time_step``: the steps, and the steps times the
         strands, are bounded (``MAX_HAIR_STEPS``, ``MAX_HAIR_STRAND_STEPS``), so a late frame

@@ -104,7 +104,9 @@ class Frame:
                  blackboard: Mapping[str, Any] | None = None,
                  binding_sources: Sequence[BindingSource] = (),
                  checked_framebuffers: dict[tuple, Any] | None = None,
-                 jitter: tuple[float, float] = (0.0, 0.0)):
+                 jitter: tuple[float, float] = (0.0, 0.0), sample_index: int = 0,
+                 history_kept: bool = False,
+                 previous_view_projection: np.ndarray | None = None):
         self.gl = gl
         self.ctx = gl.ctx
         self.time = float(time)  # seconds: the scene's timeline is applied at this time
@@ -130,6 +132,17 @@ class Frame:
         self.projection = scene.camera.projection(aspect)
         self.inverse_projection = scene.camera.inverse_projection(aspect)
         self.jitter = jitter  # pixels: the image moved by a fraction of a pixel (samples)
+        # the projection without the jitter, and the camera's view-projection without it this
+        # frame and the last (motion vectors: common/motion.glsl)
+        self.unjittered_projection = self.projection
+        self.view_projection = np.asarray(self.projection) @ np.asarray(self.view)
+        self.previous_view_projection = self.view_projection if previous_view_projection \
+            is None else np.asarray(previous_view_projection)
+        # samples since a temporal effect's history started (0: none kept; the stipple
+        # pattern's parity and other per-sample patterns follow it), and whether this frame
+        # carries the last frame's history on (deferred.render.temporal)
+        self.sample_index = int(sample_index)
+        self.history_kept = bool(history_kept)
         if jitter != (0.0, 0.0):
             # clip x gains P02 z and w is -z, so NDC x moves by -P02 everywhere: a sub-pixel
             # shift of the whole image (P12 likewise in y)
@@ -213,6 +226,9 @@ class Frame:
             "u_view": self.view,
             "u_resolution": (float(self.width), float(self.height)),
             "u_near_far": (self.scene.camera.near, self.scene.camera.far),
+            "u_view_projection": self.view_projection,
+            "u_previous_view_projection": self.previous_view_projection,
+            "u_sample_index": self.sample_index,
         }
 
     def _check_declared(self, program: moderngl.Program | moderngl.ComputeShader, what: str,

@@ -7,6 +7,8 @@ from deferred.gbuffer.layout import (
     GBUFFER_COLOR_TARGETS,
     GBUFFER_TARGETS,
     LINEAR_DEPTH,
+    MOTION,
+    MOTION_SPEC,
     NORMAL_EXPONENT_ID,
     GBufferData,
     GBufferLayout,
@@ -17,5 +19,6 @@ from deferred.gbuffer.layout import (
 from deferred.gbuffer.surface_id import MATERIAL_IDS, split_surface_id, surface_id
 
 __all__ = ["ALBEDO_SPECULAR", "DEPTH", "GBUFFER_COLOR_TARGETS", "GBUFFER_TARGETS",
-           "LINEAR_DEPTH", "MATERIAL_IDS", "NORMAL_EXPONENT_ID", "GBufferData", "GBufferLayout",
+           "LINEAR_DEPTH", "MATERIAL_IDS", "MOTION", "MOTION_SPEC", "NORMAL_EXPONENT_ID",
+           "GBufferData", "GBufferLayout",
            "decode", "octahedral_decode", "octahedral_encode", "split_surface_id", "surface_id"]

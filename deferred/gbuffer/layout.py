@@ -35,6 +35,11 @@ ALBEDO_SPECULAR = "albedo_specular"
 NORMAL_EXPONENT_ID = "normal_exponent_id"
 LINEAR_DEPTH = "linear_depth"
 DEPTH = "depth"
+# Per-pixel motion (temporal effects: deferred.effects.taa): where each pixel's surface was in the
+# last frame, in pixels, as this frame's position minus the last frame's, without the jitter.
+MOTION = "motion"
+MOTION_SPEC = TargetSpec(2, "f2", "motion in pixels: this frame's position - the last frame's "
+                                  "(unjittered)", clear=(0.0, 0.0))
 
 GBUFFER_COLOR_TARGETS = (ALBEDO_SPECULAR, NORMAL_EXPONENT_ID, LINEAR_DEPTH)
 

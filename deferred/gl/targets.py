@@ -46,6 +46,7 @@ class FrameTargets:
         size = self.size_of(spec)
         if spec.depth:
             texture = self.ctx.depth_texture(size)
+            texture.compare_func = ""  # read as depth values (a sampler2D), not compared
         else:
             texture = self.ctx.texture(size, spec.components, dtype=spec.dtype)
         texture.filter = (moderngl.NEAREST, moderngl.NEAREST)

@@ -17,6 +17,7 @@ ambient light, whichever effect it is.
 from __future__ import annotations
 
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
 
@@ -37,6 +38,29 @@ if TYPE_CHECKING:
 AMBIENT_OCCLUSION = "ssao"
 
 
+def halton(index: int, base: int) -> float:
+    """The radical inverse of ``index`` in ``base`` (the Halton sequence's term: sub-pixel
+    offsets of temporal effects and accumulated samples)."""
+    result, fraction = 0.0, 1.0 / base
+    while index > 0:
+        result += fraction * (index % base)
+        index //= base
+        fraction /= base
+    return result
+
+
+@dataclass(frozen=True)
+class FrameMoment:
+    """What a temporal effect compares between two frames: the time and the camera (with its
+    view-projection at the frame's aspect); ``step`` is the time since the frame before it
+    (None for the first frame of a history)."""
+
+    time: float
+    camera: Any
+    view_projection: Any
+    step: float | None = None
+
+
 class EffectParams(Params):
     """Base of every effect's parameter model."""
 
@@ -53,6 +77,10 @@ class Effect:
     shader_root: ClassVar[Traversable | Path | None] = None
     uniform_overrides: ClassVar[UniformOverrides] = {}
     type_id: ClassVar[int] = 0  # set by the registry
+    # A temporal effect (taa) keeps history from frame to frame: the renderer then moves the
+    # projection by jitter(index) each frame and passes count samples since the history
+    # started (Frame.sample_index), which it starts again where keeps_history says no.
+    temporal: ClassVar[bool] = False
 
     def __init__(self, params: EffectParams | None = None):
         self.params = params if params is not None else self.Params()
@@ -74,3 +102,13 @@ class Effect:
 
     def passes(self, scene: SceneLike, pipeline: str) -> list[RenderPass]:
         raise NotImplementedError
+
+    def jitter(self, index: int) -> tuple[float, float]:
+        """A temporal effect's sub-pixel offset (x, y in pixels) of sample ``index`` since the
+        history started."""
+        return (0.0, 0.0)
+
+    def keeps_history(self, previous: FrameMoment, current: FrameMoment) -> bool:
+        """A temporal effect's answer to whether ``current`` follows ``previous`` closely
+        enough for the history to carry over (no cut, no seek)."""
+        return True

@@ -151,6 +151,13 @@ class Material:
         require_regular_file(path, what, key)
         return path
 
+    def motion_extent(self, obj: SceneObjectLike) -> float:
+        """How far, in object units along the mesh's normals, what the material draws for
+        ``obj`` reaches beyond the mesh (fur shells and fins, hair): motion vectors are drawn
+        over the mesh pushed out that far (deferred.effects.taa), so the pixels of those
+        layers move with the object."""
+        return 0.0
+
     # -- shader inputs -----------------------------------------------------------------------
     @classmethod
     def shader_folder(cls) -> str:

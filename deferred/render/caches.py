@@ -77,24 +77,29 @@ class ObjectTransforms:
         self._key: tuple | None = None
         self._values: dict[int, dict[str, Any]] = {}
 
-    def of(self, objects: list[SceneObject]) -> dict[int, dict[str, Any]]:
-        """id(object) -> its uniforms."""
+    def of(self, objects: list[SceneObject],
+           previous: dict[int, np.ndarray] | None = None) -> dict[int, dict[str, Any]]:
+        """id(object) -> its uniforms; ``previous`` the models of the last frame by object id
+        (``u_previous_model``; an object missing there, or with none given, its own model)."""
         if not objects:
             return {}
+        previous = previous or {}
         surface_ids = [float(obj.material.surface_id()) for obj in objects]
+        befores = [previous.get(id(obj), obj.model) for obj in objects]
         # what the values are made of (contents, not identities: a model may be written in
         # place), and which object each belongs to
         key = (b"".join([obj.model.tobytes() for obj in objects]), surface_ids,
-               [id(obj) for obj in objects])
+               [id(obj) for obj in objects],
+               b"".join([np.asarray(before, dtype=np.float64).tobytes() for before in befores]))
         if key != self._key:
             models = np.stack([obj.model for obj in objects])
-            self._values = self._make(objects, models, surface_ids)
+            self._values = self._make(objects, models, surface_ids, np.stack(befores))
             self._key = key
         return self._values
 
     @staticmethod
     def _make(objects: list[SceneObject], models: np.ndarray,
-              surface_ids: list[float]) -> dict[int, dict[str, Any]]:
+              surface_ids: list[float], befores: np.ndarray) -> dict[int, dict[str, Any]]:
         normals = np.transpose(np.linalg.inv(models[:, :3, :3]), (0, 2, 1))
 
         def column_major(matrices: np.ndarray) -> bytes:  # GLSL's order, all at once
@@ -102,11 +107,13 @@ class ObjectTransforms:
                                         dtype=np.float32).tobytes()
 
         model_bytes, normal_bytes = column_major(models), column_major(normals)
+        before_bytes = column_major(befores)
         values = {}
         for index, (obj, surface_id) in enumerate(zip(objects, surface_ids, strict=True)):
             values[id(obj)] = StableValues(  # replaced whole when they change
                 u_model=model_bytes[64 * index:64 * index + 64],
                 u_model_normal_matrix=normal_bytes[36 * index:36 * index + 36],
+                u_previous_model=before_bytes[64 * index:64 * index + 64],
                 u_surface_id=surface_id)
         return values
 
@@ -116,8 +123,9 @@ class FrameInputs:
     frame, or kept from the last), for the frame's passes."""
 
     def __init__(self, scene: Scene, transforms: ObjectTransforms, kept: KeptMaterialInputs,
-                 strict: bool = False):
+                 strict: bool = False, previous_models: dict[int, np.ndarray] | None = None):
         self.scene = scene
+        self.previous_models = previous_models
         self.strict = strict
         self.frame: Frame | None = None  # set by the frame it serves (Frame.__init__)
         self._transforms = transforms
@@ -129,7 +137,7 @@ class FrameInputs:
         """The object's transforms and id (for every object at once, kept across frames while
         the objects hold: :class:`ObjectTransforms`)."""
         if self._objects is None:
-            self._objects = self._transforms.of(self.scene.objects)
+            self._objects = self._transforms.of(self.scene.objects, self.previous_models)
         return self._objects[id(obj)]
 
     def material_inputs(self, material: Material) -> MaterialInputs:

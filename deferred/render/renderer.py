@@ -22,6 +22,7 @@ from deferred.gl.resources import Resources
 from deferred.gl.shaderlib import ShaderLibrary
 from deferred.gl.target_spec import targets_bytes
 from deferred.gl.targets import COMPOSITE, FINAL, FrameTargets
+from deferred.interfaces.effect import halton
 from deferred.interfaces.material import Material
 from deferred.io.images import amount, srgb_decode, srgb_encode, write_image
 from deferred.io.memory import check_memory
@@ -45,6 +46,7 @@ from deferred.render.caches import (
 )
 from deferred.render.generated import generated_glsl
 from deferred.render.pipeline import PIPELINES, TONEMAPS, check_passes
+from deferred.render.temporal import TemporalState, temporal_effect
 from deferred.scene.model import Scene, SceneObject, check_size
 
 PassCallback = Callable[[RenderPass, Frame], None]
@@ -137,16 +139,6 @@ def held_memory(scene: Scene) -> dict[str, int]:
 MAX_SAMPLES = 1024  # sub-pixel samples a frame (render_samples)
 
 
-def halton(index: int, base: int) -> float:
-    """The radical inverse of ``index`` in ``base`` (the Halton sequence's term)."""
-    result, fraction = 0.0, 1.0 / base
-    while index > 0:
-        result += fraction * (index % base)
-        index //= base
-        fraction /= base
-    return result
-
-
 def halton_offsets(count: int) -> list[tuple[float, float]]:
     """``count`` sub-pixel offsets in [-0.5, 0.5)^2: Halton (2, 3) from index 1, centred."""
     return [(halton(k, 2) - 0.5, halton(k, 3) - 0.5) for k in range(1, count + 1)]
@@ -231,6 +223,7 @@ class Renderer:
         shading_models = self.shading_models = scene.shading_models()
         self.object_transforms = ObjectTransforms()  # kept across frames
         self.kept_inputs = KeptMaterialInputs()  # materials' inputs, kept across frames
+        self.temporal = TemporalState()  # the last frame's time, camera and models
         generated = generated_glsl(light_types, shading_models, scene.gbuffer_layout(),
                                    [obj.material for obj in scene.objects])
         roots = [cls.shader_root for cls in [
@@ -407,14 +400,18 @@ class Renderer:
     def render(self, on_pass: PassCallback | None = None,
                before_pass: PassCallback | None = None, readback: bool = True,
                time: float = 0.0, time_gl_calls: bool = False,
-               hdr: bool = False, jitter: tuple[float, float] = (0.0, 0.0)) -> RenderResult:
+               hdr: bool = False, jitter: tuple[float, float] | None = None,
+               sample_index: int | None = None) -> RenderResult:
         """Run every pass once for the frame at ``time`` (seconds: the scene's timeline is
         applied first, and passes see it as ``frame.time``). ``on_pass``/``before_pass`` are
         called around each pass; ``readback=False`` skips reading the images back (timing
         loops); ``hdr=True`` reads the float composite now (else when ``result.hdr`` is first
         asked for); ``jitter`` moves the image by a fraction of a pixel (x, y; see
-        :meth:`render_samples`); ``time_gl_calls`` measures the CPU time of the drawing GL calls
-        (``RenderResult.gl_call_seconds``, for the bench: two clock reads per call).
+        :meth:`render_samples`; by default none, or a temporal effect's (taa) for the frame's
+        sample since its history started); ``sample_index`` picks per-sample patterns (the
+        stipple's parity; by default that sample, else 0); ``time_gl_calls`` measures the CPU
+        time of the drawing GL calls (``RenderResult.gl_call_seconds``, for the bench: two
+        clock reads per call).
 
         Changes to the scene since the last frame are picked up first: objects, lights and
         effects added or removed, a material or mesh replaced, parameters that add or remove
@@ -443,12 +440,21 @@ class Renderer:
             warnings.warn(f"GL error {stale} left by code outside the renderer", stacklevel=2)
         self.shaders.forget_uniform_values()  # code between frames may have written them
         self.kept_inputs.start_frame(self.scene)
-        inputs = FrameInputs(self.scene, self.object_transforms, self.kept_inputs, self.strict)
+        history = self.temporal.begin(self.scene, time, self.size[0] / self.size[1])
+        effect = temporal_effect(self.scene)
+        if jitter is None:
+            jitter = effect.jitter(history.index) if effect is not None else (0.0, 0.0)
+        if sample_index is None:
+            sample_index = history.index if effect is not None else 0
+        inputs = FrameInputs(self.scene, self.object_transforms, self.kept_inputs, self.strict,
+                             history.previous_models)
         frame = Frame(self.gl, self.shaders, self.targets, self.resources, self.scene, inputs,
                       strict=self.strict, time=time, time_gl_calls=time_gl_calls,
                       blackboard=self.blackboard, binding_sources=self.binding_sources,
                       checked_framebuffers=self.checked_framebuffers,
-                      jitter=(float(jitter[0]), float(jitter[1])))
+                      jitter=(float(jitter[0]), float(jitter[1])), sample_index=sample_index,
+                      history_kept=history.kept,
+                      previous_view_projection=history.previous_view_projection)
         shading = ShadingTextures.of(self.shading_models, frame)  # the models' samplers, if any
         if shading is not None:
             frame.binding_sources.insert(0, shading)
@@ -498,6 +504,7 @@ class Renderer:
         if self.strict:
             inputs.check_material_uniforms()
         self.last_frame = frame
+        self.temporal.end(history, self.scene)
         self._frame_number += 1
         self._note_scene()
         result = RenderResult(self.read_final() if readback else None, frame.stats.draw_calls,
@@ -522,8 +529,10 @@ class Renderer:
         if samples == 1:
             return self.render(time=time, hdr=True)
         light = composite = None
-        for jitter in halton_offsets(samples):
-            result = self.render(time=time, hdr=True, jitter=jitter)
+        for index, jitter in enumerate(halton_offsets(samples)):
+            # each sample its own parity of the stipple pattern (sample_index), which the
+            # average integrates (Revie's 1-in-4 pattern covers every pixel over four)
+            result = self.render(time=time, hdr=True, jitter=jitter, sample_index=index)
             decoded = srgb_decode(result.image.astype(np.float64) / 255.0)
             light = decoded if light is None else light + decoded
             composite = result.hdr.astype(np.float64) if composite is None \

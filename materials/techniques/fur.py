@@ -173,6 +173,11 @@ class FurMaterial(Material):
         load_heightfield(self.file_parameter(self.params.heightfield, "heightfield image",
                                              key), key)
 
+    def motion_extent(self, obj: SceneObject) -> float:
+        """The shells and fins reach fur_length beyond the mesh (along the comb-bent normal:
+        techniques/shells.glsl)."""
+        return float(self.params.fur_length)
+
     def held_memory(self, obj: SceneObject) -> dict[str, int]:
         path = self.heightfield_path()
         if path is None:
