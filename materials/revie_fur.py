@@ -35,6 +35,7 @@ from deferred.api import (
     materials,
 )
 
+from .techniques.comb_field import comb_field, comb_field_texture
 from .techniques.fins import FinPass
 from .techniques.fur import (
     FUR_DEBUG_VIEWS,
@@ -52,7 +53,9 @@ from .techniques.stipple import (
 )
 
 if TYPE_CHECKING:
-    from deferred.api import SceneObject
+    import moderngl
+
+    from deferred.api import Frame, SceneObject
 
 FUR_VERTEX = "materials/revie_fur/fur.vert"
 SHELL_FRAGMENT = "materials/revie_fur/shell.frag"
@@ -77,6 +80,46 @@ class RevieFurParams(FurParams, BlinnPhongParams):
                                                    "occluded (off: Figure 2.8's error)")
 
 
+class CombFieldInputs:
+    """Passes of a revie_fur object: ``u_comb_field``, the object's comb field
+    (``techniques/comb_field.py``) from its mesh's vertex colours or its ``comb``, made when
+    either changes."""
+
+    obj: SceneObject
+
+    def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
+        mesh, params = self.obj.mesh, self.obj.material.params
+        comb = None if mesh.has_comb else tuple(params.comb)
+        texture = frame.resources.current(
+            ("revie_fur_comb_field", self.obj), (id(mesh), comb),
+            lambda ctx: comb_field_texture(ctx, comb_field(mesh, comb)))
+        return {**super().textures(frame), "u_comb_field": texture}
+
+
+class CombedGBufferPass(CombFieldInputs, GBufferPass):
+    pass
+
+
+class CombedStipplePass(CombFieldInputs, StipplePass):
+    pass
+
+
+class CombedObliterationPass(CombFieldInputs, StippleObliterationPass):
+    pass
+
+
+class CombedFinPass(CombFieldInputs, FinPass):
+    pass
+
+
+class CombedShellPass(CombFieldInputs, ShellPass):
+    pass
+
+
+class CombedForwardPass(CombFieldInputs, ForwardLitPass):
+    pass
+
+
 # Options of the shell and fin passes: in the material phase both take their light from the
 # light accumulation and the G-buffer (shell.frag); in the forward phase they light themselves.
 MATERIAL_LAYERS: dict[str, Any] = {
@@ -93,13 +136,12 @@ class RevieFurMaterial(FurMaterial):
     surface_shader = "materials/revie_fur/surface.glsl"
     inputs_from_params = True  # uniforms from the params, textures from frame.resources
     # pass counts and switches compiled as defines are not uniforms; density becomes tiles
-    uniform_overrides = {**FUR_UNIFORM_OVERRIDES, "stipple": None, "occlusion_test": None}
+    uniform_overrides = {**FUR_UNIFORM_OVERRIDES, "stipple": None, "occlusion_test": None,
+                         "comb": None}  # the comb field's texture instead (CombFieldInputs)
     debug_views = FUR_DEBUG_VIEWS
 
     def defines(self, obj: SceneObject) -> dict[str, str]:
         defines = {**super().defines(obj), **pattern_defines(4, STIPPLE_PARITY)}
-        if obj.mesh.has_comb:
-            defines["VERTEX_COMB"] = "1"
         if self.params.stipple:
             defines["FUR_STIPPLE"] = "1"
         if self.params.occlusion_test:
@@ -113,40 +155,40 @@ class RevieFurMaterial(FurMaterial):
         return stipple_scene_passes(phase) if stippled else []
 
     def geometry_passes(self, obj: SceneObject) -> list[RenderPass]:
-        return [GBufferPass(f"{obj.label}.gbuffer", Phase.GEOMETRY, obj, vertex=FUR_VERTEX,
+        return [CombedGBufferPass(f"{obj.label}.gbuffer", Phase.GEOMETRY, obj, vertex=FUR_VERTEX,
                             constants=self.vertex_constants(obj, 0.0))]
 
     def stipple_passes(self, obj: SceneObject) -> list[RenderPass]:
         if not self.params.stipple:
             return []
-        return [StipplePass(f"{obj.label}.stipple", Phase.STIPPLE, obj, vertex=FUR_VERTEX,
+        return [CombedStipplePass(f"{obj.label}.stipple", Phase.STIPPLE, obj, vertex=FUR_VERTEX,
                             fragment="materials/revie_fur/stipple.frag",
                             constants=self.vertex_constants(obj, 1.0))]
 
     def material_passes(self, obj: SceneObject) -> list[RenderPass]:
         passes: list[RenderPass] = []
         if self.params.stipple:
-            passes.append(StippleObliterationPass(f"{obj.label}.stipple_obliteration",
+            passes.append(CombedObliterationPass(f"{obj.label}.stipple_obliteration",
                                                   Phase.MATERIAL, obj, vertex=FUR_VERTEX,
                                                   constants=self.vertex_constants(obj, 1.0)))
         if self.params.shells > 0:
             # fins first: the shells composite over them, which fill the gaps between shell
             # rims at grazing angles
             if self.params.fins:
-                passes.append(FinPass(f"{obj.label}.fins", Phase.MATERIAL, obj,
+                passes.append(CombedFinPass(f"{obj.label}.fins", Phase.MATERIAL, obj,
                                       constants=self.vertex_constants(obj), **MATERIAL_LAYERS))
-            passes.append(ShellPass(f"{obj.label}.shells", Phase.MATERIAL, obj,
+            passes.append(CombedShellPass(f"{obj.label}.shells", Phase.MATERIAL, obj,
                                     constants=self.vertex_constants(obj), **MATERIAL_LAYERS))
         return passes
 
     def forward_passes(self, obj: SceneObject) -> list[RenderPass]:
-        passes: list[RenderPass] = [ForwardLitPass(f"{obj.label}.forward", Phase.FORWARD, obj,
+        passes: list[RenderPass] = [CombedForwardPass(f"{obj.label}.forward", Phase.FORWARD, obj,
                                                    vertex=FUR_VERTEX,
                                                    constants=self.vertex_constants(obj, 0.0))]
         if self.params.shells > 0:
             if self.params.fins:
-                passes.append(FinPass(f"{obj.label}.forward_fins", Phase.FORWARD, obj,
+                passes.append(CombedFinPass(f"{obj.label}.forward_fins", Phase.FORWARD, obj,
                                       constants=self.vertex_constants(obj), **FORWARD_LAYERS))
-            passes.append(ShellPass(f"{obj.label}.forward_shells", Phase.FORWARD, obj,
+            passes.append(CombedShellPass(f"{obj.label}.forward_shells", Phase.FORWARD, obj,
                                     constants=self.vertex_constants(obj), **FORWARD_LAYERS))
         return passes

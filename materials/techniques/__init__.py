@@ -4,6 +4,8 @@
   self-shadowing (Lengyel et al. 2001; Revie 2.3.1; Silva et al.'s shadow factor)
 - :mod:`.fur_volume`: the mip-mapped volume of tapered strands the shells and fins sample
 - :mod:`.heightfield`: a strand heightfield image as a fur volume (Revie 2.4.1)
+- :mod:`.comb_field`: per-vertex comb directions smoothed over the mesh, crowns at the
+  singular points (Revie 2.3.1, 2.4.1)
 - :mod:`.shells`: concentric shells, n offset draws of a mesh (Revie 2.3.1)
 - :mod:`.fins`: fins at silhouette edges from a geometry shader (Lengyel et al. 2001)
 - :mod:`.stipple`: stippled G-buffer writes and their obliteration (Revie 2.3.4, 2.4.4)

@@ -102,7 +102,8 @@ FUR_DEBUG_VIEWS: dict[str, tuple[str, dict[str, Any]]] = {
     "samples": ("light samples each shell and fin fragment used: green base, blue outer "
                 "(stipple), cyan both, yellow its own pixel, red none; white in the forward "
                 "pipeline, which lights every fragment", {"debug": "samples"}),
-    "comb": ("comb direction on the skin, tangent space (x red, y green, up blue)",
+    "comb": ("comb direction x lean on the skin, view space (x red, y green, z blue, packed "
+             "from [-1, 1]; grey: no lean)",
              {"debug": "comb"}),
     "shell_count": ("shells drawn per object: blue few .. red the most (`shells`)",
                     {"debug": "shell_count"}),

@@ -33,7 +33,9 @@ void main() {
     alpha *= v_fin_fade * smoothstep(0.0, 0.35, v_shell_depth);
 #endif
 #if defined(FUR_DEBUG_COMB)
-    out_color = vec4(v_comb.xyz, 1.0);  // tangent-space comb, packed as the vertex colour
+    // the view-space comb x lean, packed: independent of the UVs' tangent frames
+    vec3 c = v_comb.xyz * 2.0 - 1.0;
+    out_color = vec4((v_tangent * c.x + v_binormal * c.y + v_normal * c.z) * 0.5 + 0.5, 1.0);
     return;
 #elif defined(FUR_DEBUG_SHELL_COUNT)
     out_color = vec4(mix(vec3(0.1, 0.2, 1.0), vec3(1.0, 0.15, 0.1), u_shell_count), 1.0);

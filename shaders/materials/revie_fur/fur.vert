@@ -1,5 +1,6 @@
-// Revie fur: the mesh at a shell depth (0 base, 1 outermost shell), with the comb direction from
-// the vertex colour (Listing 2.7's tangent-space encoding) or from the `comb` parameter.
+// Revie fur: the mesh at a shell depth (0 base, 1 outermost shell), leaning along the comb field:
+// one object-space comb per vertex (direction x lean), from the vertex colour (Listing 2.7) or
+// the `comb` parameter, smoothed over the mesh (materials/techniques/comb_field.py).
 // With FUR_FINS the outputs feed the fin geometry shader (techniques/fins.geom) under vs_ names.
 #include "techniques/shells.glsl"
 
@@ -15,7 +16,7 @@ uniform mat4 u_projection;
 uniform float u_shell_depth;
 uniform float u_fur_length;     // object units, scaled per vertex by the comb alpha
 uniform float u_comb_strength;
-uniform vec3 u_comb;            // object space; used when the mesh has no comb colours
+uniform sampler2D u_comb_field; // RGBA32F, texel i: vertex i's object-space comb x lean
 uniform vec3 u_fur_scale;       // object axes to world units (the model matrix's scale)
 
 #ifdef FUR_FINS
@@ -57,15 +58,11 @@ invariant gl_Position;
 void main() {
     mat4 model_view = object_model_view();
     mat3 normal_matrix = object_normal_matrix();
-#ifdef VERTEX_COMB
-    vec3 comb_tangent = in_comb.xyz * 2.0 - 1.0;
-    vec3 comb = in_tangent * comb_tangent.x + in_binormal * comb_tangent.y
-              + in_normal * comb_tangent.z;
-#else
-    vec3 comb = u_comb - dot(u_comb, in_normal) * in_normal;
-    comb = dot(comb, comb) > 1e-8 ? normalize(comb) : in_tangent;
+    // the comb field (techniques/comb_field.py): smooth over the mesh, shorter in a crown
+    int width = textureSize(u_comb_field, 0).x;
+    vec3 comb = texelFetch(u_comb_field, ivec2(gl_VertexID % width, gl_VertexID / width), 0).xyz;
+    comb -= dot(comb, in_normal) * in_normal;
     vec3 comb_tangent = vec3(dot(comb, in_tangent), dot(comb, in_binormal), 0.0);
-#endif
     comb *= u_comb_strength;
     float fur_length = u_fur_length * in_comb.a;
     vec3 shell = in_position + shell_offset(in_normal, comb, u_shell_depth, fur_length);

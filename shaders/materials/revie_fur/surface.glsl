@@ -19,7 +19,11 @@ Surface material_surface(SurfaceInput i) {
     s.albedo = u_albedo_tip;
     s.specular_intensity = u_specular_intensity;
     s.specular_exponent = u_specular_exponent;
-    s.normal = u_anisotropic ? grain_normal(i.normal, fur_comb_view(i), normalize(i.position))
+    // the comb's length is the lean (comb_field.py): upright strands in a crown have no grain
+    vec3 comb = fur_comb_view(i);
+    s.normal = u_anisotropic ? normalize(mix(i.normal,
+                                             grain_normal(i.normal, comb, normalize(i.position)),
+                                             clamp(length(comb), 0.0, 1.0)))
                              : i.normal;
     return s;
 }
