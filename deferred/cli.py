@@ -447,6 +447,75 @@ def bench(scene: str | None, lights: str, shells: str | None, size: str | None, 
         stderr.print(f"wrote {', '.join(str(path) for path in outputs.values())}")
 
 
+@cli.command("view")
+@click.argument("scene", required=False, type=click.Path(dir_okay=False))
+@click.option("--pipeline", type=click.Choice(sorted(PIPELINES)), default=Pipeline.DEFERRED.value,
+              show_default=True)
+@click.option("--light-path", type=LIGHT_PATH_CHOICE, help=LIGHT_PATH_HELP)
+@click.option("--size", help="WIDTHxHEIGHT of the frame, overrides the scene's size.")
+@click.option("--time", "start_time", type=FiniteFloat(min=0.0, max=1e6), default=0.0,
+              show_default=True, metavar="SECONDS", help="The timeline's time at start.")
+@click.option("--view", "view_name", metavar="BUFFER",
+              help="Show one buffer, as render --view names it ('--view help' lists them).")
+@click.option("--split", type=click.Choice(sorted(PIPELINES)),
+              help="Split view: this pipeline on the right of the frame.")
+@click.option("--headless", is_flag=True,
+              help="Draw the window offscreen once (panels included) to --screenshot and exit.")
+@click.option("--screenshot", metavar="OUT.png", help="With --headless: the window's image.")
+@click.option("--no-panels", is_flag=True, help="The frame alone, without the panels.")
+@click.option("--reduce", type=click.IntRange(min=1, max=8), default=2, show_default=True,
+              help="While the camera moves or a value drags, draw frames this many times "
+                   "smaller in each direction (the full frame follows when input stops).")
+def view_command(scene: str | None, pipeline: str, light_path: str | None, size: str | None,
+                 start_time: float, view_name: str | None, split: str | None, headless: bool,
+                 screenshot: str | None, no_panels: bool, reduce: int) -> None:
+    """Interactive viewer of SCENE (the built-in demo when omitted): orbit camera, live
+    parameters, buffer views, split deferred / forward, pixel inspector, timeline, hot reload
+    of GLSL and scene files, screenshots and recordings (README.md, "The viewer")."""
+    try:
+        from deferred.viewer.app import ViewerOptions, run_headless, run_window
+        from deferred.viewer.session import Session
+    except ImportError as exc:
+        raise InputError(f"needs the viewer extra (pip install 'deferred[viewer]'): {exc}",
+                         "view") from None
+    if view_name == "help":
+        click.get_current_context().invoke(render, scene=scene, pipeline=pipeline,
+                                           light_path=light_path, view_name="help")
+        return
+    if headless != (screenshot is not None):
+        raise InputError("--headless draws one frame to --screenshot: give both or neither",
+                         "--headless" if headless else "--screenshot")
+    out = check_output_path(screenshot, "--screenshot", (".png",), patterns=False) \
+        if screenshot else None
+    session = Session(scene)
+    if out is not None:
+        _check_not_inputs([out], session.scene, scene, "--screenshot")
+    options = ViewerOptions(pipeline=pipeline, light_path=light_path, size=_size_option(size),
+                            time=start_time, view=view_name, split=split, reduce=reduce,
+                            panels=not no_panels)
+    if view_name is not None:
+        _check_view_name(session.scene, view_name, pipeline, light_path)
+    if out is None:
+        run_window(session, options)
+        return
+    written = run_headless(session, options, out)
+    stderr.print(f"wrote {written}", markup=False, highlight=False)
+
+
+def _check_view_name(loaded, view_name: str, pipeline: str, light_path: str | None) -> None:
+    """A buffer name is known before a window opens (``InputError`` naming --view)."""
+    from deferred.debug.views import resolve_view, with_material_view
+    from deferred.lighting.paths import resolve_light_path
+    from deferred.render.renderer import FULL_FEATURES
+
+    if with_material_view(loaded, view_name) is not None:
+        return
+    passes = PIPELINES[pipeline](
+        resolve_light_path(pipeline, light_path or loaded.light_path, FULL_FEATURES)
+    ).passes(loaded)
+    resolve_view(view_name, passes)
+
+
 def _render_outputs(out: Path, kind: str, frames: int) -> list[Path]:
     """Every file ``render -o`` writes: a sequence's frames, or the one file."""
     if kind != "sequence":

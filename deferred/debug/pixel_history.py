@@ -55,8 +55,9 @@ def parse_pixel(text: str, size: tuple[int, int]) -> tuple[int, int]:
     return x, y
 
 
-def pixel_history(renderer: Renderer, x: int, y: int) -> list[PixelEvent]:
-    """Every pass's effect on pixel (x, y) (top-down image coordinates) of the next frame.
+def pixel_history(renderer: Renderer, x: int, y: int, time: float = 0.0) -> list[PixelEvent]:
+    """Every pass's effect on pixel (x, y) (top-down image coordinates) of the next frame
+    (the frame at ``time``, seconds).
 
     The frame runs as usual; before each pass, the pass also runs once with a one-pixel scissor
     on every framebuffer it uses and an occlusion query around it, then the pixel is put back as
@@ -108,7 +109,7 @@ def pixel_history(renderer: Renderer, x: int, y: int) -> list[PixelEvent]:
             {t: _floats(v) for t, v in values.items()},
             {t: _floats(read(t)) for t in dict.fromkeys(render_pass.writes)}, cleared))
 
-    renderer.render(on_pass=after, before_pass=before)
+    renderer.render(on_pass=after, before_pass=before, time=time)
     return events
 
 

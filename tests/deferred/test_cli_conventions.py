@@ -277,7 +277,8 @@ def test_the_declared_dependencies_and_extras():
     assert not core & {"matplotlib", "imageio", "imageio-ffmpeg"} and "pillow" in core
     assert any(d.startswith("imageio-ffmpeg") for d in extras["video"])
     assert any(d.startswith("matplotlib") for d in extras["plot"])
-    assert "deferred[video,plot]" in extras["dev"]  # the README's test command gets them all
+    assert any(d.startswith("moderngl-window") for d in extras["viewer"])
+    assert "deferred[video,plot,viewer]" in extras["dev"]  # the README's test command: them all
     assert project["requires-python"] == ">=3.10"
     assert "tomli>=2.0; python_version < '3.11'" in project["dependencies"]
 

@@ -1,0 +1,573 @@
+"""The viewer: a moderngl-window window (or its headless one) showing the scene as the
+framework's renderers draw it, with the camera controller, the panels, the split and buffer
+views, the timeline, hot reload and recording.
+
+The viewport sits right of the panels, never under them, at the render size: each pixel of it
+is the pixel ``deferred render`` writes for the same camera and time. While the camera moves
+or a value is dragged, frames are drawn at a reduced resolution and filtered up; when input
+stops, the full frame is drawn again (with each pass timed for the bar chart).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time as clock
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import moderngl
+import numpy as np
+from imgui_bundle import imgui
+
+from deferred.errors import one_line
+from deferred.gl.targets import FINAL
+from deferred.names import Pipeline
+from deferred.viewer import panels
+from deferred.viewer.buffers import (
+    ALL_CHANNELS,
+    buffer_names,
+    capture_view,
+    display_image,
+    material_view_scene,
+)
+from deferred.viewer.compare import psnr
+from deferred.viewer.display import FrameSlot, Rect, Viewport
+from deferred.viewer.imgui_gl import ImguiRenderer
+from deferred.viewer.inspector import inspect_pixel
+from deferred.viewer.record import Recording, save_screenshot
+from deferred.viewer.reload import Watcher
+from deferred.viewer.renderers import RendererPool, timed_render
+from deferred.viewer.session import Session
+from deferred.viewer.timeline import Timeline, scene_duration
+
+PANEL_WIDTH = 400
+MIN_HEIGHT = 640  # the panels' room when the frame is smaller
+INTERACTION_SECONDS = 0.25  # input this recent draws reduced frames
+BACKGROUND = (0.11, 0.11, 0.12)
+MODES = ("single", "split", "difference")
+
+
+@dataclass
+class ViewerOptions:
+    pipeline: str = Pipeline.DEFERRED.value
+    light_path: str | None = None
+    size: tuple[int, int] | None = None  # the frame size (default: the scene's)
+    time: float = 0.0
+    view: str | None = None  # a buffer view
+    split: str | None = None  # the other side's pipeline: split view from the start
+    reduce: int = 2  # the reduced frames' divisor while interacting
+    panels: bool = True
+
+
+def window_size(frame: tuple[int, int], with_panels: bool = True) -> tuple[int, int]:
+    width, height = frame
+    return (width + (PANEL_WIDTH if with_panels else 0),
+            max(height, MIN_HEIGHT if with_panels else height))
+
+
+def make_window(size: tuple[int, int], headless: bool, title: str = "deferred view"):
+    """A moderngl-window window: the headless one (EGL, an offscreen framebuffer) or a real
+    one (glfw by default; ``DEFERRED_VIEW_WINDOW`` names another moderngl-window backend, e.g.
+    pyglet). GL 4.3 where the driver has it (compute shaders: the tiled and clustered light
+    paths), else 3.3."""
+    import moderngl_window
+
+    name = "headless" if headless else os.environ.get("DEFERRED_VIEW_WINDOW", "glfw")
+    cls = moderngl_window.get_local_window_cls(name)
+    extra: dict[str, Any] = {"backend": os.environ.get("DEFERRED_GL_BACKEND", "egl")} \
+        if headless else {}
+    failure: Exception | None = None
+    for version in ((4, 3), (3, 3)):
+        try:
+            return cls(title=title, size=size, gl_version=version, vsync=False,
+                       resizable=not headless, aspect_ratio=None, **extra)
+        except Exception as exc:  # noqa: BLE001 - window backends raise their own types
+            failure = exc
+    raise RuntimeError(f"cannot open a {name} window: {failure}")
+
+
+class Viewer:
+    """The viewer's state and its frame: ``update()`` draws a new frame of the scene when
+    something changed, ``draw()`` puts the viewport and the panels on the window."""
+
+    def __init__(self, session: Session, window, options: ViewerOptions | None = None):
+        options = options or ViewerOptions()
+        self.session = session
+        self.wnd = window
+        self.ctx: moderngl.Context = window.ctx
+        self.options = options
+        self.size = options.size or session.scene.size
+        self.pipeline = options.pipeline
+        self.light_path = options.light_path
+        self.mode = "split" if options.split else "single"
+        self.other_pipeline = options.split or (Pipeline.FORWARD.value
+                                                if self.pipeline == Pipeline.DEFERRED.value
+                                                else Pipeline.DEFERRED.value)
+        self.other_light_path: str | None = None
+        self.split_at = 0.5
+        self.gain = 4.0
+        self.view_name = options.view
+        self.exposure = 0.0
+        self.channel = ALL_CHANNELS
+        self.view_channels: tuple[str, ...] = ()
+        self.reduce = max(1, options.reduce)
+        self.show_panels = options.panels
+        self.timeline = Timeline(scene_duration(session.scene), time=options.time)
+        self.watcher = Watcher(session.scene, session.path)
+        self.pool = RendererPool(self.ctx)
+        self.viewport = Viewport(self.ctx)
+        self.main, self.other = FrameSlot(self.ctx), FrameSlot(self.ctx)
+        self._imgui_context = imgui.create_context()
+        imgui.set_current_context(self._imgui_context)
+        self.io = imgui.get_io()
+        self.io.set_ini_filename("")  # no imgui.ini beside the user's files
+        self.io.config_flags |= imgui.ConfigFlags_.nav_enable_keyboard
+        self.imgui = ImguiRenderer(self.ctx)
+        # what the panels show
+        self.render_error: str | None = None
+        self.render_exception: Exception | None = None
+        self.notes: list[str] = []  # reload, save, screenshot messages (latest last)
+        self.timings: dict[str, float] = {}
+        self.timings_first = False  # the timings are of a renderer's first frame
+        self.frame_ms = 0.0
+        self.fps = 0.0
+        self.psnr: float | None = None
+        self.inspector: list[str] = []
+        self.buffers: list[str] = []
+        self.recording: Recording | None = None
+        self.screenshot_path = "view.png"
+        self.record_path = "view.mp4"
+        self.panel_errors: list[str] = []  # the errors the panels drew last (tests read them)
+        # input and what is shown
+        self.last_input = -math.inf
+        self.dragging: int | None = None
+        self.mouse = (-1.0, -1.0)  # the pointer's last window position
+        self.keys_down: set[int] = set()
+        self.shown_key: tuple | None = None
+        self.shown_reduced = False
+        self.shaders_generation = 0
+        self._material_scene: tuple[tuple, Any] | None = None
+        self._last_tick = clock.perf_counter()
+        self._frame_times: list[float] = []
+        self._attach_events()
+
+    # -- layout ----------------------------------------------------------------------------------
+    def viewport_rect(self) -> Rect:
+        return Rect(PANEL_WIDTH if self.show_panels else 0, 0, *self.size)
+
+    # -- frames ----------------------------------------------------------------------------------
+    def interacting(self, now: float | None = None) -> bool:
+        now = clock.perf_counter() if now is None else now
+        return now - self.last_input < INTERACTION_SECONDS
+
+    def state_key(self) -> tuple:
+        return (self.session.controller.camera(), self.timeline.time, self.session.version,
+                id(self.session.scene), self.pipeline, self.light_path, self.mode,
+                self.other_pipeline, self.other_light_path, self.view_name, self.exposure,
+                self.channel, self.size, self.shaders_generation)
+
+    def tick(self) -> None:
+        """Once a window frame: the clock, fly keys, hot reload, then a new frame if needed."""
+        now = clock.perf_counter()
+        seconds, self._last_tick = now - self._last_tick, now
+        if self.recording is not None and self.timeline.playing:
+            self.timeline.advance(1.0 / self.timeline.fps)  # every recorded frame, in turn
+        else:
+            self.timeline.advance(seconds)
+        self._fly(seconds)
+        self.poll_files()
+        self.update()
+
+    def update(self, force_full: bool = False) -> bool:
+        """Draw a new frame of the scene if anything it depends on changed (or a reduced one
+        stands and input stopped); whether one was drawn. A failure keeps the frame shown and
+        its error for the panel."""
+        interacting = self.interacting() and not force_full
+        key = self.state_key()
+        if key == self.shown_key and (not self.shown_reduced or interacting):
+            return False
+        self.pool.gl.make_current()  # another context (a renderer of the caller's) may be
+        full = not interacting or self.reduce == 1
+        size = self.size if full else (max(1, self.size[0] // self.reduce),
+                                       max(1, self.size[1] // self.reduce))
+        start = clock.perf_counter()
+        try:
+            self._render(size, full)
+        except Exception as exc:  # noqa: BLE001 - any failure is shown, the last frame stays
+            self.render_error = one_line(f"{type(exc).__name__}: {exc}"
+                                         if not _framework_error(exc) else str(exc))
+            self.render_exception: Exception | None = exc
+        else:
+            self.render_error = self.render_exception = None
+        self.frame_ms = (clock.perf_counter() - start) * 1000.0
+        self.shown_key, self.shown_reduced = key, not full
+        return True
+
+    def _render(self, size: tuple[int, int], full: bool) -> None:
+        session = self.session
+        scene = session.scene
+        scene.camera = session.controller.camera()
+        time = self.timeline.time
+        self.pool.keep_only(scene, *([self._material_scene[1]] if self._material_scene else []))
+        if self.view_name:
+            self._render_view(size, time)
+            return
+        renderer = self.pool.get(scene, self.pipeline, self.light_path, size)
+        if full:
+            self.timings_first = renderer.last_frame is None  # compiling counted in
+            self.timings = timed_render(renderer, time)
+        else:
+            renderer.render(readback=False, time=time)
+        self.main.copy_from(renderer.targets[FINAL])
+        self.buffers = buffer_names(renderer, scene)
+        self.psnr = None
+        if self.mode != "single":
+            other = self.pool.get(scene, self.other_pipeline, self.other_light_path, size)
+            other.render(readback=False, time=time)
+            self.other.copy_from(other.targets[FINAL])
+            if full:
+                self.psnr = psnr(self.main.read(), self.other.read())
+        if self.recording is not None and full:
+            self.recording.write(self.main.read())
+
+    def _render_view(self, size: tuple[int, int], time: float) -> None:
+        scene = self.session.scene
+        token = (id(scene), self.session.version, self.view_name)
+        if self._material_scene is None or self._material_scene[0] != token:
+            self._material_scene = (token, material_view_scene(scene, self.view_name))
+        debug_scene = self._material_scene[1]
+        if debug_scene is not None:  # the material draws the view: its frame is the view
+            debug_scene.camera = scene.camera
+            renderer = self.pool.get(debug_scene, self.pipeline, self.light_path, size)
+            renderer.render(readback=False, time=time)
+            self.main.copy_from(renderer.targets[FINAL])
+            self.view_channels = ("R", "G", "B")
+            return
+        renderer = self.pool.get(scene, self.pipeline, self.light_path, size)
+        shown = capture_view(renderer, self.view_name, time)
+        self.view_channels = shown.channels
+        self.main.upload(display_image(shown, self.exposure, self.channel))
+        self.buffers = buffer_names(renderer, scene)
+
+    def full_renderer(self):
+        return self.pool.get(self.session.scene, self.pipeline, self.light_path, self.size)
+
+    # -- hot reload ------------------------------------------------------------------------------
+    def poll_files(self, force: bool = False) -> None:
+        shaders, scene_files = self.watcher.poll(force)
+        if scene_files:
+            error = self.session.reload()
+            if error is None:
+                self.watcher.track(self.session.scene)
+                self.timeline.duration = scene_duration(self.session.scene)
+                self.timeline.scrub(self.timeline.time)
+                self.note(f"reloaded {scene_files[0].name}")
+            else:
+                self.note(f"{scene_files[0].name} not reloaded: {error}")
+        if shaders:
+            self.pool.release()  # new renderers compile the files again
+            self._material_scene = None
+            self.shaders_generation += 1
+            self.note(f"recompiling: {', '.join(p.name for p in shaders[:3])} changed")
+
+    def note(self, text: str) -> None:
+        self.notes = [*self.notes[-4:], one_line(text)]
+
+    # -- actions the panels and keys share ---------------------------------------------------
+    def reset_camera(self) -> None:
+        self.session.controller.reset()
+        self.touch()
+
+    def touch(self) -> None:
+        """Input happened: reduced frames for a moment."""
+        self.last_input = clock.perf_counter()
+
+    def inspect(self, x: int, y: int) -> list[str]:
+        """The pixel history of frame pixel (x, y), top-down, for the inspector panel."""
+        self.pool.gl.make_current()
+        try:
+            renderer = self.full_renderer()
+            self.inspector = inspect_pixel(renderer, x, y, self.timeline.time)
+        except Exception as exc:  # noqa: BLE001 - shown in the panel
+            self.inspector = [one_line(str(exc))]
+        return self.inspector
+
+    def frame_pixel(self, x: float, y: float) -> tuple[int, int] | None:
+        """The frame pixel under window point (x, y), or None outside the viewport."""
+        rect = self.viewport_rect()
+        if not rect.contains(x, y):
+            return None
+        return int(x - rect.x), int(y - rect.y)
+
+    def viewport_image(self) -> np.ndarray:
+        """The frame shown, (H, W, 4) uint8, top row first."""
+        self.pool.gl.make_current()
+        return self.main.read()
+
+    def window_image(self) -> np.ndarray:
+        """The whole window as drawn last, panels included: (H, W, 3) uint8, top row first."""
+        self.pool.gl.make_current()
+        fbo = self.wnd.fbo
+        width, height = fbo.size
+        data = np.frombuffer(fbo.read(components=3, alignment=1), np.uint8)
+        return data.reshape(height, width, 3)[::-1].copy()
+
+    def screenshot(self, path: str | Path | None = None, window: bool = False) -> Path:
+        path = path or self.screenshot_path
+        hdr = None
+        if str(path).lower().endswith(".exr"):
+            hdr = self.full_renderer().read_hdr()
+        image = self.window_image() if window else self.viewport_image()
+        written = save_screenshot(path, image, hdr)
+        self.note(f"wrote {written}")
+        return written
+
+    def toggle_recording(self, path: str | None = None) -> None:
+        if self.recording is None:
+            self.recording = Recording(path or self.record_path, self.timeline.fps)
+            self.timeline.playing = True
+            self.note(f"recording {self.recording.path}")
+        else:
+            recording, self.recording = self.recording, None
+            self.note(f"wrote {recording.close()}")
+
+    def save(self, camera: bool = False) -> None:
+        try:
+            written = self.session.save(camera=camera)
+        except Exception as exc:  # noqa: BLE001 - shown in the panel
+            self.note(f"not saved: {exc}")
+            return
+        self.watcher.track(self.session.scene)  # our own write is no edit to reload
+        self.note(f"saved {written}" + (" (with the camera)" if camera else ""))
+
+    # -- drawing ---------------------------------------------------------------------------------
+    def draw(self) -> None:
+        """The viewport and the panels into the window's framebuffer."""
+        now = clock.perf_counter()
+        self._frame_times = [t for t in self._frame_times if now - t < 1.0] + [now]
+        self.fps = len(self._frame_times) - 1 if len(self._frame_times) > 1 else 0.0
+        self.pool.gl.make_current()
+        fbo = self.wnd.fbo
+        fbo.use()
+        self.ctx.viewport = (0, 0, *fbo.size)
+        self.ctx.scissor = None
+        fbo.clear(*BACKGROUND, 1.0)
+        rect = self.viewport_rect()
+        mode = "single" if self.view_name else self.mode
+        self.viewport.draw(fbo, fbo.size[1], rect, self.main,
+                           None if mode == "single" else self.other, mode, self.split_at,
+                           self.gain)
+        if self.show_panels:
+            imgui.set_current_context(self._imgui_context)
+            self.io.display_size = imgui.ImVec2(*self.wnd.size)
+            self.io.delta_time = max(1e-4, now - getattr(self, "_gui_time", now - 1 / 60))
+            self._gui_time = now
+            imgui.new_frame()
+            self.panel_errors = panels.draw(self, PANEL_WIDTH, self.wnd.size[1])
+            imgui.render()
+            self.imgui.render(imgui.get_draw_data(), fbo)
+
+    # -- input -----------------------------------------------------------------------------------
+    def _attach_events(self) -> None:
+        wnd = self.wnd
+        wnd.mouse_press_event_func = lambda x, y, b: self.mouse_press(
+            x, y, b, ctrl=bool(getattr(wnd.modifiers, "ctrl", False)))
+        wnd.mouse_release_event_func = self.mouse_release
+        wnd.mouse_drag_event_func = self.mouse_drag
+        wnd.mouse_position_event_func = self.mouse_move
+        wnd.mouse_scroll_event_func = self.mouse_scroll
+        wnd.key_event_func = self.key_event
+        wnd.unicode_char_entered_func = self.char_entered
+        wnd.resize_func = self.resize
+
+    def _in_panels(self, x: float) -> bool:
+        return self.show_panels and x < PANEL_WIDTH
+
+    def _pointer(self, x: float, y: float) -> None:
+        self.mouse = (float(x), float(y))
+        self.io.add_mouse_pos_event(float(x), float(y))
+
+    def mouse_move(self, x: float, y: float, dx: float = 0, dy: float = 0) -> None:
+        self._pointer(x, y)
+
+    def mouse_press(self, x: float, y: float, button: int, ctrl: bool = False) -> None:
+        self._pointer(x, y)
+        if self._in_panels(x):
+            self.io.add_mouse_button_event(_imgui_button(button), True)
+            return
+        pixel = self.frame_pixel(x, y)
+        if pixel is None:
+            return
+        if ctrl and button == 1:
+            self.inspect(*pixel)
+            return
+        self.dragging = button
+
+    def mouse_release(self, x: float, y: float, button: int) -> None:
+        self._pointer(x, y)
+        self.io.add_mouse_button_event(_imgui_button(button), False)
+        self.dragging = None
+
+    def mouse_drag(self, x: float, y: float, dx: float, dy: float) -> None:
+        self._pointer(x, y)
+        controller = self.session.controller
+        if self.dragging == 1:
+            controller.orbit(dx, dy)
+        elif self.dragging in (2, 3):
+            controller.pan(dx, dy, self.size[1])
+        else:
+            return
+        self.touch()
+
+    def mouse_scroll(self, x_offset: float, y_offset: float) -> None:
+        if self._in_panels(self.mouse[0]):
+            self.io.add_mouse_wheel_event(float(x_offset), float(y_offset))
+            return
+        self.session.controller.zoom(y_offset)
+        self.touch()
+
+    def char_entered(self, char: str) -> None:
+        self.io.add_input_character(ord(char))
+
+    def resize(self, width: int, height: int) -> None:
+        """A real window's viewport follows the window (the panels keep their width)."""
+        self.size = (max(16, width - (PANEL_WIDTH if self.show_panels else 0)),
+                     max(16, height))
+
+    def key_event(self, key: Any, action: Any, modifiers: Any) -> None:
+        keys = self.wnd.keys
+        pressed = action == keys.ACTION_PRESS
+        imgui_key = _imgui_key(keys, key)
+        if imgui_key is not None:
+            self.io.add_key_event(imgui_key, pressed)
+        ctrl = bool(getattr(modifiers, "ctrl", False))
+        self.io.add_key_event(imgui.Key.mod_ctrl, ctrl)
+        if not pressed:
+            self.keys_down.discard(key)
+            return
+        self.keys_down.add(key)
+        if self.io.want_text_input:
+            return
+        self.shortcut(key, ctrl)
+
+    def shortcut(self, key: Any, ctrl: bool = False) -> None:
+        """The keys (README.md, "The viewer")."""
+        keys = self.wnd.keys
+        if ctrl and key == keys.S:
+            self.save()
+        elif key == keys.R:
+            self.reset_camera()
+        elif key == keys.F:
+            self.session.controller.fly = not self.session.controller.fly
+        elif key == keys.SPACE:
+            self.timeline.toggle()
+        elif key == keys.RIGHT:
+            self.timeline.step(1)
+        elif key == keys.LEFT:
+            self.timeline.step(-1)
+        elif key == keys.HOME:
+            self.timeline.scrub(0.0)
+        elif key == keys.TAB:
+            self.mode = MODES[(MODES.index(self.mode) + 1) % len(MODES)]
+        elif key == keys.P:
+            self.pipeline, self.other_pipeline = self.other_pipeline, self.pipeline
+        elif key == keys.B:
+            self.view_name = None
+        elif key == keys.C and not ctrl:
+            self.save(camera=True)
+        elif key == keys.F12 if hasattr(keys, "F12") else False:
+            self.screenshot(window=False)
+        elif key == keys.H:
+            self.show_panels = not self.show_panels
+        elif key == keys.ESCAPE:
+            self.wnd.close()
+
+    def _fly(self, seconds: float) -> None:
+        controller = self.session.controller
+        if not controller.fly or not self.keys_down:
+            return
+        keys = self.wnd.keys
+        down = self.keys_down
+        forward = (keys.W in down) - (keys.S in down)
+        right = (keys.D in down) - (keys.A in down)
+        up = (keys.E in down) - (keys.Q in down)
+        if forward or right or up:
+            controller.fly_move(forward, right, up, min(seconds, 0.1))
+            self.touch()
+
+    # -- life ------------------------------------------------------------------------------------
+    def run(self) -> None:
+        """The window's loop until it closes."""
+        wnd = self.wnd
+        while not wnd.is_closing:
+            self.tick()
+            self.draw()
+            wnd.swap_buffers()
+            if not self.timeline.playing and not self.interacting() and \
+                    self.shown_key == self.state_key() and not self.shown_reduced:
+                clock.sleep(1 / 60)  # idle: the panels only
+
+    def close(self) -> None:
+        if self.recording is not None:
+            self.toggle_recording()
+        self.pool.release()
+        self.main.release()
+        self.other.release()
+        self.viewport.release()
+        self.imgui.release()
+        imgui.destroy_context(self._imgui_context)
+
+
+def _framework_error(exc: Exception) -> bool:
+    from deferred.errors import DeferredError
+
+    return isinstance(exc, DeferredError)
+
+
+def _imgui_button(button: int) -> int:
+    """moderngl-window's buttons (1 left, 2 right, 3 middle) as imgui's (0, 1, 2)."""
+    return {1: 0, 2: 1, 3: 2}.get(button, 0)
+
+
+def _imgui_key(keys: Any, key: Any) -> Any:
+    names = {"BACKSPACE": imgui.Key.backspace, "ENTER": imgui.Key.enter,
+             "TAB": imgui.Key.tab, "LEFT": imgui.Key.left_arrow,
+             "RIGHT": imgui.Key.right_arrow, "UP": imgui.Key.up_arrow,
+             "DOWN": imgui.Key.down_arrow, "DELETE": imgui.Key.delete,
+             "HOME": imgui.Key.home, "END": imgui.Key.end, "ESCAPE": imgui.Key.escape}
+    for name, imgui_key in names.items():
+        if getattr(keys, name, object()) == key:
+            return imgui_key
+    return None
+
+
+def run_headless(session: Session, options: ViewerOptions, screenshot: str | Path,
+                 gui_frames: int = 2) -> Path:
+    """Open the viewer's window offscreen, draw the frame (panels included) once, write it
+    to ``screenshot`` (.png) and close."""
+    size = options.size or session.scene.size
+    window = make_window(window_size(size, options.panels), headless=True)
+    viewer = Viewer(session, window, options)
+    try:
+        viewer.update(force_full=True)
+        for _ in range(gui_frames):  # imgui lays its windows out in the first frame
+            viewer.draw()
+        if viewer.render_exception is not None:
+            raise viewer.render_exception
+        return save_screenshot(screenshot, viewer.window_image())
+    finally:
+        viewer.close()
+        window.destroy()
+
+
+def run_window(session: Session, options: ViewerOptions) -> None:
+    size = options.size or session.scene.size
+    window = make_window(window_size(size, options.panels), headless=False)
+    viewer = Viewer(session, window, options)
+    try:
+        viewer.run()
+    finally:
+        viewer.close()
+        window.destroy()
