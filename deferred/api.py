@@ -76,6 +76,7 @@ from deferred.interfaces.effect import (
 from deferred.interfaces.light import (
     Light,
     LightParams,
+    ShadowParams,
     radiances,
     view_direction,
     view_directions,
@@ -88,11 +89,12 @@ from deferred.interfaces.material import (
     GBufferPass,
     Material,
     MaterialParams,
+    ShadowView,
 )
 from deferred.interfaces.registry import effects, lights, materials, shading_models
 from deferred.interfaces.shading import ShadingModel
 from deferred.io.images import check_image, read_channels, read_image, srgb_decode
-from deferred.names import LightPath, LightVolume, Pipeline
+from deferred.names import LightPath, LightVolume, Pipeline, ShadowProjection
 from deferred.params import Params, UniformOverrides
 from deferred.scene import Scene, SceneObject
 from deferred.scene.builtin_meshes import builtin_head_spheres
@@ -110,6 +112,8 @@ GLSL_INCLUDES: dict[str, str] = {
                           "object-space point (motion vectors; vertex shaders)",
     "common/lighting.glsl": "struct LightRecord and the shading-model interface (a light's "
                             "GLSL function)",
+    "lights/shadows.glsl": "light_shadow: the lit fraction of a shadowed light at a point "
+                           "(a light's GLSL function multiplies by it)",
     "common/forward_lighting.glsl": "every light of the frame at one surface point (forward "
                                     "passes)",
     "gbuffer/layout.glsl": "the G-buffer's encoding and decoding",
@@ -135,7 +139,7 @@ __all__ = [
     "BlinnPhongParams", "ClearPass", "Effect", "EffectParams", "ForwardLitPass", "Frame",
     "FullscreenPass", "GBufferData", "GBufferPass", "GpuMesh", "InputError", "Light",
     "LightParams", "LightPath", "LightVolume", "Material", "MaterialParams", "MeshData",
-    "MeshPrimitives",
+    "MeshPrimitives", "ShadowParams", "ShadowProjection", "ShadowView",
     "NonZeroVec3", "ObjectPass", "Order", "Params", "Phase", "Pipeline", "Radiance",
     "RenderError", "RenderPass", "Scene", "SceneObject", "ShadingModel", "TargetSpec",
     "UniformOverrides", "builtin_head_spheres", "check_image", "copy_pass", "effects", "halton",

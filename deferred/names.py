@@ -54,3 +54,19 @@ class LightVolume(NameEnum):
 
     FULLSCREEN = "fullscreen"  # every pixel (directional, ambient)
     SPHERE = "sphere"  # the record's position.xyz and radius position.w (point, spot)
+
+
+class ShadowProjection(NameEnum):
+    """How a light type's shadow maps see the scene (``Light.shadow_projection``;
+    ``deferred.lighting.shadows``)."""
+
+    CASCADES = "cascades"  # directional: orthographic cascades over the camera's depth range
+    PERSPECTIVE = "perspective"  # spot: one perspective map along the cone's axis
+    CUBE = "cube"  # point: six 90-degree perspective tiles of the atlas
+
+
+class ShadowFilter(NameEnum):
+    """A shadow map's filter (``shadow_filter``)."""
+
+    PCF = "pcf"  # 3x3 bilinear hardware comparisons (4x4 texels)
+    SOFT = "soft"  # a 16-tap Poisson disk of radius ``shadow_softness`` texels

@@ -5,11 +5,24 @@ from __future__ import annotations
 import numpy as np
 from pydantic import Field
 
-from deferred.api import Light, LightParams, LightVolume, NonZeroVec3, lights, view_direction
+from deferred.api import (
+    Light,
+    LightVolume,
+    NonZeroVec3,
+    ShadowParams,
+    ShadowProjection,
+    lights,
+    view_direction,
+)
 
 
-class DirectionalParams(LightParams):
+class DirectionalParams(ShadowParams):
     direction: NonZeroVec3 = Field((-0.4, -1.0, -0.6), description="direction the light travels")
+    cascades: int = Field(3, ge=1, le=4, description="shadow cascades over the view's depth")
+    cascade_lambda: float = Field(0.75, ge=0.0, le=1.0, description="cascade splits: 0 "
+                                  "uniform, 1 logarithmic (the practical split scheme's lambda)")
+    shadow_distance: float = Field(40.0, gt=0.0, description="view depth the cascades cover "
+                                   "(at most the camera's far plane)")
 
 
 @lights.register
@@ -19,6 +32,7 @@ class DirectionalLight(Light):
     glsl_file = "lights/directional.glsl"
     glsl_function = "directional_light"
     volume = LightVolume.FULLSCREEN
+    shadow_projection = ShadowProjection.CASCADES
 
     def record(self, view: np.ndarray) -> np.ndarray:
         record = np.zeros((4, 4), dtype=np.float32)

@@ -5,10 +5,18 @@ from __future__ import annotations
 import numpy as np
 from pydantic import Field
 
-from deferred.api import Light, LightParams, LightVolume, lights, radiances, view_points
+from deferred.api import (
+    Light,
+    LightVolume,
+    ShadowParams,
+    ShadowProjection,
+    lights,
+    radiances,
+    view_points,
+)
 
 
-class PointParams(LightParams):
+class PointParams(ShadowParams):
     position: tuple[float, float, float] = Field((0.0, 2.0, 2.0), description="world position")
     radius: float = Field(10.0, gt=0.0, description="distance at which the light reaches 0")
 
@@ -26,6 +34,7 @@ class PointLight(Light):
     glsl_file = "lights/point.glsl"
     glsl_function = "point_light"
     volume = LightVolume.SPHERE
+    shadow_projection = ShadowProjection.CUBE
 
     def record(self, view: np.ndarray) -> np.ndarray:
         return self.records([self], view)[0]

@@ -9,6 +9,7 @@ from deferred.api import (
     Light,
     LightVolume,
     NonZeroVec3,
+    ShadowProjection,
     lights,
     radiances,
     view_directions,
@@ -43,6 +44,7 @@ class SpotLight(Light):
     glsl_file = "lights/spot.glsl"
     glsl_function = "spot_light"
     volume = LightVolume.SPHERE
+    shadow_projection = ShadowProjection.PERSPECTIVE
 
     def record(self, view: np.ndarray) -> np.ndarray:
         return self.records([self], view)[0]

@@ -15,12 +15,12 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Literal
 
 import numpy as np
-from pydantic import Field
+from pydantic import Field, field_validator
 
-from deferred.names import LightVolume
+from deferred.names import LightVolume, ShadowProjection
 from deferred.params import Params, validate_params
 from deferred.validation import Radiance
 
@@ -38,11 +38,46 @@ class LightParams(Params):
     intensity: float = Field(1.0, ge=0.0, description="multiplier of color")
 
 
+MIN_SHADOW_RESOLUTION, MAX_SHADOW_RESOLUTION = 64, 8192
+
+
+class ShadowParams(LightParams):
+    """The parameters of a light that may cast shadows (a mixin of directional, spot and point
+    lights). Biases are in shadow-map texels at the shaded point (their world size there), so
+    they hold for any resolution, cascade and distance."""
+
+    shadows: bool = Field(False, description="cast shadows (a slot of the shadow atlas)")
+    shadow_resolution: int = Field(1024, description="texels on a side of each map (a power "
+                                   f"of two, {MIN_SHADOW_RESOLUTION}..{MAX_SHADOW_RESOLUTION})")
+    shadow_bias: float = Field(1.0, ge=0.0, le=16.0,
+                               description="depth bias toward the light, in texels")
+    normal_bias: float = Field(1.0, ge=0.0, le=16.0,
+                               description="offset along the surface normal, in texels")
+    shadow_filter: Literal["pcf", "soft"] = Field("pcf", description="pcf (3x3 hardware "
+                                        "comparisons) or soft (a wide Poisson disk)")
+    shadow_softness: float = Field(4.0, ge=1.0, le=32.0,
+                                   description="soft filter: the disk's radius, in texels")
+
+    @field_validator("shadow_resolution")
+    @classmethod
+    def _power_of_two(cls, value: int) -> int:
+        if not MIN_SHADOW_RESOLUTION <= value <= MAX_SHADOW_RESOLUTION or value & (value - 1):
+            raise ValueError(f"must be a power of two in {MIN_SHADOW_RESOLUTION}.."
+                             f"{MAX_SHADOW_RESOLUTION}")
+        return value
+
+
 class Light:
     """A light type: a ``name``, a validated ``Params`` model, a GLSL function
     (``glsl_file``, ``glsl_function``: ``vec3 f(LightRecord light, Surface s, vec3 P, vec3 V)``)
     and how it packs itself for the GPU (:meth:`record`: four ``vec4`` in view space).
     ``volume`` says whether it lights the whole screen or a sphere around it.
+
+    A type whose ``Params`` derive from :class:`ShadowParams` and that names a
+    ``shadow_projection`` casts shadows when ``shadows = true``: the framework writes the
+    light's shadow slot into its record's ``extra.w`` (so a record leaves ``extra.w`` alone),
+    and the GLSL function multiplies what it returns by ``light_shadow(...)``
+    (``lights/shadows.glsl``).
     """
 
     name: ClassVar[str]
@@ -50,6 +85,8 @@ class Light:
     glsl_file: ClassVar[str] = ""
     glsl_function: ClassVar[str] = ""
     volume: ClassVar[LightVolume] = LightVolume.FULLSCREEN
+    # how its shadow maps are made, where its Params are ShadowParams (None: it casts none)
+    shadow_projection: ClassVar[ShadowProjection | None] = None
     shader_root: ClassVar[Traversable | Path | None] = None
     type_id: ClassVar[int] = 0  # set by the registry
 
@@ -59,6 +96,12 @@ class Light:
     @classmethod
     def from_dict(cls, values: dict[str, Any], where: str | None = None) -> Light:
         return cls(validate_params(cls.Params, values, where))
+
+    @property
+    def casts_shadows(self) -> bool:
+        """Whether this light asks for shadow maps (``shadows = true`` on a type that has a
+        ``shadow_projection``)."""
+        return self.shadow_projection is not None and bool(getattr(self.params, "shadows", False))
 
     def radiance(self) -> np.ndarray:
         return np.asarray(self.params.color, dtype=np.float64) * self.params.intensity

@@ -17,10 +17,12 @@ from __future__ import annotations
 
 import sys
 from collections.abc import Iterable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
 
 import moderngl
+import numpy as np
 from pydantic import Field
 
 from deferred.core.passes import ObjectPass, Phase, RenderPass
@@ -81,6 +83,26 @@ class ForwardLitPass(ObjectPass):
     colors = (COMPOSITE,)
     depth = DEPTH
     depth_func = "lequal"
+
+
+SHADOW_CASTER_VERTEX = "shadows/caster.vert"
+SHADOW_CASTER_FRAGMENT = "shadows/caster.frag"
+
+
+@dataclass(frozen=True)
+class ShadowView:
+    """One shadow map being drawn (:meth:`Material.draw_shadow`): the light's world -> clip
+    matrix, and where the light is (a world position, or ``None`` for a directional light)
+    and the direction it shines (world, unit), for casters that shape themselves to it."""
+
+    view_projection: np.ndarray
+    position: np.ndarray | None
+    direction: np.ndarray
+
+    @property
+    def uniforms(self) -> dict[str, Any]:
+        """``u_shadow_view_projection``: what ``shadows/caster.vert`` reads."""
+        return {"u_shadow_view_projection": self.view_projection}
 
 
 class Material:
@@ -264,6 +286,17 @@ class Material:
         setup, screen or post effects of its own); ``objects`` are the scene's objects of this
         material. Passes of one name from several materials (a shared technique's) run once."""
         return []
+
+    def draw_shadow(self, frame: Frame, obj: SceneObjectLike, view: ShadowView) -> None:
+        """Draw ``obj``'s depth into the shadow map ``view`` (the framework has bound that
+        tile of the shadow atlas, cleared it and set depth-only state: depth test, no culling,
+        a slope-scaled depth offset). By default the mesh through ``shadows/caster.vert``; a
+        material whose look is not its mesh (fur shells, displaced strands) draws that, with
+        ``view.uniforms`` and a vertex stage of its own; one that casts no shadow draws
+        nothing."""
+        program = frame.shaders.program(SHADOW_CASTER_VERTEX, SHADOW_CASTER_FRAGMENT)
+        frame.bind(program, view.uniforms, offered=frame.object_uniforms(obj))
+        frame.draw_mesh(obj.mesh, program)
 
     def passes(self, phase: Phase, obj: SceneObjectLike) -> list[RenderPass]:
         hooks = {Phase.GEOMETRY: self.geometry_passes, Phase.SCREEN: self.screen_passes,

@@ -70,10 +70,12 @@ class LightBuffer:
         self._packed: tuple | None = None  # what the texture holds the records of (upload)
 
     @staticmethod
-    def pack(lights: list[Light], view: np.ndarray, projection: np.ndarray | None = None
-             ) -> tuple[np.ndarray, dict, int]:
+    def pack(lights: list[Light], view: np.ndarray, projection: np.ndarray | None = None,
+             shadow_slots: dict[int, int] | None = None) -> tuple[np.ndarray, dict, int]:
         """(records, type -> (offset, count), full-screen light count): full-screen lights
-        first, then volume lights inside the frustum of ``projection`` (all when None)."""
+        first, then volume lights inside the frustum of ``projection`` (all when None). A
+        light in ``shadow_slots`` (by ``id``) has its shadow slot in ``extra.w``
+        (deferred.lighting.shadows), the others 0."""
         ordered = sorted(lights, key=lambda light: (light.volume != LightVolume.FULLSCREEN,
                                                     light.type_id))  # stable: scene order kept
         records = np.zeros((len(ordered), RECORD_VEC4S, 4), dtype=np.float32)
@@ -82,6 +84,8 @@ class LightBuffer:
             run = list(run)
             records[start:start + len(run)] = light_type.records(run, view)
             records[start:start + len(run), 0, 3] = float(light_type.type_id)
+            records[start:start + len(run), 3, 3] = [float((shadow_slots or {}).get(id(light), 0))
+                                                     for light in run]
             start += len(run)
         keep = np.ones(len(ordered), bool)
         volumes = np.array([light.volume != LightVolume.FULLSCREEN for light in ordered], bool)
@@ -97,23 +101,24 @@ class LightBuffer:
         return records, ranges, global_count
 
     def upload(self, lights: list[Light], view: np.ndarray,
-               projection: np.ndarray | None = None) -> None:
+               projection: np.ndarray | None = None,
+               shadow_slots: dict[int, int] | None = None) -> None:
         """Pack the lights' records (culled by ``projection``'s frustum) into the texture. The
         same lights with the same parameters (frozen: a change replaces them) seen from the
         same camera give the same records, so they are packed and uploaded only when one of
         these changes: packing costs milliseconds a frame at 1024 lights."""
         key = (np.asarray(view).tobytes(),
                None if projection is None else np.asarray(projection).tobytes(),
-               [(light, light.params) for light in lights])
+               [(light, light.params) for light in lights], dict(shadow_slots or {}))
         if self._texture is not None and key == self._packed:
             return
         self._packed = None  # until this upload is done
-        self._upload(lights, view, projection)
+        self._upload(lights, view, projection, shadow_slots)
         self._packed = key
 
     def _upload(self, lights: list[Light], view: np.ndarray,
-                projection: np.ndarray | None) -> None:
-        records, ranges, global_count = self.pack(lights, view, projection)
+                projection: np.ndarray | None, shadow_slots: dict[int, int] | None) -> None:
+        records, ranges, global_count = self.pack(lights, view, projection, shadow_slots)
         # lights added after the renderer checked them (check_light_limits): refused before
         # anything here changes
         if global_count > FULLSCREEN_LIGHT_CAPACITY:

@@ -50,6 +50,7 @@ from deferred.gl.targets import (
 from deferred.interfaces.effect import AMBIENT_OCCLUSION
 from deferred.interfaces.material import ForwardLitPass
 from deferred.lighting.culling import LightCullPass, list_shading_pass
+from deferred.lighting.shadows import ShadowPass, scene_casts_shadows
 from deferred.lighting.volumes import LightTypePass, surface_pass
 from deferred.memo import overrides
 from deferred.scene.model import Scene
@@ -160,7 +161,8 @@ class DeferredPipeline(Pipeline):
         layout = scene.gbuffer_layout()
         wide = scene_passes(scene, self.name)
         clear = ClearPass("gbuffer.clear", Phase.GEOMETRY, layout.targets)
-        passes = phase_passes(scene, Phase.GEOMETRY, [clear], wide)
+        shadows = [ShadowPass(Phase.GEOMETRY)] if scene_casts_shadows(scene.lights) else []
+        passes = phase_passes(scene, Phase.GEOMETRY, [*shadows, clear], wide)
         passes += phase_passes(scene, Phase.SCREEN, [], wide)
         passes += phase_passes(scene, Phase.STIPPLE, [], wide)
         occlusion = AMBIENT_OCCLUSION if any(AMBIENT_OCCLUSION in p.creates for p in passes) \
@@ -216,7 +218,8 @@ class ForwardPipeline(Pipeline):
             fixed.append(LightCullPass("forward.cull_tiles", Phase.FORWARD, clustered=False,
                                        from_near=True))
         clear = ClearPass("forward.clear", Phase.FORWARD, creates)
-        passes = phase_passes(scene, Phase.FORWARD, [clear, *fixed], wide)
+        shadows = [ShadowPass(Phase.FORWARD)] if scene_casts_shadows(scene.lights) else []
+        passes = phase_passes(scene, Phase.FORWARD, [*shadows, clear, *fixed], wide)
         passes += phase_passes(scene, Phase.POST, [tonemap_pass(scene)], wide)
         return passes
 

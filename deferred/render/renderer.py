@@ -35,6 +35,12 @@ from deferred.lighting.lists import (
     check_light_radii,
 )
 from deferred.lighting.paths import resolve_light_path
+from deferred.lighting.shadows import (
+    SHADOW_ATLAS,
+    SHADOWS_DEFINE,
+    ShadowAtlas,
+    scene_casts_shadows,
+)
 from deferred.memo import overrides
 from deferred.names import LightVolume, Pipeline
 from deferred.params import validate_params
@@ -336,6 +342,8 @@ class Renderer:
         if self.light_path != provisional:
             self.graph = check_passes(self.pipeline.build(scene))
         defines = dict(self.pipeline.shader_defines())
+        if scene_casts_shadows(scene.lights):
+            defines[SHADOWS_DEFINE] = "1"
         self.shaders = ShaderLibrary(ctx, features.glsl_version(), defines)
         for root in roots:
             self.shaders.add_root(root)
@@ -346,11 +354,16 @@ class Renderer:
         self.resources = Resources(ctx)
         self.light_buffer = LightBuffer(ctx)
         self.light_lists = LightLists(ctx) if features.compute_shaders else None
+        budget = scene.shadow_budget
+        self.shadow_atlas = ShadowAtlas(ctx, budget.atlas_size, budget.max_shadowed_lights) \
+            if scene_casts_shadows(scene.lights) else None
         # The per-frame GPU resources every frame is given: by name on its blackboard (for the
         # passes that fill or read them), and those that bind themselves to every program as
-        # its binding sources. A new global resource (a shadow atlas) is one more entry here.
-        self.blackboard = {LIGHT_BUFFER: self.light_buffer, LIGHT_LISTS: self.light_lists}
-        self.binding_sources = [source for source in (self.light_buffer, self.light_lists)
+        # its binding sources. A new global resource is one more entry here.
+        self.blackboard = {LIGHT_BUFFER: self.light_buffer, LIGHT_LISTS: self.light_lists,
+                           SHADOW_ATLAS: self.shadow_atlas}
+        self.binding_sources = [source for source in (self.light_buffer, self.light_lists,
+                                                      self.shadow_atlas)
                                 if source is not None]
         self.checked_framebuffers: dict = {}  # Frame.use_framebuffer's, for the renderer's life
         self.last_frame: Frame | None = None
@@ -458,7 +471,10 @@ class Renderer:
         shading = ShadingTextures.of(self.shading_models, frame)  # the models' samplers, if any
         if shading is not None:
             frame.binding_sources.insert(0, shading)
-        self.light_buffer.upload(self.scene.lights, frame.view, frame.projection)
+        slots = None
+        if self.shadow_atlas is not None:
+            slots = self.shadow_atlas.update(self.scene, frame.view, frame.width / frame.height)
+        self.light_buffer.upload(self.scene.lights, frame.view, frame.projection, slots)
         self._check_gl("uploading the lights")
         # asked of each class once a frame, not of each pass (a pass an object)
         preparing = {cls for cls in {type(p) for p in self.passes}
@@ -626,8 +642,8 @@ class Renderer:
         some), not the context."""
         self.gl.make_current()
         self.gl.park()
-        for name in ("kept_inputs", "light_buffer", "light_lists", "resources", "targets",
-                     "shaders"):
+        for name in ("kept_inputs", "light_buffer", "light_lists", "shadow_atlas", "resources",
+                     "targets", "shaders"):
             part = getattr(self, name, None)
             if part is not None:
                 part.release()

@@ -34,6 +34,7 @@ from deferred.scene.model import (
     CameraModel,
     Scene,
     SceneObject,
+    ShadowBudget,
     Transform,
     check_light_name,
     check_size,
@@ -127,6 +128,22 @@ class TypedModel(BaseModel):
     type: str
 
 
+class ShadowsModel(_Strict):
+    """The ``[shadows]`` table: the shadow atlas and its budget (:class:`ShadowBudget`)."""
+
+    atlas_size: int = Field(4096, description="texels on a side of the shadow atlas (a power "
+                                              "of two, 256..16384)")
+    max_shadowed_lights: int = Field(16, ge=1, le=64, description="lights given shadow maps, "
+                                     "in scene order; the rest are unshadowed")
+
+    @field_validator("atlas_size")
+    @classmethod
+    def _power_of_two(cls, value: int) -> int:
+        if not 256 <= value <= 16384 or value & (value - 1):
+            raise ValueError("must be a power of two in 256..16384")
+        return value
+
+
 class SceneModel(_Strict):
     size: tuple[int, int] = (1280, 720)
     background: Radiance = Field((0.02, 0.02, 0.025),
@@ -137,6 +154,7 @@ class SceneModel(_Strict):
         None, description="how lights reach the pixels (deferred.lighting.paths); default the "
                           "fastest the context allows")
     camera: CameraModel = Field(default_factory=CameraModel)
+    shadows: ShadowsModel = Field(default_factory=ShadowsModel)
     ssao: dict[str, Any] | None = Field(
         None, description="screen-space ambient occlusion (the same as [[effect]] type 'ssao')")
     object: list[ObjectModel] = Field(default_factory=list)
@@ -211,7 +229,9 @@ def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
     c = model.camera
     scene = Scene(camera=Camera(c.position, c.target, c.up, c.fov, c.near, c.far),
                   size=model.size, background=model.background, exposure=model.exposure,
-                  tonemap=model.tonemap, light_path=model.light_path, source=name)
+                  tonemap=model.tonemap, light_path=model.light_path, source=name,
+                  shadow_budget=ShadowBudget(model.shadows.atlas_size,
+                                             model.shadows.max_shadowed_lights))
     meshes: dict[str, MeshData | None] = {}
     # label -> (the object, or None where it is not made; its material class, where known)
     labels: dict[str, tuple[SceneObject | None, type[Material] | None]] = {}

@@ -370,6 +370,17 @@ class SceneObject:
         return replace(self, material=material, base_params=material.params, events=events)
 
 
+
+@dataclass(frozen=True)
+class ShadowBudget:
+    """The scene's shadow atlas (a ``[shadows]`` table): one depth texture of ``atlas_size``
+    texels on a side holding every shadowed light's maps, for at most ``max_shadowed_lights``
+    lights (those beyond, or whose maps do not fit, are drawn unshadowed, with a warning)."""
+
+    atlas_size: int = 4096
+    max_shadowed_lights: int = 16
+
+
 @dataclass
 class Scene:
     """A scene ready to render (meshes loaded, materials and lights validated)."""
@@ -382,6 +393,7 @@ class Scene:
     exposure: float = 1.0
     tonemap: str = "aces"
     light_path: str | None = None
+    shadow_budget: ShadowBudget = field(default_factory=ShadowBudget)
     effects: list[Effect] = field(default_factory=list)
     source: str = "<memory>"
     # the camera's and lights' keyframe tracks (add_track; objects keep theirs), the

@@ -1,10 +1,13 @@
-// Point light: distance_falloff to zero at the radius (position.w).
+// Point light: distance_falloff to zero at the radius (position.w); shadowed through six cube
+// tiles where it casts shadows (lights/shadows.glsl).
 #include "common/lighting.glsl"
+#include "lights/shadows.glsl"
 
 vec3 point_light(LightRecord light, Surface s, vec3 P, vec3 V) {
     vec3 to_light = light.position.xyz - P;
     float d = length(to_light);
     float falloff = distance_falloff(d, light.position.w);
     if (falloff <= 0.0) return vec3(0.0);
-    return shade_light(s, to_light / d, V, light.color.rgb * falloff);
+    vec3 L = to_light / d;
+    return shade_light(s, L, V, light.color.rgb * falloff * light_shadow(light, P, s.normal, L));
 }

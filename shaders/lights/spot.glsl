@@ -1,6 +1,8 @@
 // Spot light: a point light times cone_falloff around direction.xyz
-// (direction.w = cos outer angle, extra.x = cos inner angle).
+// (direction.w = cos outer angle, extra.x = cos inner angle); shadowed through one perspective
+// map where it casts shadows (lights/shadows.glsl).
 #include "common/lighting.glsl"
+#include "lights/shadows.glsl"
 
 vec3 spot_light(LightRecord light, Surface s, vec3 P, vec3 V) {
     vec3 to_light = light.position.xyz - P;
@@ -9,5 +11,6 @@ vec3 spot_light(LightRecord light, Surface s, vec3 P, vec3 V) {
     float cone = cone_falloff(dot(-L, light.direction.xyz), light.direction.w, light.extra.x);
     float falloff = distance_falloff(d, light.position.w) * cone;
     if (falloff <= 0.0) return vec3(0.0);
+    falloff *= light_shadow(light, P, s.normal, L);
     return shade_light(s, L, V, light.color.rgb * falloff);
 }

@@ -1,0 +1,410 @@
+"""Shadow maps: one depth atlas for every shadowed light, its records, and the pass drawing the
+casters into it.
+
+A light casts shadows when its type names a ``shadow_projection`` and its params say
+``shadows = true`` (:class:`deferred.interfaces.light.ShadowParams`). Each such light, in scene
+order up to the scene's ``max_shadowed_lights``, is given a *slot* and square tiles of
+``shadow_resolution`` texels in the atlas (a quadtree of power-of-two squares):
+
+- ``cascades`` (directional): ``cascades`` orthographic maps over the camera's depth up to
+  ``shadow_distance``, split by the practical split scheme (Zhang et al. 2006, "Parallel-Split
+  Shadow Maps", Eq. 3: ``lambda`` between logarithmic and uniform splits). Each cascade bounds
+  its slice of the view frustum by a sphere, whose size does not change as the camera turns,
+  and its origin is snapped to whole texels, so a moving camera does not make the shadow's
+  edges shimmer; lookups blend the last tenth of a cascade into the next.
+- ``perspective`` (spot): one map along the cone's axis, wide enough for the outer angle.
+- ``cube`` (point): six 90-degree maps (a little wider, so a filter near a face's edge reads
+  the face's own texels), chosen by the major axis of the direction from the light.
+
+The light's record carries its slot in ``extra.w`` (the light lists keep a light's index, so
+every light path and both pipelines read the slot with the record); the slot's row of the
+records texture holds its matrices from view space to the atlas (``lights/shadows.glsl``
+documents the layout). The atlas is one binding source of the frame, bound to every program
+that reads it; programs only read it where the scene has a shadowed light (the define
+``SHADOWS``), so a scene without shadows pays nothing.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import moderngl
+import numpy as np
+import pyrr
+
+from deferred.core.passes import Order, Phase, RenderPass
+from deferred.interfaces.light import Light
+from deferred.interfaces.material import ShadowView
+from deferred.names import ShadowProjection
+
+if TYPE_CHECKING:
+    from deferred.core.frame import Frame
+    from deferred.gl.uniforms import ProgramUniforms
+    from deferred.scene.model import Scene
+
+SHADOW_ATLAS = "shadow_atlas"  # its name on a frame's blackboard
+SHADOWS_DEFINE = "SHADOWS"
+RECORD_TEXELS = 40  # texels a slot's row: 4 + 6 tiles x 6 (lights/shadows.glsl)
+MAX_TILES = 6
+CASCADE_BLEND = 0.1  # the fraction of a cascade blended into the next at its far end
+# the caster pass's slope-scaled depth offset (glPolygonOffset factor, units): with the
+# lookup's normal offset and depth bias (texels), no acne down to grazing light
+CASTER_DEPTH_OFFSET = (1.5, 2.0)
+PROJECTION_IDS = {ShadowProjection.CASCADES: 1, ShadowProjection.PERSPECTIVE: 2,
+                  ShadowProjection.CUBE: 3}
+# cube faces: the direction each looks along and its up (the lookup's major-axis order)
+CUBE_FACES = (((1, 0, 0), (0, -1, 0)), ((-1, 0, 0), (0, -1, 0)), ((0, 1, 0), (0, 0, 1)),
+              ((0, -1, 0), (0, 0, -1)), ((0, 0, 1), (0, -1, 0)), ((0, 0, -1), (0, -1, 0)))
+
+
+def scene_casts_shadows(lights: list[Light]) -> bool:
+    return any(light.casts_shadows for light in lights)
+
+
+def practical_splits(near: float, far: float, count: int, lam: float) -> np.ndarray:
+    """The far view depth of each of ``count`` cascades over [near, far]: the practical split
+    scheme, ``lam`` x logarithmic + (1 - ``lam``) x uniform (Zhang et al. 2006, Eq. 3)."""
+    i = np.arange(1, count + 1) / count
+    return lam * near * (far / near) ** i + (1.0 - lam) * (near + (far - near) * i)
+
+
+def look_at(eye, direction, up) -> np.ndarray:
+    eye = np.asarray(eye, np.float64)
+    return pyrr.matrix44.create_look_at(eye, eye + np.asarray(direction, np.float64),
+                                        np.asarray(up, np.float64)).T
+
+
+def orthographic(left: float, right: float, bottom: float, top: float, near: float,
+                 far: float) -> np.ndarray:
+    return pyrr.matrix44.create_orthogonal_projection(left, right, bottom, top, near, far,
+                                                      dtype=np.float64).T
+
+
+def perspective(tan_half: float, near: float, far: float) -> np.ndarray:
+    return pyrr.matrix44.create_perspective_projection(
+        2.0 * math.degrees(math.atan(tan_half)), 1.0, near, far, dtype=np.float64).T
+
+
+def filter_margin(params: Any) -> float:
+    """Texels a lookup's filter reaches from its centre (PCF: a texel, plus bilinear)."""
+    return 2.0 if params.shadow_filter == "pcf" else math.ceil(params.shadow_softness) + 1.0
+
+
+def light_up(direction: np.ndarray) -> np.ndarray:
+    """An up vector for a light looking along ``direction`` (world +Y unless nearly along)."""
+    return np.array([0.0, 0.0, 1.0]) if abs(direction[1]) > 0.99 else np.array([0.0, 1.0, 0.0])
+
+
+def unit(v) -> np.ndarray:
+    v = np.asarray(v, np.float64)
+    return v / max(float(np.linalg.norm(v)), 1e-12)
+
+
+def tile_matrix(x: int, y: int, size: int, atlas: int) -> np.ndarray:
+    """NDC of a map -> (u, v, depth) of its tile in the atlas."""
+    half = size / (2.0 * atlas)
+    return np.array([[half, 0.0, 0.0, x / atlas + half], [0.0, half, 0.0, y / atlas + half],
+                     [0.0, 0.0, 0.5, 0.5], [0.0, 0.0, 0.0, 1.0]])
+
+
+@dataclass
+class ShadowTile:
+    """One map of a light: its square of the atlas and the light's view and projection."""
+
+    light: Light
+    slot: int
+    x: int
+    y: int
+    size: int
+    view_projection: np.ndarray = None  # world -> clip (the caster pass)
+    view: ShadowView = None
+    # the light's reach (centre, radius) for culling casters; None: every object
+    reach: tuple[np.ndarray, float] | None = None
+
+
+class QuadtreeAllocator:
+    """Power-of-two squares in a power-of-two atlas: each request takes the smallest free
+    square that holds it, split down to its size (largest requests first)."""
+
+    def __init__(self, size: int):
+        self.free: list[tuple[int, int, int]] = [(0, 0, size)]
+
+    def take(self, size: int) -> tuple[int, int] | None:
+        fitting = [square for square in self.free if square[2] >= size]
+        if not fitting:
+            return None
+        square = min(fitting, key=lambda sq: (sq[2], sq[1], sq[0]))
+        self.free.remove(square)
+        x, y, s = square
+        while s > size:
+            s //= 2
+            self.free += [(x + s, y, s), (x, y + s, s), (x + s, y + s, s)]
+        return x, y
+
+
+def tile_counts(light: Light) -> int:
+    kind = light.shadow_projection
+    if kind == ShadowProjection.CASCADES:
+        return int(light.params.cascades)
+    return MAX_TILES if kind == ShadowProjection.CUBE else 1
+
+
+def plan_atlas(lights: list[Light], atlas_size: int, max_lights: int
+               ) -> tuple[dict[int, tuple[int, list[tuple[int, int, int]]]], list[str]]:
+    """Slots and tiles for the shadowed ``lights`` (scene order): ``{id(light): (slot,
+    [(x, y, size), ...])}``, and why each light left out is (for the warning)."""
+    wanted = [light for light in lights if light.casts_shadows]
+    left_out = [f"light {lights.index(light)} (max_shadowed_lights = {max_lights})"
+                for light in wanted[max_lights:]]
+    wanted = wanted[:max_lights]
+    requests = sorted(((light.params.shadow_resolution, order, light)
+                       for order, light in enumerate(wanted) for _ in range(tile_counts(light))),
+                      key=lambda item: (-item[0], item[1]))
+    allocator = QuadtreeAllocator(atlas_size)
+    tiles: dict[int, list[tuple[int, int, int]]] = {}
+    failed: set[int] = set()
+    for size, _, light in requests:
+        if id(light) in failed:
+            continue
+        place = allocator.take(size) if size <= atlas_size else None
+        if place is None:
+            failed.add(id(light))
+            continue
+        tiles.setdefault(id(light), []).append((*place, size))
+    plan: dict[int, tuple[int, list[tuple[int, int, int]]]] = {}
+    for light in wanted:
+        if id(light) in failed:
+            left_out.append(f"light {lights.index(light)} (its {tile_counts(light)} map(s) of "
+                            f"{light.params.shadow_resolution}^2 do not fit the "
+                            f"{atlas_size}^2 atlas)")
+        else:
+            plan[id(light)] = (len(plan) + 1, tiles[id(light)])
+    return plan, left_out
+
+
+def world_bounds(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
+    """The world box of every object (corners of each mesh's box through its model matrix)."""
+    lows, highs = [], []
+    for obj in scene.objects:
+        low, high = obj.mesh.bounds()
+        corners = np.array([[x, y, z, 1.0] for x in (low[0], high[0]) for y in (low[1], high[1])
+                            for z in (low[2], high[2])])
+        world = (np.asarray(obj.model, np.float64) @ corners.T).T[:, :3]
+        lows.append(world.min(axis=0))
+        highs.append(world.max(axis=0))
+    if not lows:
+        return np.zeros(3), np.zeros(3)
+    return np.min(lows, axis=0), np.max(highs, axis=0)
+
+
+class ShadowAtlas:
+    """The shadow atlas, its records texture and this frame's tiles (a binding source)."""
+
+    def __init__(self, ctx: moderngl.Context, atlas_size: int, max_lights: int):
+        self.ctx = ctx
+        self.size = atlas_size
+        self.max_lights = max_lights
+        self.texture = ctx.depth_texture((atlas_size, atlas_size))
+        self.texture.compare_func = "<="
+        self.texture.filter = (moderngl.LINEAR, moderngl.LINEAR)
+        self.texture.repeat_x = self.texture.repeat_y = False
+        self.framebuffer = ctx.framebuffer(depth_attachment=self.texture)
+        self.records = ctx.texture((RECORD_TEXELS, max_lights), 4, dtype="f4")
+        self.records.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        self.tiles: list[ShadowTile] = []
+        self.slots: dict[int, int] = {}  # id(light) -> slot (1-based)
+        self.splits: dict[int, np.ndarray] = {}  # id(light) -> its cascades' far depths
+        self._plan_key: tuple | None = None
+        self._plan: dict = {}
+        self._uniforms: dict[str, Any] = {}
+
+    # -- per frame ---------------------------------------------------------------------------
+    def update(self, scene: Scene, view: np.ndarray, aspect: float) -> dict[int, int]:
+        """This frame's tiles and records for the scene's lights seen through ``view`` (the
+        camera's world -> view); the slots by ``id(light)``."""
+        key = tuple((id(light), light.params) for light in scene.lights)
+        if key != self._plan_key:
+            self._plan, left_out = plan_atlas(scene.lights, self.size, self.max_lights)
+            self._plan_key = key
+            if left_out:
+                warnings.warn(f"{scene.source}: unshadowed, over the shadow budget: "
+                              f"{'; '.join(left_out)}", stacklevel=2)
+        view = np.asarray(view, np.float64)
+        inverse_view = np.linalg.inv(view)
+        records = np.zeros((self.max_lights, RECORD_TEXELS, 4), np.float32)
+        self.tiles, self.slots, self.splits = [], {}, {}
+        bounds = None
+        for light in scene.lights:
+            planned = self._plan.get(id(light))
+            if planned is None:
+                continue
+            slot, squares = planned
+            params = light.params
+            kind = light.shadow_projection
+            row = records[slot - 1]
+            row[0] = (PROJECTION_IDS[kind], len(squares),
+                      0.0 if params.shadow_filter == "pcf" else 1.0, params.shadow_softness)
+            row[1] = (params.shadow_bias, params.normal_bias, CASCADE_BLEND, 0.0)
+            if kind == ShadowProjection.CASCADES:
+                if bounds is None:
+                    bounds = world_bounds(scene)
+                frusta = self._cascades(light, scene, view, inverse_view, aspect, bounds,
+                                        squares[0][2])
+                splits = np.array([far for far, *_ in frusta])
+                row[2, :len(splits)] = splits
+                self.splits[id(light)] = splits
+            elif kind == ShadowProjection.PERSPECTIVE:
+                frusta = [self._spot(light, squares[0][2])]
+            else:
+                frusta = self._cube(light, squares[0][2])
+            for index, ((x, y, size), (_, light_view, projection, texel, perspective_texel,
+                                       reach)) in enumerate(zip(squares, frusta, strict=True)):
+                view_projection = projection @ light_view
+                to_atlas = tile_matrix(x, y, size, self.size) @ view_projection @ inverse_view
+                base = 4 + 6 * index
+                row[base:base + 4] = to_atlas.T  # columns
+                row[base + 4] = (x / self.size, y / self.size, (x + size) / self.size,
+                                 (y + size) / self.size)
+                row[base + 5] = (texel, 1.0 if perspective_texel else 0.0, 0.0, 0.0)
+                position = None if kind == ShadowProjection.CASCADES else \
+                    np.asarray(params.position, np.float64)
+                direction = unit(-light_view[2, :3])
+                self.tiles.append(ShadowTile(light, slot, x, y, size, view_projection,
+                                             ShadowView(view_projection, position, direction),
+                                             reach))
+            self.slots[id(light)] = slot
+        self.records.write(records.tobytes())
+        self._uniforms = {"u_shadow_world_from_view": inverse_view[:3, :3].copy(),
+                          "u_shadow_atlas_texel": 1.0 / self.size}
+        return self.slots
+
+    def _cascades(self, light: Light, scene: Scene, view: np.ndarray, inverse_view: np.ndarray,
+                  aspect: float, bounds: tuple[np.ndarray, np.ndarray], resolution: int
+                  ) -> list[tuple]:
+        params = light.params
+        camera = scene.camera
+        near = camera.near
+        far = min(camera.far, params.shadow_distance)
+        splits = practical_splits(near, far, params.cascades, params.cascade_lambda)
+        direction = unit(params.direction)
+        light_view = look_at((0.0, 0.0, 0.0), direction, light_up(direction))
+        tan_y = math.tan(math.radians(camera.fov) / 2.0)
+        k2 = tan_y * tan_y * (1.0 + aspect * aspect)  # squared corner radius per unit depth
+        low, high = bounds
+        corners = np.array([[x, y, z, 1.0] for x in (low[0], high[0]) for y in (low[1], high[1])
+                            for z in (low[2], high[2])])
+        scene_z = (light_view @ corners.T)[2]
+        eye = inverse_view[:3, 3]
+        forward = -inverse_view[:3, 2]
+        frusta = []
+        start = near
+        for end in splits:
+            # the slice's bounding sphere: its centre on the view axis, equally far from the
+            # near and far corners (at most the far corners' centre); it depends on the
+            # slice's depths and the field of view only, not on where the camera looks
+            centre_depth = min((end + start) * (1.0 + k2) / 2.0, end)
+            radius = math.sqrt((end - centre_depth) ** 2 + end * end * k2)
+            centre = (light_view @ np.append(eye + forward * centre_depth, 1.0))[:3]
+            texel = 2.0 * radius / resolution
+            # snapped to whole texels: the map moves in steps of a texel (stable edges)
+            cx, cy = (np.floor(centre[:2] / texel) * texel)
+            z_near = -max(centre[2] + radius, float(scene_z.max())) - texel
+            z_far = -(centre[2] - radius) + texel
+            projection = orthographic(cx - radius, cx + radius, cy - radius, cy + radius,
+                                      z_near, z_far)
+            frusta.append((end, light_view, projection, texel, False, None))
+            start = end
+        return frusta
+
+    @staticmethod
+    def _near(radius: float) -> float:
+        return min(max(radius * 0.005, 0.01), 0.5)
+
+    def _spot(self, light: Light, resolution: int) -> tuple:
+        params = light.params
+        position = np.asarray(params.position, np.float64)
+        direction = unit(params.direction)
+        margin = filter_margin(params)
+        tan_half = math.tan(math.radians(params.outer_angle)) * resolution / \
+            (resolution - 2.0 * margin)
+        tan_half = min(tan_half, math.tan(math.radians(89.0)))
+        light_view = look_at(position, direction, light_up(direction))
+        projection = perspective(tan_half, self._near(params.radius), params.radius)
+        return (0.0, light_view, projection, 2.0 * tan_half / resolution, True,
+                (position, params.radius))
+
+    def _cube(self, light: Light, resolution: int) -> list[tuple]:
+        params = light.params
+        position = np.asarray(params.position, np.float64)
+        tan_half = resolution / (resolution - 2.0 * filter_margin(params))
+        projection = perspective(tan_half, self._near(params.radius), params.radius)
+        return [(0.0, look_at(position, direction, up), projection, 2.0 * tan_half / resolution,
+                 True, (position, params.radius)) for direction, up in CUBE_FACES]
+
+    # -- binding source ----------------------------------------------------------------------
+    def bind(self, uniforms: ProgramUniforms, texture_unit: int) -> int:
+        """The atlas and records where a program reads them (lights/shadows.glsl)."""
+        if "u_shadow_records" not in uniforms.members:
+            return texture_unit
+        uniforms.set_shared("shadows", self._uniforms)
+        self.texture.use(location=texture_unit)
+        uniforms.set_one("u_shadow_atlas", texture_unit)
+        self.records.use(location=texture_unit + 1)
+        uniforms.set_one("u_shadow_records", texture_unit + 1)
+        return texture_unit + 2
+
+    def read_depth(self) -> np.ndarray:
+        """The atlas's depths, (size, size) float32, rows bottom-up (GL's)."""
+        data = np.frombuffer(self.texture.read(alignment=1), dtype=np.float32)
+        return data.reshape(self.size, self.size)
+
+    def release(self) -> None:
+        for part in (self.framebuffer, self.texture, self.records):
+            part.release()
+
+
+def object_sphere(obj) -> tuple[np.ndarray, float]:
+    low, high = obj.mesh.bounds()
+    model = np.asarray(obj.model, np.float64)
+    centre = (model @ np.append((low + high) / 2.0, 1.0))[:3]
+    scale = float(np.max(np.linalg.norm(model[:3, :3], axis=0)))
+    return centre, float(np.linalg.norm(high - low)) / 2.0 * scale
+
+
+class ShadowPass(RenderPass):
+    """Every shadowed light's maps: each tile of the atlas cleared and each object's depth
+    drawn into it by its material (:meth:`~deferred.interfaces.material.Material.draw_shadow`).
+    The atlas is not a frame target; the pass writes none (dumps read the atlas apart)."""
+
+    order = Order.FIRST
+
+    def __init__(self, phase: Phase):
+        self.name = "shadows"
+        self.phase = phase
+
+    def execute(self, frame: Frame) -> None:
+        atlas: ShadowAtlas = frame.blackboard[SHADOW_ATLAS]
+        if not atlas.tiles:
+            return
+        fbo = atlas.framebuffer
+        frame.gl_call(fbo.use)
+        fbo.depth_mask = True
+        frame.set_state(depth_test=True, depth_func="less", cull=None,
+                        depth_offset=CASTER_DEPTH_OFFSET)
+        objects = frame.scene.objects
+        spheres = [object_sphere(obj) for obj in objects]
+        try:
+            for tile in atlas.tiles:
+                rect = (tile.x, tile.y, tile.size, tile.size)
+                fbo.viewport = rect
+                frame.gl_call(lambda rect=rect: fbo.clear(depth=1.0, viewport=rect))
+                for obj, (centre, radius) in zip(objects, spheres, strict=True):
+                    if tile.reach is not None and np.linalg.norm(centre - tile.reach[0]) > \
+                            radius + tile.reach[1]:
+                        continue  # beyond the light's reach: casts nothing it lights
+                    obj.material.draw_shadow(frame, obj, tile.view)
+        finally:
+            fbo.viewport = (0, 0, atlas.size, atlas.size)

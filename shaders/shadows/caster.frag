@@ -1,0 +1,3 @@
+// Depth only: the shadow atlas has no colour attachment.
+void main() {
+}
