@@ -103,6 +103,11 @@ class FrameCapture:
     # the length of the light list each pixel's shading loops over (tiled, clustered, Forward+;
     # None on the other paths), top row first
     light_lists: np.ndarray | None = None
+    # the shadow atlas's depths, (size, size) top row first, where a light casts shadows
+    shadow_atlas: np.ndarray | None = None
+    # the cascade (1-based; 0: none) of the first shadowed directional light each pixel reads,
+    # from its linear depth; None without such a light or a linear depth
+    shadow_cascades: np.ndarray | None = None
 
     def __getitem__(self, name: str) -> PassCapture:
         for capture in self.passes:
@@ -235,8 +240,23 @@ def capture_frame(renderer: Renderer, passes: Sequence[str] | None = None,
         if renderer.pipeline_name == Pipeline.DEFERRED:  # GL's bottom row first, as the lists count
             depth = to_float(ends[LINEAR_DEPTH])[::-1, :, 0]
         light_lists = renderer.light_lists.pixel_counts(*renderer.size, depth)[::-1]
+    atlas = renderer.shadow_atlas
+    shadow_atlas = cascades = None
+    if atlas is not None:
+        shadow_atlas = atlas.read_depth()[::-1].copy()
+        splits = next(iter(atlas.splits.values()), None)  # scene order: the first light's
+        if splits is not None and LINEAR_DEPTH in ends:
+            cascades = cascade_of(to_float(ends[LINEAR_DEPTH])[..., 0], splits)
     return FrameCapture(
         scene=scene.source, pipeline=renderer.pipeline_name, size=renderer.size,
         gl_info=renderer.gl.info, specs=dict(targets.specs), passes=captures, targets=ends,
         image=result.image, frame_ms=frame_ms, tonemap=scene.tonemap, exposure=scene.exposure,
-        layout=scene.gbuffer_layout(), light_lists=light_lists)
+        layout=scene.gbuffer_layout(), light_lists=light_lists, shadow_atlas=shadow_atlas,
+        shadow_cascades=cascades)
+
+
+def cascade_of(depth: np.ndarray, splits: np.ndarray) -> np.ndarray:
+    """The cascade (1-based) a linear view depth falls in, as ``lights/shadows.glsl`` picks it
+    (the first whose far depth lies beyond it); 0 for no surface or beyond the last."""
+    index = np.searchsorted(np.asarray(splits, np.float64), depth, side="left") + 1
+    return np.where((depth > 0.0) & (index <= len(splits)), index, 0).astype(np.float32)

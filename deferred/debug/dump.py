@@ -99,6 +99,8 @@ def write_dump(capture: FrameCapture, directory: str | Path,
         DIR/final.exr         composition buffer (linear HDR), R G B A; DIR/final.png the frame
         DIR/light_lists.exr   tiled and clustered paths: the volume lights in each pixel's light
                               list, lights.listed (``--view light_lists``)
+        DIR/shadow_atlas.exr  where a light casts shadows: the shadow atlas's depths,
+                              shadow.depth (``--view shadow_atlas``; the atlas's own size)
         DIR/passes/NN_<pass>.exr   what pass NN wrote, channels "<target>.R", ... ("<target>.Z")
         DIR/contact.png       every buffer as a labelled thumbnail, in pass order
         DIR/manifest.json     passes (phase, inputs, outputs, formats, time), G-buffer layout, GL
@@ -175,6 +177,10 @@ def _write_files(capture: FrameCapture, directory: Path, files: dict[str, str],
             lists = view(capture, "light_lists")
             write("light_lists.exr", lists.pixels, channels=lists.channels, half=lists.half)
             files["light_lists"] = "light_lists.exr"
+        if capture.shadow_atlas is not None:
+            atlas = view(capture, "shadow_atlas")
+            write("shadow_atlas.exr", atlas.pixels, channels=atlas.channels, half=False)
+            files["shadow_atlas"] = "shadow_atlas.exr"
         write("final.exr", capture.target(COMPOSITE), channels=("R", "G", "B", "A"), half=True)
         write("final.png", capture.image)
         files.update({"final": "final.exr", "final_png": "final.png", "contact": "contact.png"})
@@ -208,8 +214,13 @@ def contact_tiles(capture: FrameCapture, thumb_width: int = 240) -> list[Tile]:
         if all(capture.written(t) for t in GBUFFER_COLOR_TARGETS) else []
     names += ["light"] if capture.written(LIGHT_ACCUMULATION) else []
     names += ["light_lists"] if capture.light_lists is not None else []
+    names += ["shadow.cascades"] if capture.shadow_cascades is not None else []
     for name in names + ["composite"]:
         tiles.append(Tile("frame", name, view(capture, name).preview[::step, ::step]))
+    if capture.shadow_atlas is not None:
+        atlas_step = max(1, capture.shadow_atlas.shape[1] // thumb_width)
+        tiles.append(Tile("frame", "shadow_atlas",
+                          view(capture, "shadow_atlas").preview[::atlas_step, ::atlas_step]))
     tiles.append(Tile("frame", "final.png", capture.image[::step, ::step, :3] / 255.0))
     return tiles
 

@@ -48,7 +48,13 @@ NAMED_VIEWS: dict[str, tuple[tuple[str, ...], str]] = {
     "composite": (("R", "G", "B", "A"), "composition buffer, linear HDR before tone mapping"),
     "light_lists": (("lights.listed",), "volume lights in the light list each pixel loops over "
                                         "(tiled, clustered, Forward+; a heat map in PNG)"),
+    "shadow_atlas": (("shadow.depth",), "the shadow atlas: every shadowed light's maps, depth "
+                                        "in [0, 1] (the atlas's size, not the frame's)"),
+    "shadow.cascades": (("shadow.cascade",), "the cascade of the first shadowed directional "
+                                             "light each pixel reads, 0 = none (PNG: the image "
+                                             "tinted a colour per cascade)"),
 }
+SHADOW_PASS = "shadows"  # the pass drawing the shadow atlas (deferred.lighting.shadows)
 LIST_CULLING_PASSES = (".cull_tiles", ".cull_clusters")  # the passes that fill the light lists
 
 
@@ -117,6 +123,15 @@ def resolve_view(name: str, passes: Sequence[RenderPass]) -> tuple[str | None, s
             raise InputError("view 'light_lists' shows the light lists, which only the tiled and "
                              "clustered light paths have", "--view")
         return None, None
+    if name in ("shadow_atlas", "shadow.cascades"):
+        if not any(p.name == SHADOW_PASS for p in passes):
+            raise InputError(f"view '{name}' shows shadow maps; no light of this scene casts "
+                             "shadows (shadows = true)", "--view")
+        if name == "shadow.cascades" and "linear_depth" not in written:
+            raise InputError("view 'shadow.cascades' reads the linear depth, which this "
+                             "pipeline does not write (use the deferred pipeline or forward "
+                             "tiled)", "--view")
+        return None, None
     if name in NAMED_VIEWS:
         needs = {"light": (LIGHT_ACCUMULATION,), "composite": (COMPOSITE,)}.get(
             name, GBUFFER_COLOR_TARGETS)
@@ -171,6 +186,23 @@ def _named_view(capture: FrameCapture, name: str) -> View:
         counts = capture.light_lists
         return View(name, counts[..., None], channels, bool(counts.max(initial=0.0) <= 2048.0),
                     heat_colors(counts))
+    if name == "shadow_atlas":
+        if capture.shadow_atlas is None:
+            raise KeyError("the frame was captured without a shadow atlas")
+        depth = capture.shadow_atlas
+        # stretched over the depths drawn (what is cleared, 1, stays white)
+        drawn = depth[depth < 1.0]
+        low, high = (float(drawn.min()), float(drawn.max())) if drawn.size else (0.0, 1.0)
+        stretched = np.where(depth < 1.0, (depth - low) / max(high - low, 1e-6) * 0.9, 1.0)
+        return View(name, depth[..., None], channels, False, grey(stretched))
+    if name == "shadow.cascades":
+        if capture.shadow_cascades is None:
+            raise KeyError("no shadowed directional light: the frame has no cascades")
+        cascades = capture.shadow_cascades
+        shade = capture.image[..., :3].astype(np.float32).mean(-1, keepdims=True) / 255.0
+        tint = np.where((cascades > 0)[..., None], id_colors(cascades), 1.0)
+        return View(name, cascades[..., None], channels, True,
+                    (tint * (0.35 + 0.65 * shade)).astype(np.float32))
     if name in ("light", "composite"):
         source = LIGHT_ACCUMULATION if name == "light" else COMPOSITE
         pixels = capture.target(source)[..., : len(channels)]

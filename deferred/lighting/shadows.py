@@ -212,6 +212,7 @@ class ShadowAtlas:
         self.texture.filter = (moderngl.LINEAR, moderngl.LINEAR)
         self.texture.repeat_x = self.texture.repeat_y = False
         self.framebuffer = ctx.framebuffer(depth_attachment=self.texture)
+        self.framebuffer.clear(depth=1.0)  # tiles no light holds read as lit, and show so
         self.records = ctx.texture((RECORD_TEXELS, max_lights), 4, dtype="f4")
         self.records.filter = (moderngl.NEAREST, moderngl.NEAREST)
         self.tiles: list[ShadowTile] = []

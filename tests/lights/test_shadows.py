@@ -348,3 +348,36 @@ def test_bad_shadow_parameters_are_one_line_errors(tmp_path, text, expected):
     assert done.returncode == 2
     assert len(done.stderr.strip().splitlines()) == 1 and expected.split(":")[0] in done.stderr
     assert not (tmp_path / "out.png").exists()
+
+
+def test_shadow_views_and_the_dump_show_the_atlas(tmp_path):
+    from deferred.io.images import read_image
+
+    path = tmp_path / "scene.toml"
+    path.write_text(
+        'size = [96, 64]\n[shadows]\natlas_size = 1024\n'
+        '[[object]]\nmesh = "builtin:plane"\nscale = 4.0\n'
+        '[[object]]\nmesh = "builtin:cube"\nposition = [0.0, 0.8, 0.0]\nscale = 0.4\n'
+        '[[light]]\ntype = "directional"\nshadows = true\nshadow_resolution = 256\n'
+        'cascades = 2\n')
+
+    def deferred(*args):
+        return subprocess.run([sys.executable, "-m", "deferred", *map(str, args)],
+                              capture_output=True, text=True)
+    assert deferred("render", path, "--view", "shadow_atlas", "-o",
+                    tmp_path / "atlas.exr").returncode == 0
+    atlas = read_image(tmp_path / "atlas.exr")
+    assert atlas.shape[:2] == (1024, 1024)
+    drawn = atlas[..., 0] < 1.0
+    # two cascades of 256^2 in a corner of the atlas (rows top-down: its bottom), casters drawn
+    assert drawn[-512:, :512].any() and not drawn[:512].any()
+    assert deferred("render", path, "--view", "shadow.cascades", "-o",
+                    tmp_path / "cascades.exr").returncode == 0
+    cascades = read_image(tmp_path / "cascades.exr")[..., 0]
+    assert set(np.unique(cascades)) <= {0.0, 1.0, 2.0} and (cascades == 1.0).any()
+    assert deferred("dump", path, "-o", tmp_path / "dump").returncode == 0
+    assert (tmp_path / "dump" / "shadow_atlas.exr").is_file()
+    path.write_text(path.read_text().replace("shadows = true", "shadows = false"))
+    done = deferred("render", path, "--view", "shadow_atlas", "-o", tmp_path / "none.png")
+    assert done.returncode == 2 and "no light of this scene casts shadows" in done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1
