@@ -269,12 +269,16 @@ class ShellFurState:
         self.obj = obj  # its material is read from it each time (a timeline may give it a copy)
         params = self.params_at(0.0)
         self.dt = params.time_step
-        self.linear_inverse = np.linalg.inv(obj.model[:3, :3])
-        self.strands = StrandSimulation(*triangle_strands(obj.mesh, obj.model, params.fur_length))
+        self.fur_length = params.fur_length
+        # the strands live in the world, so they are placed by the object's transform at each
+        # step (model_at: an object on a track carries them along, and they trail it)
+        self.model = np.array(obj.model_at(0.0))
+        self.linear_inverse = np.linalg.inv(self.model[:3, :3])
+        self.strands = StrandSimulation(*triangle_strands(obj.mesh, self.model, self.fur_length))
         self.average = VertexAverage(obj.mesh)
         self.size = params.mask_size
         self.wrap = uv_wrap(obj.mesh)
-        self.world_per_uv = mean_uv_scale(obj.mesh, obj.model)
+        self.world_per_uv = mean_uv_scale(obj.mesh, self.model)
         self.mask_texture = _float_texture(ctx, self.size, self.size)
         self.mask_texture.repeat_x = self.mask_texture.repeat_y = True
         # three texels per vertex: tip deflection, curl u, curl v (fur.vert)
@@ -307,12 +311,27 @@ class ShellFurState:
             later = [math.ceil(t / self.dt - 1e-9) for t in events if t > now + 1e-12]
             end = min([target, *[n for n in later if n > self.step]])
             for n in range(self.step, end):
+                if self.obj.tracks:
+                    self._place(self.obj.model_at(n * self.dt))
                 self.strands.step(self.dt, self._forces(params, n * self.dt))
             dry_out(self.mask, params.dry_rate * self.dt * (end - self.step))
             self.step = end
+        if self.obj.tracks:
+            self._place(self.obj.model_at(self.step * self.dt))
         self._rain(self.params_at(self.step * self.dt))
         if self._uploaded != self.step:
             self._upload()
+
+    def _place(self, model: np.ndarray) -> None:
+        """Move the strands' roots to where ``model`` puts the mesh (nothing if it is where
+        they are)."""
+        if np.array_equal(model, self.model):
+            return
+        self.model = np.array(model)
+        self.linear_inverse = np.linalg.inv(self.model[:3, :3])
+        self.world_per_uv = mean_uv_scale(self.obj.mesh, self.model)
+        self.strands.move(*triangle_strands(self.obj.mesh, self.model, self.fur_length))
+        self._uploaded = None
 
     def _start(self) -> None:
         params = self.params_at(0.0)
@@ -320,6 +339,7 @@ class ShellFurState:
         self.mask = load_wetness_mask(path, self.size) if path is not None \
             else dry_mask(self.size)
         self.fallen = 0
+        self._place(np.asarray(self.obj.model_at(0.0)))
         self.strands.reset()
         steps = int(round(params.settle / self.dt))
         for k in range(steps):
@@ -330,7 +350,7 @@ class ShellFurState:
     def _rain(self, params: ShellFurParams) -> None:
         """Blend the droplets that fell since last time (the ``droplets`` count grew)."""
         if params.droplets > self.fallen:
-            for droplet in random_droplets(self.obj.mesh, self.obj.model,
+            for droplet in random_droplets(self.obj.mesh, self.model,
                                            params.droplets - self.fallen, params.droplet_radius,
                                            params.droplet_wetness, params.seed,
                                            start=self.fallen):

@@ -52,6 +52,15 @@ class StrandSimulation:
         self.rest = self.roots + self.normals * self.lengths[:, None]  # p_0
         self.reset()
 
+    def move(self, roots: np.ndarray, normals: np.ndarray, lengths: np.ndarray) -> None:
+        """Put the roots where the object has moved them (its transform at this step); the
+        tips stay where they are in the world, so the strands trail a moving object."""
+        self.roots = np.asarray(roots, np.float64)
+        self.normals = np.asarray(normals, np.float64)
+        self.lengths = np.asarray(lengths, np.float64)
+        self.rest = self.roots + self.normals * self.lengths[:, None]
+        self.tips = self.constrain(self.tips)
+
     def reset(self) -> None:
         self.tips = self.rest.copy()  # p
         self.velocities = np.zeros_like(self.tips)

@@ -1092,3 +1092,34 @@ params = { droplets = 40 }
     assert text.startswith("error: s.toml: event[0].params.droplets: 40 droplets by t = 1 s"), \
         text
     assert not (tmp_path / "late.png").exists()
+
+
+def test_a_moving_object_carries_its_strands_along(gl):
+    """Issue #25: the strands follow the object's transform at each step (model_at), so a
+    sphere turned upside down by its track still has its fur hanging down the world's -y,
+    and its roots sit on the turned mesh (they stayed at the first transform)."""
+    from deferred.render.renderer import Renderer
+    from deferred.scene.loader import scene_from_dict
+
+    from deferred.materials.shell_fur import ShellFurState
+
+    scene = scene_from_dict({
+        "size": [32, 24],
+        "object": [{"name": "ball", "mesh": "builtin:sphere", "material": "shell_fur",
+                    "params": {"shells": 2, "fins": False, "settle": 0.5}}],
+        "track": [{"target": "object:ball", "interpolation": "linear",
+                   "keys": [{"time": 0.0, "position": [0.0, 0.0, 0.0], "rotation": [0, 0, 0]},
+                            {"time": 1.0, "position": [0.5, 0.0, 0.0],
+                             "rotation": [180.0, 0.0, 0.0]}]}],
+        "light": [{"type": "ambient"}]})
+    obj = scene.objects[0]
+    with Renderer(scene, gl=gl) as renderer:
+        renderer.render(time=2.0, readback=False)
+        state = renderer.resources.cached(("shell_fur_state", obj), lambda ctx: None)
+        assert isinstance(state, ShellFurState)
+        model = obj.model_at(2.0)
+        assert np.allclose(state.model, model)
+        world = state.vertex_deflections() @ model[:3, :3].T
+        assert world[:, 1].mean() < -1e-3  # hanging down the world, not the object
+        centre = state.strands.roots.mean(axis=0)
+        assert np.allclose(centre, model[:3, 3], atol=0.02)  # roots on the moved mesh
