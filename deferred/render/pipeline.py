@@ -110,6 +110,46 @@ def scene_passes(scene: Scene, pipeline: str) -> list[RenderPass]:
     return passes
 
 
+def camera_distance(scene: Scene, obj) -> float:
+    """How far in front of the camera the centre of ``obj``'s bounds is (its view depth)."""
+    low, high = obj.mesh.bounds()
+    centre = obj.model @ np.append((low + high) / 2.0, 1.0)
+    return float(-(scene.camera.view() @ centre)[2])
+
+
+def sort_blended(passes: list[RenderPass], scene: Scene) -> list[RenderPass]:
+    """``passes`` with each run of blended object passes (volumes, transparent surfaces) of
+    one phase and rank put far to near for the camera and transforms of this frame (the
+    order the passes were built in holds the first frame's): the same list where it already
+    is so."""
+    index_of = {id(obj): k for k, obj in enumerate(scene.objects)}
+    out = passes
+    start = 0
+    while start < len(passes):
+        first = passes[start]
+        end = start + 1
+        if _blended_object_pass(first):
+            while end < len(passes) and _blended_object_pass(passes[end]) and \
+                    passes[end].phase == first.phase and passes[end].order == first.order:
+                end += 1
+            if end - start > 1:
+                run = passes[start:end]
+                distances = {id(p.obj): camera_distance(scene, p.obj) for p in run}
+                ordered = sorted(run, key=lambda p: (-distances[id(p.obj)],
+                                                     index_of.get(id(p.obj), 0)))
+                if ordered != run:
+                    if out is passes:
+                        out = list(passes)
+                    out[start:end] = ordered
+        start = end
+    return out
+
+
+def _blended_object_pass(render_pass: RenderPass) -> bool:
+    return render_pass.order >= Order.VOLUME and render_pass.order != Order.LAST and \
+        getattr(render_pass, "obj", None) is not None
+
+
 def phase_passes(scene: Scene, phase: Phase, fixed: list[RenderPass],
                  scene_wide: list[RenderPass]) -> list[RenderPass]:
     """Every pass of ``phase``: the pipeline's own (``fixed``), the scene-wide ones of this
@@ -117,11 +157,8 @@ def phase_passes(scene: Scene, phase: Phase, fixed: list[RenderPass],
     keyed = [((p.order, PIPELINE_PASS, 0.0, k), p) for k, p in enumerate(fixed)]
     keyed += [((p.order, SCENE_PASS, 0.0, k), p) for k, p in enumerate(scene_wide)
               if p.phase == phase]
-    view = scene.camera.view()
     for index, obj in enumerate(scene.objects):
-        low, high = obj.mesh.bounds()
-        centre = obj.model @ np.append((low + high) / 2.0, 1.0)
-        distance = -(view @ centre)[2]
+        distance = camera_distance(scene, obj)
         for render_pass in obj.material.passes(phase, obj):
             blended = render_pass.order >= Order.VOLUME
             keyed.append(((render_pass.order, OBJECT_PASS, -distance if blended else 0.0, index),

@@ -51,7 +51,7 @@ from deferred.render.caches import (
     ShadingTextures,
 )
 from deferred.render.generated import generated_glsl
-from deferred.render.pipeline import PIPELINES, TONEMAPS, check_passes
+from deferred.render.pipeline import PIPELINES, TONEMAPS, check_passes, sort_blended
 from deferred.render.temporal import TemporalState, temporal_effect
 from deferred.scene.model import Scene, SceneObject, check_size
 
@@ -495,7 +495,8 @@ class Renderer:
         # G-buffer passes, say), not once a pass: Frame.check_errors names the pass. Hooks
         # look at each pass, so with them each is checked.
         unchecked: list[RenderPass] = []
-        passes = self.passes
+        # blended passes far to near for this frame's camera and transforms
+        passes = sort_blended(self.passes, self.scene)
         hooked = before_pass is not None or on_pass is not None
         for index, render_pass in enumerate(passes):
             raise_if_stop_requested()  # a signal lost in a pass's library or a __del__

@@ -270,3 +270,24 @@ def test_the_stipple_parity_covers_every_pixel_over_four_samples(gl):
         for dx in (-2, -1, 0, 1, 2):
             interior &= np.roll(fur, (dy, dx), axis=(0, 1))
     assert interior.sum() > 50 and np.all(union[interior] == 1)
+
+
+def test_transparent_surfaces_are_sorted_each_frame(gl):
+    """Two glass panes swapping places in depth on a track: each frame draws the far one
+    first, as a renderer built at that time does (they were sorted once, when the passes
+    were built)."""
+    glass = {"material": "stipple_glass", "mesh": "builtin:plane",
+             "rotation": [90.0, 0.0, 0.0], "scale": 1.2}
+    objects = [{**glass, "name": "red", "position": [0.0, 0.0, 0.5],
+                "params": {"color": [1.0, 0.1, 0.1], "opacity": 0.7}},
+               {**glass, "name": "blue", "position": [0.1, 0.0, -0.5],
+                "params": {"color": [0.1, 0.1, 1.0], "opacity": 0.7}}]
+    tracks = [{"target": "object:red", "interpolation": "linear",
+               "keys": [{"time": 0.0, "position": [0.0, 0.0, 0.5]},
+                        {"time": 1.0, "position": [0.0, 0.0, -1.0]}]}]
+    scene = scene_with([*objects, SPHERE], effects=(), tracks=tracks)
+    with Renderer(scene, "forward", gl=gl) as renderer:
+        renderer.render(time=0.0)
+        moved = renderer.render(time=1.0).image
+    with Renderer(scene, "forward", gl=gl) as fresh:
+        assert np.array_equal(fresh.render(time=1.0).image, moved)

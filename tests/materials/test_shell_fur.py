@@ -1098,10 +1098,9 @@ def test_a_moving_object_carries_its_strands_along(gl):
     """Issue #25: the strands follow the object's transform at each step (model_at), so a
     sphere turned upside down by its track still has its fur hanging down the world's -y,
     and its roots sit on the turned mesh (they stayed at the first transform)."""
+    from deferred.materials.shell_fur import ShellFurState
     from deferred.render.renderer import Renderer
     from deferred.scene.loader import scene_from_dict
-
-    from deferred.materials.shell_fur import ShellFurState
 
     scene = scene_from_dict({
         "size": [32, 24],
