@@ -8,9 +8,13 @@ head) is drawn too, in ``skin_color``.
 - dynamics (4.2.2-4.2.4): :mod:`.techniques.hair_dynamics`, the roots pinned to the object,
   colliding with ``collision_spheres`` (``builtin:head``'s own by default), anchored to
   ``keyframes`` (strand files at ``key_times``, Catmull-Rom in time) by ``anchor_stiffness``;
-  stepped from t = 0 at ``time_step``, so a frame's hair depends only on its time;
+  stepped from t = 0 at ``time_step`` (after ``settle`` seconds at rest before it), each step
+  with the parameters of the scene's timeline at its time (gravity, wind, drag, stiffnesses,
+  anchors, and every shading parameter may change between frames; what builds the strands and
+  the simulation, ``timeline_fixed``, may not), so a frame's hair depends only on its time;
 - tubes (4.3.1-4.3.2): :mod:`.techniques.hair_tubes`, ``hair_samples`` spline samples swept by a
-  ``sides``-gon tapered by the quadratic ``taper``;
+  ``sides``-gon tapered by the quadratic ``taper``, built every frame by compute shaders where
+  the context has them (:class:`.techniques.hair_tubes.GpuTubes`), else by numpy;
 - shading (4.3.3-4.3.6): X-toon (:mod:`.techniques.xtoon`), the G-buffer datum ``strand_id``
   (0 on the head; on the hair 1 + the object's first id + the strand's index) lets the
   ``edges`` effect outline strands of one colour where they overlap (4.3.7);
@@ -57,7 +61,7 @@ from .shading_models import Toon
 from .techniques.hair_dynamics import HairPhysics, HairSimulation
 from .techniques.hair_silhouettes import SilhouettePass, silhouette_geometry, tube_adjacency
 from .techniques.hair_strands import grow_strands, load_strands, resample_strand, scalp_roots
-from .techniques.hair_tubes import build_tubes, tube_radii
+from .techniques.hair_tubes import GpuTubes, build_tubes, tube_radii
 from .techniques.hatching import TamSettings, tam_texture, tonal_art_map
 from .techniques.xtoon import XTOON_UNIFORM_OVERRIDES, XToonParams, XToonRamp
 
@@ -104,7 +108,11 @@ class CartoonHairParams(BlinnPhongParams, XToonParams):
     key_times: tuple[float, ...] = Field((), description="seconds of each keyframe")
     gravity: Vec3 = Field((0.0, -9.81, 0.0), description="world acceleration")
     wind: Vec3 = Field((0.0, 0.0, 0.0), description="the air's velocity, world units/s")
+    drag: float = Field(2.0, ge=0.0, le=1000.0,
+                        description="1/s: how fast the hair takes the air's velocity (damping)")
     time_step: float = Field(1.0 / 60.0, gt=0.0, le=0.1, description="simulation step, s")
+    settle: float = Field(0.0, ge=0.0, le=60.0,
+                          description="seconds simulated before t = 0 (the hair at rest)")
     collision_spheres: tuple[tuple[float, float, float, float], ...] | None = Field(
         None, description="object-space (x, y, z, radius); default: builtin:head's own")
     # tubes (4.3.1-4.3.2)
@@ -135,41 +143,80 @@ class CartoonHairParams(BlinnPhongParams, XToonParams):
             raise ValueError("key_times needs a time for each keyframe")
         if any(b <= a for a, b in zip(self.key_times, self.key_times[1:], strict=False)):
             raise ValueError("key_times must increase")
+        if settle_steps(self) > MAX_HAIR_STEPS:
+            raise ValueError(f"settle / time_step is {settle_steps(self):,} steps; the most is "
+                             f"{MAX_HAIR_STEPS:,}")
         return self
+
+
+def settle_steps(params: CartoonHairParams) -> int:
+    """Steps simulated before t = 0."""
+    return int(round(params.settle / params.time_step))
+
+
+def hair_physics(params: CartoonHairParams) -> HairPhysics:
+    """The simulation's parameters of a material state."""
+    return HairPhysics(
+        edge_stiffness=params.edge_stiffness, bend_stiffness=params.bend_stiffness,
+        torsion_stiffness=params.torsion_stiffness, anchor_stiffness=params.anchor_stiffness,
+        anchor_curve=params.anchor_curve, gravity=params.gravity, wind=params.wind,
+        drag=params.drag, time_step=params.time_step)
+
+
+def params_at(obj: SceneObject, time: float) -> CartoonHairParams:
+    """``obj``'s parameters at ``time`` on its timeline (its material's, without one)."""
+    at = getattr(obj, "params_at", None)
+    return at(time) if at is not None else obj.material.params
 
 
 class HairState:
     """One object's hair in one renderer: the simulation and the tube mesh's GPU buffers,
-    brought to a frame's time by :meth:`advance`."""
+    brought to a frame's time by :meth:`advance`.
+
+    The tubes' positions and normals live in a buffer of their own (a moving
+    :class:`GpuMesh`); with compute shaders they are built there (:class:`GpuTubes`) and
+    ``mesh.positions`` keep the tubes of t = 0, else numpy builds them and they are uploaded.
+    """
 
     def __init__(self, ctx: moderngl.Context, obj: SceneObject):
         self.obj = obj
         material: CartoonHairMaterial = obj.material
-        params = material.params
+        params = params_at(obj, 0.0)  # what builds the hair: timeline_fixed
         self.params = params
         rest = material.rest_strands(obj)
         keyframes = material.keyframe_strands(rest.shape) if params.keyframes else None
-        physics = HairPhysics(
-            edge_stiffness=params.edge_stiffness, bend_stiffness=params.bend_stiffness,
-            torsion_stiffness=params.torsion_stiffness,
-            anchor_stiffness=params.anchor_stiffness, anchor_curve=params.anchor_curve,
-            gravity=params.gravity, wind=params.wind, time_step=params.time_step)
-        self.simulation = HairSimulation(rest, physics, material.spheres(obj), keyframes,
-                                         params.key_times or None, self.model_at(0.0))
+        self._physics: dict[int, tuple[CartoonHairParams, HairPhysics]] = {}
+        self.simulation = HairSimulation(rest, self.physics_at(0.0), material.spheres(obj),
+                                         keyframes, params.key_times or None,
+                                         self.model_at(0.0), settle_steps(params))
         self.inverse_model = np.linalg.inv(self.model_at(0.0))
-        tubes = self._tubes()
+        tubes = self._tubes(params)
         self.mesh = MeshData("cartoon_hair tubes", tubes[0], tubes[1],
                              *self._constant_attributes(tubes[2]), tubes[3])
-        self.gpu = GpuMesh(ctx, self.mesh)
+        self.gpu = GpuMesh(ctx, self.mesh, moving=True)
         self.ctx = ctx
+        self._gpu_tubes: GpuTubes | None = None
         self._silhouettes: MeshPrimitives | None = None
         self.time: float | None = None
         self._placed = self._placement()
 
+    def physics_at(self, time: float) -> HairPhysics:
+        """The simulation's parameters at ``time`` (made once for each state of the
+        timeline)."""
+        params = params_at(self.obj, time)
+        known = self._physics.get(id(params))
+        if known is None or known[0] is not params:
+            known = self._physics[id(params)] = (params, hair_physics(params))
+        return known[1]
+
     def _placement(self) -> tuple:
-        """What the object's motion is made of: its tracks and its placement at t = 0."""
+        """What the hair's history is made of: the object's tracks, its placement at t = 0
+        and its timeline (the base parameters and events)."""
+        material = self.obj.material
         return (tuple(map(id, getattr(self.obj, "tracks", ()))),
-                self.model_at(0.0).tobytes())
+                self.model_at(0.0).tobytes(),
+                getattr(self.obj, "base_params", material.params),
+                getattr(self.obj, "events", ()))
 
     def model_at(self, time: float) -> np.ndarray:
         """The object's model matrix at ``time``: its tracks' (SceneObject.model_at), else
@@ -187,10 +234,11 @@ class HairState:
                                                     tube_adjacency(*topology))
         return self._silhouettes
 
-    def _tubes(self):
+    def _tubes(self, params: CartoonHairParams):
+        """The tubes by numpy (:func:`build_tubes`), in object space."""
         p = self.params
-        tubes = build_tubes(self.simulation.strands, p.hair_samples, p.sides, p.radius,
-                            p.taper, reference=self.simulation.root_references())
+        tubes = build_tubes(self.simulation.strands, p.hair_samples, p.sides, params.radius,
+                            params.taper, reference=self.simulation.root_references())
         # the simulation is in world space; the object's passes draw in object space
         linear, offset = self.inverse_model[:3, :3], self.inverse_model[:3, 3]
         positions = tubes.positions @ linear.T + offset
@@ -208,27 +256,44 @@ class HairState:
         comb[:, 1] = tubes.along
         return uvs, zeros, zeros.copy(), comb
 
-    def advance(self, time: float) -> None:
-        """The hair at ``time`` (seconds): stepped from where it is (or from 0, for an earlier
-        time), the tubes rebuilt and uploaded."""
+    def advance(self, time: float, frame: Frame | None = None) -> None:
+        """The hair at ``time`` (seconds): stepped from where it is (or from the start, for an
+        earlier time), the tubes rebuilt: by compute shaders where ``frame``'s context has
+        them, else by numpy and uploaded."""
         placement = self._placement()
-        if placement != self._placed:  # new tracks or a new model: the motion starts over
+        if placement != self._placed:  # new tracks, model or timeline: the history starts over
             self.simulation.reset(self.model_at(0.0))
+            self._physics.clear()
             self._placed, self.time = placement, None
         if self.time == time:
             return
         # the roots follow the object's transform at each step (its tracks move it); the
         # tubes go back to object space through the transform at the simulated step
-        self.simulation.advance(time, self.model_at)
-        self.inverse_model = np.linalg.inv(self.model_at(self.simulation.time))
-        positions, normals, _, _ = self._tubes()
-        self.mesh.positions, self.mesh.normals = positions, normals
-        self.gpu.vbo.write(self.mesh.interleaved().tobytes())
+        self.simulation.advance(time, self.model_at, self.physics_at)
+        simulated = max(self.simulation.time, 0.0)
+        self.inverse_model = np.linalg.inv(self.model_at(simulated))
+        params = params_at(self.obj, simulated)  # the tube's radius and taper
+        if frame is not None and frame.gl.features.compute_shaders:
+            if self._gpu_tubes is None:
+                p = self.params
+                self._gpu_tubes = GpuTubes(self.ctx, self.simulation.strand_count,
+                                           self.simulation.point_count, p.hair_samples,
+                                           p.sides)
+            self._gpu_tubes.upload(self.simulation.component_points,
+                                   self.simulation.component_references())
+            self._gpu_tubes.build(frame.shaders, self.gpu.surface_vbo, params.radius,
+                                  params.taper, self.inverse_model)
+        else:
+            positions, normals, _, _ = self._tubes(params)
+            self.mesh.positions, self.mesh.normals = positions, normals
+            self.gpu.write_surface()
         self.time = time
 
     def release(self) -> None:
         if self._silhouettes is not None:
             self._silhouettes.release()
+        if self._gpu_tubes is not None:
+            self._gpu_tubes.release()
         self.gpu.release()
 
 
@@ -259,7 +324,7 @@ class PreparedHair:
 
     def prepare(self, frame: Frame) -> None:
         state = hair_state(frame, self.obj)
-        state.advance(frame.time)
+        state.advance(frame.time, frame)
         self._prepared = (weakref.ref(frame), state)
 
     def state(self, frame: Frame) -> HairState:
@@ -354,34 +419,33 @@ class CartoonHairMaterial(Material):
             "skin_color", "strands_file", "strands", "length", "segments", "style", "parting",
             "seed", "edge_stiffness", "bend_stiffness", "torsion_stiffness",
             "anchor_stiffness", "anchor_curve", "keyframes", "key_times", "gravity", "wind",
-            "time_step", "collision_spheres", "hair_samples", "sides", "radius", "taper",
+            "drag", "time_step", "settle", "collision_spheres", "hair_samples", "sides",
+            "radius", "taper",
             "silhouettes", "stroke_width", "stroke_color", "stroke_fade", "hatching",
             "hatching_strength", "hatching_scale")},
         "color": lambda value: {},  # the head's pass takes skin_color, the hair's color
     }
-    # read once, at t = 0: the strands, their simulation and the tubes' topology
-    # (and the simulation's and tubes' parameters: a timeline changing them part way would
-    # make a frame depend on the frames before it)
+    # read once, at t = 0: the strands, the simulation's structure and the tubes' topology
+    # (the dynamics' parameters follow the timeline step by step: HairState.physics_at)
     timeline_fixed = ("strands_file", "strands", "length", "segments", "style", "parting",
                       "seed", "keyframes", "key_times", "hair_samples", "sides",
-                      "collision_spheres", "time_step", "edge_stiffness", "bend_stiffness",
-                      "torsion_stiffness", "anchor_stiffness", "anchor_curve", "gravity",
-                      "wind", "radius", "taper")
+                      "collision_spheres", "time_step", "settle")
 
     def motion_extent(self, obj: SceneObject) -> float:
         """The strands reach up to their length beyond the head."""
         return float(self.params.length)
 
     def check_time_for(self, obj: SceneObject, time: float, where: str) -> None:
-        """The hair is stepped from t = 0 at ``time_step``: the steps, and the steps times the
-        strands, are bounded (``MAX_HAIR_STEPS``, ``MAX_HAIR_STRAND_STEPS``), so a late frame
-        is refused before any frame instead of running for hours."""
-        steps = round(time / self.params.time_step)
+        """The hair is stepped from t = 0 at ``time_step``, after ``settle``: the steps, and the
+        steps times the strands, are bounded (``MAX_HAIR_STEPS``, ``MAX_HAIR_STRAND_STEPS``), so
+        a late frame is refused before any frame instead of running for hours."""
+        steps = round(time / self.params.time_step) + settle_steps(self.params)
         strands = self.params.strands if self.params.strands_file is None else \
             len(load_strands(self.resolve_path(self.params.strands_file), "strands_file"))
         if steps > MAX_HAIR_STEPS or steps * strands > MAX_HAIR_STRAND_STEPS:
+            settling = " (with settle)" if self.params.settle > 0.0 else ""
             raise InputError(f"t = {time:g} s needs {steps:,} simulation steps of "
-                             f"{self.params.time_step:g} s for {strands:,} strands "
+                             f"{self.params.time_step:g} s{settling} for {strands:,} strands "
                              f"({obj.label}); the most is {MAX_HAIR_STEPS:,} steps and "
                              f"{MAX_HAIR_STRAND_STEPS:,} strand steps: render an earlier time, "
                              "raise time_step or grow fewer strands", where)

@@ -57,35 +57,72 @@ class MeshData:
 
 @dataclass
 class GpuMesh:
-    """A mesh's vertex and index buffers, with one vertex array per program using it."""
+    """A mesh's vertex and index buffers, with one vertex array per program using it.
+
+    ``moving=True`` keeps positions and normals in a buffer of their own,
+    :attr:`surface_vbo` (6 floats a vertex, rewritten as the mesh moves: by
+    :meth:`write_surface` or by a compute shader), and the constant attributes in :attr:`vbo`:
+    a frame's rewrite touches a third of the bytes of the whole vertex format."""
 
     ctx: moderngl.Context
     data: MeshData
+    moving: bool = False
     vbo: moderngl.Buffer = field(init=False)
     ibo: moderngl.Buffer = field(init=False)
+    surface_vbo: moderngl.Buffer | None = field(init=False, default=None)
     _arrays: dict[int, moderngl.VertexArray] = field(init=False, default_factory=dict)
 
     def __post_init__(self) -> None:
-        self.vbo = self.ctx.buffer(self.data.interleaved().tobytes())
+        if self.moving:
+            self.surface_vbo = self.ctx.buffer(self._surface().tobytes())
+            parts = [self.data.uvs, self.data.tangents, self.data.binormals, self.data.comb]
+            self.vbo = self.ctx.buffer(np.hstack(parts).astype(np.float32).tobytes())
+        else:
+            self.vbo = self.ctx.buffer(self.data.interleaved().tobytes())
         self.ibo = self.ctx.buffer(self.data.indices.astype(np.uint32).tobytes())
+
+    def _surface(self) -> np.ndarray:
+        return np.ascontiguousarray(np.hstack([self.data.positions, self.data.normals]),
+                                    dtype=np.float32)
+
+    def write_surface(self) -> None:
+        """Upload the mesh data's positions and normals again (``moving`` meshes)."""
+        if self.surface_vbo is None:
+            raise ValueError(f"{self.data.name}: only a moving mesh rewrites its surface")
+        self.surface_vbo.write(self._surface().tobytes())
 
     def vertex_buffer(self, program: moderngl.Program) -> tuple:
         """The vertex buffer with the format of the attributes ``program`` reads (moderngl's
-        ``(buffer, format, *names)``), for vertex arrays over other index buffers too."""
+        ``(buffer, format, *names)``), for vertex arrays over other index buffers too (a
+        moving mesh's: :meth:`vertex_buffers`)."""
+        if self.moving:
+            raise ValueError(f"{self.data.name}: a moving mesh has two vertex buffers")
+        return self._buffer_format(self.vbo, VERTEX_ATTRIBUTES, program)
+
+    def vertex_buffers(self, program: moderngl.Program) -> list[tuple]:
+        """:meth:`vertex_buffer`, or a moving mesh's two buffers (those ``program`` reads)."""
+        if not self.moving:
+            return [self.vertex_buffer(program)]
+        buffers = [self._buffer_format(self.surface_vbo, VERTEX_ATTRIBUTES[:2], program),
+                   self._buffer_format(self.vbo, VERTEX_ATTRIBUTES[2:], program)]
+        return [buffer for buffer in buffers if len(buffer) > 2]
+
+    @staticmethod
+    def _buffer_format(buffer: moderngl.Buffer, attributes, program: moderngl.Program) -> tuple:
         fmt, names = [], []
-        for name, count in VERTEX_ATTRIBUTES:
+        for name, count in attributes:
             attribute = f"in_{name}"
             if attribute in program:
                 fmt.append(f"{count}f")
                 names.append(attribute)
             else:
                 fmt.append(f"{count * 4}x")
-        return (self.vbo, " ".join(fmt), *names)
+        return (buffer, " ".join(fmt), *names)
 
     def vertex_array(self, program: moderngl.Program) -> moderngl.VertexArray:
         vao = self._arrays.get(program.glo)
         if vao is None:
-            vao = self.ctx.vertex_array(program, [self.vertex_buffer(program)],
+            vao = self.ctx.vertex_array(program, self.vertex_buffers(program),
                                         index_buffer=self.ibo, index_element_size=4)
             self._arrays[program.glo] = vao
         return vao
@@ -99,6 +136,8 @@ class GpuMesh:
         self._arrays.clear()
         self.vbo.release()
         self.ibo.release()
+        if self.surface_vbo is not None:
+            self.surface_vbo.release()
 
 
 class MeshPrimitives:
@@ -118,7 +157,7 @@ class MeshPrimitives:
     def render(self, program: moderngl.Program) -> None:
         vao = self._arrays.get(program.glo)
         if vao is None:
-            vao = self.ctx.vertex_array(program, [self.gpu_mesh.vertex_buffer(program)],
+            vao = self.ctx.vertex_array(program, self.gpu_mesh.vertex_buffers(program),
                                         index_buffer=self.ibo, index_element_size=4)
             self._arrays[program.glo] = vao
         vao.render(self.mode, vertices=self.count)

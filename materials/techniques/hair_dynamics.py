@@ -53,6 +53,13 @@ so particles end a step outside them (4.1: the head as a group of spheres; no ha
 collisions, as in 3.1).
 Structural particles are not hair and do not collide: pushing one would twist the strand's
 frame and bend the strand.
+
+**Time.** Fixed steps from t = 0, after ``settle_steps`` steps of settling before it (the object
+held at its placement at 0, the parameters at 0), so styled hair starts a render at rest. Each
+step may take its own :class:`HairPhysics` (a scene timeline changing gravity, wind, drag,
+stiffnesses or anchors between frames; the time step, iterations and structure stay the
+simulation's, ``FIXED_PHYSICS``): replayed from the start, the state at a time depends on that
+time alone.
 """
 
 from __future__ import annotations
@@ -66,6 +73,8 @@ from .hair_strands import interpolate_keyframes, quadratic, rotation_minimising_
 
 PINNED = 3  # chain particles p_-1, q_-1, p_0
 COLLISION_ROUNDS = 8
+# what a simulation is built with and keeps: the others may change at every step
+FIXED_PHYSICS = ("time_step", "iterations", "collision_margin", "structure_offset")
 
 
 @dataclass(frozen=True)
@@ -158,6 +167,29 @@ def _frame(back: np.ndarray, middle: np.ndarray, last: np.ndarray
     return e1, e2, np.cross(e1, e2)
 
 
+def _norm(v: np.ndarray, out: np.ndarray) -> np.ndarray:
+    """Lengths of component-major vectors ``(3, S)`` into ``out`` ``(S,)``."""
+    np.einsum("ij,ij->j", v, v, out=out)
+    return np.sqrt(out, out=out)
+
+
+def _normalise(v: np.ndarray, scratch: np.ndarray) -> None:
+    """Component-major vectors ``(3, S)`` made unit length in place (zero ones left zero)."""
+    _norm(v, scratch)
+    np.maximum(scratch, 1e-30, out=scratch)
+    v /= scratch
+
+
+def _cross(a: np.ndarray, b: np.ndarray, out: np.ndarray) -> None:
+    """Cross products of component-major vectors ``(3, S)`` into ``out``."""
+    np.multiply(a[1], b[2], out=out[0])
+    out[0] -= a[2] * b[1]
+    np.multiply(a[2], b[0], out=out[1])
+    out[1] -= a[0] * b[2]
+    np.multiply(a[0], b[1], out=out[2])
+    out[2] -= a[1] * b[0]
+
+
 def transform_points(model: np.ndarray, points: np.ndarray) -> np.ndarray:
     """``points`` ``(..., 3)`` through the 4x4 ``model`` matrix (column vectors)."""
     model = np.asarray(model, dtype=np.float64)
@@ -178,8 +210,12 @@ class HairSimulation:
 
     def __init__(self, rest: np.ndarray, physics: HairPhysics | None = None,
                  spheres: np.ndarray | None = None, keyframes: np.ndarray | None = None,
-                 key_times: Sequence[float] | None = None, model: np.ndarray | None = None):
+                 key_times: Sequence[float] | None = None, model: np.ndarray | None = None,
+                 settle_steps: int = 0):
         self.physics = physics or HairPhysics()
+        if settle_steps < 0:
+            raise ValueError("settle_steps must be >= 0")
+        self.settle_steps = int(settle_steps)
         rest = np.asarray(rest, dtype=np.float64)
         if rest.ndim != 3 or rest.shape[1] < 2 or rest.shape[2] != 3:
             raise ValueError("rest strands must be (strands, points >= 2, 3)")
@@ -214,10 +250,8 @@ class HairSimulation:
         along = np.zeros(self.chain_length)
         # p_i sits at chain 2 i + 2, q_i halfway to p_(i+1): the parameter along the strand
         along[2:] = np.arange(self.chain_length - 2) / (2.0 * (self.point_count - 1))
-        anchor = self.physics.anchor_stiffness * np.clip(
-            quadratic(self.physics.anchor_curve, along), 0.0, 1.0)
-        anchor[:PINNED] = 0.0
-        self._anchor = self._per_round(anchor).astype(np.float32)[:, None]  # (C, 1)
+        self._along = along
+        self._pinned_rest = np.ascontiguousarray(self._rest_chain[:, :PINNED].transpose(2, 1, 0))
         self.reset(model)
 
     def _per_round(self, stiffness: np.ndarray | float) -> np.ndarray:
@@ -226,23 +260,35 @@ class HairSimulation:
             1.0 / self.physics.iterations)
 
     def reset(self, model: np.ndarray | None = None) -> None:
-        """Back to time 0: the anchors' first pose (the rest pose without keyframes) moved by
-        ``model`` (identity by default), at rest."""
-        self.steps = 0
+        """Back to the start: the anchors' first pose (the rest pose without keyframes) moved
+        by ``model`` (identity by default), at rest, ``settle_steps`` steps before t = 0
+        (:meth:`advance` takes them first)."""
+        self.steps = -self.settle_steps
         model = np.eye(4) if model is None else np.asarray(model, dtype=np.float64)
         start = transform_points(model, self._key_chains[0])
-        start[:, :PINNED] = transform_points(model, self._rest_chain[:, :PINNED])
         self._x = np.ascontiguousarray(start.transpose(2, 1, 0), dtype=np.float32)  # (3, C, S)
+        self._x[:, :PINNED] = self._pinned(model)
         self._v = np.zeros_like(self._x)
+        self._before = np.empty_like(self._x)
+        # the solver's scratch rows
+        count = self.strand_count
+        self._d, self._e1, self._e2, self._e3 = (np.empty((3, count), np.float32)
+                                                 for _ in range(4))
+        self._length, self._dot = np.empty(count, np.float32), np.empty(count, np.float32)
 
     @property
     def time(self) -> float:
         """Simulated time: steps times the fixed step."""
         return self.steps * self.physics.time_step
 
-    def step(self, model: np.ndarray) -> None:
-        """One fixed time step, ``model`` the object's model matrix at the step's end."""
-        p = self.physics
+    def step(self, model: np.ndarray, physics: HairPhysics | None = None) -> None:
+        """One fixed time step, ``model`` the object's model matrix at the step's end;
+        ``physics`` the step's own parameters (default: the simulation's). Its time step,
+        iterations, collision margin and structure must be the simulation's (they are the
+        simulation's shape); the other parameters may change from step to step."""
+        p = self.physics if physics is None else physics
+        if physics is not None and physics is not self.physics:
+            self._check_fixed(physics)
         dt = np.float32(p.time_step)
         model = np.asarray(model, dtype=np.float64)
         x, v = self._x, self._v
@@ -250,14 +296,19 @@ class HairSimulation:
         pull = np.asarray(p.gravity) + p.drag * np.asarray(p.wind)
         v += (dt * pull).astype(np.float32)[:, None, None]
         v *= np.float32(1.0 / (1.0 + p.time_step * p.drag))
-        before = x.copy()
-        x += dt * v
-        x[:, :PINNED] = transform_points(model, self._rest_chain[:, :PINNED]).transpose(2, 1, 0)
+        before = self._before
+        np.copyto(before, x)
+        np.multiply(v, dt, out=v)  # v dt, for a moment
+        x += v
+        x[:, :PINNED] = self._pinned(model)
         anchors = None
-        if self.physics.anchor_stiffness > 0.0:
+        if p.anchor_stiffness > 0.0:
             pose = interpolate_keyframes(self._key_chains, self._key_times,
                                          (self.steps + 1) * p.time_step)
             anchors = transform_points(model, pose).transpose(2, 1, 0).astype(np.float32)
+            anchor = self._per_round(p.anchor_stiffness * np.clip(
+                quadratic(p.anchor_curve, self._along[PINNED:]), 0.0, 1.0))
+            anchor = anchor.astype(np.float32)[:, None]
         edge = np.float32(self._per_round(p.edge_stiffness))
         shape = (np.float32(self._per_round(p.bend_stiffness)),  # strand particles (even b)
                  np.float32(self._per_round(p.torsion_stiffness)))  # structural ones (odd b)
@@ -265,37 +316,68 @@ class HairSimulation:
             for b, frame, _ in self._order:
                 self._solve_particle(b, frame, edge, shape[b % 2])
             if anchors is not None:
-                x[:, PINNED:] += self._anchor[PINNED:] * (anchors[:, PINNED:] - x[:, PINNED:])
+                x[:, PINNED:] += anchor * (anchors[:, PINNED:] - x[:, PINNED:])
         self._collide(model)
         np.subtract(x, before, out=v)
         v /= dt
         v[:, :PINNED] = 0.0
         self.steps += 1
 
+    def _check_fixed(self, physics: HairPhysics) -> None:
+        for name in FIXED_PHYSICS:
+            if getattr(physics, name) != getattr(self.physics, name):
+                raise ValueError(f"{name} is fixed for a simulation: "
+                                 f"{getattr(self.physics, name)!r}, not "
+                                 f"{getattr(physics, name)!r}")
+
+    def _pinned(self, model: np.ndarray) -> np.ndarray:
+        """The pinned particles ``(3, PINNED, S)`` moved by ``model``: one 3x3 product."""
+        rest = self._pinned_rest
+        moved = model[:3, :3] @ rest.reshape(3, -1) + model[:3, 3, None]
+        return moved.reshape(rest.shape)
+
     def _solve_particle(self, b: int, frame: tuple[int, int, int], edge: np.float32,
                         shape: np.float32) -> None:
-        """Particle ``b`` of every strand moved by its springs (see :func:`solve_order`)."""
+        """Particle ``b`` of every strand moved by its springs (see :func:`solve_order`); the
+        arithmetic in place on preallocated rows (a few dozen whole-array operations a
+        particle are the simulation's cost)."""
         x = self._x
         xb = x[:, b]
+        d, length = self._d, self._length
         springs = self._edges[b]
         # a structural particle has two edge springs: two rounds of projections nearly meet both
         for a, rest in springs * 2 if len(springs) > 1 else springs:
             if edge > 0.0:
-                d = xb - x[:, a]
-                length = np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
-                xb -= d * (edge * (1.0 - rest / np.maximum(length, 1e-30)))
+                np.subtract(xb, x[:, a], out=d)
+                _norm(d, length)
+                np.maximum(length, 1e-30, out=length)
+                np.divide(rest, length, out=length)  # rest / length
+                length *= -edge
+                length += edge  # edge (1 - rest / length)
+                d *= length
+                xb -= d
         if shape > 0.0:
             back, middle, last = (x[:, i] for i in frame)
-            e1 = last - middle
-            e1 /= np.maximum(np.sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]), 1e-30)
-            e2 = back - middle
-            e2 -= (e2[0] * e1[0] + e2[1] * e1[1] + e2[2] * e1[2]) * e1
-            e2 /= np.maximum(np.sqrt(e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2]), 1e-30)
-            e3 = np.stack([e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
-                           e1[0] * e2[1] - e1[1] * e2[0]])
+            e1, e2, e3, dot = self._e1, self._e2, self._e3, self._dot
+            np.subtract(last, middle, out=e1)
+            _normalise(e1, dot)
+            np.subtract(back, middle, out=e2)
+            np.einsum("ij,ij->j", e2, e1, out=dot)
+            np.multiply(e1, dot, out=d)
+            e2 -= d
+            _normalise(e2, dot)
+            _cross(e1, e2, e3)
             c = self._shape[b]
-            target = last + c[0] * e1 + c[1] * e2 + c[2] * e3
-            xb += shape * (target - xb)
+            # target - xb = (last - xb) + c0 e1 + c1 e2 + c2 e3
+            e1 *= c[0]
+            e2 *= c[1]
+            e3 *= c[2]
+            e1 += e2
+            e1 += e3
+            e1 += last
+            e1 -= xb
+            e1 *= shape
+            xb += e1
 
     def _collide(self, model: np.ndarray) -> None:
         if not len(self._spheres):
@@ -322,15 +404,19 @@ class HairSimulation:
             if not moved:
                 break
 
-    def advance(self, until: float, model_at: Callable[[float], np.ndarray]) -> None:
+    def advance(self, until: float, model_at: Callable[[float], np.ndarray],
+                physics_at: Callable[[float], HairPhysics] | None = None) -> None:
         """Step until the simulated time is ``until`` (rounded to a whole step), ``model_at(t)``
-        giving the object's model matrix at time ``t``. Going back in time restarts from 0, so
-        the state at a time never depends on which frames were asked for before."""
+        giving the object's model matrix at time ``t`` and ``physics_at(t)`` (optional) the
+        parameters in effect then (each step takes both at its end; the settling steps before
+        t = 0 those at 0). Going back in time restarts from the settling, so the state at a
+        time never depends on which frames were asked for before."""
         target = round(until / self.physics.time_step)
         if target < self.steps:
             self.reset(model_at(0.0))
         while self.steps < target:
-            self.step(model_at((self.steps + 1) * self.physics.time_step))
+            t = max((self.steps + 1) * self.physics.time_step, 0.0)
+            self.step(model_at(t), None if physics_at is None else physics_at(t))
 
     @property
     def strands(self) -> np.ndarray:
@@ -342,12 +428,22 @@ class HairSimulation:
         """Every chain particle, structural ones included, ``(S, 2P + 1, 3)`` world space."""
         return np.ascontiguousarray(self._x.transpose(2, 1, 0))
 
+    @property
+    def component_points(self) -> np.ndarray:
+        """The strands' particles component-major, ``(3, P, S)`` float32, root first (the
+        layout :class:`.hair_tubes.GpuTubes` uploads)."""
+        return np.ascontiguousarray(self._x[:, 2::2])
+
+    def component_references(self) -> np.ndarray:
+        """:meth:`root_references` component-major, ``(3, S)`` float32."""
+        x = self._x
+        return x[:, 1] - 0.5 * (x[:, 0] + x[:, 2])
+
     def root_references(self) -> np.ndarray:
         """``(S, 3)``: a direction across each strand's root that turns with the object (from
         the pinned virtual segment to its structural particle): the first ring's orientation
         for the tube builder, so rings do not jump round as the strands swing."""
-        x = self._x
-        return np.ascontiguousarray((x[:, 1] - 0.5 * (x[:, 0] + x[:, 2])).T)
+        return np.ascontiguousarray(self.component_references().T)
 
     def kinetic_energy(self) -> float:
         """Half the sum of the free particles' squared speeds (unit masses)."""

@@ -212,3 +212,88 @@ def _vertex_normals(rings: np.ndarray, centre: np.ndarray) -> tuple[np.ndarray, 
     total[:, :, -1] += tip_cap + np.roll(tip_cap, 1, axis=-1)
     caps = np.stack([root_cap.sum(axis=-1), tip_cap.sum(axis=-1)], axis=-1)
     return _unit(total), _unit(caps)
+
+
+# --------------------------------------------------------------------------- on the GPU
+
+TUBE_FRAMES = "materials/cartoon_hair/tube_frames.comp"
+TUBE_VERTICES = "materials/cartoon_hair/tube_vertices.comp"
+# invocations a work group: GL's least maximum; llvmpipe pays a fixed cost a group that
+# made groups of 64 several times slower (benchmarks/README.md)
+TUBE_GROUP = 1024
+
+
+class GpuTubes:
+    """:func:`build_tubes`' positions and averaged normals made by two compute shaders, into a
+    vertex buffer the tubes are drawn from (GL 4.3): ``materials/cartoon_hair/tube_frames.comp``
+    samples each strand's spline and its rotation-minimising frames (an invocation a strand),
+    ``tube_vertices.comp`` each ring's vertices and their averaged normals (an invocation a
+    ring). The arithmetic is build_tubes', in float32: the results agree to float rounding.
+    Only the strands' points go up each frame (``4 x (points + 1)`` floats a strand, against
+    the ``6 x samples x sides`` of its built vertices); the vertex order, indices and the
+    vertices' other attributes are build_tubes', written once by whoever made the buffer.
+
+    ``shaders`` in :meth:`build` is the renderer's shader library (``compute(name, defines)``
+    and ``uniforms(program).set(values)``).
+    """
+
+    def __init__(self, ctx, strands: int, points: int, samples: int, sides: int):
+        if samples < 2 or sides < 3 or points < 2:
+            raise ValueError("a tube needs at least 2 points, 2 samples and 3 sides")
+        self.ctx = ctx
+        self.strands, self.points, self.samples, self.sides = strands, points, samples, sides
+        self._upload = np.zeros((strands, points + 1, 4), np.float32)
+        self._points = ctx.buffer(reserve=self._upload.nbytes)
+        self._frames = ctx.buffer(reserve=4 * 4 * 3 * samples * strands)
+
+    @property
+    def vertex_count(self) -> int:
+        return tube_vertex_count(self.strands, self.samples, self.sides)
+
+    def upload(self, points: np.ndarray, reference: np.ndarray) -> None:
+        """The strands' points, component-major ``(3, points, strands)`` (the simulation's
+        layout: :attr:`.hair_dynamics.HairSimulation.component_points`), and the first rings'
+        reference directions ``(3, strands)``."""
+        points, reference = np.asarray(points), np.asarray(reference)
+        if points.shape != (3, self.points, self.strands) or \
+                reference.shape != (3, self.strands):
+            raise ValueError(f"points must be (3, {self.points}, {self.strands}) and reference "
+                             f"(3, {self.strands}), got {points.shape} and {reference.shape}")
+        upload = self._upload
+        upload[:, :-1, :3] = points.transpose(2, 1, 0)
+        upload[:, -1, :3] = reference.T
+        self._points.write(upload)
+
+    def build(self, shaders, vertices, radius: float,
+              taper: tuple[float, float, float] = DEFAULT_TAPER,
+              to_object: np.ndarray | None = None, stride: int = 3 * 4 * 2) -> None:
+        """Write the uploaded strands' tubes into ``vertices`` (a buffer of
+        :attr:`vertex_count` vertices of ``stride`` bytes, position then normal first),
+        through the 4x4 ``to_object`` (identity by default; normals by its inverse transpose).
+        The writes are visible to draws after it (a memory barrier)."""
+        to_object = np.eye(4) if to_object is None else np.asarray(to_object, np.float64)
+        defines = {"TUBE_GROUP": str(TUBE_GROUP)}
+        frames = shaders.compute(TUBE_FRAMES, defines)
+        vertex = shaders.compute(TUBE_VERTICES, defines)
+        counts = {"u_strands": self.strands, "u_samples": self.samples}
+        shaders.uniforms(frames).set({
+            **counts, "u_points": self.points, "u_radius": float(radius),
+            "u_taper": tuple(float(v) for v in taper),
+            # GL's matrices are column-major: the transpose's rows are the columns
+            "u_to_object": tuple(float(v) for v in to_object.T.reshape(-1))})
+        turn = 2.0 * np.pi / self.sides
+        shaders.uniforms(vertex).set({
+            **counts, "u_sides": self.sides, "u_stride": stride // 4,
+            "u_turn": (float(np.cos(turn)), float(np.sin(turn))),
+            "u_orientation": -1.0 if np.linalg.det(to_object[:3, :3]) < 0.0 else 1.0})
+        self._points.bind_to_storage_buffer(0)
+        self._frames.bind_to_storage_buffer(2)
+        vertices.bind_to_storage_buffer(3)
+        frames.run(-(-self.strands // TUBE_GROUP))  # an invocation a strand
+        self.ctx.memory_barrier()
+        vertex.run(-(-self.strands * self.samples // TUBE_GROUP))  # an invocation a ring
+        self.ctx.memory_barrier()
+
+    def release(self) -> None:
+        self._points.release()
+        self._frames.release()

@@ -14,8 +14,9 @@ from deferred.render.renderer import Renderer
 from deferred.scene.loader import scene_from_dict
 
 
-def head_scene(params: dict | None = None, effects=None, size=(128, 128)) -> object:
+def head_scene(params: dict | None = None, effects=None, size=(128, 128), events=()) -> object:
     return scene_from_dict({
+        "event": [{"time": t, "object": "head", "params": p} for t, p in events],
         "size": list(size), "tonemap": "none", "background": [0.9, 0.9, 0.9],
         "camera": {"position": [0.0, 0.05, 0.55], "target": [0.0, 0.0, 0.0], "fov": 40.0},
         "object": [{"name": "head", "mesh": "builtin:head?segments=48&rings=32",
@@ -92,6 +93,7 @@ def test_a_frame_depends_only_on_its_time(gl):
     ({"keyframes": ["a.json"]}, "key_times needs a time for each keyframe"),
     ({"sides": 2}, "object[0].params.sides"),
     ({"taper": [0.0, 0.0]}, "object[0].params.taper"),
+    ({"settle": 30.0, "time_step": 0.001}, "settle / time_step is 30,000 steps; the most is"),
 ])
 def test_bad_parameters_are_one_line_errors(tmp_path, capsys, params, message):
     import json
@@ -207,4 +209,79 @@ def test_a_time_too_far_for_the_simulation_is_refused_before_a_frame(tmp_path, c
     err = capsys.readouterr().err
     assert code == 2 and err.startswith("error: --time: t = 10000 s needs 600,000 simulation "
                                         "steps"), err
+    assert not (tmp_path / "out.png").exists()
+
+
+def test_the_gpu_and_numpy_tubes_draw_the_same_hair(gl):
+    """The tubes built by compute shaders (GpuTubes) and by numpy (a GL 3.3 context) are the
+    same mesh to float rounding: the same image, strand ids and depth, both pipelines, with
+    silhouette strokes drawn from the same buffer."""
+    from conftest import psnr
+
+    from deferred.gl.context import Features, GLContext
+
+    gl33 = GLContext(gl.ctx, Features(storage_buffers=False, compute_shaders=False))
+    scene = head_scene({"bend_stiffness": 0.3, "torsion_stiffness": 0.3, "silhouettes": True})
+    for pipeline in ("deferred", "forward"):
+        gpu, gpu_targets = capture(gl, scene, pipeline, time=0.3)
+        cpu, cpu_targets = capture(gl33, scene, pipeline, time=0.3)
+        assert psnr(gpu.hdr[..., :3], cpu.hdr[..., :3]) > 60.0, pipeline
+        if pipeline == "deferred":
+            ids, other = gpu_targets["strand_id"][..., 0], cpu_targets["strand_id"][..., 0]
+            assert (ids != other).mean() < 0.002
+            assert (ids > 0.5).mean() > 0.1
+
+
+def test_dynamics_parameters_follow_the_timeline(gl):
+    """gravity, wind and the stiffnesses may change at an event: the hair before it is the
+    hair without the event, after it the simulation has run with the new values since the
+    event's time; seeking in any order gives each time's own frame (the simulation replays
+    from t = 0 with the parameters of each step)."""
+    base = {"bend_stiffness": 0.4, "torsion_stiffness": 0.4}
+    change = {"wind": [3.0, 0.0, 0.0], "gravity": [0.0, -2.0, 0.0], "bend_stiffness": 0.1}
+    timeline = head_scene(base, events=[(0.25, change)])
+    plain = head_scene(base)
+    frames = {}
+    for t in (0.2, 0.5):
+        with Renderer(timeline, gl=gl) as renderer:
+            frames[t] = renderer.render(time=t).image
+    with Renderer(plain, gl=gl) as renderer:
+        np.testing.assert_array_equal(frames[0.2], renderer.render(time=0.2).image)
+        assert np.abs(frames[0.5].astype(int) - renderer.render(time=0.5).image).mean() > 2.0
+    with Renderer(timeline, gl=gl) as renderer:  # out of order, and the same times again
+        for t in (0.5, 0.2, 0.5, 0.35, 0.2):
+            image = renderer.render(time=t).image
+            if t in frames:
+                np.testing.assert_array_equal(image, frames[t])
+
+
+def test_a_python_change_to_the_dynamics_starts_the_hair_over(gl):
+    """set_params on a parameter the simulation reads every step (not timeline_fixed) changes
+    the hair's history: the next frame is a fresh renderer's, not one stepped on from the
+    old values."""
+    scene = head_scene({"bend_stiffness": 0.4, "torsion_stiffness": 0.4})
+    with Renderer(scene, gl=gl) as renderer:
+        renderer.render(time=0.3)
+        scene.objects[0].set_params(wind=[0.0, 0.0, 4.0])
+        late = renderer.render(time=0.4).image
+    with Renderer(scene, gl=gl) as fresh:
+        np.testing.assert_array_equal(late, fresh.render(time=0.4).image)
+
+
+def test_what_builds_the_hair_cannot_follow_a_timeline():
+    from deferred.errors import InputError
+
+    for key, value in (("strands", 30), ("sides", 4), ("settle", 1.0), ("time_step", 0.01)):
+        with pytest.raises(InputError, match=f"cartoon_hair reads {key} once, at t = 0"):
+            head_scene(events=[(0.5, {key: value})])
+
+
+def test_settle_counts_toward_the_bound_on_steps(tmp_path, capsys):
+    (tmp_path / "s.toml").write_text(
+        "[[object]]\nmesh = \"builtin:head\"\nmaterial = \"cartoon_hair\"\n"
+        "[object.params]\nsettle = 60.0\ntime_step = 0.004\n")
+    code = main(["render", str(tmp_path / "s.toml"), "-o", str(tmp_path / "out.png"),
+                 "--time", "30"])
+    err = capsys.readouterr().err
+    assert code == 2 and "needs 22,500 simulation steps of 0.004 s (with settle)" in err, err
     assert not (tmp_path / "out.png").exists()

@@ -167,3 +167,72 @@ def test_the_same_inputs_give_the_same_bits():
 def test_stiffness_outside_0_1_is_refused(field):
     with pytest.raises(ValueError, match=field):
         HairPhysics(**{field: 1.5})
+
+
+def combed_head(count=40):
+    """Combed strands on builtin:head and its collision spheres: a style that is not at rest
+    (gravity pulls it down onto the head at once)."""
+    from deferred.materials.techniques.hair_strands import grow_strands, scalp_roots
+    from deferred.scene.builtin_meshes import builtin_head, builtin_head_spheres
+
+    spheres = builtin_head_spheres()
+    return grow_strands(scalp_roots(builtin_head(), count, 3), 0.15, 7, "combed", 3, spheres), \
+        spheres
+
+
+def test_settling_starts_the_hair_at_rest():
+    """``settle_steps`` run before t = 0 with the object still: combed hair, which falls
+    onto the head when it starts from its style, moves hardly at all after t = 0 then."""
+    rest, spheres = combed_head()
+    physics = HairPhysics(bend_stiffness=0.5, torsion_stiffness=0.5)
+    energies, moved = {}, {}
+    for settle in (0, 180):
+        sim = HairSimulation(rest, physics, spheres=spheres, settle_steps=settle)
+        sim.advance(0.0, lambda t: np.eye(4))
+        assert sim.steps == 0 and sim.time == 0.0
+        start = sim.strands.copy()
+        energy = []
+        for step in range(1, 13):  # the first 0.2 s
+            sim.advance(step * physics.time_step, lambda t: np.eye(4))
+            energy.append(sim.kinetic_energy())
+        energies[settle], moved[settle] = max(energy), np.abs(sim.strands - start).max()
+    assert energies[180] < 0.01 * energies[0]
+    assert moved[180] < 0.1 * moved[0]
+
+
+def test_settling_holds_the_object_at_its_placement_at_0():
+    rest, spheres = combed_head(10)
+    sim = HairSimulation(rest, HairPhysics(), spheres=spheres, settle_steps=30,
+                         model=moving_model(0.0))
+    asked = []
+
+    def model_at(t):
+        asked.append(t)
+        return moving_model(t)
+
+    sim.advance(0.0, model_at)
+    assert len(asked) == 30 and set(asked) == {0.0}
+    roots = transform_points(moving_model(0.0), rest[:, 0])
+    np.testing.assert_allclose(sim.strands[:, 0], roots, atol=1e-6)
+
+
+def test_parameters_may_change_from_step_to_step():
+    """``physics_at(t)`` gives each step its parameters (a scene timeline): wind from 0.5 s
+    on leaves the strands as they were before it and blows them after; the structure a
+    simulation is built with cannot change."""
+    rest = horizontal_strands(4)
+    still = HairPhysics(bend_stiffness=0.3, torsion_stiffness=0.3)
+    windy = HairPhysics(bend_stiffness=0.3, torsion_stiffness=0.3, wind=(0.0, 0.0, 6.0))
+
+    def physics_at(t):
+        return still if t < 0.5 - 1e-9 else windy
+
+    plain, blown = HairSimulation(rest, still), HairSimulation(rest, still)
+    for sim, at in ((plain, None), (blown, physics_at)):
+        sim.advance(0.45, lambda t: np.eye(4), at)
+    assert plain.strands.tobytes() == blown.strands.tobytes()
+    for sim, at in ((plain, None), (blown, physics_at)):
+        sim.advance(1.0, lambda t: np.eye(4), at)
+    assert blown.strands[:, -1, 2].mean() > plain.strands[:, -1, 2].mean() + 0.01
+    with pytest.raises(ValueError, match="time_step is fixed"):
+        plain.step(np.eye(4), HairPhysics(time_step=0.01))

@@ -17,6 +17,7 @@ from deferred.materials.techniques.hair_strands import (
     scalp_roots,
 )
 from deferred.materials.techniques.hair_tubes import (
+    GpuTubes,
     build_tubes,
     tube_triangle_count,
     tube_vertex_count,
@@ -256,3 +257,64 @@ def test_strand_files_asking_for_too_much_are_refused(tmp_path, monkeypatch):
     (tmp_path / "huge.json").write_text('{"strands": [[[0, 0, 0], [' + "9" * 400 + ', 0, 0]]]}')
     with pytest.raises(InputError, match="point 1 must be 3 numbers"):
         hair_strands.load_strands(tmp_path / "huge.json")
+
+
+# --------------------------------------------------------------------------- tubes on the GPU
+
+def gpu_tubes(gl, strands, samples, sides, radius, taper, reference, to_object=None):
+    """:class:`GpuTubes`' positions and normals ``(V, 3)`` each, read back."""
+    from deferred.gl.shaderlib import ShaderLibrary
+
+    strands = np.asarray(strands, np.float32)
+    builder = GpuTubes(gl.ctx, len(strands), strands.shape[1], samples, sides)
+    vertices = gl.ctx.buffer(reserve=builder.vertex_count * 24)
+    try:
+        builder.upload(strands.transpose(2, 1, 0), np.asarray(reference).T)
+        builder.build(ShaderLibrary(gl.ctx, 430), vertices, radius, taper, to_object)
+        out = np.frombuffer(vertices.read(), np.float32).reshape(-1, 6)
+    finally:
+        builder.release()
+        vertices.release()
+    return out[:, :3], out[:, 3:]
+
+
+@pytest.mark.parametrize("samples,sides,taper", [(8, 8, (0.0, -1.0, 1.0)), (2, 3, (0.0, 0.0, 1.0)),
+                                                 (13, 16, (0.3, -1.0, 1.0)),
+                                                 (9, 5, (0.0, -2.0, 1.0))])
+def test_gpu_tubes_are_the_numpy_tubes(gl, samples, sides, taper):
+    """The compute shaders build what build_tubes builds (same vertex order, so the same
+    indices make the same watertight tubes with the same radii and caps), to float32
+    rounding. The strands lie within a head's size of the origin: the triangles' edges are
+    differences of positions, so both builds' rounding grows with the distance over the
+    radius (a metre away, unit normals differ by up to 2e-4)."""
+    if not gl.features.compute_shaders:
+        pytest.skip("no compute shaders")
+    strands = wavy_strands(9)
+    strands = strands - strands[:, :1] + 0.08 * RNG.normal(size=(9, 1, 3))
+    reference = RNG.normal(size=(9, 3))
+    want = build_tubes(strands, samples, sides, 0.006, taper, reference)
+    positions, normals = gpu_tubes(gl, strands, samples, sides, 0.006, taper, reference)
+    assert len(positions) == tube_vertex_count(9, samples, sides)
+    np.testing.assert_allclose(positions, want.positions, atol=1e-7)
+    np.testing.assert_allclose(normals, want.normals, atol=5e-5)
+    # a placement with a mirror and a non-uniform scale: positions through the matrix,
+    # normals through its inverse transpose (still outward: the mirror turns them back)
+    model = np.diag([1.5, -0.7, 1.2, 1.0])
+    model[:3, 3] = (0.03, 0.01, -0.02)
+    positions, normals = gpu_tubes(gl, strands, samples, sides, 0.006, taper, reference, model)
+    moved = want.positions @ model[:3, :3].T + model[:3, 3]
+    turned = want.normals @ np.linalg.inv(model[:3, :3])
+    turned /= np.maximum(np.linalg.norm(turned, axis=1, keepdims=True), 1e-12)
+    np.testing.assert_allclose(positions, moved, atol=2e-6)
+    np.testing.assert_allclose(normals, turned, atol=5e-5)
+
+
+def test_gpu_tubes_refuse_points_of_another_shape(gl):
+    if not gl.features.compute_shaders:
+        pytest.skip("no compute shaders")
+    builder = GpuTubes(gl.ctx, 4, 6, 8, 6)
+    try:
+        with pytest.raises(ValueError, match=r"points must be \(3, 6, 4\)"):
+            builder.upload(np.zeros((3, 5, 4)), np.zeros((3, 4)))
+    finally:
+        builder.release()
