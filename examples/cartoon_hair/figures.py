@@ -2,8 +2,9 @@
 4.7-4.10 (the 1D ramp, back lighting, the Blinn band, the ramp's specular) and the depth
 metric, the outline steps of Fig. 4.11 (edges, then dilated), Fig. 4.12's comparison (a Sobel of
 the lit image against the deferred G-buffer's edges, where the thesis re-rendered the scene
-solid shaded) and the result of Fig. 4.13, the hatching of Fig. 4.20 (screen and surface), and
-the tonal art map's tones and tiling of Figs. 4.21-4.22. Run from the repository root:
+solid shaded) and the result of Fig. 4.13, the silhouette strokes of Figs. 4.17 and 4.19 (without
+and with the fade toward the roots), the hatching of Fig. 4.20 (screen and surface), and the
+tonal art map's tones and tiling of Figs. 4.21-4.22. Run from the repository root:
 python examples/cartoon_hair/figures.py
 """
 
@@ -23,6 +24,8 @@ ROOT = Path(__file__).parents[2]
 FIGURES = ROOT / "docs" / "figures" / "cartoon_hair"
 GREYS = [[0.0, "#4a4a4a"], [0.35, "#9a9a9a"], [0.75, "#ffffff"]]
 LIGHT = {"type": "directional", "direction": [-0.5, -0.6, -0.6], "intensity": 1.0}
+# strokes and ink are dark: they read on light hair (on the dark purple its shadow tone hid them)
+FAIR = [0.95, 0.72, 0.38]
 
 
 def head(params: dict | None = None, effects=None, size=(320, 320), objects=None) -> object:
@@ -112,11 +115,26 @@ def outline_figures() -> None:
                     labelled(outlined, "4.13 outlined")))
 
 
+def silhouette_figures() -> None:
+    """Figs. 4.17 and 4.19: object-space silhouette strokes along the tubes, then faded toward
+    the roots by the quadratic stroke_fade, so the strands' overlaps near the roots fade."""
+    strokes = {"color": FAIR, "silhouettes": True, "stroke_width": 5.0,
+               "stroke_color": [0.02, 0.01, 0.04]}
+    plain, _ = render(head({**strokes, "stroke_fade": [0.0, 0.0, 1.0]}))
+    faded, _ = render(head({**strokes, "stroke_fade": [-1.0, 2.0, 0.0]}))
+    write_image(FIGURES / "fig4_17_4_19_silhouettes.png",
+                row(labelled(plain, "4.17 silhouette strokes"),
+                    labelled(faded, "4.19 faded toward the roots")))
+
+
 def hatching_figures() -> None:
-    """Fig. 4.20: the hair hatched over the screen (a, Lake) and along its tubes (b, Praun);
-    Figs. 4.21-4.22: the tones of a tonal art map, and one tone tiled 2 x 2."""
-    screen, _ = render(head({"hatching": "screen"}))
-    surface, _ = render(head({"hatching": "surface"}))
+    """Fig. 4.20: the hair hatched over the screen (a, Lake) and along its tubes (b, Praun), on
+    wider strands than the default and the map once along a strand, so the map's strokes
+    are not squeezed past its smallest mip into blotches; Figs. 4.21-4.22: the tones of a tonal
+    art map, and one tone tiled 2 x 2."""
+    wide = {"color": FAIR, "radius": 0.02}
+    screen, _ = render(head({**wide, "hatching": "screen"}))
+    surface, _ = render(head({**wide, "hatching": "surface", "hatching_scale": 1.0}))
     write_image(FIGURES / "fig4_20_hatching_screen_and_surface.png",
                 row(labelled(screen, "4.20a screen hatching"),
                     labelled(surface, "4.20b surface hatching")))
@@ -135,6 +153,7 @@ def main() -> None:
     FIGURES.mkdir(parents=True, exist_ok=True)
     shading_figures()
     outline_figures()
+    silhouette_figures()
     hatching_figures()
     print(f"wrote the cartoon hair figures into {FIGURES.relative_to(ROOT)}")
 
