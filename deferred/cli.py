@@ -463,12 +463,13 @@ def bench(scene: str | None, lights: str, shells: str | None, size: str | None, 
               help="Draw the window offscreen once (panels included) to --screenshot and exit.")
 @click.option("--screenshot", metavar="OUT.png", help="With --headless: the window's image.")
 @click.option("--no-panels", is_flag=True, help="The frame alone, without the panels.")
-@click.option("--reduce", type=click.IntRange(min=1, max=8), default=2, show_default=True,
+@click.option("--reduce", type=click.IntRange(min=1, max=8),
               help="While the camera moves or a value drags, draw frames this many times "
-                   "smaller in each direction (the full frame follows when input stops).")
+                   "smaller in each direction (the full frame follows when input stops). "
+                   "Default: adapts, 2 to 8, to keep interaction near 15 fps.")
 def view_command(scene: str | None, pipeline: str, light_path: str | None, size: str | None,
                  start_time: float, view_name: str | None, split: str | None, headless: bool,
-                 screenshot: str | None, no_panels: bool, reduce: int) -> None:
+                 screenshot: str | None, no_panels: bool, reduce: int | None) -> None:
     """Interactive viewer of SCENE (the built-in demo when omitted): orbit camera, live
     parameters, buffer views, split deferred / forward, pixel inspector, timeline, hot reload
     of GLSL and scene files, screenshots and recordings (README.md, "The viewer")."""

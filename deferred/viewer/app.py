@@ -45,6 +45,10 @@ from deferred.viewer.timeline import Timeline, scene_duration
 PANEL_WIDTH = 400
 MIN_HEIGHT = 640  # the panels' room when the frame is smaller
 INTERACTION_SECONDS = 0.25  # input this recent draws reduced frames
+# Reduced frames (adaptive): the divisors tried, and the time a reduced render may take so
+# that, with the window's own drawing, interaction stays near 15 frames a second
+REDUCTIONS = (2, 3, 4, 6, 8)
+INTERACTIVE_BUDGET_MS = 45.0
 BACKGROUND = (0.11, 0.11, 0.12)
 MODES = ("single", "split", "difference")
 
@@ -57,7 +61,7 @@ class ViewerOptions:
     time: float = 0.0
     view: str | None = None  # a buffer view
     split: str | None = None  # the other side's pipeline: split view from the start
-    reduce: int = 2  # the reduced frames' divisor while interacting
+    reduce: int | None = None  # the reduced frames' divisor; None: adapts (REDUCTIONS)
     panels: bool = True
 
 
@@ -112,7 +116,8 @@ class Viewer:
         self.exposure = 0.0
         self.channel = ALL_CHANNELS
         self.view_channels: tuple[str, ...] = ()
-        self.reduce = max(1, options.reduce)
+        self.adaptive = options.reduce is None
+        self.reduce = REDUCTIONS[0] if options.reduce is None else max(1, options.reduce)
         self.show_panels = options.panels
         self.timeline = Timeline(scene_duration(session.scene), time=options.time)
         self.watcher = Watcher(session.scene, session.path)
@@ -133,6 +138,7 @@ class Viewer:
         self.timings_first = False  # the timings are of a renderer's first frame
         self.frame_ms = 0.0
         self.fps = 0.0
+        self.running = False  # the window's loop runs (the frame rate means something)
         self.psnr: float | None = None
         self.inspector: list[str] = []
         self.buffers: list[str] = []
@@ -203,7 +209,18 @@ class Viewer:
             self.render_error = self.render_exception = None
         self.frame_ms = (clock.perf_counter() - start) * 1000.0
         self.shown_key, self.shown_reduced = key, not full
+        if not full and self.adaptive and self.render_error is None:
+            self._adapt(self.frame_ms)
         return True
+
+    def _adapt(self, ms: float) -> None:
+        """The next reduced frames one step smaller when this one took longer than the
+        budget, one step larger when it took well under it (a renderer a step, kept)."""
+        index = REDUCTIONS.index(self.reduce) if self.reduce in REDUCTIONS else 0
+        if ms > INTERACTIVE_BUDGET_MS and index + 1 < len(REDUCTIONS):
+            self.reduce = REDUCTIONS[index + 1]
+        elif ms < INTERACTIVE_BUDGET_MS / 3.0 and index > 0:
+            self.reduce = REDUCTIONS[index - 1]
 
     def _render(self, size: tuple[int, int], full: bool) -> None:
         session = self.session
@@ -312,6 +329,9 @@ class Viewer:
         fbo = self.wnd.fbo
         width, height = fbo.size
         data = np.frombuffer(fbo.read(components=3, alignment=1), np.uint8)
+        # a real window's default framebuffer has no colour attachment 0 to select: moderngl
+        # reads it all the same and leaves GL_INVALID_OPERATION, which is not a renderer's
+        _ = self.ctx.error
         return data.reshape(height, width, 3)[::-1].copy()
 
     def screenshot(self, path: str | Path | None = None, window: bool = False) -> Path:
@@ -501,6 +521,7 @@ class Viewer:
     def run(self) -> None:
         """The window's loop until it closes."""
         wnd = self.wnd
+        self.running = True
         while not wnd.is_closing:
             self.tick()
             self.draw()

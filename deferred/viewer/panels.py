@@ -34,6 +34,7 @@ PIPELINES = [p.value for p in Pipeline]
 LIGHT_PATHS = ["(scene's)", *(p.value for p in LightPath)]
 MODES = ("single", "split", "difference")
 OPEN = imgui.TreeNodeFlags_.default_open
+LABEL_WIDTH = 140  # pixels right of each widget for its label
 
 
 def draw(viewer: Viewer, width: int, height: int) -> list[str]:
@@ -44,6 +45,7 @@ def draw(viewer: Viewer, width: int, height: int) -> list[str]:
     flags = (imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize |
              imgui.WindowFlags_.no_collapse | imgui.WindowFlags_.no_saved_settings)
     imgui.begin("deferred view", None, flags)
+    imgui.push_item_width(-LABEL_WIDTH)  # widgets leave the labels their room
     _status(viewer, shown)
     if imgui.collapsing_header("Timeline", OPEN):
         _timeline(viewer)
@@ -54,6 +56,8 @@ def draw(viewer: Viewer, width: int, height: int) -> list[str]:
     if imgui.collapsing_header("Objects", OPEN):
         for index, obj in enumerate(viewer.session.scene.objects):
             _open_if_refused(viewer, "object", index)
+            if index == 0:  # the first object's parameters in sight from the start
+                imgui.set_next_item_open(True, imgui.Cond_.once)
             if imgui.tree_node(f"{obj.label} ({obj.material.name})##object{index}"):
                 _params(viewer, "object", index, shown)
                 imgui.tree_pop()
@@ -80,6 +84,7 @@ def draw(viewer: Viewer, width: int, height: int) -> list[str]:
         _inspector(viewer)
     if imgui.collapsing_header("File", OPEN):
         _file(viewer)
+    imgui.pop_item_width()
     imgui.end()
     return shown
 
@@ -101,8 +106,8 @@ def _status(viewer: Viewer, shown: list[str]) -> None:
     width, height = viewer.size
     reduced = "  (reduced)" if viewer.shown_reduced else ""
     imgui.text(f"{viewer.session.scene.source}  {width}x{height}  {viewer.pipeline}{reduced}")
-    imgui.text(f"{viewer.fps:4.0f} fps  frame {viewer.frame_ms:6.1f} ms  t = "
-               f"{viewer.timeline.time:.3f} s")
+    rate = f"{viewer.fps:4.0f} fps  " if viewer.running else ""
+    imgui.text(f"{rate}frame {viewer.frame_ms:.1f} ms  t = {viewer.timeline.time:.3f} s")
     if viewer.render_error:
         _error(viewer.render_error, shown)
     if viewer.session.scene_error:

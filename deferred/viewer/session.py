@@ -90,13 +90,13 @@ class Session:
                 light = self.scene.lights[index]
                 light.params = validate_params(type(light.params),
                                                {**light.params.model_dump(), key: value},
-                                               f"light[{index}]")
+                                               f"{self.scene.source}: light[{index}]")
                 target = self.edits.lights.setdefault(index, {})
             elif kind == "effect":
                 effect = self.scene.effects[index]
                 effect.params = validate_params(type(effect.params),
                                                 {**effect.params.model_dump(), key: value},
-                                                f"effect {effect.name}")
+                                                f"{self.scene.source}: effect {effect.name}")
                 target = self.edits.effects.setdefault(index, {})
             else:
                 raise ValueError(f"unknown kind {kind!r}")
