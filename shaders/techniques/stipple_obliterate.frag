@@ -5,7 +5,8 @@
 // The neighbour must show the surface the sample covered, not an occluder beside it: among the
 // pixels around the sample (the 8 of its 3x3 block for the 1-in-4 pattern, the 4 edge-adjacent
 // for 1-in-2, all outside this pattern) those nearer than the sample are out (an occluder edge
-// stays straight), and of the rest the one whose surface (id and depth) most others share wins.
+// stays straight), and of the rest one of an opposite pair showing the same surface, else the
+// one whose surface (id and depth) most others share.
 #include "techniques/stipple.glsl"
 #include "gbuffer/layout.glsl"
 
@@ -54,18 +55,30 @@ void main() {
         // behind the sample (or background): what the stipple may have covered
         valid[k] = depths[k] <= 0.0 || depths[k] >= depth * (1.0 - 1e-3);
     }
+    // The surface the sample covered most likely runs on through the pixel: where the two
+    // neighbours of an opposite pair (left and right, above and below, a diagonal) show the
+    // same surface (id, and depth within 10% - a surface at a grazing angle, the floor
+    // toward the horizon, changes depth quickly from row to row), it is one of those; of
+    // such pairs, and failing any of the candidates, the surface most others share (its id
+    // and depth) wins. By votes alone, the sky above a floor pixel beside a silhouette
+    // (three pixels that all agree) won over the floor to its left and right: a dot of sky.
     int best = -1;
     int best_votes = 0;
+    bool best_paired = false;
     for (int k = 0; k < CANDIDATES; ++k) {
         if (!valid[k]) continue;
+        int opposite = k < 4 ? k ^ 1 : 11 - k;  // OFFSETS' order: pairs (0 1) (2 3) (4 7) (5 6)
+        bool paired = valid[opposite] && same_surface(ids[opposite], ids[k]) &&
+                      abs(depths[opposite] - depths[k]) <= 0.1 * max(depths[opposite], depths[k]);
         int votes = 0;
         for (int j = 0; j < CANDIDATES; ++j) {
             if (valid[j] && same_surface(ids[j], ids[k]) && same_depth(depths[j], depths[k]))
                 votes += 1;
         }
-        if (votes > best_votes) {
+        if ((paired && !best_paired) || (paired == best_paired && votes > best_votes)) {
             best = k;
             best_votes = votes;
+            best_paired = paired;
         }
     }
     ivec2 source = best >= 0 ? pixel + OFFSETS[best]

@@ -273,3 +273,38 @@ def test_unreadable_heightfield_is_a_clear_error(tmp_path):
         scene_from_dict({"object": [{"mesh": "builtin:sphere", "material": "revie_fur",
                                      "params": {"heightfield": "noise.png"}}]}, name="s.toml",
                         base_dir=tmp_path)
+
+
+def test_obliteration_restores_the_floor_not_the_sky_beside_a_silhouette(gl):
+    """Issue #25: a stipple sample over the floor near the horizon (its depth changing by
+    more than the tolerance from row to row) is restored from the floor, not from the sky
+    above it, whose pixels all agree: no pixel the floor held before the stipple ends as the
+    background colour once the samples are erased (the dots of sky along the fur's top
+    edge)."""
+    from dataclasses import replace
+
+    from deferred.render.renderer import Renderer
+    from deferred.scene.loader import load_scene
+
+    scene = load_scene()  # the demo, its objects far away: the torus's top meets the horizon
+    camera = scene.camera
+    target = np.array(camera.target)
+    scene.camera = replace(camera, position=tuple(
+        target + 3.0 * (np.array(camera.position) - target)))
+    seen = {}
+
+    def after(render_pass, frame):
+        if render_pass.phase.value == "geometry":
+            seen["ids"] = frame.targets.read("normal_exponent_id")[..., 3].copy()
+        if render_pass.name.endswith(".stipple_obliteration"):  # what it restored
+            seen["composite"] = frame.targets.read("composite").copy()
+
+    with Renderer(scene, "deferred", size=(320, 180), gl=gl) as renderer:
+        renderer.render(on_pass=after)
+    composite = seen["composite"]
+    floor_id = float(scene.objects[0].material.surface_id())
+    floor = np.abs(seen["ids"] - floor_id) < 0.5
+    sky = np.all(np.abs(composite[..., :3] - np.array(scene.background)) < 2e-3, axis=-1) & \
+        (composite[..., 3] == 0.0)
+    assert floor.sum() > 1000
+    assert not np.any(floor & sky)
