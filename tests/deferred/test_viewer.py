@@ -109,8 +109,45 @@ def test_orbit_changes_the_view_and_reset_restores_it(scene_file, make_viewer):
     assert np.abs(orbited.astype(int) - before).mean() > 2.0
     viewer.mouse_scroll(0, 2)  # zoom in
     assert np.abs(shown(viewer).astype(int) - orbited).mean() > 2.0
-    viewer.shortcut(viewer.wnd.keys.R)
+    viewer.shortcut(viewer.keys.R)
     np.testing.assert_array_equal(shown(viewer), before)
+
+
+def test_keys(scene_file, make_viewer, tmp_path):
+    from moderngl_window.context.base import KeyModifiers
+
+    viewer = make_viewer(scene_file)
+    keys, plain, ctrl = viewer.keys, KeyModifiers(), KeyModifiers()
+    ctrl.ctrl = True
+    home = shown(viewer)
+
+    def press(key, modifiers=plain):
+        viewer.key_event(key, keys.ACTION_PRESS, modifiers)
+        viewer.key_event(key, keys.ACTION_RELEASE, modifiers)
+
+    press(keys.SPACE)
+    assert viewer.timeline.playing
+    press(keys.SPACE)
+    press(keys.RIGHT)
+    press(keys.RIGHT)
+    assert viewer.timeline.time == pytest.approx(2 / 24)
+    press(keys.HOME)
+    press(keys.TAB)
+    assert viewer.mode == "split"
+    press(keys.TAB)
+    press(keys.TAB)
+    assert viewer.mode == "single"
+    press(keys.F)  # fly: W moves the eye and the target forward
+    viewer.key_event(keys.W, keys.ACTION_PRESS, plain)
+    viewer._fly(0.1)
+    viewer.key_event(keys.W, keys.ACTION_RELEASE, plain)
+    assert np.abs(shown(viewer).astype(int) - home).mean() > 1.0
+    press(keys.R)
+    np.testing.assert_array_equal(shown(viewer), home)
+    viewer.session.edit("object", 1, "specular_exponent", 12.0)
+    press(keys.S, ctrl)
+    assert "specular_exponent = 12.0" in scene_file.read_text()
+    assert "# grey" in scene_file.read_text()
 
 
 def test_the_viewport_is_the_frame_render_draws_for_the_same_camera(scene_file, make_viewer,
