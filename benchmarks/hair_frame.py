@@ -10,9 +10,12 @@ head turning back and forth, 30 frames a second at a fixed step of 1/60 s (two s
 - tubes, numpy: :func:`build_tubes` (the GL 3.3 path and the tests' reference), process CPU;
 - silhouettes: the ``.silhouettes`` pass of the spiky head scene at 640x360 with that many
   strands (the geometry shader finding and extruding the tubes' silhouette edges, and their
-  strokes' fragments), wall clock around ``ctx.finish()``.
+  strokes' fragments), wall clock around ``ctx.finish()``;
+- with ``--pipelines``: the whole frame of that scene (outlines by the edges effect, no
+  silhouette strokes) in each pipeline, the hair moving, wall clock around ``ctx.finish()``.
 
     OPENBLAS_NUM_THREADS=1 python benchmarks/hair_frame.py [--frames N] [--no-silhouettes]
+        [--pipelines]
 """
 
 from __future__ import annotations
@@ -80,11 +83,31 @@ def simulation_and_tubes(count: int, frames: int, gl, shaders) -> dict[str, floa
     return {key: statistics.median(values) * 1000.0 for key, values in times.items()}
 
 
+def head_scene(count: int, **params):
+    """The spiky head example with ``count`` strands (thinner at 10,000)."""
+    scene = load_scene("examples/cartoon_hair/spiky_head.toml")
+    scene.objects[0].set_params(strands=count, radius=0.012 if count < 10000 else 0.005,
+                                **params)
+    return scene
+
+
+def whole_frames(count: int, frames: int, gl, pipeline: str) -> float:
+    """Median milliseconds of a whole frame, the hair moving."""
+    spent: list[float] = []
+    with Renderer(head_scene(count), pipeline, size=(640, 360), gl=gl) as renderer:
+        ctx = renderer.gl.ctx
+        for frame in range(frames + 1):
+            ctx.finish()
+            start = time.perf_counter()
+            renderer.render(time=0.2 + frame / 30.0, readback=False)
+            ctx.finish()
+            spent.append(time.perf_counter() - start)
+    return statistics.median(spent[1:]) * 1000.0
+
+
 def silhouettes(count: int, frames: int, gl) -> float:
     """Median milliseconds of the silhouette pass a frame, the hair moving."""
-    scene = load_scene("examples/cartoon_hair/spiky_head.toml")
-    scene.objects[0].set_params(strands=count, silhouettes=True,
-                                radius=0.012 if count < 10000 else 0.005)
+    scene = head_scene(count, silhouettes=True)
     spent: list[float] = []
     with Renderer(scene, size=(640, 360), gl=gl) as renderer:
         ctx = renderer.gl.ctx
@@ -110,6 +133,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--frames", type=int, default=30)
     parser.add_argument("--no-silhouettes", action="store_true")
+    parser.add_argument("--pipelines", action="store_true")
     args = parser.parse_args()
     gl = create_context()
     if not gl.features.compute_shaders:
@@ -124,6 +148,10 @@ def main() -> None:
                     f"{t['numpy']:6.2f} ms")
             if not args.no_silhouettes:
                 line += f"; silhouette pass {silhouettes(count, min(args.frames, 8), gl):6.2f} ms"
+            if args.pipelines:
+                line += "; frame " + ", ".join(
+                    f"{pipeline} {whole_frames(count, 6, gl, pipeline):6.1f} ms"
+                    for pipeline in ("deferred", "forward"))
             print(line, flush=True)
     finally:
         gl.release()

@@ -218,9 +218,7 @@ def _vertex_normals(rings: np.ndarray, centre: np.ndarray) -> tuple[np.ndarray, 
 
 TUBE_FRAMES = "materials/cartoon_hair/tube_frames.comp"
 TUBE_VERTICES = "materials/cartoon_hair/tube_vertices.comp"
-# invocations a work group: GL's least maximum; llvmpipe pays a fixed cost a group that
-# made groups of 64 several times slower (benchmarks/README.md)
-TUBE_GROUP = 1024
+TUBE_GROUP = 256  # invocations a work group (64 to 1,024 cost the same on llvmpipe)
 
 
 class GpuTubes:

@@ -6,8 +6,9 @@
 // the six triangles round it (the quads before and after it, and the cap's fan on an end ring),
 // built from the rings of samples i - 1, i, i + 1 (tube_frames.comp's frames), walked round with
 // the vertices j - 1, j, j + 1 of each at hand; a cap centre's normal the sum of its fan.
-// Invocations run ring-major (all strands' first rings, then their second, ...) so the lanes of
-// a SIMD batch take the same branch on llvmpipe; the loop over a ring has no division.
+// Invocations run strand-major (a strand's rings, root first, then the next strand's): llvmpipe
+// stores to a storage buffer lane by lane, and neighbouring lanes then write neighbouring
+// memory (ring-major took about 1.7 times the CPU time). The loop over a ring has no division.
 // The rings come in the object's space (tube_frames.comp): the triangles' normals are there
 // the matrix's inverse transpose times build_tubes', times its determinant (u_orientation, the
 // determinant's sign, turns them back out of a mirrored object).
@@ -61,8 +62,8 @@ void main() {
     if (r >= u_strands * u_samples) {
         return;
     }
-    int i = r / u_strands;
-    int s = r - i * u_strands;
+    int s = r / u_samples;
+    int i = r - s * u_samples;
     int last = u_samples - 1;
     bool behind = i > 0;
     bool ahead = i < last;
