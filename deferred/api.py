@@ -84,6 +84,7 @@ from deferred.interfaces.light import (
     view_points,
 )
 from deferred.interfaces.material import (
+    SHADOW_CASTER_DEFINES,
     BlinnPhongParams,
     ForwardLitPass,
     GBufferPass,
@@ -139,7 +140,8 @@ __all__ = [
     "BlinnPhongParams", "ClearPass", "Effect", "EffectParams", "ForwardLitPass", "Frame",
     "FullscreenPass", "GBufferData", "GBufferPass", "GpuMesh", "InputError", "Light",
     "LightParams", "LightPath", "LightVolume", "Material", "MaterialParams", "MeshData",
-    "MeshPrimitives", "ShadowParams", "ShadowProjection", "ShadowView",
+    "MeshPrimitives", "SHADOW_CASTER_DEFINES", "ShadowParams", "ShadowProjection",
+    "ShadowView",
     "NonZeroVec3", "ObjectPass", "Order", "Params", "Phase", "Pipeline", "Radiance",
     "RenderError", "RenderPass", "Scene", "SceneObject", "ShadingModel", "TargetSpec",
     "UniformOverrides", "builtin_head_spheres", "check_image", "copy_pass", "effects", "halton",

@@ -88,12 +88,17 @@ class CombFieldInputs:
     obj: SceneObject
 
     def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
-        mesh, params = self.obj.mesh, self.obj.material.params
-        comb = None if mesh.has_comb else tuple(params.comb)
-        texture = frame.resources.current(
-            ("revie_fur_comb_field", self.obj), (id(mesh), comb),
-            lambda ctx: comb_field_texture(ctx, comb_field(mesh, comb)))
-        return {**super().textures(frame), "u_comb_field": texture}
+        return {**super().textures(frame), **comb_field_inputs(frame, self.obj)}
+
+
+def comb_field_inputs(frame: Frame, obj: SceneObject) -> dict[str, moderngl.Texture]:
+    """``u_comb_field`` of a revie_fur object (:class:`CombFieldInputs`)."""
+    mesh, params = obj.mesh, obj.material.params
+    comb = None if mesh.has_comb else tuple(params.comb)
+    texture = frame.resources.current(
+        ("revie_fur_comb_field", obj), (id(mesh), comb),
+        lambda ctx: comb_field_texture(ctx, comb_field(mesh, comb)))
+    return {"u_comb_field": texture}
 
 
 class CombedGBufferPass(CombFieldInputs, GBufferPass):
@@ -139,6 +144,10 @@ class RevieFurMaterial(FurMaterial):
     uniform_overrides = {**FUR_UNIFORM_OVERRIDES, "stipple": None, "occlusion_test": None,
                          "comb": None}  # the comb field's texture instead (CombFieldInputs)
     debug_views = FUR_DEBUG_VIEWS
+    fur_vertex = FUR_VERTEX
+
+    def shadow_textures(self, frame: Frame, obj: SceneObject) -> dict[str, moderngl.Texture]:
+        return comb_field_inputs(frame, obj)
 
     def defines(self, obj: SceneObject) -> dict[str, str]:
         defines = {**super().defines(obj), **pattern_defines(4, STIPPLE_PARITY)}

@@ -514,6 +514,13 @@ class ShellFurMaterial(FurMaterial):
                     "wet; black dry (Silva et al. Fig. 11's inset)", {"debug": "wetness"}),
     }
 
+    fur_vertex = FUR_VERTEX
+
+    def shadow_textures(self, frame: Frame, obj: SceneObject) -> dict[str, moderngl.Texture]:
+        # the state the object's passes brought to the frame's time in their prepare
+        state = object_state(frame, obj)
+        return {"u_wetness_mask": state.mask_texture, "u_strand_tips": state.tips_texture}
+
     def check_time(self, time: float, where: str) -> None:
         steps = simulation_steps(self.params, time)
         if steps > MAX_SIMULATION_STEPS:

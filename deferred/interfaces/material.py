@@ -89,20 +89,35 @@ SHADOW_CASTER_VERTEX = "shadows/caster.vert"
 SHADOW_CASTER_FRAGMENT = "shadows/caster.frag"
 
 
+# A vertex shader of the camera (``u_view``, ``u_projection``) compiled with these defines
+# draws from the light instead, reading :attr:`ShadowView.camera_uniforms`: how a material's
+# own vertex stage (fur shells, displaced strands) becomes its shadow caster's.
+SHADOW_CASTER_DEFINES = {"u_view": "u_shadow_view", "u_projection": "u_shadow_projection",
+                         "SHADOW_CASTER": "1"}
+
+
 @dataclass(frozen=True)
 class ShadowView:
-    """One shadow map being drawn (:meth:`Material.draw_shadow`): the light's world -> clip
-    matrix, and where the light is (a world position, or ``None`` for a directional light)
-    and the direction it shines (world, unit), for casters that shape themselves to it."""
+    """One shadow map being drawn (:meth:`Material.draw_shadow`): the light's world -> view
+    and view -> clip matrices, where the light is (a world position, or ``None`` for a
+    directional light) and the direction it shines (world, unit), for casters that shape
+    themselves to it."""
 
-    view_projection: np.ndarray
+    view: np.ndarray
+    projection: np.ndarray
     position: np.ndarray | None
     direction: np.ndarray
 
     @property
     def uniforms(self) -> dict[str, Any]:
         """``u_shadow_view_projection``: what ``shadows/caster.vert`` reads."""
-        return {"u_shadow_view_projection": self.view_projection}
+        return {"u_shadow_view_projection": self.projection @ self.view}
+
+    @property
+    def camera_uniforms(self) -> dict[str, Any]:
+        """The light as the camera of a vertex shader compiled with
+        :data:`SHADOW_CASTER_DEFINES`."""
+        return {"u_shadow_view": self.view, "u_shadow_projection": self.projection}
 
 
 class Material:

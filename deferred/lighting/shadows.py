@@ -274,7 +274,8 @@ class ShadowAtlas:
                     np.asarray(params.position, np.float64)
                 direction = unit(-light_view[2, :3])
                 self.tiles.append(ShadowTile(light, slot, x, y, size, view_projection,
-                                             ShadowView(view_projection, position, direction),
+                                             ShadowView(light_view, projection, position,
+                                                        direction),
                                              reach))
             self.slots[id(light)] = slot
         self.records.write(records.tobytes())

@@ -25,9 +25,15 @@ import moderngl
 import numpy as np
 from pydantic import Field, model_validator
 
-from deferred.api import Material, MaterialParams, check_image
+from deferred.api import (
+    SHADOW_CASTER_DEFINES,
+    Material,
+    MaterialParams,
+    ShadowView,
+    check_image,
+)
 
-from .fur_volume import FurPattern, pattern, strand_volume, volume_texture
+from .fur_volume import VOLUME_LAYERS, FurPattern, pattern, strand_volume, volume_texture
 from .heightfield import (
     HEIGHTFIELD_BYTES_PER_TEXEL,
     HEIGHTFIELD_GPU_BYTES_PER_TEXEL,
@@ -40,6 +46,8 @@ if TYPE_CHECKING:
 
 # A heightfield image tile counts as this many strands when density converts to tiles per unit.
 IMAGE_TILE_STRANDS = 1024
+SHADOW_CASTER_FRAGMENT = "shadows/fur_caster.frag"
+SHADOW_SHELLS = 8  # most shells a fur object casts its shadow with (with its root shell)
 
 
 class FurParams(MaterialParams):
@@ -196,6 +204,37 @@ class FurMaterial(Material):
     def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
         return {**super().textures(frame),
                 "u_fur_volume": fur_volume_texture(frame, self.params, self.heightfield_path())}
+
+    # -- shadows -------------------------------------------------------------------------------
+    fur_vertex: str = ""  # the material's fur vertex shader (its shells' and its caster's)
+
+    def shadow_textures(self, frame: Frame, obj: SceneObject) -> dict[str, moderngl.Texture]:
+        """The per-object textures the fur vertex shader reads (a comb field, a simulation's
+        state), for the shadow caster."""
+        return {}
+
+    def draw_shadow(self, frame: Frame, obj: SceneObject, view: ShadowView) -> None:
+        """The fur casts from its shells: the root shell (the skin) and up to
+        ``SHADOW_SHELLS`` shells above it through the material's own fur vertex shader seen
+        from the light (:data:`SHADOW_CASTER_DEFINES`), each kept by a dither under its
+        opacity (``shadows/fur_caster.frag``), so the floor darkens with the fur's density."""
+        params = self.params
+        if params.shells == 0 or not self.fur_vertex:
+            super().draw_shadow(frame, obj, view)
+            return
+        program = frame.shaders.program(self.fur_vertex, SHADOW_CASTER_FRAGMENT,
+                                        defines={**self.defines(obj), **SHADOW_CASTER_DEFINES})
+        count = min(params.shells, SHADOW_SHELLS) + 1.0  # the root shell and the slabs above
+        frame.bind(program, {**view.camera_uniforms, **self.vertex_constants(obj),
+                             "u_shell_depth": 0.0, "u_root_shell": True,
+                             "u_shell_weight": VOLUME_LAYERS / (count - 1.0)},
+                   self.shadow_textures(frame, obj), offered=frame.object_uniforms(obj),
+                   material=frame.material_inputs(self))
+        for k in range(int(count)):
+            if k:
+                frame.set_uniforms(program, {"u_shell_depth": shell_depth(k, count),
+                                             "u_root_shell": False})
+            frame.draw_mesh(obj.mesh, program)
 
     @staticmethod
     def vertex_constants(obj: SceneObject, shell_depth: float | None = None) -> dict[str, Any]:

@@ -62,9 +62,13 @@ float shadow_tile(int row, int tile, vec4 header, vec4 biases, vec3 P, vec3 N, v
     vec4 rect = shadow_texel(row, base + 4);
     vec4 size = shadow_texel(row, base + 5);
     float texel = size.x * (size.y > 0.5 ? distance : 1.0);  // a texel's world size at P
-    // normal offset (grows as the light grazes the surface) and depth bias along L, in texels
+    // normal offset and depth bias along L, in texels. A filter reaching r texels from the
+    // centre reads the receiver's own plane up to r sin / cos of the light's angle deeper: the
+    // offset along N grows with the reach and with sin (it lifts the point by itself, which
+    // the light sees as 1 / cos deeper), so the kernel stays above the surface it lies on.
     float grazing = sqrt(clamp(1.0 - dot(N, L) * dot(N, L), 0.0, 1.0));
-    vec3 Q = P + N * (biases.y * texel * (0.5 + grazing)) + L * (biases.x * texel);
+    float reach = header.z < 0.5 ? 1.5 : header.w;
+    vec3 Q = P + N * (biases.y * texel * (0.5 + reach * grazing)) + L * (biases.x * texel);
     vec4 clip = to_atlas * vec4(Q, 1.0);
     vec3 uvz = clip.xyz / clip.w;
     if (uvz.z >= 1.0) return 1.0;  // beyond the map's far plane

@@ -26,7 +26,7 @@ CAMERA = {"position": [0.0, 5.0, 0.0], "target": [0.0, 0.0, 0.0], "up": [0.0, 0.
           "fov": 40.0, "near": 0.1, "far": 30.0}
 LIGHTS = {
     "directional": {"type": "directional", "direction": [-0.8, -1.0, -0.3], "intensity": 2.0,
-                    "cascades": 1, "shadow_resolution": 512, "shadow_distance": 8.0},
+                    "cascades": 1, "shadow_resolution": 1024, "shadow_distance": 8.0},
     "spot": {"type": "spot", "position": [1.0, 3.0, 0.6], "direction": [-0.35, -1.0, -0.2],
              "radius": 12.0, "intensity": 30.0, "inner_angle": 55.0, "outer_angle": 65.0,
              "shadow_resolution": 512},
@@ -123,15 +123,19 @@ def analytic_shadow(kind: str, points: np.ndarray) -> np.ndarray:
 
 
 def texel_size(kind: str, tiles, points: np.ndarray) -> np.ndarray:
-    """A shadow texel's world size at each plane point."""
+    """A shadow texel's footprint on the plane at each point: its size across the light's
+    rays, over the cosine of the rays' angle with the plane's normal."""
     projection, size = tiles[0]
     if kind == "directional":  # orthographic: 2 / (size * P00) world units a texel
-        return np.full(points.shape[:-1], 2.0 / (size * projection[0, 0]))
+        d = np.asarray(LIGHTS[kind]["direction"], float)
+        return np.full(points.shape[:-1], 2.0 / (size * projection[0, 0])) * \
+            np.linalg.norm(d) / abs(d[1])
     source = np.asarray(LIGHTS[kind]["position"], float)
-    # perspective: the map covers 2 tan(half) per unit of distance; P00 = 1 / tan(half) for
-    # the view-projection of a face looking straight along an axis, and at most so for others
+    # perspective: the map covers 2 tan(half) per unit of distance (row 0 of the view and
+    # projection has the length P00 = 1 / tan(half))
     column = np.linalg.norm(projection[0, :3])
-    return np.linalg.norm(points - source, axis=-1) * 2.0 / (size * column)
+    distance = np.linalg.norm(points - source, axis=-1)
+    return distance * 2.0 / (size * column) * distance / source[1]
 
 
 @pytest.mark.parametrize("kind", ["directional", "spot", "point"])
