@@ -217,7 +217,11 @@ class FurMaterial(Material):
         """The fur casts from its shells: the root shell (the skin) and up to
         ``SHADOW_SHELLS`` shells above it through the material's own fur vertex shader seen
         from the light (:data:`SHADOW_CASTER_DEFINES`), each kept by a dither under its
-        opacity (``shadows/fur_caster.frag``), so the floor darkens with the fur's density."""
+        opacity (``shadows/fur_caster.frag``), so the floor darkens with the fur's density.
+        The vertex shader pushes them a strand's length away from the light: the fur shadows
+        other surfaces and the far side of its own body, not its own skin through its own
+        shells (the deferred shells take their light from the skin's pixels, which would make
+        the whole fur as dark as its roots); its self-shadowing stays gamma(h)."""
         params = self.params
         if params.shells == 0 or not self.fur_vertex:
             super().draw_shadow(frame, obj, view)
@@ -225,10 +229,13 @@ class FurMaterial(Material):
         program = frame.shaders.program(self.fur_vertex, SHADOW_CASTER_FRAGMENT,
                                         defines={**self.defines(obj), **SHADOW_CASTER_DEFINES})
         count = min(params.shells, SHADOW_SHELLS) + 1.0  # the root shell and the slabs above
-        frame.bind(program, {**view.camera_uniforms, **self.vertex_constants(obj),
-                             "u_shell_depth": 0.0, "u_root_shell": True,
+        # the light's matrices offered, not set: the shader declares them under the camera's
+        # names (renamed by the defines), which is what strict mode reads
+        frame.bind(program, {**self.vertex_constants(obj), "u_shell_depth": 0.0,
+                             "u_root_shell": True,
                              "u_shell_weight": VOLUME_LAYERS / (count - 1.0)},
-                   self.shadow_textures(frame, obj), offered=frame.object_uniforms(obj),
+                   self.shadow_textures(frame, obj),
+                   offered={**frame.object_uniforms(obj), **view.camera_uniforms},
                    material=frame.material_inputs(self))
         for k in range(int(count)):
             if k:

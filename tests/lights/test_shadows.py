@@ -385,3 +385,76 @@ def test_shadow_views_and_the_dump_show_the_atlas(tmp_path):
     done = deferred("render", path, "--view", "shadow_atlas", "-o", tmp_path / "none.png")
     assert done.returncode == 2 and "no light of this scene casts shadows" in done.stderr
     assert len(done.stderr.strip().splitlines()) == 1
+
+
+FUR = {"revie_fur": {"fur_length": 0.5, "shells": 12, "stipple": False},
+       "shell_fur": {"fur_length": 0.5, "shells": 12}}
+FUR_LIGHT = np.array([0.6, -1.0, 0.0])  # from the left, down
+
+
+def fur_scene(material: str, shadows: bool, *, caster_above: bool = False,
+              standard: bool = False):
+    ball = {"mesh": "builtin:sphere", "position": [0.0, 0.9, 0.0], "scale": 0.4}
+    ball.update({"params": PLAIN} if standard else {"material": material,
+                                                    "params": FUR[material]})
+    objects = [{"mesh": "builtin:plane", "scale": 8.0, "params": PLAIN}, ball]
+    if caster_above:
+        # a slab up toward the light (out of the camera's view) whose shadow falls on the
+        # ball's left half: the points x in [-0.45, 0] near the top, 1.7 units up the light
+        objects.append({"mesh": "builtin:cube", "position": [-1.28, 2.9, 0.0],
+                        "scale": [0.3, 0.03, 1.0], "params": PLAIN})
+    light = {"type": "directional", "direction": list(FUR_LIGHT), "intensity": 2.0,
+             "cascades": 1, "shadow_distance": 8.0, "shadow_resolution": 1024,
+             "shadows": shadows}
+    return scene_from_dict({"size": [W, H], "tonemap": "none", "camera": CAMERA,
+                            "object": objects, "light": [AMBIENT, light]})
+
+
+@pytest.mark.parametrize("material", ["revie_fur", "shell_fur"])
+def test_fur_casts_a_shadow_from_its_shells(gl, material):
+    """The fur ball's shadow on the floor is the sphere's grown by the fur (its shells cast,
+    not just its skin): a ring just outside the bare sphere's shadow is shaded."""
+    points, _ = plane_points()
+    centre = -0.9 * FUR_LIGHT[0] / FUR_LIGHT[1]  # where the light's ray through the centre lands
+    stretch = np.linalg.norm(FUR_LIGHT) / abs(FUR_LIGHT[1])  # the shadow's ellipse along x
+    rho = np.hypot((points[..., 0] - centre) / stretch, points[..., 2])
+    far_side = points[..., 0] > 0.8  # not hidden by the fur ball (0.6 wide) from above
+
+    def fraction(**kw):
+        shadowed, _ = render(gl, fur_scene(material, True, **kw))
+        unshadowed, _ = render(gl, fur_scene(material, False, **kw))
+        ambient, _ = render(gl, scene_from_dict({
+            "size": [W, H], "tonemap": "none", "camera": CAMERA,
+            "object": [{"mesh": "builtin:plane", "scale": 8.0, "params": PLAIN}],
+            "light": [AMBIENT]}))
+        lit = (unshadowed - ambient).sum(-1)
+        return (shadowed - ambient).sum(-1) / np.maximum(lit, 1e-6)
+    fur = fraction()
+    skin = fraction(standard=True)
+    ring = far_side & (rho > 0.42) & (rho < 0.5)  # the fur reaches 0.4 + 0.2
+    inside = far_side & (rho < 0.33)
+    outside = far_side & (rho > 0.75)
+    assert ring.sum() > 20 and inside.sum() > 20
+    assert skin[ring].mean() > 0.95  # the bare sphere leaves the ring lit
+    assert fur[ring].mean() < 0.8  # the fur shades it
+    # softly: the shadow lightens outward through the fur's reach (sparser toward the tips)
+    bands = [fur[far_side & (rho > a) & (rho < a + 0.04)].mean() for a in (0.42, 0.46, 0.5)]
+    assert bands[0] < bands[1] < bands[2] < 1.0
+    assert fur[inside].max() < 0.05 and fur[outside].min() > 0.98
+
+
+@pytest.mark.parametrize("pipeline", ["deferred", "forward"])
+@pytest.mark.parametrize("material", ["revie_fur", "shell_fur"])
+def test_fur_receives_shadows(gl, material, pipeline):
+    """A slab's shadow over the left half of a fur ball darkens the fur there (shells, fins
+    and the root shell read the shadow), in both pipelines; the right half stays lit."""
+    shadowed, _ = render(gl, fur_scene(material, True, caster_above=True), pipeline)
+    unshadowed, _ = render(gl, fur_scene(material, False, caster_above=True), pipeline)
+    points, _ = plane_points()
+    # the ball's top seen from above (its pixels within 0.3 of the middle at its top's height)
+    x, z = points[..., 0] * (5.0 - 1.3) / 5.0, points[..., 2] * (5.0 - 1.3) / 5.0
+    on_ball = np.hypot(x, z) < 0.3
+    left, right = on_ball & (x < -0.15), on_ball & (x > 0.15)
+    shaded, plain = shadowed.sum(-1), unshadowed.sum(-1)
+    assert shaded[left].mean() < 0.6 * plain[left].mean()
+    assert shaded[right].mean() > 0.95 * plain[right].mean()
