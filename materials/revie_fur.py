@@ -15,7 +15,8 @@ The shells, their fur volume, level of detail and fins are the shared fur techni
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Literal
 
 from pydantic import Field
 
@@ -78,6 +79,12 @@ class RevieFurParams(FurParams, BlinnPhongParams):
     comb_strength: float = Field(0.6, ge=0.0, le=8.0, description="how far strands lean")
     occlusion_test: bool = Field(True, description="reject light samples the G-buffer shows "
                                                    "occluded (off: Figure 2.8's error)")
+    shading: Literal["classic", "marschner"] = Field(
+        "classic", description="classic: the paper's grain normals and rim bending, lit "
+                               "Blinn-Phong; marschner: the hair shading model (R, TT, TRT "
+                               "about the strand direction; no grain normal, no rim bending)")
+    roughness: float = Field(0.2, gt=0.0, le=1.0,
+                             description="marschner: longitudinal roughness beta, radians")
 
 
 class CombFieldInputs:
@@ -142,7 +149,14 @@ class RevieFurMaterial(FurMaterial):
     inputs_from_params = True  # uniforms from the params, textures from frame.resources
     # pass counts and switches compiled as defines are not uniforms; density becomes tiles
     uniform_overrides = {**FUR_UNIFORM_OVERRIDES, "stipple": None, "occlusion_test": None,
+                         "shading": None,
                          "comb": None}  # the comb field's texture instead (CombFieldInputs)
+    timeline_fixed = ("shading",)  # the shading model, and so the G-buffer layout
+
+    def __init__(self, params: RevieFurParams | None = None, base_dir: Path | None = None):
+        super().__init__(params, base_dir)
+        self.shading_model = "marschner" if self.params.shading == "marschner" else "blinn_phong"
+
     debug_views = FUR_DEBUG_VIEWS
     fur_vertex = FUR_VERTEX
 
@@ -155,6 +169,8 @@ class RevieFurMaterial(FurMaterial):
             defines["FUR_STIPPLE"] = "1"
         if self.params.occlusion_test:
             defines["FUR_OCCLUSION_TEST"] = "1"
+        if self.params.shading == "marschner":
+            defines["FUR_MARSCHNER"] = "1"
         return {**defines, **debug_defines(self.params)}
 
     # -- passes ------------------------------------------------------------------------------

@@ -4,6 +4,10 @@ registers them.
 - ``blinn_phong``: the standard model (albedo, specular intensity and exponent).
 - ``kajiya_kay``: strands (Silva et al. Eq. 6; Kajiya and Kay 1989): diffuse |T x L|, specular
   ((T.L)(T.E) + |T x L||T x E|)^p along the strand tangent T, stored as G-buffer data.
+- ``marschner``: hair (Marschner et al. 2003 in Karis's 2016 real-time form): R, TT and TRT
+  lobes about the strand tangent (G-buffer data ``strand_tangent``, root to tip) and a
+  multiple-scattering lobe, which also answers the ambient; ``specular_exponent`` carries the
+  longitudinal roughness (radians), ``specular_intensity`` scales R.
 - ``toon``: N.L through a ramp texture (a row per ramp, chosen per pixel by G-buffer data) and
   a hard-edged specular band (X-toon, Costigan's cartoon shading).
 """
@@ -123,3 +127,12 @@ class Toon(ShadingModel):
     def xtoon_row(scene, ramp: XToonRamp) -> float:
         """The ``toon_ramp`` value selecting X-toon ``ramp`` in ``scene``."""
         return ramp_layer(scene, ramp, len(TOON_RAMP_NAMES)) / 255.0
+
+
+@shading_models.register
+class Marschner(ShadingModel):
+    name = "marschner"
+    glsl_file = "shading_models/marschner.glsl"
+    glsl_function = "marschner"
+    ambient_function = "marschner_ambient"
+    gbuffer_data = (STRAND_TANGENT,)

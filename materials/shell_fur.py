@@ -146,6 +146,11 @@ class ShellFurParams(FurParams, BlinnPhongParams):
     fins: bool = Field(False, description="fins at silhouette edges (Lengyel 2001; not in the "
                                           "paper): straight, along the strand's chord, they "
                                           "suit uncurled fur")
+    shading: Literal["kajiya_kay", "marschner"] = Field(
+        "kajiya_kay", description="kajiya_kay: the paper's Eq. 6; marschner: the hair shading "
+                                  "model (R, TT, TRT about the strand)")
+    roughness: float = Field(0.2, gt=0.0, le=1.0,
+                             description="marschner: longitudinal roughness beta, radians")
     debug: Literal["none", "samples", "shell_count", "single_shell", "wetness"] = Field(
         "none", description="debug view instead of the fur (shell_fur's debug_views)")
 
@@ -201,7 +206,7 @@ def _layers_uniform(shells: int) -> dict[str, Any]:
 NOT_UNIFORMS = ("fur_mapping", "color_texture", "color_pattern", "pattern_color", "droplets",
                 "droplet_radius", "droplet_wetness", "wetness_mask", "mask_size", "dry_rate",
                 "stiffness", "mass", "damping", "gravity", "wind", "gust", "gust_frequency",
-                "time_step", "settle", "heightfield")
+                "time_step", "settle", "heightfield", "shading")
 
 
 # -- colour texture --------------------------------------------------------------------------
@@ -503,7 +508,7 @@ class ShellFurMaterial(FurMaterial):
     # the simulation's set-up (ShellFurState), and the passes built once
     timeline_growing = ("droplets",)  # fallen droplets stay (Algorithm 1 blends, never removes)
     timeline_fixed = ("fur_length", "mask_size", "wetness_mask", "time_step", "settle", "seed",
-                      "fins")
+                      "fins", "shading")  # shading: the shading model, so the G-buffer
     debug_views = {
         **{name: view for name, view in FUR_DEBUG_VIEWS.items() if name not in ("comb",
                                                                                  "samples")},
@@ -520,6 +525,10 @@ class ShellFurMaterial(FurMaterial):
         # the state the object's passes brought to the frame's time in their prepare
         state = object_state(frame, obj)
         return {"u_wetness_mask": state.mask_texture, "u_strand_tips": state.tips_texture}
+
+    def __init__(self, params: ShellFurParams | None = None, base_dir: Path | None = None):
+        super().__init__(params, base_dir)
+        self.shading_model = self.params.shading
 
     def check_time(self, time: float, where: str) -> None:
         steps = simulation_steps(self.params, time)
@@ -585,6 +594,8 @@ class ShellFurMaterial(FurMaterial):
             defines["FUR_UV_MAPPING"] = "1"
         if self.has_color_map():
             defines["FUR_COLOR_MAP"] = "1"
+        if self.params.shading == "marschner":
+            defines["FUR_MARSCHNER"] = "1"
         return defines
 
     def has_color_map(self) -> bool:

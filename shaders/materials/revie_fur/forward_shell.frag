@@ -53,7 +53,7 @@ void main() {
     Surface s = evaluate_surface(i);
     vec3 V = normalize(-i.position);
     vec3 light = forward_lighting(s, i.position, V);
-#ifdef FUR_STIPPLE
+#if defined(FUR_STIPPLE) && !defined(FUR_MARSCHNER)  // marschner: TT lights the rim
     Surface rim = s;
     rim.normal = rim_bend(i.normal, s.normal, -V, u_rim_strength, u_rim_falloff);
     light = max(light, forward_lighting(rim, i.position, V));

@@ -13,6 +13,8 @@ void main() {
     if (!stipple_sample(ivec2(gl_FragCoord.xy))) discard;
     SurfaceInput i = surface_input();
     Surface s = evaluate_surface(i);
+#ifndef FUR_MARSCHNER  // the hair model's TT lobe lights the back-lit rim instead
     s.normal = rim_bend(i.normal, s.normal, normalize(i.position), u_rim_strength, u_rim_falloff);
+#endif
     gbuffer_write(s, i.position, u_surface_id);
 }

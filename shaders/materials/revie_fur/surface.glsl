@@ -1,5 +1,6 @@
 // Revie fur surface for the G-buffer and the forward base pass: the outer albedo, specular, and
-// the anisotropic grain normal (Listing 2.5) unless `anisotropic` is off. What shows of the base
+// the anisotropic grain normal (Listing 2.5) unless `anisotropic` is off; with FUR_MARSCHNER
+// (shading = "marschner") the strand direction and roughness for the hair shading model instead. What shows of the base
 // is the root shell drawn over it (the skin); this albedo is what the light samples divide out.
 #include "common/surface.glsl"
 #include "techniques/grain_normal.glsl"
@@ -8,6 +9,11 @@ uniform vec3 u_albedo_tip;
 uniform float u_specular_intensity;
 uniform float u_specular_exponent;
 uniform bool u_anisotropic;
+#ifdef FUR_MARSCHNER
+#include "techniques/strand_tangent.glsl"
+uniform float u_roughness;
+uniform float u_comb_strength;
+#endif
 
 vec3 fur_comb_view(SurfaceInput i) {
     vec3 c = i.comb.xyz * 2.0 - 1.0;
@@ -19,8 +25,16 @@ Surface material_surface(SurfaceInput i) {
     s.albedo = u_albedo_tip;
     s.specular_intensity = u_specular_intensity;
     s.specular_exponent = u_specular_exponent;
-    // the comb's length is the lean (comb_field.py): upright strands in a crown have no grain
     vec3 comb = fur_comb_view(i);
+#ifdef FUR_MARSCHNER
+    // the hair shading model about the strand, root to tip: the normal leaning along the comb
+    // as the shells lean (fur.vert, techniques/shells.glsl)
+    s.normal = i.normal;
+    s.specular_exponent = u_roughness;
+    s.data.strand_tangent = strand_tangent_encode(normalize(i.normal + comb * u_comb_strength));
+    return s;
+#endif
+    // the comb's length is the lean (comb_field.py): upright strands in a crown have no grain
     s.normal = u_anisotropic ? normalize(mix(i.normal,
                                              grain_normal(i.normal, comb, normalize(i.position)),
                                              clamp(length(comb), 0.0, 1.0)))

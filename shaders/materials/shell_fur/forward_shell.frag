@@ -52,7 +52,11 @@ void main() {
     Surface s;
     s.albedo = albedo;
     s.specular_intensity = u_specular_intensity;
+#ifdef FUR_MARSCHNER
+    s.specular_exponent = u_roughness;  // marschner reads its roughness there
+#else
     s.specular_exponent = u_specular_exponent;
+#endif
     s.normal = normalize(v_normal);
     s.occlusion = 1.0;
     s.shading_model = surface_shading_model(u_surface_id);

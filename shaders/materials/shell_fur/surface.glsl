@@ -8,6 +8,9 @@
 
 uniform float u_specular_intensity;  // K_s
 uniform float u_specular_exponent;   // p_phong
+#ifdef FUR_MARSCHNER
+uniform float u_roughness;           // the marschner shading model's beta, radians
+#endif
 
 in vec3 v_strand_tangent;
 
@@ -15,7 +18,11 @@ Surface material_surface(SurfaceInput i) {
     Surface s;
     s.albedo = fur_color(i.uv);
     s.specular_intensity = u_specular_intensity;
+#ifdef FUR_MARSCHNER
+    s.specular_exponent = u_roughness;  // marschner reads its roughness there
+#else
     s.specular_exponent = u_specular_exponent;
+#endif
     s.normal = i.normal;
     s.data.strand_tangent = strand_tangent_encode(v_strand_tangent);
     return s;
