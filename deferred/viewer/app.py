@@ -454,8 +454,11 @@ class Viewer:
 
     def resize(self, width: int, height: int) -> None:
         """A real window's viewport follows the window (the panels keep their width)."""
-        self.size = (max(16, width - (PANEL_WIDTH if self.show_panels else 0)),
-                     max(16, height))
+        size = (max(16, width - (PANEL_WIDTH if self.show_panels else 0)), max(16, height))
+        if size != self.size:
+            self.pool.release()  # the renderers of the old size: a resize compiles once
+            self._material_scene = None
+            self.size = size
 
     def key_event(self, key: Any, action: Any, modifiers: Any) -> None:
         keys = self.keys

@@ -36,7 +36,7 @@ class Refused:
 class Edits:
     """Values changed in the viewer since the scene was loaded, by where they go in the file."""
 
-    objects: dict[int, dict[str, Any]] = field(default_factory=dict)  # [[object]] index
+    objects: dict[int, dict[str, Any]] = field(default_factory=dict)  # scene.objects index
     lights: dict[int, dict[str, Any]] = field(default_factory=dict)  # [[light]] index
     effects: dict[int, dict[str, Any]] = field(default_factory=dict)  # scene.effects index
 
@@ -83,9 +83,8 @@ class Session:
         where = (kind, index, key)
         try:
             if kind == "object":
-                obj = self.scene.objects[index]
-                obj.set_params(**{key: value})
-                target = self.edits.objects.setdefault(self._file_index(obj), {})
+                self.scene.objects[index].set_params(**{key: value})
+                target = self.edits.objects.setdefault(index, {})
             elif kind == "light":
                 light = self.scene.lights[index]
                 light.params = validate_params(type(light.params),
@@ -162,18 +161,14 @@ class Session:
             document = tomlkit.parse(resources.files("deferred").joinpath(
                 "scenes", f"{name.removesuffix('.toml')}.toml").read_text("utf-8"))
         for index, values in self.edits.objects.items():
-            table = document["object"][index]
+            table = document["object"][self._file_index(self.scene.objects[index])]
             if "params" not in table:
                 table["params"] = tomlkit.table()
-            for key, value in values.items():
-                table["params"][key] = _toml_value(value)
+            _set_values(table["params"], values)
         for index, values in self.edits.lights.items():
-            for key, value in values.items():
-                document["light"][index][key] = _toml_value(value)
+            _set_values(document["light"][index], values)
         for index, values in self.edits.effects.items():
-            table = self._effect_table(document, index)
-            for key, value in values.items():
-                table[key] = _toml_value(value)
+            _set_values(self._effect_table(document, index), values)
         if camera:
             cam = self.controller.camera()
             if "camera" not in document:
@@ -190,6 +185,15 @@ class Session:
         tables = ([document["ssao"]] if "ssao" in document else []) + \
             list(document.get("effect", []))
         return tables[index]
+
+
+def _set_values(table, values: dict[str, Any]) -> None:
+    """Write ``values`` into a TOML table; None (TOML has none) leaves the key out."""
+    for key, value in values.items():
+        if value is None:
+            table.pop(key, None)
+        else:
+            table[key] = _toml_value(value)
 
 
 def _toml_value(value: Any) -> Any:
