@@ -113,8 +113,9 @@ GLSL_INCLUDES: dict[str, str] = {
                           "object-space point (motion vectors; vertex shaders)",
     "common/lighting.glsl": "struct LightRecord and the shading-model interface (a light's "
                             "GLSL function)",
-    "lights/shadows.glsl": "light_shadow: the lit fraction of a shadowed light at a point "
-                           "(a light's GLSL function multiplies by it)",
+    "lights/shadows.glsl": "light_shadow_cascades, _perspective, _cube: the lit fraction of "
+                           "a shadowed light at a point (a light's GLSL function multiplies "
+                           "by its projection's)",
     "common/forward_lighting.glsl": "every light of the frame at one surface point (forward "
                                     "passes)",
     "gbuffer/layout.glsl": "the G-buffer's encoding and decoding",

@@ -76,8 +76,8 @@ class Light:
     A type whose ``Params`` derive from :class:`ShadowParams` and that names a
     ``shadow_projection`` casts shadows when ``shadows = true``: the framework writes the
     light's shadow slot into its record's ``extra.w`` (so a record leaves ``extra.w`` alone),
-    and the GLSL function multiplies what it returns by ``light_shadow(...)``
-    (``lights/shadows.glsl``).
+    and the GLSL function multiplies what it returns by its projection's
+    ``light_shadow_<projection>(...)`` (``lights/shadows.glsl``).
     """
 
     name: ClassVar[str]

@@ -5,5 +5,5 @@
 
 vec3 directional_light(LightRecord light, Surface s, vec3 P, vec3 V) {
     vec3 L = -light.direction.xyz;
-    return shade_light(s, L, V, light.color.rgb * light_shadow(light, P, s.normal, L));
+    return shade_light(s, L, V, light.color.rgb * light_shadow_cascades(light, P, s.normal, L));
 }

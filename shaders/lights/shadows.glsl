@@ -1,7 +1,8 @@
 // Shadow maps (deferred.lighting.shadows): every shadowed light's maps are tiles of one depth
 // texture, the shadow atlas, read with hardware comparison (sampler2DShadow, bilinear: each
 // lookup is a 2x2 PCF). A light's record holds its shadow slot in extra.w (0: no shadow);
-// slot k is row k - 1 of u_shadow_records, an RGBA32F texture of SHADOW_RECORD_TEXELS texels a row:
+// slot k is row k - 1 of u_shadow_records, an RGBA32F texture of RECORD_TEXELS (40) texels
+// a row:
 //   0: projection (1 cascades, 2 perspective, 3 cube), tiles, filter (0 pcf, 1 soft), softness
 //   1: depth bias, normal bias (texels), cascade blend band (fraction of a cascade), -
 //   2: the cascades' far view depths
@@ -9,7 +10,8 @@
 //   4 + 6 i .. 9 + 6 i, tile i: the view-space -> atlas (u, v, depth) matrix's columns, the
 //      tile's rectangle in the atlas (u0, v0, u1, v1), a texel's world size (x; per unit of
 //      distance from the light where y = 1: a perspective tile)
-// Without SHADOWS (no light of the scene casts shadows) light_shadow is 1 and reads nothing.
+// Without SHADOWS (no light of the scene casts shadows) the light_shadow_* functions are 1 and
+// read nothing.
 #include "common/lighting.glsl"
 
 #ifdef SHADOWS
@@ -22,7 +24,11 @@ vec4 shadow_texel(int row, int texel) {
     return texelFetch(u_shadow_records, ivec2(texel, row), 0);
 }
 
-// A 16-tap Poisson disk in the unit circle (the soft filter).
+// The pcf filter's 3x3 offsets, a texel apart (each a bilinear comparison: 4x4 texels, a tent).
+const vec2 SHADOW_GRID[9] = vec2[](
+    vec2(-1.0, -1.0), vec2(0.0, -1.0), vec2(1.0, -1.0), vec2(-1.0, 0.0), vec2(0.0, 0.0),
+    vec2(1.0, 0.0), vec2(-1.0, 1.0), vec2(0.0, 1.0), vec2(1.0, 1.0));
+// The soft filter's 16-tap Poisson disk in the unit circle.
 const vec2 SHADOW_POISSON[16] = vec2[](
     vec2(-0.9420, -0.3991), vec2(0.9456, -0.7689), vec2(-0.0942, -0.9294),
     vec2(0.3450, 0.2939), vec2(-0.9159, 0.4577), vec2(-0.8154, -0.8791),
@@ -32,25 +38,28 @@ const vec2 SHADOW_POISSON[16] = vec2[](
     vec2(0.1438, -0.1410));
 
 float shadow_compare(vec3 uvz, vec4 rect) {
-    // kept half a texel inside the tile: bilinear comparison never reads a neighbour's texels
+    // kept half a texel inside the tile: bilinear comparison never reads a neighbour's texels;
+    // level 0 given (the atlas has no mipmaps): no derivatives to find a level from
     vec2 margin = vec2(0.5 * u_shadow_atlas_texel);
-    return texture(u_shadow_atlas, vec3(clamp(uvz.xy, rect.xy + margin, rect.zw - margin),
-                                        uvz.z));
+    return textureLod(u_shadow_atlas, vec3(clamp(uvz.xy, rect.xy + margin, rect.zw - margin),
+                                           uvz.z), 0.0);
 }
 
-// The lit fraction of a point at atlas coordinates uvz in tile rect.
+// The lit fraction of a point at atlas coordinates uvz in tile rect: one loop whichever the
+// filter (pcf: SHADOW_GRID, a texel apart; soft: SHADOW_POISSON, header.w texels wide), so a
+// light pays for its own filter's taps only (where a shader runs as masked SIMD lanes, as on
+// llvmpipe, the two branches of an `if` both run).
 float shadow_filter(vec3 uvz, vec4 rect, vec4 header) {
-    float t = u_shadow_atlas_texel;
+    bool soft = header.z > 0.5;
+    int taps = soft ? 16 : 9;
+    float scale = (soft ? header.w : 1.0) * u_shadow_atlas_texel;
     float lit = 0.0;
-    if (header.z < 0.5) {  // pcf: 3x3 bilinear comparisons a texel apart (4x4 texels, tent)
-        for (int y = -1; y <= 1; ++y)
-            for (int x = -1; x <= 1; ++x)
-                lit += shadow_compare(uvz + vec3(vec2(x, y) * t, 0.0), rect);
-        return lit / 9.0;
-    }
-    for (int k = 0; k < 16; ++k)  // soft: the disk, radius header.w texels
-        lit += shadow_compare(uvz + vec3(SHADOW_POISSON[k] * header.w * t, 0.0), rect);
-    return lit / 16.0;
+    int k = 0;
+    do {
+        vec2 offset = soft ? SHADOW_POISSON[k] : SHADOW_GRID[min(k, 8)];
+        lit += shadow_compare(uvz + vec3(offset * scale, 0.0), rect);
+    } while (++k < taps);
+    return lit / float(taps);
 }
 
 // One tile's lit fraction at view-space P (normal N, unit L toward the light, distance to it).
@@ -75,46 +84,67 @@ float shadow_tile(int row, int tile, vec4 header, vec4 biases, vec3 P, vec3 N, v
     return shadow_filter(uvz, rect, header);
 }
 
-// The fraction of a light reaching view-space P on a surface of normal N (1: lit, 0: shadow).
-float light_shadow(LightRecord light, vec3 P, vec3 N, vec3 L) {
+// The fraction of a light reaching view-space P on a surface of normal N (1: lit, 0: shadow),
+// L unit toward the light: one function per projection (deferred.names.ShadowProjection), which
+// a light type's GLSL calls for its own, so no light runs another projection's code.
+float light_shadow_cascades(LightRecord light, vec3 P, vec3 N, vec3 L) {
     int slot = int(light.extra.w + 0.5);
     if (slot <= 0) return 1.0;
     int row = slot - 1;
     vec4 header = shadow_texel(row, 0);
     vec4 biases = shadow_texel(row, 1);
-    int kind = int(header.x + 0.5);
-    if (kind == 1) {  // cascades: the first whose far depth lies beyond P, blended at its end
-        vec4 splits = shadow_texel(row, 2);
-        float depth = -P.z;
-        int count = int(header.y + 0.5);
-        float near = 0.0;
-        for (int i = 0; i < count; ++i) {
-            float far = splits[i];
-            if (depth <= far) {
-                float lit = shadow_tile(row, i, header, biases, P, N, L, 1.0);
-                float band = biases.z * (far - near);
-                if (i + 1 < count && depth > far - band) {
-                    float next = shadow_tile(row, i + 1, header, biases, P, N, L, 1.0);
-                    lit = mix(lit, next, smoothstep(far - band, far, depth));
-                }
-                return lit;
-            }
-            near = far;
+    vec4 splits = shadow_texel(row, 2);
+    int count = int(header.y + 0.5);
+    float depth = -P.z;
+    if (depth > splits[count - 1]) return 1.0;  // beyond the shadow distance
+    // the first cascade whose far depth lies beyond P (a cheap loop, then one lookup)
+    int i = 0;
+    float near = 0.0;
+    for (int k = 0; k < 3; ++k) {
+        if (k + 1 < count && depth > splits[k]) {
+            i = k + 1;
+            near = splits[k];
         }
-        return 1.0;  // beyond the shadow distance
     }
-    vec3 from_light = P - light.position.xyz;
-    float distance = length(from_light);
-    if (kind == 2) return shadow_tile(row, 0, header, biases, P, N, L, distance);
-    // cube: the face of the direction's major axis (+X, -X, +Y, -Y, +Z, -Z)
-    vec3 d = u_shadow_world_from_view * from_light;
+    float far = splits[i];
+    float lit = shadow_tile(row, i, header, biases, P, N, L, 1.0);
+    // blended into the next over the last CASCADE_BLEND of its depth range: no seam
+    float band = biases.z * (far - near);
+    float t = i + 1 < count ? smoothstep(far - band, far, depth) : 0.0;
+    if (t > 0.0) lit = mix(lit, shadow_tile(row, i + 1, header, biases, P, N, L, 1.0), t);
+    return lit;
+}
+
+float light_shadow_perspective(LightRecord light, vec3 P, vec3 N, vec3 L) {
+    int slot = int(light.extra.w + 0.5);
+    if (slot <= 0) return 1.0;
+    int row = slot - 1;
+    return shadow_tile(row, 0, shadow_texel(row, 0), shadow_texel(row, 1), P, N, L,
+                       length(P - light.position.xyz));
+}
+
+float light_shadow_cube(LightRecord light, vec3 P, vec3 N, vec3 L) {
+    int slot = int(light.extra.w + 0.5);
+    if (slot <= 0) return 1.0;
+    int row = slot - 1;
+    // the face of the direction's major axis in world space (+X, -X, +Y, -Y, +Z, -Z)
+    vec3 d = u_shadow_world_from_view * (P - light.position.xyz);
     vec3 a = abs(d);
     int face = a.x >= a.y && a.x >= a.z ? (d.x >= 0.0 ? 0 : 1)
              : a.y >= a.z ? (d.y >= 0.0 ? 2 : 3) : (d.z >= 0.0 ? 4 : 5);
-    return shadow_tile(row, face, header, biases, P, N, L, distance);
+    return shadow_tile(row, face, shadow_texel(row, 0), shadow_texel(row, 1), P, N, L,
+                       length(d));
 }
 #else
-float light_shadow(LightRecord light, vec3 P, vec3 N, vec3 L) {
+float light_shadow_cascades(LightRecord light, vec3 P, vec3 N, vec3 L) {
+    return 1.0;
+}
+
+float light_shadow_perspective(LightRecord light, vec3 P, vec3 N, vec3 L) {
+    return 1.0;
+}
+
+float light_shadow_cube(LightRecord light, vec3 P, vec3 N, vec3 L) {
     return 1.0;
 }
 #endif

@@ -11,6 +11,6 @@ vec3 spot_light(LightRecord light, Surface s, vec3 P, vec3 V) {
     float cone = cone_falloff(dot(-L, light.direction.xyz), light.direction.w, light.extra.x);
     float falloff = distance_falloff(d, light.position.w) * cone;
     if (falloff <= 0.0) return vec3(0.0);
-    falloff *= light_shadow(light, P, s.normal, L);
+    falloff *= light_shadow_perspective(light, P, s.normal, L);
     return shade_light(s, L, V, light.color.rgb * falloff);
 }
