@@ -64,6 +64,14 @@ def scene_casts_shadows(lights: list[Light]) -> bool:
     return any(light.casts_shadows for light in lights)
 
 
+def atlas_memory(budget: Any) -> dict[str, int]:
+    """What the shadow atlas of a scene's budget holds, for the memory budget: its depths
+    (4 bytes a texel) and its records."""
+    size = budget.atlas_size
+    return {f"shadow atlas {size}^2": size * size * 4 +
+            RECORD_TEXELS * 16 * budget.max_shadowed_lights}
+
+
 def practical_splits(near: float, far: float, count: int, lam: float) -> np.ndarray:
     """The far view depth of each of ``count`` cascades over [near, far]: the practical split
     scheme, ``lam`` x logarithmic + (1 - ``lam``) x uniform (Zhang et al. 2006, Eq. 3)."""
@@ -226,7 +234,10 @@ class ShadowAtlas:
     def update(self, scene: Scene, view: np.ndarray, aspect: float) -> dict[int, int]:
         """This frame's tiles and records for the scene's lights seen through ``view`` (the
         camera's world -> view); the slots by ``id(light)``."""
-        key = tuple((id(light), light.params) for light in scene.lights)
+        # what the plan depends on (an animated light's params change every frame)
+        key = tuple((id(light), light.casts_shadows,
+                     getattr(light.params, "shadow_resolution", None),
+                     getattr(light.params, "cascades", None)) for light in scene.lights)
         if key != self._plan_key:
             self._plan, left_out = plan_atlas(scene.lights, self.size, self.max_lights)
             self._plan_key = key

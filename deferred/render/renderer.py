@@ -39,6 +39,7 @@ from deferred.lighting.shadows import (
     SHADOW_ATLAS,
     SHADOWS_DEFINE,
     ShadowAtlas,
+    atlas_memory,
     scene_casts_shadows,
 )
 from deferred.memo import overrides
@@ -223,6 +224,8 @@ class Renderer:
         # where the frame size came from, for errors about it
         self.size_where = "size" if given else f"{scene.source}: size"
         held = held_memory(scene)  # counted once: the scene's files are read for it
+        if scene_casts_shadows(scene.lights):
+            held.update(atlas_memory(scene.shadow_budget))
         self._held_bytes = sum(held.values())
         check_target_memory(self.graph, self.size, self.size_where, held, scene.source)
         light_types = scene.light_types()
@@ -251,11 +254,14 @@ class Renderer:
     # -- following the scene -------------------------------------------------------------------
     def _scene_structure(self) -> tuple:
         """What the passes, targets and programs are built from, apart from parameters: which
-        objects (their meshes, their materials' types), which lights and effects, the clear
-        colour, the tone mapping operator, the light path and the size asked for."""
+        objects (their meshes, their materials' types), which lights and effects, whether a
+        light casts shadows and the shadow budget (the shadow pass, the atlas and the SHADOWS
+        define), the clear colour, the tone mapping operator, the light path and the size
+        asked for."""
         scene = self.scene
         return (tuple((id(obj), id(obj.mesh), type(obj.material)) for obj in scene.objects),
-                tuple(map(type, scene.lights)), tuple(map(id, scene.effects)),
+                tuple(map(type, scene.lights)), scene_casts_shadows(scene.lights),
+                scene.shadow_budget, tuple(map(id, scene.effects)),
                 tuple(scene.background), scene.tonemap,
                 scene.light_path if self._light_path_arg is None else None,
                 scene.size if self._size_arg is None else None)

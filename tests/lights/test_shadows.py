@@ -458,3 +458,15 @@ def test_fur_receives_shadows(gl, material, pipeline):
     shaded, plain = shadowed.sum(-1), unshadowed.sum(-1)
     assert shaded[left].mean() < 0.6 * plain[left].mean()
     assert shaded[right].mean() > 0.95 * plain[right].mean()
+
+
+def test_turning_shadows_on_between_frames_rebuilds_the_renderer(gl):
+    the_scene = scene(LIGHTS["spot"], shadows=False)
+    with Renderer(the_scene, gl=gl) as renderer:
+        before = renderer.render(hdr=True).hdr
+        assert renderer.shadow_atlas is None
+        light = the_scene.lights[1]
+        light.params = light.params.model_copy(update={"shadows": True})
+        after = renderer.render(hdr=True).hdr
+        assert renderer.shadow_atlas is not None and renderer.shadow_atlas.slots
+        assert after[..., :3].sum() < 0.97 * before[..., :3].sum()  # the cube's shadow
