@@ -221,6 +221,11 @@ def _widget(key: str, value: Any, row: dict[str, Any]) -> tuple[bool, Any]:
         return imgui.drag_float(key, value, speed, 0.0, 0.0, "%.4g")
     if isinstance(value, tuple | list) and 2 <= len(value) <= 4 and \
             all(isinstance(v, float | int) and not isinstance(v, bool) for v in value):
+        # whole numbers stay whole: validation converts nothing
+        if all(isinstance(v, int) for v in value):
+            drag_int = {2: imgui.drag_int2, 3: imgui.drag_int3, 4: imgui.drag_int4}
+            changed, out = drag_int[len(value)](key, list(value), 0.2)
+            return changed, tuple(int(v) for v in out)
         values = [float(v) for v in value]
         if len(values) == 3 and any(word in key for word in COLOR_WORDS):
             changed, out = imgui.color_edit3(key, values, imgui.ColorEditFlags_.float |

@@ -102,6 +102,9 @@ class Session:
         except DeferredError as exc:
             self.refused[where] = Refused(value, one_line(str(exc)))
             return self.refused[where].error
+        except (TypeError, ValueError) as exc:  # a plugin's own check, not an InputError
+            self.refused[where] = Refused(value, one_line(f"{kind}[{index}].{key}: {exc}"))
+            return self.refused[where].error
         self.refused.pop(where, None)
         target[key] = value
         self.version += 1
