@@ -129,6 +129,9 @@ class Viewer:
         self.io = imgui.get_io()
         self.io.set_ini_filename("")  # no imgui.ini beside the user's files
         self.io.config_flags |= imgui.ConfigFlags_.nav_enable_keyboard
+        # a panel that fails part way is closed by imgui at the end of the frame, not asserted
+        self.io.config_error_recovery = True
+        self.io.config_error_recovery_enable_assert = False
         self.imgui = ImguiRenderer(self.ctx)
         # what the panels show
         self.render_error: str | None = None
@@ -386,7 +389,10 @@ class Viewer:
             self.io.delta_time = max(1e-4, now - getattr(self, "_gui_time", now - 1 / 60))
             self._gui_time = now
             imgui.new_frame()
-            self.panel_errors = panels.draw(self, PANEL_WIDTH, self.wnd.size[1])
+            try:
+                self.panel_errors = panels.draw(self, PANEL_WIDTH, self.wnd.size[1])
+            except Exception as exc:  # noqa: BLE001 - a panel's failure is shown, not fatal
+                self.note(f"panel failed: {type(exc).__name__}: {exc}")
             imgui.render()
             self.imgui.render(imgui.get_draw_data(), fbo)
 

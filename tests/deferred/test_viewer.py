@@ -234,6 +234,24 @@ def test_an_invalid_edit_shows_its_error_and_keeps_the_last_good_frame(scene_fil
     assert viewer.session.errors() == []
 
 
+def test_a_failing_panel_is_noted_and_the_next_frame_draws(scene_file, make_viewer,
+                                                            monkeypatch):
+    from deferred.viewer import panels
+
+    viewer = make_viewer(scene_file)
+    shown(viewer)
+
+    def broken(viewer):
+        raise ValueError("broken panel")
+
+    monkeypatch.setattr(panels, "_timeline", broken)
+    viewer.draw()  # the panel window is left open part way: imgui closes it
+    assert viewer.notes[-1] == "panel failed: ValueError: broken panel"
+    monkeypatch.undo()
+    viewer.draw()
+    assert viewer.window_image()[:, :400].std() > 10
+
+
 def test_scrubbing_to_t_equals_render_at_t(scene_file, make_viewer, gl):
     viewer = make_viewer(scene_file)
     start = shown(viewer)
