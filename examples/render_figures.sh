@@ -10,6 +10,7 @@ deferred render -o docs/figures/demo.png --size 960x540
 python examples/fur_figures.py
 python examples/comb_figures.py  # the demo before and after the comb field
 python examples/marschner_figures.py  # the demo and Fig. 2.21 with shading = "marschner"
+python examples/taa_figures.py  # taa and --samples 16 on Fig. 2.21 and the demo; the turntable GIF
 # Silva et al., curling and clumping fur (the shell_fur material): Figs. 7, 9, 11, 12 (c), Table 1's
 # torus and the wet-in-the-wind GIF (examples/shell_fur/README.md)
 python examples/shell_fur/figures.py

@@ -12,7 +12,7 @@
 // 1 - u_feedback of the weight.
 uniform sampler2D u_composite;
 uniform sampler2D u_motion;
-uniform sampler2D u_history;  // linear RGB, samples averaged (alpha); bilinear
+uniform sampler2D u_history;  // linear RGB, samples averaged (alpha); bilinear filter
 uniform bool u_history_valid;
 uniform float u_feedback;
 uniform int u_still_samples;
@@ -43,6 +43,35 @@ vec3 to_ycocg(vec3 c) {
 
 vec3 from_ycocg(vec3 c) {
     return vec3(c.x + c.y - c.z, c.x + c.z, c.x - c.y - c.z);
+}
+
+// The history at `uv` through a Catmull-Rom filter in 9 bilinear taps (the 4x4 texels around
+// it, the middle two of each row and column merged into one tap): a moving image is resampled
+// every frame, and bilinear taps would blur it more each time. At a pixel's centre (no motion)
+// it is that texel exactly.
+vec4 history_at(vec2 uv) {
+    vec2 size = vec2(textureSize(u_history, 0));
+    vec2 position = uv * size;
+    vec2 centre = floor(position - 0.5) + 0.5;
+    vec2 f = position - centre;
+    vec2 w0 = f * (-0.5 + f * (1.0 - 0.5 * f));
+    vec2 w1 = 1.0 + f * f * (-2.5 + 1.5 * f);
+    vec2 w2 = f * (0.5 + f * (2.0 - 1.5 * f));
+    vec2 w3 = f * f * (-0.5 + 0.5 * f);
+    vec2 w12 = w1 + w2;
+    vec2 t0 = (centre - 1.0) / size;
+    vec2 t12 = (centre + w2 / w12) / size;
+    vec2 t3 = (centre + 2.0) / size;
+    vec4 sum = texture(u_history, vec2(t0.x, t0.y)) * (w0.x * w0.y)
+             + texture(u_history, vec2(t12.x, t0.y)) * (w12.x * w0.y)
+             + texture(u_history, vec2(t3.x, t0.y)) * (w3.x * w0.y)
+             + texture(u_history, vec2(t0.x, t12.y)) * (w0.x * w12.y)
+             + texture(u_history, vec2(t12.x, t12.y)) * (w12.x * w12.y)
+             + texture(u_history, vec2(t3.x, t12.y)) * (w3.x * w12.y)
+             + texture(u_history, vec2(t0.x, t3.y)) * (w0.x * w3.y)
+             + texture(u_history, vec2(t12.x, t3.y)) * (w12.x * w3.y)
+             + texture(u_history, vec2(t3.x, t3.y)) * (w3.x * w3.y);
+    return max(sum, vec4(0.0));
 }
 
 // The point where the segment from the box's centre to `history` leaves the box (the
@@ -93,7 +122,7 @@ void main() {
         out_history = vec4(max(centre.rgb, vec3(0.0)), 1.0);
         return;
     }
-    vec4 stored = texture(u_history, previous);
+    vec4 stored = history_at(previous);
     vec3 history = to_ycocg(compress(max(stored.rgb, vec3(0.0))));
     bool still = length(motion) < STILL;
     // a still pixel's jittered samples spread over its neighbourhood's min/max, and their
