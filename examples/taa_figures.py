@@ -1,8 +1,8 @@
 """Temporal anti-aliasing and accumulated samples (#25) in docs/figures/taa_*: Revie's Figure
-2.21 (the demo) and the demo from afar as one frame, with taa (after 16 frames of a still camera) and with
---samples 16, in both pipelines, a close-up of the fur's silhouettes; and a turntable of the
-demo's fur without and with taa (taa_turntable.gif, the second of two turns, so the history
-has built up). Run from the repository root: python examples/taa_figures.py"""
+2.21 (the demo) and the demo from afar as one frame, with taa (after 16 frames of a still
+camera) and with --samples 16, in both pipelines, a close-up of the fur's silhouettes; and a
+turntable of the demo's fur without and with taa (taa_turntable.gif, the second of two turns,
+so the history has built up). Run from the repository root: python examples/taa_figures.py"""
 
 from __future__ import annotations
 
