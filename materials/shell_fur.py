@@ -127,6 +127,9 @@ class ShellFurParams(FurParams, BlinnPhongParams):
                                                        "B radius, A wetness) under the droplets")
     mask_size: int = Field(256, ge=16, le=4096, description="wetness mask texels per side")
     dry_rate: float = Field(0.0, ge=0.0, le=100.0, description="wetness lost per second")
+    soak_time: float = Field(0.5, ge=0.0, le=60.0,
+                             description="seconds the droplets of an event after t = 0 take to "
+                                         "soak in: their wetness ramps up (0: at once)")
     # strand dynamics (3.2.1, Eq. 2, 3)
     stiffness: float = Field(2.0, gt=0.0, le=1e6, description="k, spring constant")
     mass: float = Field(0.01, gt=0.0, le=1e3, description="m, mass at the strand tip")
@@ -204,7 +207,7 @@ def _layers_uniform(shells: int) -> dict[str, Any]:
 
 
 NOT_UNIFORMS = ("fur_mapping", "color_texture", "color_pattern", "pattern_color", "droplets",
-                "droplet_radius", "droplet_wetness", "wetness_mask", "mask_size", "dry_rate",
+                "droplet_radius", "droplet_wetness", "wetness_mask", "mask_size", "dry_rate", "soak_time",
                 "stiffness", "mass", "damping", "gravity", "wind", "gust", "gust_frequency",
                 "time_step", "settle", "heightfield", "shading")
 
@@ -295,7 +298,8 @@ class ShellFurState:
         self.strand_data[2:3 * vertices:3, :3] = curl_v
         self.tips_texture = _float_texture(ctx, TIPS_WIDTH, len(self.strand_data) // TIPS_WIDTH)
         self.step: int | None = None  # steps taken since t = 0
-        self.mask = dry_mask(self.size)
+        self.mask = dry_mask(self.size)  # Algorithm 1's, drying included
+        self.shown = self.mask.copy()  # what the shaders see: the mask as it soaks in (_soak)
         self.fallen = 0
         self._uploaded: int | None = None
 
@@ -320,6 +324,7 @@ class ShellFurState:
                     self._place(self.obj.model_at(n * self.dt))
                 self.strands.step(self.dt, self._forces(params, n * self.dt))
             dry_out(self.mask, params.dry_rate * self.dt * (end - self.step))
+            self._soak(params, end - self.step)
             self.step = end
         if self.obj.tracks:
             self._place(self.obj.model_at(self.step * self.dt))
@@ -345,12 +350,23 @@ class ShellFurState:
             else dry_mask(self.size)
         self.fallen = 0
         self._place(np.asarray(self.obj.model_at(0.0)))
+        self._rain(params)  # the droplets fallen by t = 0 have soaked in
+        self.shown = self.mask.copy()
         self.strands.reset()
         steps = int(round(params.settle / self.dt))
         for k in range(steps):
             self.strands.step(self.dt, self._forces(params, (k - steps) * self.dt))
         self.step = 0
         self._uploaded = None
+
+    def _soak(self, params: ShellFurParams, steps: int) -> None:
+        """The shown mask after ``steps`` steps: its wetness rises toward the mask's (Algorithm
+        1's, drying included) by ``dt / soak_time`` a step, never above it, so an event's
+        droplets soak in over ``soak_time`` instead of in one frame; drying shows at once. The
+        ramp is linear, so steps taken at once or one by one give the same mask."""
+        rise = math.inf if params.soak_time <= 0.0 else steps * self.dt / params.soak_time
+        self.shown[..., :3] = self.mask[..., :3]
+        self.shown[..., 3] = np.minimum(self.mask[..., 3], self.shown[..., 3] + rise)
 
     def _rain(self, params: ShellFurParams) -> None:
         """Blend the droplets that fell since last time (the ``droplets`` count grew)."""
@@ -378,7 +394,7 @@ class ShellFurState:
         return self.average(self.strands.deflections()) @ self.linear_inverse.T
 
     def _upload(self) -> None:
-        self.mask_texture.write(np.ascontiguousarray(self.mask, np.float32).tobytes())
+        self.mask_texture.write(np.ascontiguousarray(self.shown, np.float32).tobytes())
         vertices = self.obj.mesh.vertex_count
         self.strand_data[0:3 * vertices:3, :3] = self.vertex_deflections()
         self.tips_texture.write(self.strand_data.tobytes())

@@ -17,7 +17,8 @@
 // merges a droplet into a clump exactly when their centres are that close). Without it
 // neighbouring wet clumps run into each other and fur wet all over shows no clumps at all.
 
-uniform sampler2D u_wetness_mask;
+// u_wetness_mask is declared in wet.glsl
+#include "materials/shell_fur/wet.glsl"
 uniform float u_clump_shape;     // w
 uniform float u_clump_strength;  // s
 uniform float u_layers;          // N, the most layers (shells)

@@ -34,7 +34,9 @@ void main() {
     vec2 strands = fur_sample_grad(layer.fur_position, v_fur_normal, v_shell_depth,
                                    layer.fur_dx, layer.fur_dy);
 #endif
-    vec3 albedo = fur_color_grad(layer.color_uv, layer.color_dx, layer.color_dy);
+    float wetness = fur_wetness(v_uv);
+    vec3 albedo = wet_albedo(fur_color_grad(layer.color_uv, layer.color_dx, layer.color_dy),
+                             wetness);
     float alpha = u_root_shell ? 1.0 : shell_opacity(strands.x, u_shell_weight) * u_shell_fade;
 #ifdef FUR_FINS
     alpha *= v_fin_fade * smoothstep(0.0, 0.35, v_shell_depth);
@@ -51,11 +53,11 @@ void main() {
 #endif
     Surface s;
     s.albedo = albedo;
-    s.specular_intensity = u_specular_intensity;
+    s.specular_intensity = wet_specular_intensity(u_specular_intensity, wetness);
 #ifdef FUR_MARSCHNER
-    s.specular_exponent = u_roughness;  // marschner reads its roughness there
+    s.specular_exponent = wet_specular_shape(u_roughness, wetness);  // marschner's roughness
 #else
-    s.specular_exponent = u_specular_exponent;
+    s.specular_exponent = wet_specular_shape(u_specular_exponent, wetness);
 #endif
     s.normal = normalize(v_normal);
     s.occlusion = 1.0;

@@ -42,8 +42,8 @@ void main() {
     vec2 strands = fur_sample_grad(layer.fur_position, v_fur_normal, v_shell_depth,
                                    layer.fur_dx, layer.fur_dy);
 #endif
-    vec3 albedo = fur_color_grad(layer.color_uv, layer.color_dx, layer.color_dy)
-                * fur_shadow(v_shell_depth);
+    vec3 albedo = wet_albedo(fur_color_grad(layer.color_uv, layer.color_dx, layer.color_dy),
+                             fur_wetness(v_uv)) * fur_shadow(v_shell_depth);
     float alpha = u_root_shell ? 1.0 : shell_opacity(strands.x, u_shell_weight) * u_shell_fade;
 #ifdef FUR_FINS
     alpha *= v_fin_fade * smoothstep(0.0, 0.35, v_shell_depth);

@@ -5,6 +5,7 @@
 #include "common/surface.glsl"
 #include "techniques/strand_tangent.glsl"
 #include "materials/shell_fur/color.glsl"
+#include "materials/shell_fur/wet.glsl"
 
 uniform float u_specular_intensity;  // K_s
 uniform float u_specular_exponent;   // p_phong
@@ -16,12 +17,13 @@ in vec3 v_strand_tangent;
 
 Surface material_surface(SurfaceInput i) {
     Surface s;
-    s.albedo = fur_color(i.uv);
-    s.specular_intensity = u_specular_intensity;
+    float wetness = fur_wetness(i.uv);
+    s.albedo = wet_albedo(fur_color(i.uv), wetness);
+    s.specular_intensity = wet_specular_intensity(u_specular_intensity, wetness);
 #ifdef FUR_MARSCHNER
-    s.specular_exponent = u_roughness;  // marschner reads its roughness there
+    s.specular_exponent = wet_specular_shape(u_roughness, wetness);  // marschner's roughness
 #else
-    s.specular_exponent = u_specular_exponent;
+    s.specular_exponent = wet_specular_shape(u_specular_exponent, wetness);
 #endif
     s.normal = i.normal;
     s.data.strand_tangent = strand_tangent_encode(v_strand_tangent);
