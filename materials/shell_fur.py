@@ -208,8 +208,8 @@ def _layers_uniform(shells: int) -> dict[str, Any]:
 
 NOT_UNIFORMS = ("fur_mapping", "color_texture", "color_pattern", "pattern_color", "droplets",
                 "droplet_radius", "droplet_wetness", "wetness_mask", "mask_size", "dry_rate",
-                "soak_time",                "stiffness", "mass", "damping", "gravity", "wind", "gust", "gust_frequency",
-                "time_step", "settle", "heightfield", "shading")
+                "soak_time", "stiffness", "mass", "damping", "gravity", "wind", "gust",
+                "gust_frequency", "time_step", "settle", "heightfield", "shading")
 
 
 # -- colour texture --------------------------------------------------------------------------
