@@ -193,11 +193,20 @@ def plan_atlas(lights: list[Light], atlas_size: int, max_lights: int
     return plan, left_out
 
 
+def object_box(obj) -> tuple[np.ndarray, np.ndarray]:
+    """The object-space box of what the object draws: its mesh's, grown by how far its
+    material draws beyond the mesh (fur shells, hair: ``Material.motion_extent``)."""
+    low, high = obj.mesh.bounds()
+    extent = float(obj.material.motion_extent(obj))
+    return low - extent, high + extent
+
+
 def world_bounds(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
-    """The world box of every object (corners of each mesh's box through its model matrix)."""
+    """The world box of every object (corners of each object's box through its model
+    matrix)."""
     lows, highs = [], []
     for obj in scene.objects:
-        low, high = obj.mesh.bounds()
+        low, high = object_box(obj)
         corners = np.array([[x, y, z, 1.0] for x in (low[0], high[0]) for y in (low[1], high[1])
                             for z in (low[2], high[2])])
         world = (np.asarray(obj.model, np.float64) @ corners.T).T[:, :3]
@@ -380,7 +389,7 @@ class ShadowAtlas:
 
 
 def object_sphere(obj) -> tuple[np.ndarray, float]:
-    low, high = obj.mesh.bounds()
+    low, high = object_box(obj)
     model = np.asarray(obj.model, np.float64)
     centre = (model @ np.append((low + high) / 2.0, 1.0))[:3]
     scale = float(np.max(np.linalg.norm(model[:3, :3], axis=0)))
