@@ -45,7 +45,7 @@ from .techniques.fur import (
     FurParams,
     debug_defines,
 )
-from .techniques.shells import ShellPass
+from .techniques.shells import DitheredShells, ShellPass
 from .techniques.stipple import (
     StippleObliterationPass,
     StipplePass,
@@ -124,7 +124,7 @@ class CombedFinPass(CombFieldInputs, FinPass):
     pass
 
 
-class CombedShellPass(CombFieldInputs, ShellPass):
+class CombedShellPass(CombFieldInputs, DitheredShells, ShellPass):
     pass
 
 

@@ -9,12 +9,48 @@ from __future__ import annotations
 
 from typing import Any
 
-from deferred.api import DEPTH, ObjectPass, Order
+import numpy as np
+
+from deferred.api import DEPTH, ObjectPass, Order, halton
 
 from .fur import FurParams, shell_count, shell_layout
 from .fur_volume import VOLUME_LAYERS
 
 ROOT_OFFSET = (-1.0, -2.0)  # glPolygonOffset (factor, units) of the root shell
+
+
+def shell_dither(sample_index: int) -> float:
+    """Where in its slab a shell is drawn for sample ``sample_index`` (Frame.sample_index), as a
+    fraction of the slab from its middle: 0 for sample 0 (a single frame), then the Halton
+    sequence in base 5 (not 2 or 3, the jitter's, nor the stipple's period of 4). Averaged over
+    samples (render --samples, taa under a still camera) a shell's rim covers its whole slab,
+    not one step of a staircase at grazing angles."""
+    return (halton(sample_index, 5) + 0.5) % 1.0 - 0.5
+
+
+class DitheredShells:
+    """A shell pass whose vertex stage offsets each shell but the root by ``u_shell_dither``
+    (of the layer's depth) beyond its ``u_shell_depth``, which its shading keeps: the geometry
+    moves within the slab from sample to sample, not the strands' colour or coverage (moving
+    those too changed the fur's brightness by a quarter from sample to sample where the level
+    of detail leaves few shells)."""
+
+    def draws(self, frame) -> int:
+        count = super().draws(frame)
+        # Not while a temporal history follows a moving camera: it keeps a tenth of each
+        # frame there, too little to average the dither out, which then shimmers
+        # (benchmarks/crawl.py: 1.24 / 1.44 levels with it, 0.65 / 0.74 without).
+        moving = frame.history_kept and not np.array_equal(frame.previous_view_projection,
+                                                           frame.view_projection)
+        self._dither = 0.0 if moving else \
+            shell_dither(frame.sample_index) / max(self.slabs(self._count), 1.0)
+        return count
+
+    def draw_uniforms(self, frame, index: int, count: int) -> dict[str, Any] | None:
+        uniforms = super().draw_uniforms(frame, index, count)
+        if uniforms is not None:
+            uniforms["u_shell_dither"] = 0.0 if self._root else self._dither
+        return uniforms
 
 
 class ShellPass(ObjectPass):

@@ -308,3 +308,31 @@ def test_obliteration_restores_the_floor_not_the_sky_beside_a_silhouette(gl):
         (composite[..., 3] == 0.0)
     assert floor.sum() > 1000
     assert not np.any(floor & sky)
+
+
+def test_the_shell_dither_covers_the_slab_and_keeps_the_colour(gl):
+    """Issue #25: from sample to sample (render --samples, taa under a still camera) the shells
+    move within their slabs, sample 0 where they always were; the rims move, the fur's
+    brightness does not (only the geometry is dithered)."""
+    from deferred.materials.techniques.shells import shell_dither
+    from deferred.render.renderer import Renderer
+    from deferred.scene.loader import scene_from_dict
+
+    values = [shell_dither(k) for k in range(5)]
+    assert values[0] == 0.0 and all(-0.5 <= v < 0.5 for v in values)
+    assert sorted(values) == pytest.approx([-0.4, -0.2, 0.0, 0.2, 0.4])  # five strata
+    scene = scene_from_dict({
+        "size": [96, 72], "background": [0.0, 0.0, 0.0],
+        "camera": {"position": [0.0, 0.0, 2.6], "target": [0.0, 0.0, 0.0]},
+        "object": [{"mesh": "builtin:sphere", "material": "revie_fur",
+                    "params": {"shells": 8, "stipple": False, "fur_length": 0.25}}],
+        "light": [{"type": "directional", "direction": [-0.3, -0.5, -1.0]},
+                  {"type": "ambient", "color": [0.3, 0.3, 0.3]}]})
+    with Renderer(scene, gl=gl) as renderer:
+        images = [renderer.render(sample_index=k, jitter=(0.0, 0.0)).image[..., :3]
+                  .astype(np.float64) for k in (0, 1, 4)]
+    covered = images[0].mean(axis=-1) > 10
+    assert covered.sum() > 1000
+    for image in images[1:]:
+        assert np.abs(image - images[0]).max() > 20  # the rims moved
+        assert abs(image[covered].mean() - images[0][covered].mean()) < 2.0

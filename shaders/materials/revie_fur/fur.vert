@@ -14,6 +14,7 @@ in vec4 in_comb;
 #include "common/object_transform.glsl"
 uniform mat4 u_projection;
 uniform float u_shell_depth;
+uniform float u_shell_dither = 0.0;  // geometry only: the shell moved within its slab (shells.py)
 uniform float u_fur_length;     // object units, scaled per vertex by the comb alpha
 uniform float u_comb_strength;
 uniform sampler2D u_comb_field; // RGBA32F, texel i: vertex i's object-space comb x lean
@@ -65,7 +66,9 @@ void main() {
     vec3 comb_tangent = vec3(dot(comb, in_tangent), dot(comb, in_binormal), 0.0);
     comb *= u_comb_strength;
     float fur_length = u_fur_length * in_comb.a;
-    vec3 shell = in_position + shell_offset(in_normal, comb, u_shell_depth, fur_length);
+    vec3 shell = in_position + shell_offset(in_normal, comb,
+                                            clamp(u_shell_depth + u_shell_dither, 0.0, 1.0),
+                                            fur_length);
     vec3 tip = in_position + shell_offset(in_normal, comb, 1.0, fur_length);
 
     vec4 position = model_view * vec4(shell, 1.0);
