@@ -38,6 +38,7 @@ import pyrr
 from deferred.core.passes import Order, Phase, RenderPass
 from deferred.interfaces.light import Light
 from deferred.interfaces.material import ShadowView
+from deferred.lighting.buffer import visible_spheres
 from deferred.names import ShadowProjection
 
 if TYPE_CHECKING:
@@ -240,9 +241,12 @@ class ShadowAtlas:
         self._uniforms: dict[str, Any] = {}
 
     # -- per frame ---------------------------------------------------------------------------
-    def update(self, scene: Scene, view: np.ndarray, aspect: float) -> dict[int, int]:
+    def update(self, scene: Scene, view: np.ndarray, aspect: float,
+               projection: np.ndarray | None = None) -> dict[int, int]:
         """This frame's tiles and records for the scene's lights seen through ``view`` (the
-        camera's world -> view); the slots by ``id(light)``."""
+        camera's world -> view); the slots by ``id(light)``. A spot or point light whose
+        sphere lies outside the frustum of ``projection`` lights nothing in view (the light
+        buffer drops it too): its maps are not drawn this frame."""
         # what the plan depends on (an animated light's params change every frame)
         key = tuple((id(light), light.casts_shadows,
                      getattr(light.params, "shadow_resolution", None),
@@ -265,6 +269,12 @@ class ShadowAtlas:
             slot, squares = planned
             params = light.params
             kind = light.shadow_projection
+            if kind != ShadowProjection.CASCADES and projection is not None:
+                centre = view @ np.append(np.asarray(params.position, np.float64), 1.0)
+                sphere = np.zeros((1, 4, 4), np.float32)
+                sphere[0, 1] = (*centre[:3], params.radius)
+                if not visible_spheres(sphere, projection)[0]:
+                    continue
             row = records[slot - 1]
             row[0] = (PROJECTION_IDS[kind], len(squares),
                       0.0 if params.shadow_filter == "pcf" else 1.0, params.shadow_softness)

@@ -479,7 +479,8 @@ class Renderer:
             frame.binding_sources.insert(0, shading)
         slots = None
         if self.shadow_atlas is not None:
-            slots = self.shadow_atlas.update(self.scene, frame.view, frame.width / frame.height)
+            slots = self.shadow_atlas.update(self.scene, frame.view, frame.width / frame.height,
+                                             frame.projection)
         self.light_buffer.upload(self.scene.lights, frame.view, frame.projection, slots)
         self._check_gl("uploading the lights")
         # asked of each class once a frame, not of each pass (a pass an object)

@@ -470,3 +470,16 @@ def test_turning_shadows_on_between_frames_rebuilds_the_renderer(gl):
         after = renderer.render(hdr=True).hdr
         assert renderer.shadow_atlas is not None and renderer.shadow_atlas.slots
         assert after[..., :3].sum() < 0.97 * before[..., :3].sum()  # the cube's shadow
+
+
+def test_a_light_out_of_view_draws_no_maps(gl):
+    behind = {**LIGHTS["spot"], "position": [0.0, 9.0, 0.0], "radius": 2.0}  # above the camera
+    the_scene = scene_from_dict({"size": [W, H], "tonemap": "none", "camera": CAMERA,
+                                 "object": [{"mesh": "builtin:plane", "scale": 8.0}],
+                                 "light": [AMBIENT, {**LIGHTS["spot"], "shadows": True},
+                                           {**behind, "shadows": True}]})
+    with Renderer(the_scene, gl=gl) as renderer:
+        renderer.render()
+        atlas = renderer.shadow_atlas
+        assert [tile.light for tile in atlas.tiles] == [the_scene.lights[1]]
+        assert id(the_scene.lights[2]) not in atlas.slots
