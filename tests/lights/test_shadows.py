@@ -126,16 +126,15 @@ def texel_size(kind: str, tiles, points: np.ndarray) -> np.ndarray:
     """A shadow texel's footprint on the plane at each point: its size across the light's
     rays, over the cosine of the rays' angle with the plane's normal."""
     projection, size = tiles[0]
+    # row 0 of the view and projection is P00 times the light's unit right vector
+    scale = np.linalg.norm(projection[0, :3])
     if kind == "directional":  # orthographic: 2 / (size * P00) world units a texel
         d = np.asarray(LIGHTS[kind]["direction"], float)
-        return np.full(points.shape[:-1], 2.0 / (size * projection[0, 0])) * \
-            np.linalg.norm(d) / abs(d[1])
+        return np.full(points.shape[:-1], 2.0 / (size * scale)) * np.linalg.norm(d) / abs(d[1])
     source = np.asarray(LIGHTS[kind]["position"], float)
-    # perspective: the map covers 2 tan(half) per unit of distance (row 0 of the view and
-    # projection has the length P00 = 1 / tan(half))
-    column = np.linalg.norm(projection[0, :3])
+    # perspective: the map covers 2 tan(half) per unit of distance (P00 = 1 / tan(half))
     distance = np.linalg.norm(points - source, axis=-1)
-    return distance * 2.0 / (size * column) * distance / source[1]
+    return distance * 2.0 / (size * scale) * distance / source[1]
 
 
 @pytest.mark.parametrize("kind", ["directional", "spot", "point"])
@@ -483,3 +482,26 @@ def test_a_light_out_of_view_draws_no_maps(gl):
         atlas = renderer.shadow_atlas
         assert [tile.light for tile in atlas.tiles] == [the_scene.lights[1]]
         assert id(the_scene.lights[2]) not in atlas.slots
+
+
+def test_the_soft_filter_widens_the_penumbra(gl):
+    """The same shadow edge through pcf and through the soft filter 6 texels wide: the
+    transition (lit fraction between 0.1 and 0.9) spans about 2 texels with pcf and several
+    times that with the soft filter, centred on the analytic edge either way."""
+    points, on_cube = plane_points()
+    distance = analytic_shadow("directional", points)
+    ambient, _ = render(gl, scene(None))
+    widths = {}
+    for name, extra in (("pcf", {}), ("soft", {"shadow_filter": "soft",
+                                               "shadow_softness": 6.0})):
+        light = {**LIGHTS["directional"], **extra}
+        shadowed, tiles = render(gl, scene(light))
+        unshadowed, _ = render(gl, scene(light, shadows=False))
+        lit = (unshadowed - ambient).sum(-1)
+        fraction = (shadowed - ambient).sum(-1) / np.maximum(lit, 1e-6)
+        texel = texel_size("directional", tiles, points)
+        between = ~on_cube & (fraction > 0.1) & (fraction < 0.9)
+        widths[name] = float(np.percentile(np.abs(distance[between] / texel[between]), 90))
+        # the half-lit line on the analytic edge
+        assert abs(float(np.median(distance[between] / texel[between]))) < 1.5
+    assert widths["pcf"] < 3.0 and widths["soft"] > 2.0 * widths["pcf"], widths
