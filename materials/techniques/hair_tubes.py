@@ -12,6 +12,10 @@ a vertex at each end joined to its ring (4.3.2). Each vertex exists once and tri
 
 Per strand the vertices are the rings, root first (``samples x sides``, ring ``i`` vertex ``j``
 at ``i * sides + j``), then the root cap's centre, then the tip cap's: ``samples x sides + 2``.
+
+:func:`build_tubes` is numpy; :class:`GpuTubes` makes the same positions and averaged normals
+with two compute shaders straight into the vertex buffer the tubes are drawn from (what the
+material uses where the context has GL 4.3; numpy is its GL 3.3 path and the tests' reference).
 """
 
 from __future__ import annotations
