@@ -60,6 +60,8 @@ from .techniques.strands import (
     StrandSimulation,
     VertexAverage,
     curl_frames,
+    curl_phases,
+    gust_wind,
     triangle_strands,
 )
 from .techniques.wetness import (
@@ -113,6 +115,9 @@ class ShellFurParams(FurParams, BlinnPhongParams):
     curl_radius: float = Field(0.0, ge=0.0, le=4.0, description="K_alpha, object units")
     curl_frequency: float = Field(0.0, ge=0.0, le=1000.0,
                                   description="w, radians along the strand")
+    curl_variation: float = Field(1.0, ge=0.0, le=1.0,
+                                  description="curls start at phases spread over this much of "
+                                              "a turn (seeded; 0: all in one phase, the paper)")
     # clump (3.3, Eq. 5)
     clump_shape: float = Field(0.5, ge=0.0, le=1.0,
                                description="w: 0 leans straight to the centre, 1 bends in")
@@ -138,7 +143,12 @@ class ShellFurParams(FurParams, BlinnPhongParams):
     wind: Vec3 = Field((0.0, 0.0, 0.0), description="world force on each strand tip")
     gust: float = Field(0.0, ge=0.0, le=8.0,
                         description="wind varies by +- this fraction in travelling gusts")
-    gust_frequency: float = Field(0.5, ge=0.0, le=100.0, description="gusts per second")
+    gust_frequency: float = Field(0.5, ge=0.0, le=100.0,
+                                  description="gusts per second (the slowest of the gust "
+                                              "waves: they never repeat)")
+    strand_variation: float = Field(0.35, ge=0.0, le=0.9,
+                                    description="each strand's stiffness, mass and wind "
+                                                "response vary by +- this fraction (seeded)")
     time_step: float = Field(1.0 / 240.0, gt=0.0, le=0.1, description="simulation step, s")
     settle: float = Field(2.0, ge=0.0, le=60.0,
                           description="seconds simulated before t = 0 (strands at rest)")
@@ -209,7 +219,8 @@ def _layers_uniform(shells: int) -> dict[str, Any]:
 NOT_UNIFORMS = ("fur_mapping", "color_texture", "color_pattern", "pattern_color", "droplets",
                 "droplet_radius", "droplet_wetness", "wetness_mask", "mask_size", "dry_rate",
                 "soak_time", "stiffness", "mass", "damping", "gravity", "wind", "gust",
-                "gust_frequency", "time_step", "settle", "heightfield", "shading")
+                "gust_frequency", "time_step", "settle", "heightfield", "shading",
+                "strand_variation", "curl_variation")
 
 
 # -- colour texture --------------------------------------------------------------------------
@@ -283,6 +294,7 @@ class ShellFurState:
         self.model = np.array(obj.model_at(0.0))
         self.linear_inverse = np.linalg.inv(self.model[:3, :3])
         self.strands = StrandSimulation(*triangle_strands(obj.mesh, self.model, self.fur_length))
+        self.strands.vary(params.strand_variation, params.seed)
         self.average = VertexAverage(obj.mesh)
         self.size = params.mask_size
         self.wrap = uv_wrap(obj.mesh)
@@ -294,6 +306,10 @@ class ShellFurState:
         self.strand_data = np.zeros((max(1, math.ceil(3 * vertices / TIPS_WIDTH)) * TIPS_WIDTH,
                                      4), np.float32)
         curl_u, curl_v = curl_frames(obj.mesh, self.average.welded)
+        phase = curl_phases(obj.mesh, self.average.welded, params.curl_variation,
+                            params.seed)[:, None]
+        curl_u, curl_v = (np.cos(phase) * curl_u + np.sin(phase) * curl_v,
+                          np.cos(phase) * curl_v - np.sin(phase) * curl_u)
         self.strand_data[1:3 * vertices:3, :3] = curl_u
         self.strand_data[2:3 * vertices:3, :3] = curl_v
         self.tips_texture = _float_texture(ctx, TIPS_WIDTH, len(self.strand_data) // TIPS_WIDTH)
@@ -380,12 +396,9 @@ class ShellFurState:
             self._uploaded = None
 
     def _forces(self, params: ShellFurParams, time: float) -> StrandForces:
-        wind = np.asarray(params.wind, np.float64)
-        strength = float(np.linalg.norm(wind))
-        if params.gust > 0.0 and strength > 0.0:
-            along = self.strands.roots @ (wind / strength) / GUST_WAVELENGTH
-            phase = 2.0 * np.pi * (params.gust_frequency * time - along)
-            wind = wind[None, :] * (1.0 + params.gust * np.sin(phase))[:, None]
+        wind = gust_wind(np.asarray(params.wind, np.float64), self.strands.roots,
+                         self.strands.normals, params.gust, params.gust_frequency, time,
+                         GUST_WAVELENGTH)
         return StrandForces(params.stiffness, params.mass, params.damping,
                             np.asarray(params.gravity, np.float64), wind)
 
@@ -524,7 +537,7 @@ class ShellFurMaterial(FurMaterial):
     # the simulation's set-up (ShellFurState), and the passes built once
     timeline_growing = ("droplets",)  # fallen droplets stay (Algorithm 1 blends, never removes)
     timeline_fixed = ("fur_length", "mask_size", "wetness_mask", "time_step", "settle", "seed",
-                      "fins", "shading")  # shading: the shading model, so the G-buffer
+                      "fins", "shading", "strand_variation", "curl_variation")
     debug_views = {
         **{name: view for name, view in FUR_DEBUG_VIEWS.items() if name not in ("comb",
                                                                                  "samples")},

@@ -65,13 +65,27 @@ class StrandSimulation:
         self.tips = self.rest.copy()  # p
         self.velocities = np.zeros_like(self.tips)
 
+    def vary(self, variation: float, seed: int) -> None:
+        """Give each strand its own stiffness, mass and response to the wind: factors drawn
+        uniformly in [1 - variation, 1 + variation] (seeded), so strands settle and overshoot
+        each at its own pace instead of in lockstep. 0: every strand the same (the paper)."""
+        rng = np.random.default_rng([seed, 0x5712A4D])
+        count = len(self.roots)
+        self.stiffness_scale, self.mass_scale, self.wind_scale = (
+            1.0 + variation * rng.uniform(-1.0, 1.0, (count, 1)) for _ in range(3))
+
+    stiffness_scale: np.ndarray | float = 1.0  # per strand (T, 1): vary
+    mass_scale: np.ndarray | float = 1.0
+    wind_scale: np.ndarray | float = 1.0
+
     def step(self, dt: float, forces: StrandForces) -> None:
         """Advance by ``dt`` (Eq. 2, see the module documentation), then constrain (Eq. 3)."""
-        m = forces.mass
-        external = forces.mass * forces.gravity + forces.wind
-        spring = forces.stiffness * (self.tips - self.rest)
+        m = forces.mass * self.mass_scale
+        k = forces.stiffness * self.stiffness_scale
+        external = m * forces.gravity + forces.wind * self.wind_scale
+        spring = k * (self.tips - self.rest)
         velocities = (self.velocities + dt * (external - spring) / m) / \
-            (1.0 + dt * forces.damping / m + dt * dt * forces.stiffness / m)
+            (1.0 + dt * forces.damping / m + dt * dt * k / m)
         moved = self.tips + dt * velocities
         constrained = self.constrain(moved)
         self.velocities = (constrained - self.tips) / dt
@@ -90,6 +104,43 @@ class StrandSimulation:
     def deflections(self) -> np.ndarray:
         """(T, 3) ``p - p_0`` per strand."""
         return self.tips - self.rest
+
+
+def gust_wind(wind: np.ndarray, roots: np.ndarray, normals: np.ndarray, gust: float,
+              frequency: float, time: float, wavelength: float) -> np.ndarray:
+    """(T, 3) the wind on each strand at ``time``: ``wind`` varied by gusts that differ over the
+    surface and never repeat, and sheltered in the object's lee. Silva et al.'s wind is one
+    force for all strands (and a single travelling gust wave repeats exactly at its period).
+
+    - Along the wind, three travelling waves of incommensurate frequencies (``frequency`` times
+      1, the golden ratio and 1 + sqrt 2) and wavelengths, crossing at angles, scale it by
+      1 +- about ``gust``.
+    - Turbulence: three more waves push along, across and up by up to half ``gust`` of the
+      wind's strength.
+    - Shelter: a strand facing downwind (its normal along the wind: the lee) gets less of the
+      steady wind, which only presses it along its length there, and more of the turbulence:
+      eddies push it back and forth, so the leeward outline moves too."""
+    strength = float(np.linalg.norm(wind))
+    if gust <= 0.0 or strength <= 0.0:
+        return np.broadcast_to(wind, roots.shape)
+    along = wind / strength
+    helper = np.array([0.0, 1.0, 0.0]) if abs(along[1]) < 0.9 else np.array([1.0, 0.0, 0.0])
+    side = np.cross(along, helper)
+    side /= np.linalg.norm(side)
+    up = np.cross(side, along)
+    x, y, z = (roots @ axis / wavelength for axis in (along, side, up))
+    phase = 2.0 * np.pi * frequency * time
+    golden, silver = (1.0 + 5.0 ** 0.5) / 2.0, 1.0 + 2.0 ** 0.5
+    scale = (np.sin(phase - 2.0 * np.pi * x)
+             + 0.6 * np.sin(golden * phase - 2.0 * np.pi * (1.7 * x - 0.9 * y) + 1.3)
+             + 0.4 * np.sin(silver * phase - 2.0 * np.pi * (2.3 * x + 1.1 * z) + 2.1)) / 2.0
+    turbulence = 0.5 * (
+        np.sin(1.31 * phase - 2.0 * np.pi * (1.4 * x - 2.0 * z) + 0.7)[:, None] * side
+        + np.sin(1.73 * phase - 2.0 * np.pi * (0.8 * x + 1.9 * y) + 2.9)[:, None] * up
+        + np.sin(2.11 * phase - 2.0 * np.pi * (1.2 * y + 1.6 * z) + 4.4)[:, None] * along)
+    shelter = np.clip(np.asarray(normals, np.float64) @ along, 0.0, 1.0)[:, None]
+    return wind[None, :] * (1.0 + gust * scale)[:, None] * (1.0 - shelter) + \
+        strength * gust * (1.0 + shelter) * turbulence
 
 
 def triangle_strands(mesh: MeshData, model: np.ndarray,
@@ -143,6 +194,30 @@ def curl_frames(mesh: MeshData, welded: np.ndarray) -> tuple[np.ndarray, np.ndar
     u = t / np.linalg.norm(t, axis=1, keepdims=True)
     v = np.cross(n, u)
     return u[welded], v[welded]
+
+
+def curl_phases(mesh: MeshData, welded: np.ndarray, variation: float, seed: int,
+                smoothing: int = 2) -> np.ndarray:
+    """(V,) an angle per vertex to turn its curl's (u, v) by: each strand's helix starts at its
+    own phase, so neighbouring curls do not wind in lockstep (Eq. 4 gives every strand the same
+    phase). Drawn uniformly over ``variation`` of a turn per welded vertex (seeded; the copies
+    of a vertex split at a seam share it), then averaged with the neighbours' ``smoothing``
+    times as unit vectors, so the layers do not crumple between neighbouring vertices."""
+    groups = int(welded.max()) + 1
+    if variation <= 0.0:
+        return np.zeros(len(welded))
+    rng = np.random.default_rng([seed, 0xC011])
+    angle = 2.0 * np.pi * variation * rng.uniform(-0.5, 0.5, groups)
+    z = np.exp(1j * angle)
+    faces = welded[np.asarray(mesh.indices, np.int64).reshape(-1, 3)]
+    a = faces.reshape(-1)
+    b = faces[:, [1, 2, 0]].reshape(-1)
+    for _ in range(smoothing):
+        total = z.copy()
+        np.add.at(total, a, z[b])
+        np.add.at(total, b, z[a])
+        z = total / np.maximum(np.abs(total), 1e-12)
+    return np.angle(z)[welded]
 
 
 class VertexAverage:

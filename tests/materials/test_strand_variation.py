@@ -1,0 +1,120 @@
+"""Strands that differ (shell_fur): per-strand stiffness, mass and wind response, a gust field
+that varies over the surface and never repeats, curls in different phases; and the outlines of
+examples/shell_fur/wet_wind.toml in the wind."""
+
+from pathlib import Path
+
+import numpy as np
+
+from deferred.materials.techniques.strands import (
+    StrandForces,
+    StrandSimulation,
+    curl_phases,
+    gust_wind,
+)
+from deferred.materials.techniques.topology import weld
+from deferred.scene.builtin_meshes import builtin_sphere
+from deferred.scene.loader import scene_from_dict
+
+try:
+    import tomllib
+except ImportError:  # Python 3.10
+    import tomli as tomllib  # type: ignore[no-redef]
+
+ROOT = Path(__file__).parents[2]
+
+
+def sphere_strands(count=400, seed=3):
+    rng = np.random.default_rng(seed)
+    normals = rng.normal(size=(count, 3))
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    return StrandSimulation(normals, normals, np.full(count, 0.3))
+
+
+def test_varied_strands_settle_each_at_its_own_pace():
+    forces = StrandForces(2.0, 0.01, 0.05, np.zeros(3), np.array([0.25, 0.0, 0.0]))
+    same, varied = sphere_strands(), sphere_strands()
+    varied.vary(0.35, seed=1)
+    paths = {"same": [], "varied": []}
+    for _ in range(240):
+        for name, strands in (("same", same), ("varied", varied)):
+            strands.step(1.0 / 240.0, forces)
+            paths[name].append(strands.deflections().copy())
+    # strands whose roots face the same way move identically without variation, not with it
+    twins = sphere_strands(2)
+    twins.roots[1] = twins.roots[0] + 5.0  # the same normal, elsewhere
+    twins.normals[1] = twins.normals[0]
+    twins.rest = twins.roots + twins.normals * twins.lengths[:, None]
+    twins.reset()
+    twins.vary(0.35, seed=1)
+    for _ in range(120):
+        twins.step(1.0 / 240.0, forces)
+    assert np.linalg.norm(twins.deflections()[0] - twins.deflections()[1]) > 1e-3
+    # the same scales from the same seed
+    again = sphere_strands()
+    again.vary(0.35, seed=1)
+    np.testing.assert_array_equal(again.stiffness_scale, varied.stiffness_scale)
+    assert 0.65 <= float(np.min(varied.mass_scale)) and float(np.max(varied.mass_scale)) <= 1.35
+
+
+def test_gust_field_varies_over_the_surface_and_never_repeats():
+    strands = sphere_strands(500)
+    wind = np.array([0.25, 0.0, 0.0])
+    period = 1.0 / 1.5
+    field = [gust_wind(wind, strands.roots, strands.normals, 0.6, 1.5, t, 1.0)
+             for t in np.arange(0.0, 6.0, period)]
+    # over the surface: strands feel different winds at one time
+    assert np.std(field[0], axis=0).max() > 0.02
+    # in time: a gust period later the field is another (a single travelling wave repeated)
+    repeat = [np.abs(b - a).mean() for a, b in zip(field, field[1:], strict=False)]
+    assert min(repeat) > 0.01
+    # the lee: strands facing downwind feel turbulence, not the steady wind along their length
+    lee = strands.normals @ (wind / np.linalg.norm(wind)) > 0.9
+    steady = np.mean([f[lee] for f in field], axis=0) @ wind / np.linalg.norm(wind)
+    assert np.abs(steady).mean() < 0.1 * np.linalg.norm(wind)
+    assert np.std([f[lee] for f in field], axis=0).mean() > 0.02
+
+
+def test_curl_phases_differ_but_change_slowly_between_neighbours():
+    mesh = builtin_sphere(32, 16)
+    welded = weld(mesh.positions)
+    phase = curl_phases(mesh, welded, 1.0, seed=2)
+    assert np.std(np.exp(1j * phase)) > 0.3  # spread round the turn
+    faces = mesh.indices.reshape(-1, 3).astype(np.int64)
+    step = np.abs(np.angle(np.exp(1j * (phase[faces[:, 0]] - phase[faces[:, 1]]))))
+    assert np.median(step) < np.pi / 3  # neighbours nearly agree: the layers do not crumple
+    assert np.all(curl_phases(mesh, welded, 0.0, seed=2) == 0.0)
+    # the copies of a seam vertex share their phase
+    first = np.unique(welded, return_index=True)[1]
+    assert np.abs(phase - phase[first][welded]).max() < 1e-9
+
+
+def outlines(render, scene, times):
+    """(frames, 2, rows): the leftmost and rightmost fur pixel of each row of the ball's middle."""
+    result, renderer = render(scene, time=times[0])
+    images = [result.image]
+    images += [renderer.render(time=t).image for t in times[1:]]
+    edges = []
+    for image in images:
+        rgb = image[..., :3].astype(np.float64)
+        fur = np.abs(rgb - rgb[0, 0]).max(-1) > 20
+        rows = range(rgb.shape[0] // 4, 3 * rgb.shape[0] // 4)
+        edges.append([[np.flatnonzero(fur[r])[0] for r in rows],
+                      [np.flatnonzero(fur[r])[-1] for r in rows]])
+    return np.array(edges, np.float64)
+
+
+def test_wet_wind_outlines_both_move_and_do_not_repeat(render):
+    """wet_wind.toml from t = 2.5 s at 12 frames a second (the gust period is 8 frames): the
+    windward (left) and leeward (right) outlines both move, and a gust period later the outline
+    is not where it was (it repeated to a pixel)."""
+    path = ROOT / "examples" / "shell_fur" / "wet_wind.toml"
+    scene = scene_from_dict({**tomllib.loads(path.read_text()), "size": [240, 180]}, str(path),
+                            base_dir=path.parent)
+    edges = outlines(render, scene, [2.5 + k / 12.0 for k in range(17)])
+    motion = edges.std(axis=0).mean(axis=1)  # windward, leeward: pixels
+    repeat = np.abs(edges[8:] - edges[:-8]).mean(axis=(0, 2))
+    print(f"outline motion windward {motion[0]:.2f} px, leeward {motion[1]:.2f} px; a gust "
+          f"period later {repeat[0]:.2f} and {repeat[1]:.2f} px away")
+    assert motion[0] > 1.0 and motion[1] > 0.5
+    assert repeat.min() > 0.5
