@@ -39,7 +39,7 @@ class DitheredShells:
         count = super().draws(frame)
         # Not while a temporal history follows a moving camera: it keeps a tenth of each
         # frame there, too little to average the dither out, which then shimmers
-        # (benchmarks/crawl.py: 1.24 / 1.44 levels with it, 0.65 / 0.74 without).
+        # (benchmarks/crawl.py and its README: about twice the residual with it).
         moving = frame.history_kept and not np.array_equal(frame.previous_view_projection,
                                                            frame.view_projection)
         self._dither = 0.0 if moving else \

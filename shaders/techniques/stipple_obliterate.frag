@@ -83,6 +83,17 @@ void main() {
     }
     ivec2 source = best >= 0 ? pixel + OFFSETS[best]
                              : clamp(pixel + ivec2(1, 0), ivec2(0), size - 1);
+    if (best_paired) {
+        // between the two: the surface's colour and depth interpolated across the pixel (one
+        // neighbour's depth at a grazing silhouette is off by the fur's whole thickness, and
+        // the shells failed the depth test over the dark root shell: a dark dot)
+        ivec2 other = pixel + OFFSETS[best < 4 ? best ^ 1 : 11 - best];
+        out_color = 0.5 * (texelFetch(u_composite_snapshot, source, 0) +
+                           texelFetch(u_composite_snapshot, other, 0));
+        gl_FragDepth = window_depth(0.5 * (depths[best] + depths[best < 4 ? best ^ 1 : 11 - best]),
+                                    u_projection);
+        return;
+    }
     out_color = texelFetch(u_composite_snapshot, source, 0);
     gl_FragDepth = window_depth(texelFetch(u_linear_depth, source, 0).r, u_projection);
 }
