@@ -291,3 +291,36 @@ def test_transparent_surfaces_are_sorted_each_frame(gl):
         moved = renderer.render(time=1.0).image
     with Renderer(scene, "forward", gl=gl) as fresh:
         assert np.array_equal(fresh.render(time=1.0).image, moved)
+
+
+@pytest.mark.parametrize("pipeline", PIPELINES)
+def test_fur_beyond_the_mesh_moves_with_its_object(gl, pipeline):
+    """A furred sphere moving sideways over the empty background: the fur's fringe, where its
+    shells and fins are drawn beyond the mesh's silhouette, has the object's motion (its
+    material's motion_extent), not the background's none."""
+    speed = 1.2
+    objects, tracks = moving_sphere(speed)
+    objects = [{**objects[0], "material": "revie_fur",
+                "params": {"shells": 8, "fur_length": 0.25}}]
+    scene = scene_with(objects, background=(0.0, 0.0, 0.0), tracks=tracks)
+    t0, t1 = 1.0, 1.0 + 1.0 / FPS
+    with Renderer(scene, pipeline, gl=gl) as renderer:
+        renderer.render(time=t0)
+        before = renderer.last_frame.view_projection
+        image = renderer.render(time=t1).image
+        frame = renderer.last_frame
+        motion = renderer.targets.read("motion")[::-1]
+        depth = renderer.targets.read("depth")[::-1, :, 0]
+    shown = image[..., :3].max(axis=-1) > 8
+    fringe = shown & (depth >= 1.0)  # fur drawn where the mesh is not
+    assert fringe.sum() > 20
+
+    def pixels(vp, point):
+        clip = vp @ np.append(point, 1.0)
+        return clip[:2] / clip[3] * 0.5 * np.array([frame.width, frame.height])
+
+    centre = np.array([-1.0 + speed * t1, 0.0, 0.0])
+    expected = pixels(frame.view_projection, centre) - \
+        pixels(before, centre - [speed / FPS, 0.0, 0.0])
+    assert expected[0] > 0.8
+    assert np.allclose(motion[fringe].mean(axis=0), expected, atol=0.2 * expected[0])
