@@ -19,6 +19,7 @@ from deferred.gbuffer.layout import (
     ALBEDO_SPECULAR,
     DEPTH,
     LINEAR_DEPTH,
+    MOTION,
     NORMAL_EXPONENT_ID,
     octahedral_decode,
 )
@@ -128,12 +129,27 @@ def target_views(name: str, pixels: np.ndarray, spec: TargetSpec, tonemap_method
         return [("tone mapped", tonemap(pixels, tonemap_method, exposure))]
     if name == FINAL:
         return [("", np.clip(pixels[..., :3], 0.0, 1.0))]
+    if name == MOTION:
+        return [motion_colors(pixels[..., :2])]
     components = pixels.shape[2]
     if components == 1:
         return [("", grey(pixels[..., 0]))]
     rgb = np.zeros(pixels.shape[:2] + (3,), np.float32)
     rgb[..., : min(components, 3)] = pixels[..., :3]
     return [("", np.clip(rgb, 0.0, 1.0))]
+
+
+def motion_colors(motion: np.ndarray) -> tuple[str, np.ndarray]:
+    """Motion vectors as colours: grey where still, x to red (right) or cyan (left), y to
+    green (up) or magenta (down), full at the 99th percentile of the lengths; the label says
+    that length in pixels."""
+    lengths = np.linalg.norm(motion, axis=-1)
+    scale = max(float(np.percentile(lengths, 99)), 1e-3)
+    rgb = np.empty(motion.shape[:2] + (3,), np.float32)
+    rgb[..., 0] = 0.5 + 0.5 * motion[..., 0] / scale
+    rgb[..., 1] = 0.5 + 0.5 * motion[..., 1] / scale
+    rgb[..., 2] = 0.5 - 0.25 * (motion[..., 0] + motion[..., 1]) / scale
+    return f"motion (full at {scale:.3g} px)", np.clip(rgb, 0.0, 1.0)
 
 
 def to_uint8(rgb: np.ndarray) -> np.ndarray:

@@ -324,3 +324,26 @@ def test_fur_beyond_the_mesh_moves_with_its_object(gl, pipeline):
         pixels(before, centre - [speed / FPS, 0.0, 0.0])
     assert expected[0] > 0.8
     assert np.allclose(motion[fringe].mean(axis=0), expected, atol=0.2 * expected[0])
+
+
+def test_view_motion_shows_the_frame_before(tmp_path, capsys):
+    """``render --view motion --time T`` renders the frame before T first, so the view holds
+    this frame's motion: the camera on a track moves the image, the background too."""
+    from deferred.cli import main
+    from deferred.io.images import read_channels
+
+    scene = tmp_path / "moving.toml"
+    scene.write_text(
+        'size = [64, 48]\n[camera]\nposition = [0.0, 0.3, 3.0]\n'
+        '[[object]]\nmesh = "builtin:sphere"\n[[light]]\ntype = "ambient"\n'
+        '[[effect]]\ntype = "taa"\n'
+        '[[track]]\ntarget = "camera"\ninterpolation = "linear"\n'
+        'keys = [{ time = 0.0, position = [0.0, 0.3, 3.0] },'
+        ' { time = 2.0, position = [2.0, 0.3, 3.0] }]\n')
+    out = tmp_path / "motion.exr"
+    assert main(["render", str(scene), "--view", "motion", "--time", "1", "-o", str(out)]) == 0
+    capsys.readouterr()
+    motion = read_channels(out)[0][..., :2]
+    assert np.median(np.linalg.norm(motion, axis=-1)) > 0.3  # the image moved
+    png = tmp_path / "motion.png"
+    assert main(["render", str(scene), "--view", "motion", "--time", "1", "-o", str(png)]) == 0
