@@ -65,6 +65,20 @@ vec2 fur_sample(vec3 fur_position, vec3 fur_normal, float h) {
     return fur_sample_grad(fur_position, fur_normal, h, dFdx(fur_position), dFdy(fur_position));
 }
 
+// The strands' own brightness where they cover (the volume's, 0.7 .. 1 a strand, seeded); the
+// skin between them, on the root shell, is 1.
+float strand_brightness(vec2 strands) {
+    return mix(1.0, strands.y / max(strands.x, 1e-4), min(strands.x, 1.0));
+}
+
+// Each strand's own tint (not in the papers): its brightness also saturates a darker strand's
+// colour and pales a lighter one's, albedo^(1 + 1.2 (0.85 - brightness)) where strands cover,
+// so neighbouring strands differ in hue, not only in value.
+vec3 strand_tint(vec3 albedo, vec2 strands) {
+    float shift = 1.2 * (0.85 - strand_brightness(strands)) * min(strands.x, 1.0);
+    return pow(max(albedo, vec3(0.0)), vec3(1.0 + shift));
+}
+
 // A shell's opacity from the volume's coverage: each shell stands for 1/n of the layer, so with
 // n shells coverage c becomes 1 - (1 - c)^(slices / n) (`weight`): the fur's optical depth, and
 // so its colour, stays the same whatever the level of detail draws.

@@ -59,8 +59,7 @@ void main() {
     light = max(light, forward_lighting(rim, i.position, V));
 #endif
     vec3 irradiance = light / max(s.albedo, vec3(1.0 / 255.0));
-    // strands' own brightness where they cover; the skin between them on the root shell
-    float brightness = mix(1.0, strands.y / max(strands.x, 1e-4), min(strands.x, 1.0));
+    float brightness = strand_brightness(strands);
     vec3 albedo = mix(u_albedo_base, u_albedo_tip, v_shell_depth) * fur_shadow(v_shell_depth);
-    out_color = vec4(irradiance * albedo * brightness, alpha);
+    out_color = vec4(irradiance * strand_tint(albedo, strands) * brightness, alpha);
 }

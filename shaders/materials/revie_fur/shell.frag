@@ -84,8 +84,7 @@ void main() {
     if (!base_valid && !tip_valid && !own_valid) discard;  // the strand's light is unknown
     vec3 irradiance = base_valid && tip_valid ? max(base_light, tip_light)
                     : (base_valid ? base_light : (tip_valid ? tip_light : irradiance_at(own)));
-    // strands' own brightness where they cover; the skin between them on the root shell
-    float brightness = mix(1.0, strands.y / max(strands.x, 1e-4), min(strands.x, 1.0));
+    float brightness = strand_brightness(strands);
     vec3 albedo = mix(u_albedo_base, u_albedo_tip, v_shell_depth) * fur_shadow(v_shell_depth);
-    out_color = vec4(irradiance * albedo * brightness, alpha);
+    out_color = vec4(irradiance * strand_tint(albedo, strands) * brightness, alpha);
 }

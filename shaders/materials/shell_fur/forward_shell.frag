@@ -52,7 +52,7 @@ void main() {
     return;
 #endif
     Surface s;
-    s.albedo = albedo;
+    s.albedo = strand_tint(albedo, strands);
     s.specular_intensity = wet_specular_intensity(u_specular_intensity, wetness);
 #ifdef FUR_MARSCHNER
     s.specular_exponent = wet_specular_shape(u_roughness, wetness);  // marschner's roughness
@@ -64,6 +64,5 @@ void main() {
     s.shading_model = surface_shading_model(u_surface_id);
     s.data.strand_tangent = strand_tangent_encode(v_strand_tangent);
     vec3 light = forward_lighting(s, v_position, normalize(-v_position));
-    float brightness = mix(1.0, strands.y / max(strands.x, 1e-4), min(strands.x, 1.0));
-    out_color = vec4(light * fur_shadow(v_shell_depth) * brightness, alpha);
+    out_color = vec4(light * fur_shadow(v_shell_depth) * strand_brightness(strands), alpha);
 }

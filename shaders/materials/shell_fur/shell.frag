@@ -66,7 +66,6 @@ void main() {
 #endif
     if (!base_valid && !own_valid) discard;  // the strand's light is unknown
     if (own_valid) irradiance = own_irradiance;
-    // strands' own brightness where they cover; the skin between them on the root layer
-    float brightness = mix(1.0, strands.y / max(strands.x, 1e-4), min(strands.x, 1.0));
-    out_color = vec4(irradiance * albedo * brightness, alpha);
+    float brightness = strand_brightness(strands);
+    out_color = vec4(irradiance * strand_tint(albedo, strands) * brightness, alpha);
 }
