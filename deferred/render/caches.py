@@ -83,17 +83,21 @@ class ObjectTransforms:
         (``u_previous_model``; an object missing there, or with none given, its own model)."""
         if not objects:
             return {}
-        previous = previous or {}
         surface_ids = [float(obj.material.surface_id()) for obj in objects]
-        befores = [previous.get(id(obj), obj.model) for obj in objects]
+        # the last frame's models where they differ (none without a temporal history)
+        befores = None
+        if previous:
+            befores = [previous.get(id(obj), obj.model) for obj in objects]
         # what the values are made of (contents, not identities: a model may be written in
         # place), and which object each belongs to
         key = (b"".join([obj.model.tobytes() for obj in objects]), surface_ids,
                [id(obj) for obj in objects],
+               None if befores is None else
                b"".join([np.asarray(before, dtype=np.float64).tobytes() for before in befores]))
         if key != self._key:
             models = np.stack([obj.model for obj in objects])
-            self._values = self._make(objects, models, surface_ids, np.stack(befores))
+            self._values = self._make(objects, models, surface_ids,
+                                      models if befores is None else np.stack(befores))
             self._key = key
         return self._values
 
