@@ -382,10 +382,26 @@ def test_eq5_and_algorithm2_in_glsl_against_numpy(gl, shaders):
     np.testing.assert_allclose(out[60, 3:5], (0.024, 0.0), atol=1e-6)
     assert kept[60] and not kept[61] and not kept[62] and kept[63]
     np.testing.assert_allclose(out[63, 3:5], 0.0)
+    def wetness(uv):  # the mask's alpha filtered bilinearly, wrapping (wet.glsl)
+        x, y = uv[0] * size - 0.5, uv[1] * size - 0.5
+        j, i = int(np.floor(x)), int(np.floor(y))
+        fx, fy = x - j, y - i
+        a = image[:, :, 3]
+        i0, i1, j0, j1 = i % size, (i + 1) % size, j % size, (j + 1) % size
+        return ((1 - fx) * (1 - fy) * a[i0, j0] + fx * (1 - fy) * a[i0, j1]
+                + (1 - fx) * fy * a[i1, j0] + fx * fy * a[i1, j1])
+
+    def wetness_near(uv):  # wet.glsl: the mean of five, four of them 4 texels away diagonally
+        step = 4.0 / size
+        return np.mean([wetness(uv + offset) for offset in
+                        ((0.0, 0.0), (step, step), (-step, -step), (step, -step), (-step, step))])
+
     for k in range(n):
         m = texel(pixel[k])
         if m[3] == 0.0:
-            assert kept[k] and np.allclose(out[k, 3:5], 0.0), k
+            # dry fur stays where it is, its top cut down beside wet fur (a sloping border)
+            assert np.allclose(out[k, 3:5], 0.0), k
+            assert kept[k] == (h[k] <= 1.0 - 0.6 * wetness_near(pixel[k]) + 1e-6), k
             continue
         want_d = eq5_reference(h[k:k + 1], m[None], pixel[k:k + 1], w, layers, strength)[1][0]
         np.testing.assert_allclose(out[k, 3:5], want_d, atol=1e-5)

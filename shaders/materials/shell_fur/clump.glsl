@@ -51,12 +51,14 @@ vec2 clump_displacement(float h, vec4 mask, vec2 c_pixel, float w, float layers,
 // and fur coordinates, its gain (within a clump uv + d = uv + gain (uv - c), so lookups there
 // change (1 + gain) times as fast as uv), and whether the fragment is kept (false: it belongs
 // to another clump, or its displaced coordinate falls on dry fur or into another clump). Dry
-// fragments keep their coordinates.
+// fragments keep their coordinates; beside wet fur (not in the paper) the dry fur's top is cut
+// down to 1 - 0.6 of the wetness about it (fur_wetness_near), so a dry patch's border slopes
+// into the clumps over a few texels instead of standing as a wall.
 bool clump_fur(vec2 uv, float h, out vec2 d, out float gain) {
     d = vec2(0.0);
     gain = 0.0;
     vec4 mask = textureLod(u_wetness_mask, uv, 0.0);
-    if (mask.a == 0.0) return true;
+    if (mask.a == 0.0) return h <= 1.0 - 0.6 * fur_wetness_near(uv);
     gain = clump_gain(h, mask, u_clump_shape, u_layers, u_clump_strength);
     vec2 from_centre = uv_delta(uv, mask.rg);
     d = gain * from_centre;

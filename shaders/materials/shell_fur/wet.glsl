@@ -24,6 +24,15 @@ float fur_wetness(vec2 uv) {
     return clamp(mix(mix(w00, w10, f.x), mix(w01, w11, f.x), f.y), 0.0, 1.0);
 }
 
+// The wetness about uv: the mean of the filtered wetness at four points 4 texels away
+// diagonally (and uv itself): it rises over about eight texels toward a wet area.
+float fur_wetness_near(vec2 uv) {
+    vec2 step = 4.0 / vec2(textureSize(u_wetness_mask, 0));
+    return (fur_wetness(uv) + fur_wetness(uv + step) + fur_wetness(uv - step)
+            + fur_wetness(uv + vec2(step.x, -step.y)) + fur_wetness(uv + vec2(-step.x, step.y)))
+           / 5.0;
+}
+
 vec3 wet_albedo(vec3 albedo, float wetness) {
     return pow(max(albedo, vec3(0.0)), vec3(1.0 + WET_DARKENING * wetness));
 }
