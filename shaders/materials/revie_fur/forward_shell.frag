@@ -6,6 +6,7 @@
 #include "common/forward_lighting.glsl"
 #include "techniques/rim.glsl"
 #include "techniques/fur.glsl"
+#include "materials/revie_fur/slab.glsl"
 #include SURFACE_FILE
 
 uniform vec3 u_albedo_base;
@@ -25,7 +26,16 @@ in float v_fin_fade;
 out vec4 out_color;
 
 void main() {
+#ifdef FUR_FINS
     vec2 strands = fur_sample(v_fur_position, v_fur_normal, v_shell_depth);
+#else
+    vec3 comb_packed = v_comb.xyz * 2.0 - 1.0;
+    vec2 strands = u_root_shell
+        ? fur_sample(v_fur_position, v_fur_normal, v_shell_depth)
+        : fur_sample_slab(v_fur_position, v_fur_normal, v_shell_depth, u_shell_weight / 16.0,
+                          v_position, v_tangent * comb_packed.x + v_binormal * comb_packed.y,
+                          v_comb.a);
+#endif
     float alpha = u_root_shell ? 1.0 : shell_opacity(strands.x, u_shell_weight) * u_shell_fade;
 #ifdef FUR_FINS
     // Fins show the strands above the shells' rims; their roots sit inside the fur in front

@@ -12,7 +12,7 @@ uniform bool u_anisotropic;
 #ifdef FUR_MARSCHNER
 #include "techniques/strand_tangent.glsl"
 uniform float u_roughness;
-uniform float u_comb_strength;
+#include "materials/revie_fur/comb.glsl"
 #endif
 
 vec3 fur_comb_view(SurfaceInput i) {
