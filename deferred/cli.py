@@ -118,6 +118,7 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
     image sequence or a video."""
     from deferred.debug.capture import capture_frame
     from deferred.debug.views import (
+        check_material_view,
         resolve_view,
         view,
         view_catalogue,
@@ -184,6 +185,7 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
         if view_name is not None:
             debug_scene = with_material_view(loaded, view_name)
             if debug_scene is not None:  # the material draws the view: the frame shows it
+                check_material_view(loaded, view_name, pipeline)
                 loaded, view_name = debug_scene, None
         progress.status("starting the renderer")
         with Renderer(loaded, pipeline, size_override, strict=strict or None,
@@ -505,11 +507,12 @@ def view_command(scene: str | None, pipeline: str, light_path: str | None, size:
 
 def _check_view_name(loaded, view_name: str, pipeline: str, light_path: str | None) -> None:
     """A buffer name is known before a window opens (``InputError`` naming --view)."""
-    from deferred.debug.views import resolve_view, with_material_view
+    from deferred.debug.views import check_material_view, resolve_view, with_material_view
     from deferred.lighting.paths import resolve_light_path
     from deferred.render.renderer import FULL_FEATURES
 
     if with_material_view(loaded, view_name) is not None:
+        check_material_view(loaded, view_name, pipeline)
         return
     passes = PIPELINES[pipeline](
         resolve_light_path(pipeline, light_path or loaded.light_path, FULL_FEATURES)

@@ -164,7 +164,8 @@ class ShellFurParams(FurParams, BlinnPhongParams):
                                   "model (R, TT, TRT about the strand)")
     roughness: float = Field(0.2, gt=0.0, le=1.0,
                              description="marschner: longitudinal roughness beta, radians")
-    debug: Literal["none", "samples", "shell_count", "single_shell", "wetness"] = Field(
+    debug: Literal["none", "samples", "shell_count", "single_shell", "wetness",
+                   "opacity_shadow"] = Field(
         "none", description="debug view instead of the fur (shell_fur's debug_views)")
 
     @model_validator(mode="after")

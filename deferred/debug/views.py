@@ -96,6 +96,21 @@ def with_material_view(scene: Scene, name: str) -> Scene | None:
     return replace(scene, objects=objects) if found else None
 
 
+def check_material_view(scene: Scene, name: str, pipeline: str) -> None:
+    """Refuse a material view the scene or pipeline cannot show: ``<fur>.opacity_shadow``
+    needs a shadowed light and the forward pipeline (whose shells read the deep opacity maps;
+    the deferred shells take their light from the skin's pixels)."""
+    if not name.endswith(".opacity_shadow"):
+        return
+    if not any(light.casts_shadows for light in scene.lights):
+        raise InputError(f"view '{name}' shows the fur's deep opacity maps; no light of this "
+                         "scene casts shadows (shadows = true)", "--view")
+    if pipeline != "forward":
+        raise InputError(f"view '{name}' shows the deep opacity maps the forward shells read "
+                         "(the deferred shells take their light from the skin): use "
+                         "--pipeline forward", "--view")
+
+
 def view_catalogue(passes: Sequence[RenderPass], scene: Scene | None = None
                    ) -> list[tuple[str, str]]:
     """Every ``--view`` name for a pass list (and the scene's material views), with what it

@@ -313,6 +313,21 @@ class Material:
         frame.bind(program, view.uniforms, offered=frame.object_uniforms(obj))
         frame.draw_mesh(obj.mesh, program)
 
+    # A volume that shadows itself through deep opacity maps (fur; deferred.lighting.shadows):
+    # it draws them (draw_opacity) and its receivers compile with OPACITY_RECEIVER.
+    opacity_shadows: bool = False
+
+    def opacity_layer(self, obj: SceneObjectLike) -> float:
+        """World thickness of ``obj``'s volume (the opacity layers span a few of the thickest)."""
+        return 0.0
+
+    def draw_opacity(self, frame: Frame, obj: SceneObjectLike, view: ShadowView,
+                     stage: str) -> None:
+        """Draw ``obj``'s volume into the deep opacity maps of ``view`` (materials with
+        ``opacity_shadows``): ``stage`` "first", the light-view depth of its front into an R32F
+        target with a depth test; "density", its optical depth added into the four layers
+        behind that front (``u_opacity_first``, ``u_opacity_layers``), blended additively."""
+
     def passes(self, phase: Phase, obj: SceneObjectLike) -> list[RenderPass]:
         hooks = {Phase.GEOMETRY: self.geometry_passes, Phase.SCREEN: self.screen_passes,
                  Phase.STIPPLE: self.stipple_passes, Phase.MATERIAL: self.material_passes,

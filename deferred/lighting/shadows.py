@@ -22,6 +22,16 @@ records texture holds its matrices from view space to the atlas (``lights/shadow
 documents the layout). The atlas is one binding source of the frame, bound to every program
 that reads it; programs only read it where the scene has a shadowed light (the define
 ``SHADOWS``), so a scene without shadows pays nothing.
+
+**Deep opacity maps** (Yuksel and Keyser 2008), where an object's material draws a volume
+(``Material.opacity_shadows``: fur): beside the atlas, two textures of half its size over the
+same atlas coordinates: ``opacity_first``, the light-view depth of the first volume fragment
+each texel sees (the volume's own front, not the depth atlas's casters), and ``opacity``, four
+layers (RGBA) of the volume's optical depth accumulated from that front up to
+``OPACITY_LAYERS`` x the thickest volume's layer (``Material.opacity_layer``). Each material
+draws both stages (:meth:`~deferred.interfaces.material.Material.draw_opacity`); a receiver
+compiled with ``OPACITY_RECEIVER`` multiplies a shadowed light by the transmittance there
+(``lights/shadows.glsl``, ``opacity_transmittance``). Programs see ``OPACITY_SHADOWS``.
 """
 
 from __future__ import annotations
@@ -48,6 +58,11 @@ if TYPE_CHECKING:
 
 SHADOW_ATLAS = "shadow_atlas"  # its name on a frame's blackboard
 SHADOWS_DEFINE = "SHADOWS"
+OPACITY_SHADOWS_DEFINE = "OPACITY_SHADOWS"
+# where the four opacity layers end, in units of the thickest volume's layer: finer near the
+# volume's front, where light falls fastest (Yuksel and Keyser 2008, section 3: layer sizes)
+OPACITY_LAYERS = (0.25, 0.5, 1.0, 2.0)
+OPACITY_FAR = 3.0e38  # the first-depth map's clear value: no volume along the texel
 RECORD_TEXELS = 40  # texels a slot's row: 4 + 6 tiles x 6 (lights/shadows.glsl)
 MAX_TILES = 6
 CASCADE_BLEND = 0.1  # the fraction of a cascade blended into the next at its far end
@@ -65,12 +80,38 @@ def scene_casts_shadows(lights: list[Light]) -> bool:
     return any(light.casts_shadows for light in lights)
 
 
-def atlas_memory(budget: Any) -> dict[str, int]:
+def scene_has_opacity(scene: Scene) -> bool:
+    """Whether a shadowed scene draws deep opacity maps (an object's material asks for them)."""
+    return scene_casts_shadows(scene.lights) and any(
+        obj.material.opacity_shadows for obj in scene.objects)
+
+
+def opacity_size(atlas_size: int) -> int:
+    """Texels on a side of the opacity maps: half the atlas (the volume's shadow is soft)."""
+    return max(atlas_size // 2, 1)
+
+
+def atlas_memory(budget: Any, opacity: bool = False) -> dict[str, int]:
     """What the shadow atlas of a scene's budget holds, for the memory budget: its depths
-    (4 bytes a texel) and its records."""
+    (4 bytes a texel) and its records; with ``opacity``, the opacity maps (first depth 4 +
+    depth 4 + four half-float layers 8 bytes a texel)."""
     size = budget.atlas_size
-    return {f"shadow atlas {size}^2": size * size * 4 +
+    held = {f"shadow atlas {size}^2": size * size * 4 +
             RECORD_TEXELS * 16 * budget.max_shadowed_lights}
+    if opacity:
+        half = opacity_size(size)
+        held[f"opacity shadow maps {half}^2"] = half * half * 16
+    return held
+
+
+def near_far(projection: np.ndarray) -> tuple[float, float]:
+    """The near and far distances of a GL projection matrix (orthographic or perspective)."""
+    p22, p23 = float(projection[2, 2]), float(projection[2, 3])
+    if abs(float(projection[3, 3]) - 1.0) < 1e-9:  # orthographic
+        span = -2.0 / p22
+        total = -p23 * span
+        return (total - span) / 2.0, (total + span) / 2.0
+    return p23 / (p22 - 1.0), p23 / (p22 + 1.0)
 
 
 def practical_splits(near: float, far: float, count: int, lam: float) -> np.ndarray:
@@ -221,7 +262,8 @@ def world_bounds(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
 class ShadowAtlas:
     """The shadow atlas, its records texture and this frame's tiles (a binding source)."""
 
-    def __init__(self, ctx: moderngl.Context, atlas_size: int, max_lights: int):
+    def __init__(self, ctx: moderngl.Context, atlas_size: int, max_lights: int,
+                 opacity: bool = False):
         self.ctx = ctx
         self.size = atlas_size
         self.max_lights = max_lights
@@ -239,6 +281,21 @@ class ShadowAtlas:
         self._plan_key: tuple | None = None
         self._plan: dict = {}
         self._uniforms: dict[str, Any] = {}
+        self.opacity = None
+        self.opacity_layer = 0.0  # world units: the thickest opacity volume's layer
+        if opacity:
+            half = opacity_size(atlas_size)
+            self.opacity_first = ctx.texture((half, half), 1, dtype="f4")
+            self.opacity_first.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            self.opacity_depth = ctx.depth_texture((half, half))
+            self.opacity = ctx.texture((half, half), 4, dtype="f2")
+            self.opacity.filter = (moderngl.LINEAR, moderngl.LINEAR)
+            for texture in (self.opacity_first, self.opacity):
+                texture.repeat_x = texture.repeat_y = False
+            self.first_framebuffer = ctx.framebuffer([self.opacity_first], self.opacity_depth)
+            self.opacity_framebuffer = ctx.framebuffer([self.opacity])
+            self.first_framebuffer.clear(OPACITY_FAR, 0.0, 0.0, 0.0, depth=1.0)
+            self.opacity_framebuffer.clear(0.0, 0.0, 0.0, 0.0)
 
     # -- per frame ---------------------------------------------------------------------------
     def update(self, scene: Scene, view: np.ndarray, aspect: float,
@@ -299,7 +356,8 @@ class ShadowAtlas:
                 row[base:base + 4] = to_atlas.T  # columns
                 row[base + 4] = (x / self.size, y / self.size, (x + size) / self.size,
                                  (y + size) / self.size)
-                row[base + 5] = (texel, 1.0 if perspective_texel else 0.0, 0.0, 0.0)
+                row[base + 5] = (texel, 1.0 if perspective_texel else 0.0,
+                                 *near_far(projection))
                 position = None if kind == ShadowProjection.CASCADES else \
                     np.asarray(params.position, np.float64)
                 direction = unit(-light_view[2, :3])
@@ -311,6 +369,12 @@ class ShadowAtlas:
         self.records.write(records.tobytes())
         self._uniforms = {"u_shadow_world_from_view": inverse_view[:3, :3].copy(),
                           "u_shadow_atlas_texel": 1.0 / self.size}
+        if self.opacity is not None:
+            self.opacity_layer = max((float(obj.material.opacity_layer(obj))
+                                      for obj in scene.objects if obj.material.opacity_shadows),
+                                     default=0.0)
+            self._uniforms["u_opacity_layers"] = tuple(b * self.opacity_layer
+                                                       for b in OPACITY_LAYERS)
         return self.slots
 
     def _cascades(self, light: Light, scene: Scene, view: np.ndarray, inverse_view: np.ndarray,
@@ -378,23 +442,46 @@ class ShadowAtlas:
 
     # -- binding source ----------------------------------------------------------------------
     def bind(self, uniforms: ProgramUniforms, texture_unit: int) -> int:
-        """The atlas and records where a program reads them (lights/shadows.glsl)."""
-        if "u_shadow_records" not in uniforms.members:
+        """The atlas and records where a program reads them (lights/shadows.glsl), and the
+        opacity maps where it reads those (the opacity stage reads the first depth only)."""
+        if "u_shadow_records" in uniforms.members:
+            uniforms.set_shared("shadows", self._uniforms)
+            self.texture.use(location=texture_unit)
+            uniforms.set_one("u_shadow_atlas", texture_unit)
+            self.records.use(location=texture_unit + 1)
+            uniforms.set_one("u_shadow_records", texture_unit + 1)
+            texture_unit += 2
+        if self.opacity is None:
             return texture_unit
-        uniforms.set_shared("shadows", self._uniforms)
-        self.texture.use(location=texture_unit)
-        uniforms.set_one("u_shadow_atlas", texture_unit)
-        self.records.use(location=texture_unit + 1)
-        uniforms.set_one("u_shadow_records", texture_unit + 1)
-        return texture_unit + 2
+        for name, texture in (("u_opacity_first", self.opacity_first),
+                              ("u_opacity", self.opacity)):
+            if name in uniforms.members:
+                texture.use(location=texture_unit)
+                uniforms.set_one(name, texture_unit)
+                texture_unit += 1
+        if "u_opacity_layers" in uniforms.members:
+            uniforms.set_one("u_opacity_layers", self._uniforms["u_opacity_layers"])
+        return texture_unit
 
     def read_depth(self) -> np.ndarray:
         """The atlas's depths, (size, size) float32, rows bottom-up (GL's)."""
         data = np.frombuffer(self.texture.read(alignment=1), dtype=np.float32)
         return data.reshape(self.size, self.size)
 
+    def read_opacity(self) -> tuple[np.ndarray, np.ndarray]:
+        """The opacity maps: the first light-view depth (half, half) and the four layers'
+        optical depths (half, half, 4), float32, rows bottom-up."""
+        half = self.opacity.size[0]
+        first = np.frombuffer(self.opacity_first.read(alignment=1), dtype=np.float32)
+        layers = np.frombuffer(self.opacity.read(alignment=1), dtype=np.float16)
+        return first.reshape(half, half), layers.reshape(half, half, 4).astype(np.float32)
+
     def release(self) -> None:
-        for part in (self.framebuffer, self.texture, self.records):
+        parts = [self.framebuffer, self.texture, self.records]
+        if self.opacity is not None:
+            parts += [self.first_framebuffer, self.opacity_framebuffer, self.opacity_first,
+                      self.opacity_depth, self.opacity]
+        for part in parts:
             part.release()
 
 
@@ -428,15 +515,47 @@ class ShadowPass(RenderPass):
                         depth_offset=CASTER_DEPTH_OFFSET)
         objects = frame.scene.objects
         spheres = [object_sphere(obj) for obj in objects]
+
+        def reached(tile: ShadowTile) -> list:
+            return [obj for obj, (centre, radius) in zip(objects, spheres, strict=True)
+                    if tile.reach is None or
+                    np.linalg.norm(centre - tile.reach[0]) <= radius + tile.reach[1]]
+
         try:
             for tile in atlas.tiles:
                 rect = (tile.x, tile.y, tile.size, tile.size)
                 fbo.viewport = rect
                 frame.gl_call(lambda rect=rect: fbo.clear(depth=1.0, viewport=rect))
-                for obj, (centre, radius) in zip(objects, spheres, strict=True):
-                    if tile.reach is not None and np.linalg.norm(centre - tile.reach[0]) > \
-                            radius + tile.reach[1]:
-                        continue  # beyond the light's reach: casts nothing it lights
+                for obj in reached(tile):  # beyond the light's reach: casts nothing it lights
                     obj.material.draw_shadow(frame, obj, tile.view)
         finally:
             fbo.viewport = (0, 0, atlas.size, atlas.size)
+        if atlas.opacity is not None:
+            self._opacity(frame, atlas, reached)
+
+    @staticmethod
+    def _opacity(frame: Frame, atlas: ShadowAtlas, reached) -> None:
+        """The deep opacity maps of each tile: the volume's first depth (nearest wins), then its
+        optical depth added into the layers behind that depth (Yuksel and Keyser 2008, 3.1-3.2)."""
+        scale = atlas.opacity.size[0] / atlas.size
+        stages = ((atlas.first_framebuffer, "first", dict(depth_test=True, depth_func="less")),
+                  (atlas.opacity_framebuffer, "density", dict(depth_test=False, blend="add")))
+        for fbo, stage, state in stages:
+            frame.gl_call(fbo.use)
+            frame.set_state(cull=None, **state)
+            try:
+                for tile in atlas.tiles:
+                    volumes = [obj for obj in reached(tile) if obj.material.opacity_shadows]
+                    rect = tuple(round(v * scale) for v in (tile.x, tile.y, tile.size,
+                                                              tile.size))
+                    fbo.viewport = rect
+                    if stage == "first":
+                        frame.gl_call(lambda f=fbo, r=rect: f.clear(OPACITY_FAR, 0.0, 0.0, 0.0,
+                                                                    depth=1.0, viewport=r))
+                    else:
+                        frame.gl_call(lambda f=fbo, r=rect: f.clear(0.0, 0.0, 0.0, 0.0,
+                                                                    viewport=r))
+                    for obj in volumes:
+                        obj.material.draw_opacity(frame, obj, tile.view, stage)
+            finally:
+                fbo.viewport = (0, 0, *atlas.opacity.size)

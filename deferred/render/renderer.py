@@ -36,11 +36,13 @@ from deferred.lighting.lists import (
 )
 from deferred.lighting.paths import resolve_light_path
 from deferred.lighting.shadows import (
+    OPACITY_SHADOWS_DEFINE,
     SHADOW_ATLAS,
     SHADOWS_DEFINE,
     ShadowAtlas,
     atlas_memory,
     scene_casts_shadows,
+    scene_has_opacity,
 )
 from deferred.memo import overrides
 from deferred.names import LightVolume, Pipeline
@@ -225,7 +227,7 @@ class Renderer:
         self.size_where = "size" if given else f"{scene.source}: size"
         held = held_memory(scene)  # counted once: the scene's files are read for it
         if scene_casts_shadows(scene.lights):
-            held.update(atlas_memory(scene.shadow_budget))
+            held.update(atlas_memory(scene.shadow_budget, scene_has_opacity(scene)))
         self._held_bytes = sum(held.values())
         check_target_memory(self.graph, self.size, self.size_where, held, scene.source)
         light_types = scene.light_types()
@@ -255,13 +257,13 @@ class Renderer:
     def _scene_structure(self) -> tuple:
         """What the passes, targets and programs are built from, apart from parameters: which
         objects (their meshes, their materials' types), which lights and effects, whether a
-        light casts shadows and the shadow budget (the shadow pass, the atlas and the SHADOWS
-        define), the clear colour, the tone mapping operator, the light path and the size
-        asked for."""
+        light casts shadows, whether a material draws opacity maps and the shadow budget (the
+        shadow pass, the atlas and the SHADOWS and OPACITY_SHADOWS defines), the clear colour,
+        the tone mapping operator, the light path and the size asked for."""
         scene = self.scene
         return (tuple((id(obj), id(obj.mesh), type(obj.material)) for obj in scene.objects),
                 tuple(map(type, scene.lights)), scene_casts_shadows(scene.lights),
-                scene.shadow_budget, tuple(map(id, scene.effects)),
+                scene_has_opacity(scene), scene.shadow_budget, tuple(map(id, scene.effects)),
                 tuple(scene.background), scene.tonemap,
                 scene.light_path if self._light_path_arg is None else None,
                 scene.size if self._size_arg is None else None)
@@ -350,6 +352,8 @@ class Renderer:
         defines = dict(self.pipeline.shader_defines())
         if scene_casts_shadows(scene.lights):
             defines[SHADOWS_DEFINE] = "1"
+        if scene_has_opacity(scene):
+            defines[OPACITY_SHADOWS_DEFINE] = "1"
         self.shaders = ShaderLibrary(ctx, features.glsl_version(), defines)
         for root in roots:
             self.shaders.add_root(root)
@@ -361,7 +365,8 @@ class Renderer:
         self.light_buffer = LightBuffer(ctx)
         self.light_lists = LightLists(ctx) if features.compute_shaders else None
         budget = scene.shadow_budget
-        self.shadow_atlas = ShadowAtlas(ctx, budget.atlas_size, budget.max_shadowed_lights) \
+        self.shadow_atlas = ShadowAtlas(ctx, budget.atlas_size, budget.max_shadowed_lights,
+                                        scene_has_opacity(scene)) \
             if scene_casts_shadows(scene.lights) else None
         # The per-frame GPU resources every frame is given: by name on its blackboard (for the
         # passes that fill or read them), and those that bind themselves to every program as

@@ -48,6 +48,8 @@ if TYPE_CHECKING:
 IMAGE_TILE_STRANDS = 1024
 SHADOW_CASTER_FRAGMENT = "shadows/fur_caster.frag"
 SHADOW_SHELLS = 8  # most shells a fur object casts its shadow with (with its root shell)
+OPACITY_FRAGMENT = "shadows/fur_opacity.frag"
+OPACITY_SHELLS = 12  # most shells the fur draws into the deep opacity maps (without the skin)
 
 
 class FurParams(MaterialParams):
@@ -77,14 +79,20 @@ class FurParams(MaterialParams):
                                    description="fade of a heightfield strand's tip")
     seed: int = Field(1, ge=0, description="seed of the strand pattern")
     self_shadow: float = Field(2.5, ge=1.0, le=64.0,
-                               description="Silva's K_shadow: roots darkened to (K - 1) / K")
+                               description="Silva's K_shadow: roots darkened to (K - 1) / K "
+                                           "(lights without a shadow)")
+    self_shadow_density: float = Field(1.0, ge=0.0, le=64.0,
+                                       description="k: a shadowed light reaches the fur as "
+                                                   "exp(-k x the optical depth of the fur "
+                                                   "in front; deep opacity maps)")
     fins: bool = Field(True, description="fins at silhouette edges (Lengyel 2001)")
     fin_band: float = Field(0.3, gt=0.0, le=1.0,
                             description="|N.V| below which an edge grows a fin")
     shell_range: tuple[float, float] = Field(
         (0.0, 1.0), description="draw only shells at depths in this range (debugging: one "
                                 "shell, the roots)")
-    debug: Literal["none", "samples", "comb", "shell_count", "single_shell"] = Field(
+    debug: Literal["none", "samples", "comb", "shell_count", "single_shell",
+                   "opacity_shadow"] = Field(
         "none", description="debug view instead of the fur (see FUR_DEBUG_VIEWS)")
 
     @model_validator(mode="after")
@@ -117,6 +125,10 @@ FUR_DEBUG_VIEWS: dict[str, tuple[str, dict[str, Any]]] = {
                     {"debug": "shell_count"}),
     "single_shell": ("only the middle shell (of those in shell_range), strands cut through "
                      "opaque", {"debug": "single_shell"}),
+    "opacity_shadow": ("the deep opacity maps of the first shadowed light at each shell "
+                       "fragment: 1 - transmittance to the end of layers 1, 2 and 4 as red, "
+                       "green, blue (black: no fur in front; needs a shadowed light)",
+                       {"debug": "opacity_shadow"}),
 }
 
 
@@ -205,7 +217,21 @@ class FurMaterial(Material):
         return {**super().textures(frame),
                 "u_fur_volume": fur_volume_texture(frame, self.params, self.heightfield_path())}
 
+    def defines(self, obj: SceneObject) -> dict[str, str]:
+        """The fur's programs receive the deep opacity maps (lights/shadows.glsl) unless
+        ``self_shadow_density`` is 0: where the scene draws them, a shadowed light reaches a
+        forward shell through the fur in front."""
+        defines = super().defines(obj)
+        if self.opacity_shadows:
+            defines["OPACITY_RECEIVER"] = "1"
+        return defines
+
     # -- shadows -------------------------------------------------------------------------------
+    @property
+    def opacity_shadows(self) -> bool:  # type: ignore[override]
+        """The fur shadows itself through deep opacity maps; with ``self_shadow_density`` 0
+        it does not draw them and gamma(h) darkens it for every light."""
+        return self.params.self_shadow_density > 0.0
     fur_vertex: str = ""  # the material's fur vertex shader (its shells' and its caster's)
 
     def shadow_textures(self, frame: Frame, obj: SceneObject) -> dict[str, moderngl.Texture]:
@@ -241,6 +267,32 @@ class FurMaterial(Material):
             if k:
                 frame.set_uniforms(program, {"u_shell_depth": shell_depth(k, count),
                                              "u_root_shell": False})
+            frame.draw_mesh(obj.mesh, program)
+
+    def opacity_layer(self, obj: SceneObject) -> float:
+        """The fur's world thickness: a strand's length."""
+        return float(self.params.fur_length * object_scale(obj).max())
+
+    def draw_opacity(self, frame: Frame, obj: SceneObject, view: ShadowView,
+                     stage: str) -> None:
+        """The fur's shells in the deep opacity maps, where they are (not pushed away as the
+        depth casters are): up to ``OPACITY_SHELLS`` outer shells, each adding the optical depth
+        of the opacity it draws (``shadows/fur_opacity.frag``); the skin is the depth atlas's."""
+        params = self.params
+        if params.shells == 0 or not self.fur_vertex:
+            return
+        defines = {**self.defines(obj), **SHADOW_CASTER_DEFINES, "OPACITY_CASTER": "1"}
+        if stage == "first":
+            defines["OPACITY_FIRST"] = "1"
+        program = frame.shaders.program(self.fur_vertex, OPACITY_FRAGMENT, defines=defines)
+        count = min(params.shells, OPACITY_SHELLS) + 1.0  # as the shells: a root and slabs
+        frame.bind(program, {**self.vertex_constants(obj),
+                             "u_shell_weight": VOLUME_LAYERS / (count - 1.0)},
+                   self.shadow_textures(frame, obj),
+                   offered={**frame.object_uniforms(obj), **view.camera_uniforms},
+                   material=frame.material_inputs(self))
+        for k in range(1, int(count)):
+            frame.set_uniforms(program, {"u_shell_depth": shell_depth(k, count)})
             frame.draw_mesh(obj.mesh, program)
 
     @staticmethod

@@ -9,10 +9,32 @@
 //   3: -
 //   4 + 6 i .. 9 + 6 i, tile i: the view-space -> atlas (u, v, depth) matrix's columns, the
 //      tile's rectangle in the atlas (u0, v0, u1, v1), a texel's world size (x; per unit of
-//      distance from the light where y = 1: a perspective tile)
+//      distance from the light where y = 1: a perspective tile), the tile's near and far
+//      distances (z, w: a depth back to the light's view depth)
 // Without SHADOWS (no light of the scene casts shadows) the light_shadow_* functions are 1 and
 // read nothing.
+//
+// Deep opacity maps (OPACITY_SHADOWS: a volume such as fur draws them; Yuksel and Keyser 2008):
+// over the same atlas coordinates, u_opacity_first holds the light-view depth of the volume's
+// front and u_opacity four layers of optical depth accumulated from it up to u_opacity_layers
+// behind. A receiver compiled with OPACITY_RECEIVER (the volume's own shading) multiplies each
+// shadowed light by the transmittance exp(-u_self_shadow_density x optical depth) at its depth,
+// and takes opacity_fallback (the volume's cheap stand-in, set before the lights are evaluated)
+// for a light without a shadow slot.
 #include "common/lighting.glsl"
+
+#ifdef OPACITY_RECEIVER
+float opacity_fallback = 1.0;  // a global: what an unshadowed light is multiplied by
+// the first shadowed light's layers where the lights were evaluated, as 1 - transmittance to
+// the ends of layers 1, 2 and 4 (the fur's opacity_shadow debug view); -1: none looked up
+vec3 opacity_seen = vec3(-1.0);
+#endif
+
+#ifdef OPACITY_RECEIVER
+#define SHADOW_UNSHADOWED opacity_fallback
+#else
+#define SHADOW_UNSHADOWED 1.0
+#endif
 
 #ifdef SHADOWS
 uniform sampler2DShadow u_shadow_atlas;
@@ -36,6 +58,45 @@ const vec2 SHADOW_POISSON[16] = vec2[](
     vec2(0.5374, -0.4737), vec2(-0.2650, -0.4189), vec2(0.7920, 0.1909),
     vec2(-0.2419, 0.9971), vec2(-0.8141, 0.9144), vec2(0.1998, 0.7864),
     vec2(0.1438, -0.1410));
+
+#if defined(OPACITY_RECEIVER) && defined(OPACITY_SHADOWS)
+uniform sampler2D u_opacity_first;  // R32F: light-view depth of the volume's front
+uniform sampler2D u_opacity;        // RGBA16F: optical depth up to each layer's far end
+uniform vec4 u_opacity_layers;      // the layers' far ends behind the front, world units
+uniform float u_self_shadow_density;  // k: transmittance exp(-k x optical depth)
+
+// The light-view depth of a depth-buffer value of a tile (near, far; perspective or not).
+float shadow_view_depth(float window_z, vec4 size) {
+    float n = size.z, f = size.w;
+    if (size.y < 0.5) return n + window_z * (f - n);
+    return 2.0 * n * f / (f + n - (2.0 * window_z - 1.0) * (f - n));
+}
+
+// The volume's optical depth in front of view-space P along the tile's light: the layers
+// interpolated linearly at P's depth behind the front (0 at the front; the last layer beyond).
+float opacity_depth_at(mat4 to_atlas, vec4 rect, vec4 size, vec3 P) {
+    vec4 clip = to_atlas * vec4(P, 1.0);
+    vec3 uvz = clip.xyz / clip.w;
+    vec2 uv = clamp(uvz.xy, rect.xy, rect.zw);
+    float first = textureLod(u_opacity_first, uv, 0.0).r;
+    if (first > 1.0e37) return 0.0;  // no volume along this texel
+    float behind = shadow_view_depth(uvz.z, size) - first;
+    vec4 layers = textureLod(u_opacity, uv, 0.0);
+    if (opacity_seen.x < 0.0) opacity_seen = 1.0 - exp(-u_self_shadow_density * layers.xyw);
+    vec4 b = u_opacity_layers;
+    // piecewise linear through (0, 0), (b.x, layers.x) .. (b.w, layers.w)
+    float t0 = clamp(behind / b.x, 0.0, 1.0);
+    float t1 = clamp((behind - b.x) / (b.y - b.x), 0.0, 1.0);
+    float t2 = clamp((behind - b.y) / (b.z - b.y), 0.0, 1.0);
+    float t3 = clamp((behind - b.z) / (b.w - b.z), 0.0, 1.0);
+    return layers.x * t0 + (layers.y - layers.x) * t1 + (layers.z - layers.y) * t2
+         + (layers.w - layers.z) * t3;
+}
+
+float opacity_transmittance(mat4 to_atlas, vec4 rect, vec4 size, vec3 P) {
+    return exp(-u_self_shadow_density * opacity_depth_at(to_atlas, rect, size, P));
+}
+#endif
 
 float shadow_compare(vec3 uvz, vec4 rect) {
     // kept half a texel inside the tile: bilinear comparison never reads a neighbour's texels;
@@ -81,7 +142,11 @@ float shadow_tile(int row, int tile, vec4 header, vec4 biases, vec3 P, vec3 N, v
     vec4 clip = to_atlas * vec4(Q, 1.0);
     vec3 uvz = clip.xyz / clip.w;
     if (uvz.z >= 1.0) return 1.0;  // beyond the map's far plane
+#if defined(OPACITY_RECEIVER) && defined(OPACITY_SHADOWS)
+    return shadow_filter(uvz, rect, header) * opacity_transmittance(to_atlas, rect, size, P);
+#else
     return shadow_filter(uvz, rect, header);
+#endif
 }
 
 // The fraction of a light reaching view-space P on a surface of normal N (1: lit, 0: shadow),
@@ -89,14 +154,14 @@ float shadow_tile(int row, int tile, vec4 header, vec4 biases, vec3 P, vec3 N, v
 // a light type's GLSL calls for its own, so no light runs another projection's code.
 float light_shadow_cascades(LightRecord light, vec3 P, vec3 N, vec3 L) {
     int slot = int(light.extra.w + 0.5);
-    if (slot <= 0) return 1.0;
+    if (slot <= 0) return SHADOW_UNSHADOWED;
     int row = slot - 1;
     vec4 header = shadow_texel(row, 0);
     vec4 biases = shadow_texel(row, 1);
     vec4 splits = shadow_texel(row, 2);
     int count = int(header.y + 0.5);
     float depth = -P.z;
-    if (depth > splits[count - 1]) return 1.0;  // beyond the shadow distance
+    if (depth > splits[count - 1]) return SHADOW_UNSHADOWED;  // beyond the shadow distance
     // the first cascade whose far depth lies beyond P (a cheap loop, then one lookup)
     int i = 0;
     float near = 0.0;
@@ -117,7 +182,7 @@ float light_shadow_cascades(LightRecord light, vec3 P, vec3 N, vec3 L) {
 
 float light_shadow_perspective(LightRecord light, vec3 P, vec3 N, vec3 L) {
     int slot = int(light.extra.w + 0.5);
-    if (slot <= 0) return 1.0;
+    if (slot <= 0) return SHADOW_UNSHADOWED;
     int row = slot - 1;
     return shadow_tile(row, 0, shadow_texel(row, 0), shadow_texel(row, 1), P, N, L,
                        length(P - light.position.xyz));
@@ -125,7 +190,7 @@ float light_shadow_perspective(LightRecord light, vec3 P, vec3 N, vec3 L) {
 
 float light_shadow_cube(LightRecord light, vec3 P, vec3 N, vec3 L) {
     int slot = int(light.extra.w + 0.5);
-    if (slot <= 0) return 1.0;
+    if (slot <= 0) return SHADOW_UNSHADOWED;
     int row = slot - 1;
     // the face of the direction's major axis in world space (+X, -X, +Y, -Y, +Z, -Z)
     vec3 d = u_shadow_world_from_view * (P - light.position.xyz);
@@ -137,14 +202,14 @@ float light_shadow_cube(LightRecord light, vec3 P, vec3 N, vec3 L) {
 }
 #else
 float light_shadow_cascades(LightRecord light, vec3 P, vec3 N, vec3 L) {
-    return 1.0;
+    return SHADOW_UNSHADOWED;
 }
 
 float light_shadow_perspective(LightRecord light, vec3 P, vec3 N, vec3 L) {
-    return 1.0;
+    return SHADOW_UNSHADOWED;
 }
 
 float light_shadow_cube(LightRecord light, vec3 P, vec3 N, vec3 L) {
-    return 1.0;
+    return SHADOW_UNSHADOWED;
 }
 #endif

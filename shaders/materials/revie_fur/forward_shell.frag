@@ -1,7 +1,9 @@
 // Revie fur, forward technique (2.4: "a separate technique ... in a forward-shaded fashion"):
 // each shell or fin fragment is lit directly by every light, with the grain normal and, as the
 // deferred stipple sample does, with the rim-bent normal; the brighter wins. Coverage, albedo
-// over the depth and self-shadowing are those of the deferred shells.
+// over the depth and self-shadowing are those of the deferred shells; where the scene draws deep
+// opacity maps (OPACITY_SHADOWS), a shadowed light reaches the shell through the fur in front of
+// it (lights/shadows.glsl) and gamma(h) stays for the lights without a shadow and the ambient.
 #include "common/surface_input.glsl"
 #include "common/forward_lighting.glsl"
 #include "techniques/rim.glsl"
@@ -62,7 +64,18 @@ void main() {
     SurfaceInput i = surface_input();
     Surface s = evaluate_surface(i);
     vec3 V = normalize(-i.position);
+#if defined(SHADOWS) && defined(OPACITY_SHADOWS) && defined(OPACITY_RECEIVER)
+    float gamma = 1.0;  // per light: the opacity maps, or gamma(h) where a light has none
+    opacity_fallback = fur_shadow(v_shell_depth);
+    s.occlusion *= opacity_fallback;
+#else
+    float gamma = fur_shadow(v_shell_depth);
+#endif
     vec3 light = forward_lighting(s, i.position, V);
+#ifdef FUR_DEBUG_OPACITY_SHADOW
+    out_color = vec4(max(opacity_seen, vec3(0.0)), 1.0);
+    return;
+#endif
 #if defined(FUR_STIPPLE) && !defined(FUR_MARSCHNER)  // marschner: TT lights the rim
     Surface rim = s;
     rim.normal = rim_bend(i.normal, s.normal, -V, u_rim_strength, u_rim_falloff);
@@ -70,6 +83,6 @@ void main() {
 #endif
     vec3 irradiance = light / max(s.albedo, vec3(1.0 / 255.0));
     float brightness = strand_brightness(strands);
-    vec3 albedo = mix(u_albedo_base, u_albedo_tip, v_shell_depth) * fur_shadow(v_shell_depth);
+    vec3 albedo = mix(u_albedo_base, u_albedo_tip, v_shell_depth) * gamma;
     out_color = vec4(irradiance * strand_tint(albedo, strands) * brightness, alpha);
 }

@@ -89,10 +89,11 @@ void main() {
     v_fur_position = in_position * u_fur_scale;
     v_fur_normal = in_normal;
     v_tip_position = tip_view.xyz;
-#ifdef SHADOW_CASTER
+#if defined(SHADOW_CASTER) && !defined(OPACITY_CASTER)
     // drawn from the light (deferred.api.SHADOW_CASTER_DEFINES): the fur casts a strand's
     // length further from the light, onto other surfaces but not onto its own skin and
-    // shells, whose self-shadowing is gamma(h) (techniques/fur.glsl)
+    // shells, whose self-shadowing is the deep opacity maps' (OPACITY_CASTER: drawn where it
+    // is; deferred.lighting.shadows) or gamma(h) (techniques/fur.glsl)
     position.z -= v_fur_extent;
 #endif
     gl_Position = u_projection * position;

@@ -1,6 +1,9 @@
 // shell_fur, forward pipeline: each layer (and fin) fragment lit by every light directly, with
 // Kajiya-Kay along the strand's own tangent at this layer (Silva et al. Eq. 6: C_frag =
 // gamma(C_d + C_s)); colour and strands from the clumped coordinates as in the deferred layers.
+// Where the scene draws deep opacity maps (OPACITY_SHADOWS), a shadowed light reaches the layer
+// through the fur in front of it instead (lights/shadows.glsl), and gamma(h) stays for the
+// lights without a shadow and the ambient (its occlusion).
 #include "common/surface_input.glsl"
 #include "common/forward_lighting.glsl"
 #include "techniques/fur.glsl"
@@ -63,6 +66,17 @@ void main() {
     s.occlusion = 1.0;
     s.shading_model = surface_shading_model(u_surface_id);
     s.data.strand_tangent = strand_tangent_encode(v_strand_tangent);
+#if defined(SHADOWS) && defined(OPACITY_SHADOWS) && defined(OPACITY_RECEIVER)
+    float gamma = 1.0;  // per light: the opacity maps, or gamma(h) where a light has none
+    opacity_fallback = fur_shadow(v_shell_depth);
+    s.occlusion = opacity_fallback;
+#else
+    float gamma = fur_shadow(v_shell_depth);
+#endif
     vec3 light = forward_lighting(s, v_position, normalize(-v_position));
-    out_color = vec4(light * fur_shadow(v_shell_depth) * strand_brightness(strands), alpha);
+#ifdef FUR_DEBUG_OPACITY_SHADOW
+    out_color = vec4(max(opacity_seen, vec3(0.0)), 1.0);
+    return;
+#endif
+    out_color = vec4(light * gamma * strand_brightness(strands), alpha);
 }
