@@ -81,7 +81,7 @@ class FurParams(MaterialParams):
     self_shadow: float = Field(2.5, ge=1.0, le=64.0,
                                description="Silva's K_shadow: roots darkened to (K - 1) / K "
                                            "(lights without a shadow)")
-    self_shadow_density: float = Field(1.0, ge=0.0, le=64.0,
+    self_shadow_density: float = Field(0.5, ge=0.0, le=64.0,
                                        description="k: a shadowed light reaches the fur as "
                                                    "exp(-k x the optical depth of the fur "
                                                    "in front; deep opacity maps)")
@@ -286,13 +286,14 @@ class FurMaterial(Material):
             defines["OPACITY_FIRST"] = "1"
         program = frame.shaders.program(self.fur_vertex, OPACITY_FRAGMENT, defines=defines)
         count = min(params.shells, OPACITY_SHELLS) + 1.0  # as the shells: a root and slabs
-        frame.bind(program, {**self.vertex_constants(obj),
+        frame.bind(program, {**self.vertex_constants(obj, shell_depth(1, count)),
                              "u_shell_weight": VOLUME_LAYERS / (count - 1.0)},
                    self.shadow_textures(frame, obj),
                    offered={**frame.object_uniforms(obj), **view.camera_uniforms},
                    material=frame.material_inputs(self))
         for k in range(1, int(count)):
-            frame.set_uniforms(program, {"u_shell_depth": shell_depth(k, count)})
+            if k > 1:
+                frame.set_uniforms(program, {"u_shell_depth": shell_depth(k, count)})
             frame.draw_mesh(obj.mesh, program)
 
     @staticmethod

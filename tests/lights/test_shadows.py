@@ -386,8 +386,11 @@ def test_shadow_views_and_the_dump_show_the_atlas(tmp_path):
     assert len(done.stderr.strip().splitlines()) == 1
 
 
-FUR = {"revie_fur": {"fur_length": 0.5, "shells": 12, "stipple": False},
-       "shell_fur": {"fur_length": 0.5, "shells": 12}}
+# self-shadowing (deep opacity maps) off: these tests compare shadowed and unshadowed scenes,
+# and the fur's own shadow is tests/lights/test_opacity_shadows.py's
+FUR = {"revie_fur": {"fur_length": 0.5, "shells": 12, "stipple": False,
+                     "self_shadow_density": 0.0},
+       "shell_fur": {"fur_length": 0.5, "shells": 12, "self_shadow_density": 0.0}}
 FUR_LIGHT = np.array([0.6, -1.0, 0.0])  # from the left, down
 
 

@@ -1,0 +1,214 @@
+"""Fur self-shadowing through deep opacity maps (#27; Yuksel and Keyser 2008;
+deferred.lighting.shadows): the layers a slab of known density accumulates match a numpy
+reference; close up under a side light, the forward fur's light falls with depth into the fur
+along the light and its lit and far sides differ more than without; the debug view; gamma(h)
+without a shadow."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from deferred.interfaces import registry
+from deferred.lighting.shadows import OPACITY_LAYERS
+from deferred.render.renderer import Renderer
+from deferred.scene.loader import scene_from_dict
+
+W, H = 128, 96
+AMBIENT = {"type": "ambient", "color": [0.05, 0.05, 0.05], "ground": [0.05, 0.05, 0.05]}
+
+
+@pytest.fixture
+def slab_material():
+    from opacity_slab import OpacitySlab
+
+    registry.materials.register(OpacitySlab)
+    yield OpacitySlab
+    registry.materials.unregister(OpacitySlab.name)
+
+
+def test_slab_layers_match_numpy(gl, slab_material):
+    """Eight planes 0.07 apart, each of opacity 0.2, under a light straight down: at the slab's
+    centre the first depth is the top plane's and layer i holds the optical depth of the planes
+    within OPACITY_LAYERS[i] x layer of it."""
+    planes, spacing, opacity, layer = 8, 0.07, 0.2, 0.4
+    scene = scene_from_dict({
+        "size": [64, 48], "tonemap": "none",
+        "camera": {"position": [0.0, 4.0, 0.01], "target": [0.0, 0.0, 0.0], "fov": 40.0},
+        "shadows": {"atlas_size": 1024},
+        "object": [{"mesh": "builtin:plane", "position": [0.0, 1.5, 0.0],
+                    "material": "test_opacity_slab",
+                    "params": {"planes": planes, "spacing": spacing, "opacity": opacity,
+                               "layer": layer}}],
+        "light": [AMBIENT, {"type": "directional", "direction": [0.0, -1.0, 0.0],
+                            "cascades": 1, "shadows": True, "shadow_resolution": 512,
+                            "shadow_distance": 8.0}]})
+    with Renderer(scene, "forward", gl=gl) as renderer:
+        renderer.render(hdr=True)
+        atlas = renderer.shadow_atlas
+        first, layers = atlas.read_opacity()
+        tile = atlas.tiles[0]
+        top = np.array([0.0, 1.5, 0.0, 1.0])
+        ndc = tile.view_projection @ top
+        ndc = ndc[:3] / ndc[3]
+        scale = atlas.opacity.size[0] / atlas.size
+        x = int((tile.x + (ndc[0] * 0.5 + 0.5) * tile.size) * scale)
+        y = int((tile.y + (ndc[1] * 0.5 + 0.5) * tile.size) * scale)
+        expected_first = -(tile.view.view @ top)[2]
+    depths = np.arange(planes) * spacing
+    od = -np.log(1.0 - opacity)
+    reference = np.array([od * np.count_nonzero(depths <= b * layer) for b in OPACITY_LAYERS])
+    assert first[y, x] == pytest.approx(expected_first, abs=1e-4)
+    np.testing.assert_allclose(layers[y, x], reference, rtol=2e-3)
+    # the slab covers the tile's middle alike; outside the slab: nothing in front
+    np.testing.assert_allclose(layers[y + 3, x - 3], reference, rtol=2e-3)
+    assert first.max() > 1e37 and layers[first > 1e37].max() == 0.0
+
+
+FUR = {"revie_fur": {"fur_length": 0.35, "shells": 16, "stipple": False, "self_shadow": 64.0,
+                     "albedo_base": [0.7, 0.6, 0.5], "albedo_tip": [0.7, 0.6, 0.5]},
+       "shell_fur": {"fur_length": 0.35, "shells": 16, "self_shadow": 64.0}}
+
+
+SIDE = [1.0, -0.1, 0.0]  # from the left (the camera looks down -z)
+FRONT = [0.0, 0.0, -1.0]  # from the camera: depth into the fur along the light is toward the
+# ball's centre where the ball faces the camera
+
+
+def fur_scene(material: str, density: float, shell_range=(0.0, 1.0), shadows: bool = True,
+              direction=SIDE, **extra):
+    params = {**FUR[material], "self_shadow_density": density,
+              "shell_range": list(shell_range), **extra}
+    return scene_from_dict({
+        "size": [W, H], "tonemap": "none", "background": [0.0, 0.0, 0.0],
+        "camera": {"position": [0.0, 0.0, 2.0], "target": [0.0, 0.0, 0.0], "fov": 40.0},
+        "shadows": {"atlas_size": 1024},
+        "object": [{"mesh": "builtin:sphere", "scale": 0.45, "material": material,
+                    "params": params}],
+        "light": [AMBIENT, {"type": "directional", "direction": direction,
+                            "intensity": 2.0, "cascades": 1, "shadows": shadows,
+                            "shadow_resolution": 1024, "shadow_distance": 8.0}]})
+
+
+def luminance(gl, scene, pipeline="forward"):
+    """Luminance and alpha (the fur's coverage over the black background) of each pixel."""
+    with Renderer(scene, pipeline, gl=gl) as renderer:
+        hdr = renderer.render(hdr=True).hdr
+    rgb = hdr[..., :3].astype(np.float64)
+    return rgb @ np.array([0.2126, 0.7152, 0.0722]), hdr[..., 3].astype(np.float64)
+
+
+def side_means(lum, alpha):
+    """Mean luminance of the fur (its colour before blending: luminance / coverage, where it
+    covers a fifth or more) on the light's side (left third) and the far side (right third)."""
+    drawn = alpha > 0.2
+    lum = np.where(drawn, lum / np.maximum(alpha, 1e-6), 0.0)
+    left, right = drawn.copy(), drawn.copy()
+    left[:, W // 3:] = False
+    right[:, :2 * W // 3] = False
+    return lum[left].mean(), lum[right].mean()
+
+
+def test_fur_light_falls_with_depth_along_the_light(gl):
+    """revie_fur's single-shell view (forward: the middle shell of shell_range, its strands cut
+    opaque and lit) under a light from the camera, where the ball faces it: against the same
+    shell without self-shadowing, a shell deeper into the fur along the light keeps less of
+    its light. Measured on the shell's strands: the pixels that differ from the bare skin."""
+    params = {"albedo_base": [0.0, 0.0, 0.0], "albedo_tip": [0.8, 0.7, 0.6],
+              "specular_intensity": 0.0, "debug": "single_shell"}
+    yy, xx = np.mgrid[:H, :W]
+    centre = (xx - W / 2) ** 2 + (yy - H / 2) ** 2 < (0.25 * H) ** 2
+    skin, _ = luminance(gl, fur_scene("revie_fur", 0.0, direction=FRONT, **params, shells=0))
+    kept = []
+    # outer .. inner; not the outermost shell, which fades with the level of detail
+    for band in [(0.75, 0.9), (0.5, 0.65), (0.2, 0.35)]:
+        with_, _ = luminance(gl, fur_scene("revie_fur", 0.25, band, direction=FRONT,
+                                           **params))
+        without, _ = luminance(gl, fur_scene("revie_fur", 0.0, band, direction=FRONT,
+                                             **params))
+        strands = centre & (np.abs(without - skin) > 0.02) & (without > 0.02)
+        assert strands.sum() > 50
+        kept.append(float(np.median(with_[strands] / without[strands])))
+    print("kept", kept)
+    assert kept[0] > 0.9
+    assert kept[0] > kept[1] + 0.05 > kept[2] + 0.1
+
+
+@pytest.mark.parametrize("material", ["revie_fur", "shell_fur"])
+def test_lit_and_far_sides_differ_more(gl, material):
+    """Under a light from the left, self-shadowing darkens the far side (the light crosses the
+    whole fur to reach it) much more than the side facing the light: the ratio of the two
+    grows by 1.4 or more. (The forward shells light the far side's strands, across the light,
+    by their tangent; revie_fur's grain normal lights little of the near side of a light
+    square to the view.)"""
+    with_ = side_means(*luminance(gl, fur_scene(material, 0.5)))
+    without = side_means(*luminance(gl, fur_scene(material, 0.0)))
+    print(material, "with", with_, "without", without)
+    assert with_[1] < 0.7 * without[1]
+    assert with_[0] / with_[1] > 1.4 * without[0] / without[1]
+
+
+def test_gamma_stays_without_shadows(gl):
+    """Without a shadowed light there are no opacity maps: self_shadow_density changes
+    nothing (gamma(h) darkens the fur as before)."""
+    a = luminance(gl, fur_scene("shell_fur", 0.5, shadows=False))[0]
+    b = luminance(gl, fur_scene("shell_fur", 0.0, shadows=False))[0]
+    np.testing.assert_array_equal(a, b)
+
+
+def run_cli(*args):
+    return subprocess.run([sys.executable, "-m", "deferred", *args], capture_output=True,
+                          text=True, timeout=300)
+
+
+def test_opacity_shadow_view(tmp_path):
+    """--view <fur>.opacity_shadow shows the layers on the forward shells (the fur in front of
+    the lit side is thinner along the light than in front of the far side); the deferred
+    pipeline and a scene without shadows refuse it in one line."""
+    scene_text = f"""size = [{W}, {H}]
+background = [0.0, 0.0, 0.0]
+[camera]
+position = [0.0, 0.0, 2.0]
+target = [0.0, 0.0, 0.0]
+[shadows]
+atlas_size = 1024
+[[object]]
+mesh = "builtin:sphere"
+scale = 0.45
+material = "shell_fur"
+[object.params]
+fur_length = 0.35
+shells = 16
+[[light]]
+type = "directional"
+direction = {SIDE}
+cascades = 1
+shadows = true
+shadow_resolution = 1024
+"""
+    path = tmp_path / "fur.toml"
+    path.write_text(scene_text)
+    out = tmp_path / "view.exr"
+    done = run_cli("render", str(path), "--pipeline", "forward", "--view",
+                   "shell_fur.opacity_shadow", "-o", str(out))
+    assert done.returncode == 0, done.stderr
+    from deferred.io.images import read_image
+
+    layers = read_image(out)[..., :3]
+    drawn = layers.sum(-1) > 0.0
+    assert drawn.sum() > 0.15 * W * H
+    # layer 1 (red) holds at most what layer 4 (blue) does; the layers are 1 - transmittance
+    assert (layers[..., 0] <= layers[..., 2] + 1e-3).all() and layers.max() <= 1.0 + 1e-3
+    for args, message in (((), "use --pipeline forward"),):
+        done = run_cli("render", str(path), "--view", "shell_fur.opacity_shadow", "-o",
+                       str(tmp_path / "x.png"), *args)
+        assert done.returncode == 2 and message in done.stderr
+        assert len(done.stderr.strip().splitlines()) == 1
+        assert not (tmp_path / "x.png").exists()
+    path.write_text(scene_text.replace("shadows = true", "shadows = false"))
+    done = run_cli("render", str(path), "--pipeline", "forward", "--view",
+                   "shell_fur.opacity_shadow", "-o", str(tmp_path / "x.png"))
+    assert done.returncode == 2 and "no light of this scene casts shadows" in done.stderr
