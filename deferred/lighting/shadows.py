@@ -49,7 +49,7 @@ from deferred.core.passes import Order, Phase, RenderPass
 from deferred.interfaces.light import Light
 from deferred.interfaces.material import ShadowView
 from deferred.lighting.buffer import visible_spheres
-from deferred.names import ShadowProjection
+from deferred.names import Pipeline, ShadowProjection
 
 if TYPE_CHECKING:
     from deferred.core.frame import Frame
@@ -80,9 +80,12 @@ def scene_casts_shadows(lights: list[Light]) -> bool:
     return any(light.casts_shadows for light in lights)
 
 
-def scene_has_opacity(scene: Scene) -> bool:
-    """Whether a shadowed scene draws deep opacity maps (an object's material asks for them)."""
-    return scene_casts_shadows(scene.lights) and any(
+def scene_has_opacity(scene: Scene, pipeline: str) -> bool:
+    """Whether a shadowed scene draws deep opacity maps (an object's material asks for them):
+    in the forward pipeline, whose volume fragments are lit light by light; the deferred
+    pipeline's fur takes its light summed over the lights from its skin's pixels, where a
+    light's own transmittance cannot reach it."""
+    return pipeline == Pipeline.FORWARD and scene_casts_shadows(scene.lights) and any(
         obj.material.opacity_shadows for obj in scene.objects)
 
 

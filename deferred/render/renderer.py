@@ -227,7 +227,7 @@ class Renderer:
         self.size_where = "size" if given else f"{scene.source}: size"
         held = held_memory(scene)  # counted once: the scene's files are read for it
         if scene_casts_shadows(scene.lights):
-            held.update(atlas_memory(scene.shadow_budget, scene_has_opacity(scene)))
+            held.update(atlas_memory(scene.shadow_budget, scene_has_opacity(scene, pipeline)))
         self._held_bytes = sum(held.values())
         check_target_memory(self.graph, self.size, self.size_where, held, scene.source)
         light_types = scene.light_types()
@@ -263,7 +263,8 @@ class Renderer:
         scene = self.scene
         return (tuple((id(obj), id(obj.mesh), type(obj.material)) for obj in scene.objects),
                 tuple(map(type, scene.lights)), scene_casts_shadows(scene.lights),
-                scene_has_opacity(scene), scene.shadow_budget, tuple(map(id, scene.effects)),
+                scene_has_opacity(scene, self.pipeline_name), scene.shadow_budget,
+                tuple(map(id, scene.effects)),
                 tuple(scene.background), scene.tonemap,
                 scene.light_path if self._light_path_arg is None else None,
                 scene.size if self._size_arg is None else None)
@@ -352,7 +353,7 @@ class Renderer:
         defines = dict(self.pipeline.shader_defines())
         if scene_casts_shadows(scene.lights):
             defines[SHADOWS_DEFINE] = "1"
-        if scene_has_opacity(scene):
+        if scene_has_opacity(scene, pipeline):
             defines[OPACITY_SHADOWS_DEFINE] = "1"
         self.shaders = ShaderLibrary(ctx, features.glsl_version(), defines)
         for root in roots:
@@ -366,7 +367,7 @@ class Renderer:
         self.light_lists = LightLists(ctx) if features.compute_shaders else None
         budget = scene.shadow_budget
         self.shadow_atlas = ShadowAtlas(ctx, budget.atlas_size, budget.max_shadowed_lights,
-                                        scene_has_opacity(scene)) \
+                                        scene_has_opacity(scene, pipeline)) \
             if scene_casts_shadows(scene.lights) else None
         # The per-frame GPU resources every frame is given: by name on its blackboard (for the
         # passes that fill or read them), and those that bind themselves to every program as

@@ -63,7 +63,10 @@ const vec2 SHADOW_POISSON[16] = vec2[](
 uniform sampler2D u_opacity_first;  // R32F: light-view depth of the volume's front
 uniform sampler2D u_opacity;        // RGBA16F: optical depth up to each layer's far end
 uniform vec4 u_opacity_layers;      // the layers' far ends behind the front, world units
+#ifndef SELF_SHADOW_DENSITY  // declared once, here or by the receiver's own GLSL (fur.glsl)
+#define SELF_SHADOW_DENSITY
 uniform float u_self_shadow_density;  // k: transmittance exp(-k x optical depth)
+#endif
 
 // The light-view depth of a depth-buffer value of a tile (near, far; perspective or not).
 float shadow_view_depth(float window_z, vec4 size) {
