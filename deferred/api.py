@@ -115,7 +115,8 @@ GLSL_INCLUDES: dict[str, str] = {
                             "GLSL function)",
     "lights/shadows.glsl": "light_shadow_cascades, _perspective, _cube: the lit fraction of "
                            "a shadowed light at a point (a light's GLSL function multiplies "
-                           "by its projection's)",
+                           "by its projection's); with OPACITY_RECEIVER, times the "
+                           "transmittance through the deep opacity maps",
     "common/forward_lighting.glsl": "every light of the frame at one surface point (forward "
                                     "passes)",
     "gbuffer/layout.glsl": "the G-buffer's encoding and decoding",

@@ -1,0 +1,60 @@
+"""Fur self-shadowing (#27) in docs/figures/fur_self_shadowing.png: the demo with shadows
+(examples/shadows_demo.toml) in the forward pipeline without self-shadowing (gamma(h) only,
+self_shadow_density = 0) and with it (the deep opacity maps, the default), and the deferred
+pipeline (which takes the fur's light from its skin and draws no opacity maps); the whole
+frame and a close-up of the ball's side away from the key light. Run from the repository root:
+python examples/self_shadow_figures.py"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import tomllib
+from PIL import Image, ImageDraw
+
+from deferred.render.renderer import Renderer
+from deferred.scene.loader import scene_from_dict
+
+ROOT = Path(__file__).parents[1]
+FIGURES = ROOT / "docs" / "figures"
+DEMO = ROOT / "examples" / "shadows_demo.toml"
+SIZE = (1280, 720)
+CROP = (170, 200, 550, 520)  # the ball, x0, y0, x1, y1 at SIZE
+
+
+def demo(density: float | None) -> object:
+    with open(DEMO, "rb") as file:
+        data = tomllib.load(file)
+    if density is not None:
+        for obj in data["object"]:
+            if obj.get("material") in ("revie_fur", "shell_fur"):
+                obj["params"]["self_shadow_density"] = density
+    return scene_from_dict(data, str(DEMO), DEMO.parent)
+
+
+def labelled(image: np.ndarray, text: str) -> np.ndarray:
+    picture = Image.fromarray(image)
+    draw = ImageDraw.Draw(picture)
+    draw.rectangle((0, 0, 8 + 6 * len(text), 14), fill=(0, 0, 0))
+    draw.text((4, 2), text, fill=(255, 255, 255))
+    return np.asarray(picture)
+
+
+def main() -> None:
+    columns = []
+    for pipeline, density, title in (("forward", 0.0, "forward, without self-shadowing"),
+                                     ("forward", None, "forward, deep opacity maps"),
+                                     ("deferred", None, "deferred (gamma(h) only)")):
+        with Renderer(demo(density), pipeline, SIZE) as renderer:
+            image = renderer.render().image[..., :3]
+        x0, y0, x1, y1 = CROP
+        close = np.ascontiguousarray(image[y0:y1, x0:x1])
+        whole = np.asarray(Image.fromarray(image).resize((close.shape[1],
+                                                          close.shape[1] * SIZE[1] // SIZE[0])))
+        columns.append(np.concatenate([labelled(whole, title), close], axis=0))
+    Image.fromarray(np.concatenate(columns, axis=1)).save(FIGURES / "fur_self_shadowing.png")
+
+
+if __name__ == "__main__":
+    main()
