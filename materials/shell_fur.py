@@ -550,6 +550,7 @@ class ShellFurMaterial(FurMaterial):
     }
 
     fur_vertex = FUR_VERTEX
+    deferred_opacity = True  # its layers correct their root's light light by light (shell.frag)
 
     def shadow_textures(self, frame: Frame, obj: SceneObject) -> dict[str, moderngl.Texture]:
         # the state the object's passes brought to the frame's time in their prepare

@@ -98,14 +98,18 @@ def with_material_view(scene: Scene, name: str) -> Scene | None:
 
 def check_material_view(scene: Scene, name: str, pipeline: str) -> None:
     """Refuse a material view the scene or pipeline cannot show: ``<fur>.opacity_shadow``
-    needs a shadowed light and the forward pipeline (whose shells read the deep opacity maps;
-    the deferred shells take their light from the skin's pixels)."""
+    needs a shadowed light and a pipeline whose shells read the deep opacity maps (forward;
+    deferred where the material's ``deferred_opacity`` says so: not revie_fur, whose deferred
+    shells take their light summed from the skin's pixels)."""
     if not name.endswith(".opacity_shadow"):
         return
     if not any(light.casts_shadows for light in scene.lights):
         raise InputError(f"view '{name}' shows the fur's deep opacity maps; no light of this "
                          "scene casts shadows (shadows = true)", "--view")
-    if pipeline != "forward":
+    material = name.partition(".")[0]
+    if pipeline != "forward" and not any(obj.material.name == material and
+                                         obj.material.deferred_opacity
+                                         for obj in scene.objects):
         raise InputError(f"view '{name}' shows the deep opacity maps the forward shells read "
                          "(the deferred shells take their light from the skin): use "
                          "--pipeline forward", "--view")

@@ -316,6 +316,8 @@ class Material:
     # A volume that shadows itself through deep opacity maps (fur; deferred.lighting.shadows):
     # it draws them (draw_opacity) and its receivers compile with OPACITY_RECEIVER.
     opacity_shadows: bool = False
+    # ... and its deferred passes read them too (the forward passes of such a material do)
+    deferred_opacity: ClassVar[bool] = False
 
     def opacity_layer(self, obj: SceneObjectLike) -> float:
         """World thickness of ``obj``'s volume (the opacity layers span a few of the thickest)."""

@@ -24,13 +24,14 @@ that reads it; programs only read it where the scene has a shadowed light (the d
 ``SHADOWS``), so a scene without shadows pays nothing.
 
 **Deep opacity maps** (Yuksel and Keyser 2008), where an object's material draws a volume
-(``Material.opacity_shadows``: fur): beside the atlas, two textures of half its size over the
-same atlas coordinates: ``opacity_first``, the light-view depth of the first volume fragment
-each texel sees (the volume's own front, not the depth atlas's casters), and ``opacity``, four
-layers (RGBA) of the volume's optical depth accumulated from that front up to
-``OPACITY_LAYERS`` x the thickest volume's layer (``Material.opacity_layer``). Each material
-draws both stages (:meth:`~deferred.interfaces.material.Material.draw_opacity`); a receiver
-compiled with ``OPACITY_RECEIVER`` multiplies a shadowed light by the transmittance there
+(``Material.opacity_shadows``: fur; in the deferred pipeline ``deferred_opacity`` too): beside
+the atlas, two textures of half its size over the same atlas coordinates: ``opacity_first``,
+the light-view depth of the first volume fragment each texel sees (the volume's own front, not
+the depth atlas's casters), and ``opacity``, four layers (RGBA) of the volume's optical depth
+accumulated from that front up to ``OPACITY_LAYERS`` x the thickest volume's layer
+(``Material.opacity_layer``). Each material draws both stages
+(:meth:`~deferred.interfaces.material.Material.draw_opacity`); a receiver compiled with
+``OPACITY_RECEIVER`` multiplies a shadowed light by the transmittance there
 (``lights/shadows.glsl``, ``opacity_transmittance``). Programs see ``OPACITY_SHADOWS``.
 """
 
@@ -81,12 +82,14 @@ def scene_casts_shadows(lights: list[Light]) -> bool:
 
 
 def scene_has_opacity(scene: Scene, pipeline: str) -> bool:
-    """Whether a shadowed scene draws deep opacity maps (an object's material asks for them):
-    in the forward pipeline, whose volume fragments are lit light by light; the deferred
-    pipeline's fur takes its light summed over the lights from its skin's pixels, where a
-    light's own transmittance cannot reach it."""
-    return pipeline == Pipeline.FORWARD and scene_casts_shadows(scene.lights) and any(
-        obj.material.opacity_shadows for obj in scene.objects)
+    """Whether a shadowed scene draws deep opacity maps: an object's material asks for them
+    (``opacity_shadows``) and reads them in this pipeline (every such material in the forward
+    pipeline; in the deferred one only where ``deferred_opacity`` says its deferred passes
+    do)."""
+    return scene_casts_shadows(scene.lights) and any(
+        obj.material.opacity_shadows and (pipeline == Pipeline.FORWARD
+                                          or obj.material.deferred_opacity)
+        for obj in scene.objects)
 
 
 def opacity_size(atlas_size: int) -> int:

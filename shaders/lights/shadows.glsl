@@ -28,6 +28,10 @@ float opacity_fallback = 1.0;  // a global: what an unshadowed light is multipli
 // the first shadowed light's layers where the lights were evaluated, as 1 - transmittance to
 // the ends of layers 1, 2 and 4 (the fur's opacity_shadow debug view); -1: none looked up
 vec3 opacity_seen = vec3(-1.0);
+// opacity_split: shadowed lights return their depth shadow alone and leave the transmittance in
+// opacity_last (a deferred fur layer corrects the summed light it read by it, light by light)
+bool opacity_split = false;
+float opacity_last = 1.0;
 #endif
 
 #ifdef OPACITY_RECEIVER
@@ -146,7 +150,9 @@ float shadow_tile(int row, int tile, vec4 header, vec4 biases, vec3 P, vec3 N, v
     vec3 uvz = clip.xyz / clip.w;
     if (uvz.z >= 1.0) return 1.0;  // beyond the map's far plane
 #if defined(OPACITY_RECEIVER) && defined(OPACITY_SHADOWS)
-    return shadow_filter(uvz, rect, header) * opacity_transmittance(to_atlas, rect, size, P);
+    float transmittance = opacity_transmittance(to_atlas, rect, size, P);
+    opacity_last = transmittance;
+    return shadow_filter(uvz, rect, header) * (opacity_split ? 1.0 : transmittance);
 #else
     return shadow_filter(uvz, rect, header);
 #endif

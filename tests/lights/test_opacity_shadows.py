@@ -141,14 +141,35 @@ def test_fur_light_falls_with_depth_along_the_light(gl):
 def test_lit_and_far_sides_differ_more(gl, material):
     """Under a light from the left, self-shadowing darkens the far side (the light crosses the
     whole fur to reach it) much more than the side facing the light: the ratio of the two
-    grows by 1.4 or more. (The forward shells light the far side's strands, across the light,
-    by their tangent; revie_fur's grain normal lights little of the near side of a light
-    square to the view.)"""
+    grows by 1.4 or more (forward: its shells light the far side's strands, across the light,
+    by their tangent; the deferred layers take the far side's light from its unlit skin and
+    have little of it to lose). revie_fur's grain normal lights little of the near side of a
+    light square to the view."""
     with_ = side_means(*luminance(gl, fur_scene(material, 0.5)))
     without = side_means(*luminance(gl, fur_scene(material, 0.0)))
     print(material, "with", with_, "without", without)
     assert with_[1] < 0.7 * without[1]
     assert with_[0] / with_[1] > 1.4 * without[0] / without[1]
+
+
+@pytest.mark.parametrize("direction", [SIDE, [1.0, -0.3, -0.5]])
+def test_shell_fur_deferred_layers_agree_with_forward_on_the_lit_side(gl, direction):
+    """shell_fur's deferred layers take each shadowed light's transmittance as the forward
+    layers do (the light they read at the root, corrected light by light): the lit side's
+    fur agrees within 2%, and self-shadowing brings the two pipelines' images closer."""
+    images = {(k, p): luminance(gl, fur_scene("shell_fur", k, direction=direction), p)
+              for k in (0.0, 0.5) for p in ("forward", "deferred")}
+    lit = {key: side_means(*image)[0] for key, image in images.items()}
+    assert lit[(0.5, "deferred")] == pytest.approx(lit[(0.5, "forward")], rel=0.02)
+    assert lit[(0.5, "deferred")] < 0.9 * lit[(0.0, "deferred")]
+
+    def psnr(a, b):
+        return 10.0 * np.log10(1.0 / np.mean((np.clip(a, 0, 1) - np.clip(b, 0, 1)) ** 2))
+
+    with_ = psnr(images[(0.5, "forward")][0], images[(0.5, "deferred")][0])
+    without = psnr(images[(0.0, "forward")][0], images[(0.0, "deferred")][0])
+    print("forward vs deferred PSNR", without, "->", with_)
+    assert with_ > without
 
 
 def test_gamma_stays_without_shadows(gl):
@@ -165,9 +186,9 @@ def run_cli(*args):
 
 
 def test_opacity_shadow_view(tmp_path):
-    """--view <fur>.opacity_shadow shows the layers on the forward shells (the fur in front of
-    the lit side is thinner along the light than in front of the far side); the deferred
-    pipeline and a scene without shadows refuse it in one line."""
+    """--view <fur>.opacity_shadow shows the layers on the shells (shell_fur: both pipelines);
+    revie_fur's deferred pipeline, whose shells read no opacity maps, and a scene without
+    shadows refuse it in one line."""
     scene_text = f"""size = [{W}, {H}]
 background = [0.0, 0.0, 0.0]
 [camera]
@@ -202,12 +223,18 @@ shadow_resolution = 1024
     assert drawn.sum() > 0.15 * W * H
     # layer 1 (red) holds at most what layer 4 (blue) does; the layers are 1 - transmittance
     assert (layers[..., 0] <= layers[..., 2] + 1e-3).all() and layers.max() <= 1.0 + 1e-3
-    for args, message in (((), "use --pipeline forward"),):
-        done = run_cli("render", str(path), "--view", "shell_fur.opacity_shadow", "-o",
-                       str(tmp_path / "x.png"), *args)
-        assert done.returncode == 2 and message in done.stderr
-        assert len(done.stderr.strip().splitlines()) == 1
-        assert not (tmp_path / "x.png").exists()
+    deferred = tmp_path / "deferred.exr"
+    done = run_cli("render", str(path), "--view", "shell_fur.opacity_shadow", "-o",
+                   str(deferred))
+    assert done.returncode == 0, done.stderr
+    assert (read_image(deferred)[..., :3].sum(-1) > 0.0).sum() > 0.15 * W * H
+    revie = tmp_path / "revie.toml"
+    revie.write_text(scene_text.replace("shell_fur", "revie_fur"))
+    done = run_cli("render", str(revie), "--view", "revie_fur.opacity_shadow", "-o",
+                   str(tmp_path / "x.png"))
+    assert done.returncode == 2 and "use --pipeline forward" in done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1
+    assert not (tmp_path / "x.png").exists()
     path.write_text(scene_text.replace("shadows = true", "shadows = false"))
     done = run_cli("render", str(path), "--pipeline", "forward", "--view",
                    "shell_fur.opacity_shadow", "-o", str(tmp_path / "x.png"))

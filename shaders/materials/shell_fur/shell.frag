@@ -13,6 +13,60 @@
 #include "materials/shell_fur/layer.glsl"
 #include "materials/shell_fur/color.glsl"
 #include "materials/shell_fur/debug.glsl"
+#if defined(SHADOWS) && defined(OPACITY_SHADOWS) && defined(OPACITY_RECEIVER)
+// Self-shadowing (deep opacity maps, lights/shadows.glsl): the summed light read at the root
+// holds each shadowed light whole; each is evaluated again at this layer (Kajiya-Kay along the
+// strand's chord, as the base surface was lit) for the transmittance-weighted share to scale
+// (self_shadowed), gamma(h) staying on the rest (the forward layers' split)
+#define FUR_LAYER_SELF_SHADOW
+#include "common/light_buffer.glsl"
+#include "generated/lights.glsl"
+#include "techniques/strand_tangent.glsl"
+in vec3 v_position;
+in vec3 v_normal;
+in vec3 v_strand_tangent;
+uniform float u_specular_intensity;  // K_s
+uniform float u_specular_exponent;   // p_phong
+#ifdef FUR_MARSCHNER
+uniform float u_roughness;
+#endif
+
+// The light read at the root (irradiance, before gamma) with the shadowed lights' share of it
+// scaled by their transmittance here: each shadowed light evaluated again at this layer (e_i),
+// f = sum(e_i T_i / gamma) / sum(e_i), and the share sum(e_i) / irradiance (at most 1: where the
+// layer sees a light its root did not, at the terminator, the root's light is all it has)
+vec3 self_shadowed(vec3 irradiance, vec3 albedo, float gamma, float wetness) {
+    Surface s;
+    s.albedo = albedo;
+    s.specular_intensity = wet_specular_intensity(u_specular_intensity, wetness);
+#ifdef FUR_MARSCHNER
+    s.specular_exponent = wet_specular_shape(u_roughness, wetness);
+#else
+    s.specular_exponent = wet_specular_shape(u_specular_exponent, wetness);
+#endif
+    s.normal = normalize(v_normal);
+    s.occlusion = 1.0;
+    s.view_depth = -v_position.z;
+    s.shading_model = surface_shading_model(u_surface_id);
+    s.data.strand_tangent = strand_tangent_encode(v_strand_tangent);
+    vec3 V = normalize(-v_position);
+    const vec3 LUMA = vec3(0.2126, 0.7152, 0.0722);
+    float total = 0.0;
+    float kept = 0.0;
+    opacity_split = true;
+    for (int k = 0; k < u_light_count; ++k) {
+        LightRecord light = fetch_light(k);
+        if (light.extra.w < 0.5) continue;  // no shadow slot: gamma(h) stays
+        opacity_last = 1.0;
+        float e = dot(evaluate_light(light, s, v_position, V)
+                      / max(albedo, vec3(1.0 / 255.0)), LUMA);
+        total += e;
+        kept += e * opacity_last / max(gamma, 1e-3);
+    }
+    float share = clamp(total / max(dot(irradiance, LUMA), 1e-6), 0.0, 1.0);
+    return irradiance * mix(1.0, kept / max(total, 1e-6), share);
+}
+#endif
 
 uniform float u_fur_uv_tiles;  // volume tiles per UV unit (FUR_UV_MAPPING)
 uniform float u_shell_fade;    // the outermost layer fades in with the level of detail
@@ -66,6 +120,14 @@ void main() {
 #endif
     if (!base_valid && !own_valid) discard;  // the strand's light is unknown
     if (own_valid) irradiance = own_irradiance;
+#ifdef FUR_LAYER_SELF_SHADOW
+    irradiance = self_shadowed(irradiance, albedo / fur_shadow(v_shell_depth),
+                               fur_shadow(v_shell_depth), fur_wetness(v_uv));
+#ifdef FUR_DEBUG_OPACITY_SHADOW
+    out_color = vec4(max(opacity_seen, vec3(0.0)), 1.0);
+    return;
+#endif
+#endif
     float brightness = strand_brightness(strands);
     out_color = vec4(irradiance * strand_tint(albedo, strands) * brightness, alpha);
 }
