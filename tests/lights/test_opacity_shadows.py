@@ -180,6 +180,24 @@ def test_gamma_stays_without_shadows(gl):
     np.testing.assert_array_equal(a, b)
 
 
+@pytest.mark.parametrize("pipeline", ["forward", "deferred"])
+def test_self_shadowing_switched_in_python_equals_a_fresh_renderer(gl, pipeline):
+    """self_shadow_density set between 0 and a positive value on a live renderer (the maps
+    are drawn or not): each frame equals a fresh renderer's of the edited scene."""
+    scene = fur_scene("shell_fur", 0.5)
+    with Renderer(scene, pipeline, gl=gl) as renderer:
+        frames = [renderer.render(hdr=True).hdr]
+        for density in (0.0, 0.5):
+            scene.objects[0].set_params(self_shadow_density=density)
+            frames.append(renderer.render(hdr=True).hdr)
+    fresh = {k: luminance(gl, fur_scene("shell_fur", k), pipeline)[0] for k in (0.0, 0.5)}
+    weights = np.array([0.2126, 0.7152, 0.0722])
+    for frame, density in zip(frames, (0.5, 0.0, 0.5), strict=True):
+        np.testing.assert_allclose(frame[..., :3].astype(np.float64) @ weights,
+                                   fresh[density], atol=1e-6)
+    assert not np.allclose(fresh[0.0], fresh[0.5], atol=1e-3)  # the switch shows
+
+
 def run_cli(*args):
     return subprocess.run([sys.executable, "-m", "deferred", *args], capture_output=True,
                           text=True, timeout=300)
