@@ -117,7 +117,9 @@ class ShellFurParams(FurParams, BlinnPhongParams):
                                   description="w, radians along the strand")
     curl_variation: float = Field(1.0, ge=0.0, le=1.0,
                                   description="curls start at phases spread over this much of "
-                                              "a turn (seeded; 0: all in one phase, the paper)")
+                                              "a turn (seeded, a smooth field: slower for a "
+                                              "larger curl_radius at t = 0; 0: all in one "
+                                              "phase, the paper)")
     # clump (3.3, Eq. 5)
     clump_shape: float = Field(0.5, ge=0.0, le=1.0,
                                description="w: 0 leans straight to the centre, 1 bends in")
@@ -307,8 +309,8 @@ class ShellFurState:
         self.strand_data = np.zeros((max(1, math.ceil(3 * vertices / TIPS_WIDTH)) * TIPS_WIDTH,
                                      4), np.float32)
         curl_u, curl_v = curl_frames(obj.mesh, self.average.welded)
-        phase = curl_phases(obj.mesh, self.average.welded, params.curl_variation,
-                            params.seed)[:, None]
+        phase = curl_phases(obj.mesh, params.curl_variation, params.seed,
+                            params.curl_radius)[:, None]
         curl_u, curl_v = (np.cos(phase) * curl_u + np.sin(phase) * curl_v,
                           np.cos(phase) * curl_v - np.sin(phase) * curl_u)
         self.strand_data[1:3 * vertices:3, :3] = curl_u

@@ -196,28 +196,42 @@ def curl_frames(mesh: MeshData, welded: np.ndarray) -> tuple[np.ndarray, np.ndar
     return u[welded], v[welded]
 
 
-def curl_phases(mesh: MeshData, welded: np.ndarray, variation: float, seed: int,
-                smoothing: int = 2) -> np.ndarray:
+# The curl's layer displacement may change by at most this fraction of the distance between two
+# points of the surface through the phases' variation, so that no layer folds over itself
+# (curl_phases).
+CURL_PHASE_STRAIN = 0.4
+CURL_PHASE_WAVES = 6  # plane waves summed into the phase field
+
+
+def curl_phases(mesh: MeshData, variation: float, seed: int, curl_radius: float) -> np.ndarray:
     """(V,) an angle per vertex to turn its curl's (u, v) by: each strand's helix starts at its
     own phase, so neighbouring curls do not wind in lockstep (Eq. 4 gives every strand the same
-    phase). Drawn uniformly over ``variation`` of a turn per welded vertex (seeded; the copies
-    of a vertex split at a seam share it), then averaged with the neighbours' ``smoothing``
-    times as unit vectors, so the layers do not crumple between neighbouring vertices."""
-    groups = int(welded.max()) + 1
+    phase). A smooth field over the object: ``CURL_PHASE_WAVES`` plane waves of random
+    directions and phases in object space, averaged and scaled to +- ``variation`` / 2 of a turn
+    (seeded; the copies of a vertex split at a seam share their position, so their phase).
+
+    Its wavenumber keeps the layers whole: all strands of a triangle share the layer's
+    displacement (the curl ``K h (cos(w h) u + sin(w h) v)``, turned by the phase), so where
+    the phase changes by ``d phi`` between two vertices a distance ``d`` apart their layer
+    points move apart by up to ``K d phi``, and once that passes ``d`` the triangle between
+    them turns over (a crumpled, cracked layer: phases drawn per vertex did that on most of a
+    curled ball). The field's gradient is at most ``pi variation k``, so ``k`` is chosen for
+    ``K pi variation k = CURL_PHASE_STRAIN``, and no finer than six median edges a wave."""
+    positions = np.asarray(mesh.positions, np.float64)
     if variation <= 0.0:
-        return np.zeros(len(welded))
+        return np.zeros(len(positions))
+    faces = np.asarray(mesh.indices, np.int64).reshape(-1, 3)
+    edges = positions[faces] - positions[faces[:, [1, 2, 0]]]
+    edge = float(np.median(np.linalg.norm(edges, axis=-1)))
+    finest = 2.0 * np.pi / max(6.0 * edge, 1e-12)
+    k = finest if curl_radius <= 0.0 else \
+        min(CURL_PHASE_STRAIN / (np.pi * variation * curl_radius), finest)
     rng = np.random.default_rng([seed, 0xC011])
-    angle = 2.0 * np.pi * variation * rng.uniform(-0.5, 0.5, groups)
-    z = np.exp(1j * angle)
-    faces = welded[np.asarray(mesh.indices, np.int64).reshape(-1, 3)]
-    a = faces.reshape(-1)
-    b = faces[:, [1, 2, 0]].reshape(-1)
-    for _ in range(smoothing):
-        total = z.copy()
-        np.add.at(total, a, z[b])
-        np.add.at(total, b, z[a])
-        z = total / np.maximum(np.abs(total), 1e-12)
-    return np.angle(z)[welded]
+    directions = rng.normal(size=(CURL_PHASE_WAVES, 3))
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    offsets = rng.uniform(0.0, 2.0 * np.pi, CURL_PHASE_WAVES)
+    field = np.sin(positions @ (k * directions).T + offsets).mean(axis=1)  # |grad| <= k
+    return np.pi * variation * field
 
 
 class VertexAverage:

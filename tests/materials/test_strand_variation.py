@@ -10,6 +10,7 @@ import pytest
 from deferred.materials.techniques.strands import (
     StrandForces,
     StrandSimulation,
+    curl_frames,
     curl_phases,
     gust_wind,
 )
@@ -76,18 +77,49 @@ def test_gust_field_varies_over_the_surface_and_never_repeats():
     assert np.std([f[lee] for f in field], axis=0).mean() > 0.02
 
 
-def test_curl_phases_differ_but_change_slowly_between_neighbours():
-    mesh = builtin_sphere(32, 16)
+def curled_layers_turned_over(mesh, radius, frequency, variation, seed=0):
+    """Triangles of a curled ball's layers (fur.vert's offset without the bend: n L h plus the
+    curl, phases as ShellFurState turns them) that face inward at some depth h: a layer
+    folded over itself."""
     welded = weld(mesh.positions)
-    phase = curl_phases(mesh, welded, 1.0, seed=2)
-    assert np.std(np.exp(1j * phase)) > 0.3  # spread round the turn
+    u, v = curl_frames(mesh, welded)
+    phase = curl_phases(mesh, variation, seed, radius)[:, None]
+    u, v = np.cos(phase) * u + np.sin(phase) * v, np.cos(phase) * v - np.sin(phase) * u
+    p = mesh.positions.astype(np.float64)
+    n = mesh.normals.astype(np.float64)
     faces = mesh.indices.reshape(-1, 3).astype(np.int64)
-    step = np.abs(np.angle(np.exp(1j * (phase[faces[:, 0]] - phase[faces[:, 1]]))))
-    assert np.median(step) < np.pi / 3  # neighbours nearly agree: the layers do not crumple
-    assert np.all(curl_phases(mesh, welded, 0.0, seed=2) == 0.0)
-    # the copies of a seam vertex share their phase
-    first = np.unique(welded, return_index=True)[1]
-    assert np.abs(phase - phase[first][welded]).max() < 1e-9
+    turned = np.zeros(len(faces), bool)
+    for h in np.linspace(0.025, 1.0, 40):
+        layer = p + n * 0.25 * h + radius * h * (np.cos(frequency * h) * u
+                                                 + np.sin(frequency * h) * v)
+        corners = layer[faces]
+        normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+        real = np.linalg.norm(normal, axis=1) > 1e-12  # not a pole's collapsed triangle
+        turned |= real & (np.einsum("ij,ij->i", normal, n[faces].sum(axis=1)) < 0.0)
+    return int(turned.sum())
+
+
+def test_curl_phases_differ_but_no_layer_turns_over():
+    mesh = builtin_sphere(96, 48)  # Silva Fig. 7's ball (examples/shell_fur/fig7_curls.toml)
+    welded = weld(mesh.positions)
+    for radius, frequency in ((0.05, 12.6), (0.015, 38.0)):  # Fig. 7 (c), (d)
+        phase = curl_phases(mesh, 1.0, 2, radius)
+        assert np.std(np.exp(1j * phase)) > 0.5  # spread round the turn
+        # phases drawn per vertex and averaged with the neighbours twice turned 2360 and 359
+        # triangles over: the crumpled, cracked layers of Fig. 7 (c), (d)
+        assert curled_layers_turned_over(mesh, radius, frequency, 1.0) == 0
+        # the copies of a seam vertex share their phase
+        first = np.unique(welded, return_index=True)[1]
+        assert np.abs(phase - phase[first][welded]).max() < 1e-9
+    assert np.all(curl_phases(mesh, 0.0, 2, 0.05) == 0.0)
+    # the phase varies more slowly for larger curls
+    small, large = curl_phases(mesh, 1.0, 2, 0.015), curl_phases(mesh, 1.0, 2, 0.05)
+    faces = mesh.indices.reshape(-1, 3).astype(np.int64)
+
+    def step(phase):
+        return np.median(np.abs(phase[faces[:, 0]] - phase[faces[:, 1]]))
+
+    assert step(large) < 0.5 * step(small)
 
 
 def outlines(render, scene, times):
