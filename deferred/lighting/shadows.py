@@ -354,21 +354,24 @@ class ShadowAtlas:
                 frusta = [self._spot(light, squares[0][2])]
             else:
                 frusta = self._cube(light, squares[0][2])
-            for index, ((x, y, size), (_, light_view, projection, texel, perspective_texel,
-                                       reach)) in enumerate(zip(squares, frusta, strict=True)):
-                view_projection = projection @ light_view
+            # light_projection: ``projection`` is the camera's, which the next light's
+            # visibility test above still needs
+            for index, ((x, y, size), (_, light_view, light_projection, texel,
+                                       perspective_texel, reach)) in enumerate(
+                    zip(squares, frusta, strict=True)):
+                view_projection = light_projection @ light_view
                 to_atlas = tile_matrix(x, y, size, self.size) @ view_projection @ inverse_view
                 base = 4 + 6 * index
                 row[base:base + 4] = to_atlas.T  # columns
                 row[base + 4] = (x / self.size, y / self.size, (x + size) / self.size,
                                  (y + size) / self.size)
                 row[base + 5] = (texel, 1.0 if perspective_texel else 0.0,
-                                 *near_far(projection))
+                                 *near_far(light_projection))
                 position = None if kind == ShadowProjection.CASCADES else \
                     np.asarray(params.position, np.float64)
                 direction = unit(-light_view[2, :3])
                 self.tiles.append(ShadowTile(light, slot, x, y, size, view_projection,
-                                             ShadowView(light_view, projection, position,
+                                             ShadowView(light_view, light_projection, position,
                                                         direction),
                                              reach))
             self.slots[id(light)] = slot

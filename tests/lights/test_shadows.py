@@ -487,6 +487,36 @@ def test_a_light_out_of_view_draws_no_maps(gl):
         assert id(the_scene.lights[2]) not in atlas.slots
 
 
+@pytest.mark.parametrize("spot_first", [True, False])
+def test_each_light_is_tested_for_view_against_the_camera(gl, spot_first):
+    """A narrow spot light and a point light off to the side, both in view: each gets its maps
+    whichever is listed first (the point light was tested against the spot light's frustum
+    when listed after it), and the two orders give the same image."""
+    spot = {"type": "spot", "position": [0.0, 2.0, 0.0], "direction": [0.0, -1.0, 0.0],
+            "radius": 3.0, "outer_angle": 15.0, "inner_angle": 10.0, "shadows": True,
+            "shadow_resolution": 128}
+    point = {"type": "point", "position": [1.9, -0.25, 0.6], "radius": 0.8, "intensity": 4.0,
+             "shadows": True, "shadow_resolution": 64}
+
+    def lit(order):
+        the_scene = scene_from_dict({
+            "size": [64, 36], "tonemap": "none", "shadows": {"atlas_size": 512},
+            "camera": {"position": [0.0, 0.5, 3.0], "target": [0.0, 0.0, 0.0], "fov": 45.0},
+            "object": [{"mesh": "builtin:plane", "scale": 6.0, "position": [0.0, -0.7, 0.0]},
+                       {"mesh": "builtin:sphere", "scale": 0.5},
+                       {"mesh": "builtin:cube", "position": [1.8, -0.5, 0.6], "scale": 0.1}],
+            "light": [*order, {"type": "ambient", "color": [0.05, 0.05, 0.05]}]})
+        with Renderer(the_scene, gl=gl) as renderer:
+            image = renderer.render(hdr=True).hdr
+            slots = renderer.shadow_atlas.slots
+            assert all(id(light) in slots for light in the_scene.lights[:2])
+        return image
+
+    first = lit([spot, point] if spot_first else [point, spot])
+    other = lit([point, spot] if spot_first else [spot, point])
+    np.testing.assert_allclose(first, other, atol=1e-5)
+
+
 def test_the_soft_filter_widens_the_penumbra(gl):
     """The same shadow edge through pcf and through the soft filter 6 texels wide: the
     transition (lit fraction between 0.1 and 0.9) spans about 2 texels with pcf and several
