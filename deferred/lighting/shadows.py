@@ -208,6 +208,27 @@ def tile_counts(light: Light) -> int:
     return MAX_TILES if kind == ShadowProjection.CUBE else 1
 
 
+def _place_tiles(lights: list[Light], atlas_size: int
+                 ) -> tuple[dict[int, list[tuple[int, int, int]]], list[int]]:
+    """The squares of each of ``lights`` whose maps all fit, largest maps first, and the
+    lights whose maps did not (``id``), the first to run out of room first."""
+    requests = sorted(((light.params.shadow_resolution, order, light)
+                       for order, light in enumerate(lights) for _ in range(tile_counts(light))),
+                      key=lambda item: (-item[0], item[1]))
+    allocator = QuadtreeAllocator(atlas_size)
+    tiles: dict[int, list[tuple[int, int, int]]] = {}
+    failed: list[int] = []
+    for size, _, light in requests:
+        if id(light) in failed:
+            continue
+        place = allocator.take(size) if size <= atlas_size else None
+        if place is None:
+            failed.append(id(light))
+            continue
+        tiles.setdefault(id(light), []).append((*place, size))
+    return {key: squares for key, squares in tiles.items() if key not in failed}, failed
+
+
 def plan_atlas(lights: list[Light], atlas_size: int, max_lights: int
                ) -> tuple[dict[int, tuple[int, list[tuple[int, int, int]]]], list[str]]:
     """Slots and tiles for the shadowed ``lights`` (scene order): ``{id(light): (slot,
@@ -216,20 +237,15 @@ def plan_atlas(lights: list[Light], atlas_size: int, max_lights: int
     left_out = [f"light {lights.index(light)} (max_shadowed_lights = {max_lights})"
                 for light in wanted[max_lights:]]
     wanted = wanted[:max_lights]
-    requests = sorted(((light.params.shadow_resolution, order, light)
-                       for order, light in enumerate(wanted) for _ in range(tile_counts(light))),
-                      key=lambda item: (-item[0], item[1]))
-    allocator = QuadtreeAllocator(atlas_size)
-    tiles: dict[int, list[tuple[int, int, int]]] = {}
+    # Largest maps first packs best; the first light to run out of room is left out and the
+    # rest planned again, so the squares it took are not lost to the lights after it.
     failed: set[int] = set()
-    for size, _, light in requests:
-        if id(light) in failed:
-            continue
-        place = allocator.take(size) if size <= atlas_size else None
-        if place is None:
-            failed.add(id(light))
-            continue
-        tiles.setdefault(id(light), []).append((*place, size))
+    while True:
+        tiles, missing = _place_tiles([light for light in wanted if id(light) not in failed],
+                                      atlas_size)
+        if not missing:
+            break
+        failed.add(missing[0])
     plan: dict[int, tuple[int, list[tuple[int, int, int]]]] = {}
     for light in wanted:
         if id(light) in failed:

@@ -330,6 +330,24 @@ def test_lights_over_the_budget_are_unshadowed_with_one_warning(gl):
     assert "light 3" in str(budget[0].message)
 
 
+@pytest.mark.parametrize("point_first", [True, False])
+def test_a_light_whose_maps_do_not_fit_leaves_its_squares_to_the_others(point_first):
+    """A 256^2 atlas holds four 128^2 squares: a point light's six do not fit, a spot light's
+    one does, listed before or after it (the point light's first four squares were kept,
+    and the spot light was refused as not fitting)."""
+    from deferred.lighting.shadows import plan_atlas
+
+    the_scene = scene_from_dict({"light": [
+        {"type": "point", "position": [0.0, 2.0, 0.0], "shadows": True,
+         "shadow_resolution": 128},
+        {"type": "spot", "position": [0.0, 2.0, 0.0], "shadows": True,
+         "shadow_resolution": 128}]})
+    point, spot = the_scene.lights
+    plan, left_out = plan_atlas([point, spot] if point_first else [spot, point], 256, 16)
+    assert list(plan) == [id(spot)] and len(plan[id(spot)][1]) == 1
+    assert len(left_out) == 1 and "6 map(s) of 128^2 do not fit the 256^2 atlas" in left_out[0]
+
+
 @pytest.mark.parametrize(("text", "expected"), [
     ('[[light]]\ntype = "directional"\nshadows = true\nshadow_resolution = 1000\n',
      "light[0].shadow_resolution: must be a power of two"),
