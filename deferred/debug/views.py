@@ -216,7 +216,8 @@ def _named_view(capture: FrameCapture, name: str) -> View:
         return View(name, depth[..., None], channels, False, grey(stretched))
     if name == "shadow.cascades":
         if capture.shadow_cascades is None:
-            raise KeyError("no shadowed directional light: the frame has no cascades")
+            raise InputError("view 'shadow.cascades' shows a directional light's cascades; no "
+                             "directional light of this scene casts shadows", "--view")
         cascades = capture.shadow_cascades
         shade = capture.image[..., :3].astype(np.float32).mean(-1, keepdims=True) / 255.0
         tint = np.where((cascades > 0)[..., None], id_colors(cascades), 1.0)

@@ -398,6 +398,13 @@ def test_shadow_views_and_the_dump_show_the_atlas(tmp_path):
     assert set(np.unique(cascades)) <= {0.0, 1.0, 2.0} and (cascades == 1.0).any()
     assert deferred("dump", path, "-o", tmp_path / "dump").returncode == 0
     assert (tmp_path / "dump" / "shadow_atlas.exr").is_file()
+    spot = path.read_text().replace('type = "directional"', 'type = "spot"\n'
+                                     'position = [0.0, 3.0, 0.0]').replace("cascades = 2\n", "")
+    path.write_text(spot)  # shadows, but no directional light's cascades
+    done = deferred("render", path, "--view", "shadow.cascades", "-o", tmp_path / "c.png")
+    assert done.returncode == 2 and "no directional light of this scene casts shadows" in \
+        done.stderr and len(done.stderr.strip().splitlines()) == 1, done.stderr
+    assert not (tmp_path / "c.png").exists()
     path.write_text(path.read_text().replace("shadows = true", "shadows = false"))
     done = deferred("render", path, "--view", "shadow_atlas", "-o", tmp_path / "none.png")
     assert done.returncode == 2 and "no light of this scene casts shadows" in done.stderr
