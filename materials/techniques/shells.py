@@ -31,15 +31,15 @@ def shell_dither(sample_index: int) -> float:
 class DitheredShells:
     """A shell pass whose vertex stage offsets each shell but the root by ``u_shell_dither``
     (of the layer's depth) beyond its ``u_shell_depth``, which its shading keeps: the geometry
-    moves within the slab from sample to sample, not the strands' colour or coverage (moving
-    those too changed the fur's brightness by a quarter from sample to sample where the level
-    of detail leaves few shells)."""
+    moves within the slab from sample to sample, not the strands' colour or coverage: where the
+    level of detail leaves few shells, moving those too would change the fur's brightness from
+    sample to sample instead of only where its rim lies."""
 
     def draws(self, frame) -> int:
         count = super().draws(frame)
-        # Not while a temporal history follows a moving camera: it keeps a tenth of each
-        # frame there, too little to average the dither out, which then shimmers
-        # (benchmarks/crawl.py and its README: about twice the residual with it).
+        # Not while a temporal history follows a moving camera: it keeps only a small share of
+        # each frame there, too little to average the dither out, which then shimmers
+        # (benchmarks/crawl.py measures it).
         moving = frame.history_kept and not np.array_equal(frame.previous_view_projection,
                                                            frame.view_projection)
         self._dither = 0.0 if moving else \

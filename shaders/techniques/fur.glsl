@@ -34,9 +34,9 @@ vec2 fur_slices(vec2 coord, vec2 dx, vec2 dy, float h) {
 //
 // Triplanar by selection, not by mixing: where the planes' weights overlap, each cell of a
 // volume tile shows the strands of one plane, chosen by a hash of the cell with the weights as
-// the odds. Mixing the planes' coverages laid two sparser patterns of strands over each other:
-// more pixels half covered, the darker roots hidden, and the fur up to 7% brighter (coarse
-// strands) in the blend zones than on an axis. A cell's choice is the same for every shell
+// the odds. Mixing the planes' coverages would lay two sparser patterns of strands over each
+// other: more pixels half covered, the darker roots hidden, and coarse fur brighter in the
+// blend zones than on an axis. A cell's choice is the same for every shell
 // (the base point decides), so strands stay whole inside it.
 #define FUR_SELECT_CELLS 1.0  // selection cells per volume tile (more cut more strands)
 

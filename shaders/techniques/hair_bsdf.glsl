@@ -8,7 +8,7 @@
 // plus Karis's multiple-scattering lobe (a wrapped diffuse about the fibre mixed with
 // Kajiya-Kay's |T x L|), which stands for light scattered through many strands; its colour is
 // the albedo (Karis's sqrt(albedo) goes with a tint from the depth into the fur's shadow, which
-// this framework does not know per light: the square root alone washed the fur out to grey).
+// this framework does not know per light: the square root alone would lift dark colours toward grey).
 // Colour becomes absorption as Karis's: a path through the fibre passes albedo^(length).
 // Angles (Marschner section 2): T the strand direction root to tip, theta the angle of a
 // direction to the normal plane of T (sin theta = T.w), phi the azimuth between the light's and

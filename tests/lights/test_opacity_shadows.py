@@ -174,7 +174,7 @@ def test_shell_fur_deferred_layers_agree_with_forward_on_the_lit_side(gl, direct
 
 def test_gamma_stays_without_shadows(gl):
     """Without a shadowed light there are no opacity maps: self_shadow_density changes
-    nothing (gamma(h) darkens the fur as before)."""
+    nothing (gamma(h) alone darkens the fur)."""
     a = luminance(gl, fur_scene("shell_fur", 0.5, shadows=False))[0]
     b = luminance(gl, fur_scene("shell_fur", 0.0, shadows=False))[0]
     np.testing.assert_array_equal(a, b)

@@ -140,7 +140,7 @@ def outlines(render, scene, times):
 def test_wet_wind_outlines_both_move_and_do_not_repeat(render):
     """wet_wind.toml from t = 2.5 s at 12 frames a second (the gust period is 8 frames): the
     windward (left) and leeward (right) outlines both move, and a gust period later the outline
-    is not where it was (it repeated to a pixel)."""
+    is somewhere else (not repeated to a pixel)."""
     path = ROOT / "examples" / "shell_fur" / "wet_wind.toml"
     scene = scene_from_dict({**tomllib.loads(path.read_text()), "size": [240, 180]}, str(path),
                             base_dir=path.parent)

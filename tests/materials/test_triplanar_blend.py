@@ -1,6 +1,6 @@
 """The fur volume's triplanar lookup (shaders/techniques/fur.glsl) picks one plane per cell
 where the planes' weights overlap: the fur is as bright in a blend zone as on an axis (mixing
-the planes' coverages made coarse fur 6-8% brighter there)."""
+the planes' coverages would make coarse fur brighter there)."""
 
 import numpy as np
 import pytest
