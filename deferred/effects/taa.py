@@ -47,6 +47,7 @@ from deferred.api import (
     Phase,
     Pipeline,
     RenderPass,
+    Scene,
     TargetSpec,
     effects,
     halton,
@@ -203,7 +204,7 @@ class TAA(Effect):
         return not camera_cut(previous.camera, current.camera, self.params.cut_angle,
                               self.params.cut_distance)
 
-    def passes(self, scene, pipeline: str) -> list[RenderPass]:
+    def passes(self, scene: Scene, pipeline: str) -> list[RenderPass]:
         # after the opaque depth: the deferred G-buffer (before any stipple sample), or every
         # forward pass
         phase = Phase.SCREEN if pipeline == Pipeline.DEFERRED else Phase.FORWARD

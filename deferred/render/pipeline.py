@@ -53,7 +53,7 @@ from deferred.lighting.culling import LightCullPass, list_shading_pass
 from deferred.lighting.shadows import ShadowPass, scene_casts_shadows
 from deferred.lighting.volumes import LightTypePass, surface_pass
 from deferred.memo import overrides
-from deferred.scene.model import Scene
+from deferred.scene.model import Scene, SceneObject
 
 # what the pass graph checks beyond the core's rules: the G-buffer's
 GRAPH_RULES = (surfaces_need_depth,)
@@ -110,7 +110,7 @@ def scene_passes(scene: Scene, pipeline: str) -> list[RenderPass]:
     return passes
 
 
-def camera_distance(scene: Scene, obj) -> float:
+def camera_distance(scene: Scene, obj: SceneObject) -> float:
     """How far in front of the camera the centre of ``obj``'s bounds is (its view depth)."""
     low, high = obj.mesh.bounds()
     centre = obj.model @ np.append((low + high) / 2.0, 1.0)

@@ -15,7 +15,7 @@ import os
 import time as clock
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import moderngl
 import numpy as np
@@ -24,6 +24,7 @@ from imgui_bundle import imgui
 from deferred.errors import one_line
 from deferred.gl.targets import FINAL
 from deferred.names import Pipeline
+from deferred.render.renderer import Renderer
 from deferred.viewer import panels
 from deferred.viewer.buffers import (
     ALL_CHANNELS,
@@ -41,6 +42,9 @@ from deferred.viewer.reload import Watcher
 from deferred.viewer.renderers import RendererPool, timed_render
 from deferred.viewer.session import Session
 from deferred.viewer.timeline import Timeline, scene_duration
+
+if TYPE_CHECKING:
+    from moderngl_window.context.base import BaseWindow
 
 PANEL_WIDTH = 400
 MIN_HEIGHT = 640  # the panels' room when the frame is smaller
@@ -71,7 +75,8 @@ def window_size(frame: tuple[int, int], with_panels: bool = True) -> tuple[int, 
             max(height, MIN_HEIGHT if with_panels else height))
 
 
-def make_window(size: tuple[int, int], headless: bool, title: str = "deferred view"):
+def make_window(size: tuple[int, int], headless: bool,
+                title: str = "deferred view") -> BaseWindow:
     """A moderngl-window window: the headless one (EGL, an offscreen framebuffer) or a real
     one (glfw by default; ``DEFERRED_VIEW_WINDOW`` names another moderngl-window backend, e.g.
     pyglet). GL 4.3 where the driver has it (compute shaders: the tiled and clustered light
@@ -272,7 +277,7 @@ class Viewer:
         self.main.upload(display_image(shown, self.exposure, self.channel))
         self.buffers = buffer_names(renderer, scene)
 
-    def full_renderer(self):
+    def full_renderer(self) -> Renderer:
         return self.pool.get(self.session.scene, self.pipeline, self.light_path, self.size)
 
     # -- hot reload ------------------------------------------------------------------------------
