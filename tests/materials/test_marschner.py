@@ -1,12 +1,13 @@
 """The marschner shading model: its GLSL (techniques/hair_bsdf.glsl) against an independent numpy
 reference of the same lobes, and what it does to fur in both pipelines (back-lit tips glow)."""
 
-import importlib.resources
+from pathlib import Path
 
 import moderngl
 import numpy as np
 import pytest
 
+from deferred.gl.shaderlib import ShaderLibrary
 from deferred.scene.loader import scene_from_dict
 
 ETA, TILT, SCATTER = 1.55, -0.06, 0.6
@@ -56,33 +57,17 @@ def unit(v):
     return v / np.linalg.norm(v)
 
 
-VERTEX = """#version 330
-in vec2 in_position;
-void main() { gl_Position = vec4(in_position, 0.0, 1.0); }
-"""
-FRAGMENT = """#version 330
-%s
-uniform sampler2D u_inputs;  // five texels a sample: T, L, V, albedo, (beta, specular)
-out vec4 out_value;
-vec4 input_texel(int sample, int k) { return texelFetch(u_inputs, ivec2(k, sample), 0); }
-void main() {
-    int sample = int(gl_FragCoord.x);
-    vec4 rs = input_texel(sample, 4);
-    out_value = vec4(hair_bsdf(normalize(input_texel(sample, 0).xyz),
-                               normalize(input_texel(sample, 1).xyz),
-                               normalize(input_texel(sample, 2).xyz),
-                               input_texel(sample, 3).xyz, rs.x, rs.y), 1.0);
-}
-"""
+HARNESS = Path(__file__).parents[1] / "fixtures" / "hair_bsdf_harness"
 
 
 def glsl_values(gl, rows):
     """hair_bsdf of each row, one fragment a row (into a float target)."""
-    source = (importlib.resources.files("deferred.shaders") / "techniques" /
-              "hair_bsdf.glsl").read_text()
     ctx = gl.ctx
     gl.make_current()
-    program = ctx.program(vertex_shader=VERTEX, fragment_shader=FRAGMENT % source)
+    gl.park()  # creating a framebuffer re-binds the last one used: ours, not a released one
+    lib = ShaderLibrary(ctx, 330)
+    lib.add_root(HARNESS)
+    program = lib.program("hair_bsdf_harness.vert", "hair_bsdf_harness.frag")
     data = np.zeros((len(rows), 5, 4), np.float32)
     for i, (t, light, v, a, b, s) in enumerate(rows):
         data[i, 0, :3], data[i, 1, :3], data[i, 2, :3], data[i, 3, :3] = t, light, v, a
@@ -91,17 +76,18 @@ def glsl_values(gl, rows):
     inputs.filter = (moderngl.NEAREST, moderngl.NEAREST)
     target = ctx.texture((len(rows), 1), 4, dtype="f4")
     framebuffer = ctx.framebuffer([target])
-    triangle = ctx.buffer(np.array([-1, -1, 3, -1, -1, 3], np.float32).tobytes())
-    vao = ctx.vertex_array(program, [(triangle, "2f", "in_position")])
+    vao = ctx.vertex_array(program, [])
     framebuffer.use()
     ctx.viewport = (0, 0, len(rows), 1)
+    ctx.enable_only(moderngl.NOTHING)
     inputs.use(0)
     program["u_inputs"] = 0
     vao.render(moderngl.TRIANGLES, vertices=3)
     values = np.frombuffer(target.read(), np.float32).reshape(-1, 4)[:, :3].copy()
     gl.park()
-    for thing in (vao, triangle, framebuffer, target, inputs, program):
+    for thing in (vao, framebuffer, target, inputs):
         thing.release()
+    lib.release()
     return values
 
 
