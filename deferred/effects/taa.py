@@ -190,6 +190,9 @@ class TAA(Effect):
         "sharpen": None,  # the sharpen pass's own
     }
 
+    def held_memory(self, size: tuple[int, int]) -> dict[str, int]:
+        return {f"taa history {id(self)}": size[0] * size[1] * 16}  # HeldHistory's RGBA32F
+
     def jitter(self, index: int) -> tuple[float, float]:
         k = index % self.params.jitter_samples + 1
         return (halton(k, 2) - 0.5, halton(k, 3) - 0.5)

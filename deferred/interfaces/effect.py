@@ -103,6 +103,12 @@ class Effect:
     def passes(self, scene: SceneLike, pipeline: str) -> list[RenderPass]:
         raise NotImplementedError
 
+    def held_memory(self, size: tuple[int, int]) -> dict[str, int]:
+        """Bytes the effect holds outside the pass graph's targets at frame ``size`` (a
+        history kept from frame to frame), by what they are; counted with the render targets
+        against the memory budget. By default nothing."""
+        return {}
+
     def jitter(self, index: int) -> tuple[float, float]:
         """A temporal effect's sub-pixel offset (x, y in pixels) of sample ``index`` since the
         history started."""

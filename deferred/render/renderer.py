@@ -145,6 +145,17 @@ def held_memory(scene: Scene) -> dict[str, int]:
     return held
 
 
+def renderer_holdings(scene: Scene, pipeline: str, size: tuple[int, int]) -> dict[str, int]:
+    """What a renderer of ``scene`` holds besides its pass graph's targets: the materials'
+    textures and state, the shadow atlas and opacity maps, the effects' histories."""
+    held = held_memory(scene)
+    if scene_casts_shadows(scene.lights):
+        held.update(atlas_memory(scene.shadow_budget, scene_has_opacity(scene, pipeline)))
+    for effect in scene.effects:
+        held.update(effect.held_memory(size))
+    return held
+
+
 MAX_SAMPLES = 1024  # sub-pixel samples a frame (render_samples)
 
 
@@ -225,9 +236,8 @@ class Renderer:
         self.graph: PassGraph = check_passes(PIPELINES[pipeline](provisional).build(scene))
         # where the frame size came from, for errors about it
         self.size_where = "size" if given else f"{scene.source}: size"
-        held = held_memory(scene)  # counted once: the scene's files are read for it
-        if scene_casts_shadows(scene.lights):
-            held.update(atlas_memory(scene.shadow_budget, scene_has_opacity(scene, pipeline)))
+        # counted again only when parameters change: the scene's files are read for it
+        held = renderer_holdings(scene, pipeline, self.size)
         self._held_bytes = sum(held.values())
         check_target_memory(self.graph, self.size, self.size_where, held, scene.source)
         light_types = scene.light_types()
@@ -310,8 +320,8 @@ class Renderer:
             self._rebuild()
 
     def _count_held_memory(self) -> None:
-        """Count what the materials hold again and check it against the budget."""
-        held = held_memory(self.scene)
+        """Count what the renderer holds again and check it against the budget."""
+        held = renderer_holdings(self.scene, self.pipeline_name, self.size)
         check_target_memory(self.graph, self.size, self.size_where, held, self.scene.source)
         self._held_bytes = sum(held.values())
 
@@ -390,8 +400,8 @@ class Renderer:
 
     def memory_bytes(self) -> int:
         """What the renderer holds as the memory budget counts it: its render targets and the
-        materials' textures and state (:func:`held_memory`, counted again when parameters
-        change)."""
+        materials' textures and state, the shadow maps and the effects' histories
+        (:func:`renderer_holdings`, counted again when parameters change)."""
         return targets_bytes(self.graph.targets.values(), *self.size) + self._held_bytes
 
     @property

@@ -174,3 +174,37 @@ def test_a_texture_set_in_python_counts_against_the_memory_budget(gl, tmp_path, 
         monkeypatch.setenv("DEFERRED_TARGET_MEMORY", str(targets + (8 << 20)))
         renderer.render()
         assert renderer.memory_bytes() == targets + image_texture_bytes(1024, 512)
+
+
+def test_what_a_renderer_holds_counts_shadow_maps_and_histories_after_an_edit(gl):
+    """memory_bytes counts the shadow atlas and TAA's history besides the targets and the
+    materials' holdings, when built and after a parameter edit alike."""
+    from deferred.lighting.shadows import atlas_memory
+    from deferred.render.renderer import Renderer, renderer_holdings
+    from deferred.scene.loader import scene_from_dict
+
+    def build(shadows: bool, taa: bool):
+        return scene_from_dict({
+            "size": [32, 18], "shadows": {"atlas_size": 512},
+            "object": [{"mesh": "builtin:sphere", "material": "standard"}],
+            "light": [{"type": "directional", "shadows": shadows, "cascades": 1,
+                       "shadow_resolution": 128}],
+            "effect": [{"type": "taa"}] if taa else []})
+
+    def held(scene):
+        with Renderer(scene, gl=gl) as renderer:
+            renderer.render()
+            built = renderer.memory_bytes()
+            scene.objects[0].set_params(specular_exponent=12.0)
+            renderer.render()
+            assert renderer.memory_bytes() == built
+            return built
+
+    plain = held(build(False, False))
+    assert held(build(True, False)) - plain == sum(atlas_memory(
+        build(True, False).shadow_budget, False).values())
+    history = {key: size for key, size in renderer_holdings(build(False, True), "deferred",
+                                                             (32, 18)).items()
+               if key.startswith("taa history")}
+    assert list(history.values()) == [32 * 18 * 16]  # RGBA32F, besides taa's own targets
+    held(build(False, True))
