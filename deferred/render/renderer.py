@@ -478,7 +478,9 @@ class Renderer:
         history = self.temporal.begin(self.scene, time, self.size[0] / self.size[1])
         effect = temporal_effect(self.scene)
         if jitter is None:
-            jitter = effect.jitter(history.index) if effect is not None else (0.0, 0.0)
+            # a frame starting a history is not moved: a still with taa is the frame itself
+            jitter = effect.jitter(history.index) if effect is not None and history.index > 0 \
+                else (0.0, 0.0)
         if sample_index is None:
             sample_index = history.index if effect is not None else 0
         inputs = FrameInputs(self.scene, self.object_transforms, self.kept_inputs, self.strict,
@@ -572,6 +574,8 @@ class Renderer:
         for index, jitter in enumerate(halton_offsets(samples)):
             # each sample its own parity of the stipple pattern (sample_index), which the
             # average integrates (Revie's 1-in-4 pattern covers every pixel over four)
+            # each sample alone: a temporal effect's history would average the samples twice
+            self.temporal.reset()
             result = self.render(time=time, hdr=True, jitter=jitter, sample_index=index)
             decoded = srgb_decode(result.image.astype(np.float64) / 255.0)
             light = decoded if light is None else light + decoded

@@ -48,8 +48,8 @@ class TemporalState:
         self.models: dict[int, np.ndarray] = {}
 
     def reset(self) -> None:
-        """Forget the last frame: the next starts a history (a rebuilt renderer's passes hold
-        none)."""
+        """Forget the last frame: the next starts a history (each of render_samples'
+        renders stands alone)."""
         self.moment = None
 
     def begin(self, scene: Scene, time: float, aspect: float) -> FrameHistory:

@@ -70,6 +70,29 @@ def test_sixteen_samples_converge_to_the_supersampled_edges(gl):
     assert sixteen.draws_by_pass and sixteen.draw_calls > 16
 
 
+def test_samples_of_a_scene_with_taa_are_each_alone(gl):
+    """With taa in the scene, each of render_samples' renders starts its own history (else
+    each would already be TAA's running mean, averaged again: the first sample weighted
+    most), so the average is the plain scene's; and a single still with taa is the unmoved
+    frame (the first of a history is not jittered)."""
+    from deferred.effects.taa import TAA
+
+    def with_taa():
+        scene = bare_scene()
+        scene.effects.append(TAA())
+        return scene
+
+    with Renderer(bare_scene(), gl=gl) as renderer:
+        plain_one = renderer.render(hdr=True).hdr
+        plain = renderer.render_samples(8).hdr
+    with Renderer(with_taa(), gl=gl) as renderer:
+        taa = renderer.render_samples(8).hdr
+    with Renderer(with_taa(), gl=gl) as renderer:
+        taa_one = renderer.render(hdr=True).hdr
+    np.testing.assert_allclose(taa, plain, atol=2e-3)
+    np.testing.assert_allclose(taa_one, plain_one, atol=2e-3)
+
+
 def test_bad_sample_counts_are_refused(gl):
     from deferred.errors import InputError
 
