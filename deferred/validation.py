@@ -182,13 +182,19 @@ def _message(error: dict) -> str:
     return message
 
 
+MIN_DIRECTION_LENGTH = 1e-6  # shorter: squaring its components to normalise it underflows
+
+
 def _nonzero(value: tuple[float, float, float]) -> tuple[float, float, float]:
     if not any(value):
         raise ValueError("must not be the zero vector")
+    if math.hypot(*value) < MIN_DIRECTION_LENGTH:
+        raise ValueError(f"is too short to give a direction (length under "
+                         f"{MIN_DIRECTION_LENGTH:g})")
     return value
 
 
-# A direction: three floats, not all zero (normalised where it is used).
+# A direction: three floats, at least MIN_DIRECTION_LENGTH long (normalised where it is used).
 NonZeroVec3 = Annotated[tuple[float, float, float], AfterValidator(_nonzero)]
 
 

@@ -147,6 +147,8 @@ CASES = [
     ("light[0].color", [0.1, INF, 0.1], "finite"),
     ("light[0].ground", [-0.1, 0.0, 0.0], "greater than or equal to 0"),
     ("light[1].direction", [0.0, 0.0, 0.0], "zero vector"),
+    ("light[1].direction", [0.0, -1e-300, 0.0], "too short to give a direction"),
+    ("object[1].params.comb", [0.0, 1e-300, 0.0], "too short to give a direction"),
     ("light[1].direction", [NAN, -1.0, 0.0], "finite"),
     ("light[1].intensity", "bright", "expected a number, not a string"),
     ("light[2].intensity", NAN, "finite"),
