@@ -55,7 +55,7 @@ from deferred.names import Pipeline, ShadowProjection
 if TYPE_CHECKING:
     from deferred.core.frame import Frame
     from deferred.gl.uniforms import ProgramUniforms
-    from deferred.scene.model import Scene
+    from deferred.scene.model import Scene, SceneObject
 
 SHADOW_ATLAS = "shadow_atlas"  # its name on a frame's blackboard
 SHADOWS_DEFINE = "SHADOWS"
@@ -127,7 +127,7 @@ def practical_splits(near: float, far: float, count: int, lam: float) -> np.ndar
     return lam * near * (far / near) ** i + (1.0 - lam) * (near + (far - near) * i)
 
 
-def look_at(eye, direction, up) -> np.ndarray:
+def look_at(eye: np.ndarray, direction: np.ndarray, up: np.ndarray) -> np.ndarray:
     eye = np.asarray(eye, np.float64)
     return pyrr.matrix44.create_look_at(eye, eye + np.asarray(direction, np.float64),
                                         np.asarray(up, np.float64)).T
@@ -175,8 +175,8 @@ class ShadowTile:
     x: int
     y: int
     size: int
-    view_projection: np.ndarray = None  # world -> clip (the caster pass)
-    view: ShadowView = None
+    view_projection: np.ndarray  # world -> clip (the caster pass)
+    view: ShadowView
     # the light's reach (centre, radius) for culling casters; None: every object
     reach: tuple[np.ndarray, float] | None = None
 
@@ -257,7 +257,7 @@ def plan_atlas(lights: list[Light], atlas_size: int, max_lights: int
     return plan, left_out
 
 
-def object_box(obj) -> tuple[np.ndarray, np.ndarray]:
+def object_box(obj: SceneObject) -> tuple[np.ndarray, np.ndarray]:
     """The object-space box of what the object draws: its mesh's, grown by how far its
     material draws beyond the mesh (fur shells, hair: ``Material.motion_extent``)."""
     low, high = obj.mesh.bounds()
@@ -510,7 +510,7 @@ class ShadowAtlas:
             part.release()
 
 
-def object_sphere(obj) -> tuple[np.ndarray, float]:
+def object_sphere(obj: SceneObject) -> tuple[np.ndarray, float]:
     low, high = object_box(obj)
     model = np.asarray(obj.model, np.float64)
     centre = (model @ np.append((low + high) / 2.0, 1.0))[:3]
