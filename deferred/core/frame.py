@@ -219,6 +219,16 @@ class Frame:
         raise gl_error(f"pass {names}", error, (self.width, self.height))
 
     # -- uniforms ------------------------------------------------------------------------------
+    def moved_since_last_frame(self, obj: Any) -> bool:
+        """Whether a temporal history follows a moving camera or a moving ``obj`` this frame
+        (its model differs from the frame before's); False without a history."""
+        if not self.history_kept:
+            return False
+        if not np.array_equal(self.previous_view_projection, self.view_projection):
+            return True
+        previous = (getattr(self.inputs, "previous_models", None) or {}).get(id(obj))
+        return previous is not None and not np.array_equal(previous, obj.model)
+
     def camera_uniforms(self) -> dict[str, Any]:
         return {
             "u_projection": self.projection,

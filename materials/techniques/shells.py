@@ -9,8 +9,6 @@ from __future__ import annotations
 
 from typing import Any
 
-import numpy as np
-
 from deferred.api import DEPTH, ObjectPass, Order, halton
 
 from .fur import FurParams, shell_count, shell_layout
@@ -37,11 +35,10 @@ class DitheredShells:
 
     def draws(self, frame) -> int:
         count = super().draws(frame)
-        # Not while a temporal history follows a moving camera: it keeps only a small share of
-        # each frame there, too little to average the dither out, which then shimmers
-        # (benchmarks/crawl.py measures it).
-        moving = frame.history_kept and not np.array_equal(frame.previous_view_projection,
-                                                           frame.view_projection)
+        # Not while a temporal history follows a moving camera or object: it keeps only a small
+        # share of each frame there, too little to average the dither out, which then
+        # shimmers (benchmarks/crawl.py measures it).
+        moving = frame.moved_since_last_frame(self.obj)
         self._dither = 0.0 if moving else \
             shell_dither(frame.sample_index) / max(self.slabs(self._count), 1.0)
         return count

@@ -387,3 +387,30 @@ def test_no_dark_stipple_dots_inside_the_fur_seen_from_afar(gl):
     darker = images["forward"].mean(axis=-1) - images["deferred"].mean(axis=-1) > 25
     assert inside.sum() > 500
     assert not np.any(darker & inside & stipple_class)
+
+
+@pytest.mark.parametrize("moving", [False, True])
+def test_the_shell_dither_stops_while_taa_follows_a_moving_object(gl, moving):
+    """Under a still camera with taa, the shells dither from frame to frame where the object
+    holds still (the history averages it), and not while the object moves (the history keeps
+    too little of each frame to average it: it would shimmer)."""
+    from deferred.render.renderer import Renderer
+    from deferred.scene.loader import scene_from_dict
+
+    keys = [{"time": 0.0, "position": [0.0, 0.0, 0.0]},
+            {"time": 1.0, "position": [0.5 if moving else 0.0, 0.0, 0.0]}]
+    scene = scene_from_dict({
+        "size": [48, 36], "effect": [{"type": "taa"}],
+        "camera": {"position": [0.0, 0.0, 2.6], "target": [0.0, 0.0, 0.0]},
+        "object": [{"name": "ball", "mesh": "builtin:sphere", "material": "revie_fur",
+                    "params": {"shells": 8, "stipple": False}}],
+        "track": [{"target": "object:ball", "interpolation": "linear", "keys": keys}],
+        "light": [{"type": "directional", "direction": [-0.3, -0.5, -1.0]}]})
+    with Renderer(scene, gl=gl) as renderer:
+        dithers = []
+        for k in range(3):
+            renderer.render(time=k / 30.0)
+            dithers.append([p._dither for p in renderer.passes if hasattr(p, "_dither")])
+    assert dithers[0] and all(d == 0.0 for d in dithers[0])  # a history's first frame
+    later = [d for frame in dithers[1:] for d in frame]
+    assert all(d == 0.0 for d in later) if moving else all(d != 0.0 for d in later)
