@@ -17,11 +17,11 @@ Passes:
 - ``post.taa_sharpen``: the result into the composite, optionally sharpened.
 
 The history starts again (the frame alone) on a cut, the camera turning or moving more than
-``cut_angle`` / ``cut_distance`` in a frame, and on a seek: a time before the last frame's, a
-step more than ``max_step``, or a step other than the last one's (a still frame, the same time
-again, keeps it). Per-sample patterns follow the sample index since it started: the stipple's
-parity (``techniques/stipple.glsl``) covers every pixel of its 2x2 tile over four frames, so
-the history integrates it.
+``cut_angle`` / ``cut_distance`` in a frame, and on a seek: a time before the last frame's or
+a step more than ``max_step`` (a still frame, the same time again, keeps it, and so does a step
+of another length than the last one's). Per-sample patterns follow the sample index since it
+started: the stipple's parity (``techniques/stipple.glsl``) covers every pixel of its 2x2 tile
+over four frames, so the history integrates it.
 """
 
 from __future__ import annotations
@@ -199,11 +199,10 @@ class TAA(Effect):
 
     def keeps_history(self, previous: FrameMoment, current: FrameMoment) -> bool:
         step = current.step
+        # A step back or a long one is a seek; a step of another length is not: a viewer plays
+        # by the window's frames, whose time steps vary, and the motion vectors follow it.
         if step is None or step < 0.0 or step > self.params.max_step:
             return False
-        if step > 0.0 and previous.step is not None and previous.step > 0.0 and \
-                abs(step - previous.step) > 1e-6 * max(step, previous.step, 1.0):
-            return False  # not the next frame of the sequence: a seek
         return not camera_cut(previous.camera, current.camera, self.params.cut_angle,
                               self.params.cut_distance)
 

@@ -7,6 +7,8 @@ deterministic whatever was shown before it.
 
 from __future__ import annotations
 
+import math
+
 from deferred.scene.model import Scene
 
 DEFAULT_DURATION = 10.0  # seconds, for a scene whose timeline says nothing longer
@@ -34,9 +36,11 @@ class Timeline:
         self.time = time
         self.playing = False
         self.loop = True
+        self._unspent = 0.0  # wall seconds played that do not make a whole frame yet
 
     def scrub(self, time: float) -> None:
         self.time = min(max(float(time), 0.0), self.duration)
+        self._unspent = 0.0
 
     def step(self, frames: int = 1) -> None:
         """Move by whole frames (1 / fps each) and pause."""
@@ -45,12 +49,21 @@ class Timeline:
 
     def toggle(self) -> None:
         self.playing = not self.playing
+        self._unspent = 0.0
 
     def advance(self, seconds: float) -> bool:
-        """Run the clock by ``seconds`` of wall time while playing; whether the time changed."""
+        """Run the clock by ``seconds`` of wall time while playing, in whole frames (1 / fps
+        each; the rest is carried to the next call), so that the frames shown are the
+        sequence's and a temporal effect sees steps of whole frames; whether the time
+        changed."""
         if not self.playing or seconds <= 0.0:
             return False
-        time = self.time + seconds
+        self._unspent += seconds
+        frames = math.floor(self._unspent * self.fps + 1e-9)
+        if frames < 1:
+            return False
+        self._unspent = max(self._unspent - frames / self.fps, 0.0)
+        time = self.time + frames / self.fps
         if time > self.duration:
             time = time % self.duration if self.loop else self.duration
             if not self.loop:

@@ -7,7 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from deferred.effects.taa import camera_cut
+from deferred.effects.taa import TAA, camera_cut
+from deferred.interfaces.effect import FrameMoment
 from deferred.io.images import srgb_decode, srgb_encode
 from deferred.render.renderer import Renderer
 from deferred.scene.camera import Camera
@@ -205,6 +206,27 @@ def test_a_cut_or_a_seek_starts_the_history_again(gl, pipeline):
         assert np.array_equal(fresh.render(time=6 / FPS).image, cut)
     with Renderer(scene, pipeline, gl=gl) as fresh:
         assert np.array_equal(fresh.render(time=2 / FPS).image, seek)
+
+
+def test_only_a_step_back_or_over_max_step_is_a_seek():
+    """A step of another length than the last (a viewer playing by the window's frames) keeps
+    the history; a step back, or over ``max_step``, starts it again."""
+    taa, camera = TAA(), Camera(position=(0.0, 0.3, 3.0))
+    last = FrameMoment(0.0, camera, None, 1 / 60)
+    assert taa.keeps_history(last, FrameMoment(0.1, camera, None, 1 / 59))
+    assert taa.keeps_history(last, FrameMoment(0.0, camera, None, 0.0))  # a still frame
+    assert not taa.keeps_history(last, FrameMoment(0.0, camera, None, -1 / 60))
+    assert not taa.keeps_history(last, FrameMoment(0.3, camera, None, 0.3))  # max_step 0.25
+
+
+def test_steps_of_varying_length_keep_the_history(gl):
+    """Frames at irregular times forward (a window's frame rate) carry one history on."""
+    scene = scene_with([SPHERE, WALL])
+    with Renderer(scene, "deferred", gl=gl) as renderer:
+        for k, time in enumerate((0.0, 1 / 60, 1 / 60 + 1 / 59, 0.05, 0.09)):
+            renderer.render(time=time)
+            assert renderer.last_frame.history_kept == (k > 0)
+            assert renderer.last_frame.sample_index == k
 
 
 def test_what_is_a_cut():
