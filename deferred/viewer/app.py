@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 import os
 import time as clock
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -155,6 +156,8 @@ class Viewer:
         self.record_path = "view.mp4"
         self.panel_errors: list[str] = []  # the errors the panels drew last (tests read them)
         # input and what is shown
+        # the clock input, interaction and playback read (tests set their own)
+        self.now: Callable[[], float] = clock.perf_counter
         self.last_input = -math.inf
         self.dragging: int | None = None
         self.mouse = (-1.0, -1.0)  # the pointer's last window position
@@ -163,7 +166,7 @@ class Viewer:
         self.shown_reduced = False
         self.shaders_generation = 0
         self._material_scene: tuple[tuple, Any] | None = None
-        self._last_tick = clock.perf_counter()
+        self._last_tick = self.now()
         self._frame_times: list[float] = []
         self.keys = key_codes(window)
         self._attach_events()
@@ -174,7 +177,7 @@ class Viewer:
 
     # -- frames ----------------------------------------------------------------------------------
     def interacting(self, now: float | None = None) -> bool:
-        now = clock.perf_counter() if now is None else now
+        now = self.now() if now is None else now
         return now - self.last_input < INTERACTION_SECONDS
 
     def state_key(self) -> tuple:
@@ -185,7 +188,7 @@ class Viewer:
 
     def tick(self) -> None:
         """Once a window frame: the clock, fly keys, hot reload, then a new frame if needed."""
-        now = clock.perf_counter()
+        now = self.now()
         seconds, self._last_tick = now - self._last_tick, now
         if self.recording is not None and self.timeline.playing:
             self.timeline.advance(1.0 / self.timeline.fps)  # every recorded frame, in turn
@@ -308,7 +311,7 @@ class Viewer:
 
     def touch(self) -> None:
         """Input happened: reduced frames for a moment."""
-        self.last_input = clock.perf_counter()
+        self.last_input = self.now()
 
     def inspect(self, x: int, y: int) -> list[str]:
         """The pixel history of frame pixel (x, y), top-down, for the inspector panel."""

@@ -296,15 +296,50 @@ def test_split_and_difference_views_report_psnr(scene_file, make_viewer, gl):
 
 
 def test_interaction_draws_reduced_frames_and_refines_when_idle(scene_file, make_viewer):
+    from deferred.viewer.app import INTERACTION_SECONDS
+
     viewer = make_viewer(scene_file, reduce=2)
+    now = [100.0]
+    viewer.now = lambda: now[0]  # the viewer's clock, not the wall's
     shown(viewer)
     viewer.mouse_press(480, 60, 1)
     viewer.mouse_drag(490, 60, 10, 0)
+    assert viewer.last_input == 100.0
     assert viewer.update()
     assert viewer.shown_reduced and viewer.main.texture.size == (80, 60)
-    viewer.last_input -= 1.0  # input stopped a second ago
+    now[0] += INTERACTION_SECONDS / 2  # input still recent: the reduced frame stands
+    assert not viewer.update()
+    now[0] += INTERACTION_SECONDS  # input stopped
     assert viewer.update()
     assert not viewer.shown_reduced and viewer.main.texture.size == SIZE
+
+
+TAA_SCENE = SCENE + '\n[[effect]]\ntype = "taa"\nstill_samples = 4\n'
+
+
+def test_playing_steps_whole_frames_and_taa_keeps_its_history(tmp_path, make_viewer):
+    """Playing, the clock moves by whole frames (1 / fps) whatever the window's frame times,
+    and taa's history carries on from frame to frame (no restart each frame)."""
+    path = tmp_path / "taa.toml"
+    path.write_text(TAA_SCENE)
+    viewer = make_viewer(path)
+    now = [100.0]
+    viewer.now = lambda: now[0]
+    viewer._last_tick = now[0]
+    shown(viewer)
+    viewer.timeline.toggle()
+    wall, times = 0.0, []
+    for seconds in (0.03, 0.02, 0.05, 0.035, 0.09, 0.045):
+        now[0] += seconds
+        wall += seconds
+        viewer.tick()
+        frames = viewer.timeline.time * viewer.timeline.fps
+        assert frames == pytest.approx(round(frames), abs=1e-9)  # a whole frame
+        assert round(frames) == int(wall * viewer.timeline.fps + 1e-9)
+        times.append(viewer.timeline.time)
+        if viewer.timeline.time > 0.0:  # a frame after the first
+            assert viewer.full_renderer().last_frame.history_kept
+    assert len(set(times)) > 3  # it played
 
 
 def test_pixel_inspector_lists_the_passes_of_a_clicked_pixel(scene_file, make_viewer):
