@@ -26,6 +26,7 @@ from deferred.errors import one_line
 from deferred.gl.targets import FINAL
 from deferred.names import Pipeline
 from deferred.render.renderer import Renderer
+from deferred.render.temporal import temporal_effect
 from deferred.viewer import panels
 from deferred.viewer.buffers import (
     ALL_CHANNELS,
@@ -54,6 +55,8 @@ INTERACTION_SECONDS = 0.25  # input this recent draws reduced frames
 # that, with the window's own drawing, interaction stays near 15 frames a second
 REDUCTIONS = (2, 3, 4, 6, 8)
 INTERACTIVE_BUDGET_MS = 45.0
+# At most this many frames of an unchanged state are drawn (a temporal history converging)
+STILL_FRAMES = 256
 BACKGROUND = (0.11, 0.11, 0.12)
 MODES = ("single", "split", "difference")
 
@@ -167,6 +170,7 @@ class Viewer:
         self.shaders_generation = 0
         self._material_scene: tuple[tuple, Any] | None = None
         self._last_tick = self.now()
+        self.still_frames = 0  # frames drawn again for an unchanged state (a history converging)
         self._frame_times: list[float] = []
         self.keys = key_codes(window)
         self._attach_events()
@@ -199,12 +203,14 @@ class Viewer:
         self.update()
 
     def update(self, force_full: bool = False) -> bool:
-        """Draw a new frame of the scene if anything it depends on changed (or a reduced one
-        stands and input stopped); whether one was drawn. A failure keeps the frame shown and
-        its error for the panel."""
+        """Draw a new frame of the scene if anything it depends on changed, a reduced one
+        stands and input stopped, or a temporal effect's history has not yet accumulated its
+        still samples for the frame shown; whether one was drawn. A failure keeps the frame
+        shown and its error for the panel."""
         interacting = self.interacting() and not force_full
         key = self.state_key()
-        if key == self.shown_key and (not self.shown_reduced or interacting):
+        same = key == self.shown_key
+        if same and (interacting if self.shown_reduced else not self.converging()):
             return False
         self.pool.gl.make_current()  # another context (a renderer of the caller's) may be
         full = not interacting or self.reduce == 1
@@ -220,10 +226,22 @@ class Viewer:
         else:
             self.render_error = self.render_exception = None
         self.frame_ms = (clock.perf_counter() - start) * 1000.0
+        self.still_frames = self.still_frames + 1 if same and full and not self.shown_reduced \
+            else 0
         self.shown_key, self.shown_reduced = key, not full
         if not full and self.adaptive and self.render_error is None:
             self._adapt(self.frame_ms)
         return True
+
+    def converging(self) -> bool:
+        """Whether the full frame shown is a temporal effect's (taa) history still short of
+        its ``still_samples``: a still camera draws again until then (each frame adds a sample
+        with another jitter), then stops."""
+        effect = temporal_effect(self.session.scene)
+        if effect is None or self.render_error is not None:
+            return False
+        samples = getattr(effect.params, "still_samples", STILL_FRAMES)
+        return self.still_frames + 1 < min(samples, STILL_FRAMES)
 
     def _adapt(self, ms: float) -> None:
         """The next reduced frames one step smaller when this one took longer than the

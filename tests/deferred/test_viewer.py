@@ -342,6 +342,28 @@ def test_playing_steps_whole_frames_and_taa_keeps_its_history(tmp_path, make_vie
     assert len(set(times)) > 3  # it played
 
 
+def test_a_still_camera_with_taa_draws_until_its_samples_are_in_then_stops(scene_file, tmp_path,
+                                                                          make_viewer):
+    """Nothing changing, the viewer draws again while taa's history has fewer than
+    still_samples (4) frames, then draws nothing more; without taa it draws nothing more."""
+    path = tmp_path / "taa.toml"
+    path.write_text(TAA_SCENE)
+    viewer = make_viewer(path)
+    first = shown(viewer)
+    drawn = 0
+    while viewer.update() and drawn < 10:
+        drawn += 1
+    assert drawn == 3
+    assert viewer.full_renderer().last_frame.sample_index == 3
+    assert not np.array_equal(viewer.viewport_image(), first)  # samples accumulated
+    assert not viewer.update()
+    viewer.timeline.step()  # a new frame: the history continues, drawn again to converge
+    assert viewer.update()
+    plain = make_viewer(scene_file)
+    shown(plain)
+    assert not plain.update()
+
+
 def test_pixel_inspector_lists_the_passes_of_a_clicked_pixel(scene_file, make_viewer):
     viewer = make_viewer(scene_file)
     shown(viewer)
