@@ -65,7 +65,7 @@ from .techniques.strands import (
     triangle_strands,
 )
 from .techniques.wetness import (
-    blend_droplet,
+    UVSeams,
     dry_mask,
     dry_out,
     footprint_texels,
@@ -195,7 +195,7 @@ def droplet_texels(obj: SceneObject, time: float) -> tuple[int, str]:
     :class:`ShellFurState` rains them), and where the droplets that pass
     :data:`MAX_DROPLET_TEXELS` were asked for (the object's params or an event's)."""
     first = _params_at(obj, 0.0)
-    wrap, fallen, texels = None, 0, 0
+    wrap, seams, fallen, texels = None, None, 0, 0
     named = getattr(obj, "where", None)
     where = f"{named}.params" if named else f"{obj.label}: params"
     blame = where
@@ -204,10 +204,11 @@ def droplet_texels(obj: SceneObject, time: float) -> tuple[int, str]:
         params = _params_at(obj, at)
         if params.droplets > fallen:
             wrap = uv_wrap(obj.mesh) if wrap is None else wrap
+            seams = UVSeams(obj.mesh) if seams is None else seams
             texels += footprint_texels(
                 random_droplets(obj.mesh, obj.model, params.droplets - fallen,
                                 params.droplet_radius, params.droplet_wetness, params.seed,
-                                start=fallen), first.mask_size, wrap)
+                                start=fallen), first.mask_size, wrap, seams)
             fallen = params.droplets
             if texels > MAX_DROPLET_TEXELS and blame is where:
                 latest = [e for e in events if e.time <= at and "droplets" in e.params]
@@ -301,6 +302,7 @@ class ShellFurState:
         self.average = VertexAverage(obj.mesh)
         self.size = params.mask_size
         self.wrap = uv_wrap(obj.mesh)
+        self.seams = UVSeams(obj.mesh)  # droplets near a chart's seam wet the chart across it
         self.world_per_uv = mean_uv_scale(obj.mesh, self.model)
         self.mask_texture = _float_texture(ctx, self.size, self.size)
         self.mask_texture.repeat_x = self.mask_texture.repeat_y = True
@@ -394,7 +396,7 @@ class ShellFurState:
                                            params.droplets - self.fallen, params.droplet_radius,
                                            params.droplet_wetness, params.seed,
                                            start=self.fallen):
-                blend_droplet(self.mask, droplet, self.wrap)
+                self.seams.blend(self.mask, droplet, self.wrap)
             self.fallen = params.droplets
             self._uploaded = None
 

@@ -31,9 +31,10 @@ import numpy as np  # noqa: E402
 from deferred.debug.views import with_material_view  # noqa: E402
 from deferred.io.images import read_image, write_image  # noqa: E402
 from deferred.materials.techniques.wetness import (  # noqa: E402
-    blend_droplet,
+    UVSeams,
     dry_mask,
     random_droplets,
+    uv_wrap,
 )
 from deferred.render.renderer import Renderer  # noqa: E402
 from deferred.scene.loader import scene_from_dict  # noqa: E402
@@ -167,9 +168,10 @@ def object_mask(data: dict, size: int = 256) -> tuple[np.ndarray, object]:
     obj = scene.objects[0]
     params = obj.material.params
     mask = dry_mask(size)
+    seams, wrap = UVSeams(obj.mesh), uv_wrap(obj.mesh)
     for droplet in random_droplets(obj.mesh, obj.model, params.droplets, params.droplet_radius,
                                    params.droplet_wetness, params.seed):
-        blend_droplet(mask, droplet)
+        seams.blend(mask, droplet, wrap)
     return mask, obj.mesh
 
 
