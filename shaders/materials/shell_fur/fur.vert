@@ -6,7 +6,8 @@
 // at a UV seam).
 // v_strand_tangent is the strand's direction there (d v_offset / dh), or with STRAND_CHORD the
 // strand's chord, root to simulated tip (the base surface, the skin and the fins: one direction
-// for the whole strand, the curl averaged out). With FUR_FINS the outputs feed the fin geometry
+// for the whole strand, the curl averaged out); the layers have the chord too (v_strand_chord).
+// With FUR_FINS the outputs feed the fin geometry
 // shader (techniques/fins.geom) under vs_ names.
 #include "materials/shell_fur/strand.glsl"
 
@@ -62,6 +63,9 @@ out vec3 v_fur_position;  // the root in world-scaled object space (fur volume l
 out vec3 v_fur_normal;    // object-space normal (triplanar weights)
 out vec3 v_tip_position;  // view space (fins)
 out vec3 v_strand_tangent;  // view space
+#if !defined(STRAND_CHORD) && !defined(FUR_FINS)
+out vec3 v_strand_chord;    // view space: the chord, as the base surface was lit (shell.frag)
+#endif
 
 invariant gl_Position;
 
@@ -116,6 +120,10 @@ void main() {
     v_fur_normal = in_normal;
     v_tip_position = tip_view.xyz;
     v_strand_tangent = normalize(mat3(model_view) * direction);
+#if !defined(STRAND_CHORD) && !defined(FUR_FINS)
+    vec3 chord = tip - in_position;
+    v_strand_chord = normalize(mat3(model_view) * (dot(chord, chord) > 1e-20 ? chord : in_normal));
+#endif
 #if defined(SHADOW_CASTER) && !defined(OPACITY_CASTER)
     // drawn from the light (deferred.api.SHADOW_CASTER_DEFINES): the fur casts a strand's
     // length further from the light, onto other surfaces but not onto its own skin and

@@ -4,38 +4,34 @@
 // lights shaded the base surface with kajiya_kay along the strand's chord, the G-buffer's
 // strand_tangent), divided by the base albedo and multiplied by this layer's colour and the
 // shadow factor gamma(h) (Eq. 6); the root's light comes from the fur_light gather, made once
-// per pixel for the frame (techniques/fur_light.glsl). So the layers cost the same whatever the
-// number of lights; what they lose against the forward pipeline is the tangent of each layer
-// (one per strand here) and the light's variation between the root and the layer.
+// per pixel for the frame (techniques/fur_light.glsl). Each layer then shades the full-screen
+// lights again along its own tangent against the chord (layer_light: a curl's light and dark
+// bands); what the layers lose against the forward pipeline is the volume lights' variation
+// with the tangent and the light's variation between the root and the layer.
 #include "techniques/fur.glsl"
 #include "techniques/accumulated_light.glsl"
 #include "techniques/fur_light.glsl"
 #include "materials/shell_fur/layer.glsl"
 #include "materials/shell_fur/color.glsl"
 #include "materials/shell_fur/debug.glsl"
-#if defined(SHADOWS) && defined(OPACITY_SHADOWS) && defined(OPACITY_RECEIVER)
-// Self-shadowing (deep opacity maps, lights/shadows.glsl): the summed light read at the root
-// holds each shadowed light whole; each is evaluated again at this layer (Kajiya-Kay along the
-// strand's chord, as the base surface was lit) for the transmittance-weighted share to scale
-// (self_shadowed), gamma(h) staying on the rest (the forward layers' split)
-#define FUR_LAYER_SELF_SHADOW
+#ifndef STRAND_CHORD
+// The layers (not the fins, lit along the chord like the base surface) shade again with their
+// own tangent: the curl's light and dark bands (layer_light)
+#define FUR_LAYER_RESHADE
 #include "common/light_buffer.glsl"
 #include "generated/lights.glsl"
 #include "techniques/strand_tangent.glsl"
 in vec3 v_position;
 in vec3 v_normal;
-in vec3 v_strand_tangent;
+in vec3 v_strand_tangent;  // this layer's, along the curl (fur.vert)
+in vec3 v_strand_chord;    // the strand's chord, as the base surface was lit
 uniform float u_specular_intensity;  // K_s
 uniform float u_specular_exponent;   // p_phong
 #ifdef FUR_MARSCHNER
 uniform float u_roughness;
 #endif
 
-// The light read at the root (irradiance, before gamma) with the shadowed lights' share of it
-// scaled by their transmittance here: each shadowed light evaluated again at this layer (e_i),
-// f = sum(e_i T_i / gamma) / sum(e_i), and the share sum(e_i) / irradiance (at most 1: where the
-// layer sees a light its root did not, at the terminator, the root's light is all it has)
-vec3 self_shadowed(vec3 irradiance, vec3 albedo, float gamma, float wetness) {
+Surface layer_surface(vec3 albedo, float wetness, vec3 tangent) {
     Surface s;
     s.albedo = albedo;
     s.specular_intensity = wet_specular_intensity(u_specular_intensity, wetness);
@@ -48,7 +44,45 @@ vec3 self_shadowed(vec3 irradiance, vec3 albedo, float gamma, float wetness) {
     s.occlusion = 1.0;
     s.view_depth = -v_position.z;
     s.shading_model = surface_shading_model(u_surface_id);
-    s.data.strand_tangent = strand_tangent_encode(v_strand_tangent);
+    s.data.strand_tangent = strand_tangent_encode(tangent);
+    return s;
+}
+
+// The light read at the root (irradiance, before gamma) re-shaded along this layer's tangent:
+// the full-screen lights (ambient, directional) evaluated here along the chord (c, as the root
+// was lit) and along the layer's curled tangent (t), per channel. Where c is a share of the
+// root's light at most 1 it is swapped for t (irradiance - c + t); where the root saw less
+// (its shadow), the root's light is scaled by t / c. The volume lights keep the chord's. The
+// shadowed lights are evaluated without their transmittance, which self_shadowed applies.
+vec3 layer_light(vec3 irradiance, vec3 albedo, float wetness) {
+    vec3 V = normalize(-v_position);
+    vec3 scale = 1.0 / max(albedo, vec3(1.0 / 255.0));
+#if defined(SHADOWS) && defined(OPACITY_SHADOWS) && defined(OPACITY_RECEIVER)
+    opacity_split = true;  // the root's light holds the shadowed lights whole (self_shadowed)
+#endif
+    vec3 c = evaluate_fullscreen_lights(layer_surface(albedo, wetness, v_strand_chord),
+                                        v_position, V) * scale;
+    vec3 t = evaluate_fullscreen_lights(layer_surface(albedo, wetness, v_strand_tangent),
+                                        v_position, V) * scale;
+    vec3 share = clamp(c / max(irradiance, vec3(1e-6)), 0.0, 1.0);
+    return irradiance * mix(vec3(1.0), t / max(c, vec3(1e-6)), share);
+}
+#endif
+
+#if defined(SHADOWS) && defined(OPACITY_SHADOWS) && defined(OPACITY_RECEIVER) \
+    && defined(FUR_LAYER_RESHADE)
+// Self-shadowing (deep opacity maps, lights/shadows.glsl): the summed light read at the root
+// holds each shadowed light whole; each is evaluated again at this layer (Kajiya-Kay along the
+// layer's tangent) for the transmittance-weighted share to scale (self_shadowed), gamma(h)
+// staying on the rest (the forward layers' split)
+#define FUR_LAYER_SELF_SHADOW
+
+// The light read at the root (irradiance, before gamma) with the shadowed lights' share of it
+// scaled by their transmittance here: each shadowed light evaluated again at this layer (e_i),
+// f = sum(e_i T_i / gamma) / sum(e_i), and the share sum(e_i) / irradiance (at most 1: where the
+// layer sees a light its root did not, at the terminator, the root's light is all it has)
+vec3 self_shadowed(vec3 irradiance, vec3 albedo, float gamma, float wetness) {
+    Surface s = layer_surface(albedo, wetness, v_strand_tangent);
     vec3 V = normalize(-v_position);
     const vec3 LUMA = vec3(0.2126, 0.7152, 0.0722);
     float total = 0.0;
@@ -120,6 +154,9 @@ void main() {
 #endif
     if (!base_valid && !own_valid) discard;  // the strand's light is unknown
     if (own_valid) irradiance = own_irradiance;
+#ifdef FUR_LAYER_RESHADE
+    irradiance = layer_light(irradiance, albedo / fur_shadow(v_shell_depth), fur_wetness(v_uv));
+#endif
 #ifdef FUR_LAYER_SELF_SHADOW
     irradiance = self_shadowed(irradiance, albedo / fur_shadow(v_shell_depth),
                                fur_shadow(v_shell_depth), fur_wetness(v_uv));
