@@ -1,8 +1,9 @@
 """Fur self-shadowing (#27) in docs/figures/fur_self_shadowing.png: the demo with shadows
 (examples/shadows_demo.toml) in the forward pipeline without self-shadowing (gamma(h) only,
-self_shadow_density = 0) and with it (the deep opacity maps, the default), and the deferred
-pipeline (which takes the fur's light from its skin and draws no opacity maps); the whole
-frame and a close-up of the ball's side away from the key light. Run from the repository root:
+self_shadow_density = 0) and with it (the deep opacity maps, the default), and the same two in
+the deferred pipeline (whose shells correct the light they read from the skin and stipple
+samples by each shadowed light's transmittance); the whole frame and a close-up of the ball's
+side away from the key light. Run from the repository root:
 python examples/self_shadow_figures.py"""
 
 from __future__ import annotations
@@ -45,7 +46,8 @@ def main() -> None:
     columns = []
     for pipeline, density, title in (("forward", 0.0, "forward, without self-shadowing"),
                                      ("forward", None, "forward, deep opacity maps"),
-                                     ("deferred", None, "deferred (gamma(h) only)")):
+                                     ("deferred", 0.0, "deferred, without self-shadowing"),
+                                     ("deferred", None, "deferred, deep opacity maps")):
         with Renderer(demo(density), pipeline, SIZE) as renderer:
             image = renderer.render().image[..., :3]
         x0, y0, x1, y1 = CROP

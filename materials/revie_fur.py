@@ -33,6 +33,7 @@ from deferred.api import (
     NonZeroVec3,
     Phase,
     RenderPass,
+    lights,
     materials,
 )
 
@@ -159,6 +160,7 @@ class RevieFurMaterial(FurMaterial):
 
     debug_views = FUR_DEBUG_VIEWS
     fur_vertex = FUR_VERTEX
+    deferred_opacity = True  # its shells correct their samples' light light by light (shell.frag)
 
     def shadow_textures(self, frame: Frame, obj: SceneObject) -> dict[str, moderngl.Texture]:
         return comb_field_inputs(frame, obj)
@@ -171,6 +173,9 @@ class RevieFurMaterial(FurMaterial):
             defines["FUR_OCCLUSION_TEST"] = "1"
         if self.params.shading == "marschner":
             defines["FUR_MARSCHNER"] = "1"
+        ambient = dict(lights.items()).get("ambient")
+        if ambient is not None:  # the light self-shadowing leaves in the shells (shell.frag)
+            defines["FUR_AMBIENT_LIGHT"] = str(ambient.type_id)
         return {**defines, **debug_defines(self.params)}
 
     # -- passes ------------------------------------------------------------------------------

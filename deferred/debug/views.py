@@ -99,8 +99,8 @@ def with_material_view(scene: Scene, name: str) -> Scene | None:
 def check_material_view(scene: Scene, name: str, pipeline: str) -> None:
     """Refuse a material view the scene or pipeline cannot show: ``<fur>.opacity_shadow``
     needs a shadowed light and a pipeline whose shells read the deep opacity maps (forward;
-    deferred where the material's ``deferred_opacity`` says so: not revie_fur, whose deferred
-    shells take their light summed from the skin's pixels)."""
+    deferred where the material's ``deferred_opacity`` says so, as both built-in furs' does:
+    a plugin's fur whose deferred passes do not read them is refused there)."""
     if not name.endswith(".opacity_shadow"):
         return
     if not any(light.casts_shadows for light in scene.lights):
@@ -110,9 +110,8 @@ def check_material_view(scene: Scene, name: str, pipeline: str) -> None:
     if pipeline != "forward" and not any(obj.material.name == material and
                                          obj.material.deferred_opacity
                                          for obj in scene.objects):
-        raise InputError(f"view '{name}' shows the deep opacity maps the forward shells read "
-                         "(the deferred shells take their light from the skin): use "
-                         "--pipeline forward", "--view")
+        raise InputError(f"view '{name}' shows the deep opacity maps, which {material}'s "
+                         "deferred passes do not read: use --pipeline forward", "--view")
 
 
 def view_catalogue(passes: Sequence[RenderPass], scene: Scene | None = None

@@ -13,9 +13,26 @@
 #include "techniques/fur.glsl"
 #include "materials/revie_fur/slab.glsl"
 #include "techniques/accumulated_light.glsl"
+#if defined(SHADOWS) && defined(OPACITY_SHADOWS) && defined(OPACITY_RECEIVER)
+// Self-shadowing (deep opacity maps, lights/shadows.glsl): the light read at the base and
+// stipple samples holds each shadowed light whole; each is evaluated again at this shell (the
+// surface the samples were lit with: the grain normal, and with FUR_STIPPLE the rim-bent one,
+// the brighter, as the forward shells) for the transmittance-weighted share to scale
+// (self_shadowed), gamma(h) staying on the rest (the forward shells' split)
+#define FUR_LAYER_SELF_SHADOW
+#include "common/light_buffer.glsl"
+#include "generated/lights.glsl"
+#include "techniques/rim.glsl"
+// material_surface (the grain normal) and u_albedo_tip
+#include SURFACE_FILE
+in vec2 v_uv;
+uniform float u_rim_strength;
+uniform float u_rim_falloff;
+#else
+uniform vec3 u_albedo_tip;
+#endif
 
 uniform vec3 u_albedo_base;
-uniform vec3 u_albedo_tip;
 uniform float u_shell_fade;    // the outermost shell fades in with the level of detail
 uniform float u_shell_weight;  // slices of the fur volume per shell (shell_opacity)
 uniform float u_shell_count;   // shells drawn / the most (the shell_count debug view)
@@ -39,6 +56,60 @@ in float v_fin_fade;
 #endif
 
 out vec4 out_color;
+
+#ifdef FUR_LAYER_SELF_SHADOW
+// The light read from the samples (irradiance, before gamma) with the shadowed lights' share of
+// it scaled by their transmittance here: each shadowed light evaluated again at this shell
+// (e_i), f = sum(e_i T_i / gamma) / sum(e_i), and the share sum(e_i) / irradiance, at most what
+// the ambient (FUR_AMBIENT_LIGHT, evaluated here too) leaves of it: where the shell sees more of
+// a light than its samples did, past their terminator, the ambient in their light is kept, so
+// the fur there falls to its ambient light and turns no black
+vec3 self_shadowed(vec3 irradiance, float gamma) {
+    SurfaceInput i;
+    i.position = v_position;
+    i.normal = normalize(v_normal);
+    i.tangent = normalize(v_tangent);
+    i.binormal = normalize(v_binormal);
+    i.uv = v_uv;
+    i.comb = v_comb;
+    Surface s = material_surface(i);
+    s.shading_model = surface_shading_model(u_surface_id);
+    s.occlusion = 1.0;
+#if defined(FUR_STIPPLE) && !defined(FUR_MARSCHNER)  // the stipple sample's rim-bent normal
+    Surface rim = s;
+    rim.normal = rim_bend(i.normal, s.normal, normalize(v_position), u_rim_strength,
+                          u_rim_falloff);
+#endif
+    vec3 V = normalize(-v_position);
+    vec3 inverse_albedo = 1.0 / max(s.albedo, vec3(1.0 / 255.0));
+    const vec3 LUMA = vec3(0.2126, 0.7152, 0.0722);
+    float total = 0.0;
+    float kept = 0.0;
+    float ambient = 0.0;
+    opacity_split = true;
+    for (int k = 0; k < u_light_count; ++k) {
+        LightRecord light = fetch_light(k);
+#ifdef FUR_AMBIENT_LIGHT
+        if (int(light.color.w + 0.5) == FUR_AMBIENT_LIGHT) {
+            ambient += dot(evaluate_light(light, s, v_position, V) * inverse_albedo, LUMA);
+            continue;
+        }
+#endif
+        if (light.extra.w < 0.5) continue;  // no shadow slot: gamma(h) stays
+        opacity_last = 1.0;
+        vec3 lit = evaluate_light(light, s, v_position, V);
+#if defined(FUR_STIPPLE) && !defined(FUR_MARSCHNER)
+        lit = max(lit, evaluate_light(light, rim, v_position, V));
+#endif
+        float e = dot(lit * inverse_albedo, LUMA);
+        total += e;
+        kept += e * opacity_last / max(gamma, 1e-3);
+    }
+    float read = max(dot(irradiance, LUMA), 1e-6);
+    float share = clamp(total / read, 0.0, max(1.0 - ambient / read, 0.0));
+    return irradiance * mix(1.0, kept / max(total, 1e-6), share);
+}
+#endif
 
 void main() {
 #ifdef FUR_FINS
@@ -93,6 +164,13 @@ void main() {
     if (!base_valid && !tip_valid && !own_valid) discard;  // the strand's light is unknown
     vec3 irradiance = base_valid && tip_valid ? max(base_light, tip_light)
                     : (base_valid ? base_light : (tip_valid ? tip_light : irradiance_at(own)));
+#ifdef FUR_LAYER_SELF_SHADOW
+    irradiance = self_shadowed(irradiance, fur_shadow(v_shell_depth));
+#ifdef FUR_DEBUG_OPACITY_SHADOW
+    out_color = vec4(max(opacity_seen, vec3(0.0)), 1.0);
+    return;
+#endif
+#endif
     float brightness = strand_brightness(strands);
     vec3 albedo = mix(u_albedo_base, u_albedo_tip, v_shell_depth) * fur_shadow(v_shell_depth);
     out_color = vec4(irradiance * strand_tint(albedo, strands) * brightness, alpha);
