@@ -1,9 +1,9 @@
 """What fur self-shadowing costs: the demo with shadows (examples/shadows_demo.toml, its size,
-two fur objects under three shadowed lights) in the forward pipeline with the fur's deep
-opacity maps (self_shadow_density at its default) against without (0: gamma(h) only), and the
-deferred pipeline, which draws none. Median wall-clock frame time around ``ctx.finish()``, and
-the ``shadows`` pass's alone (the depth atlas, and the opacity maps where drawn). Run from the
-repository root:
+two fur objects under three shadowed lights) with the fur's deep opacity maps
+(self_shadow_density at its default) against without (0: gamma(h) only), in both pipelines
+(the deferred shells evaluate the shadowed lights again for their transmittance). Median
+wall-clock frame time around ``ctx.finish()``, and the ``shadows`` pass's alone (the depth
+atlas, and the opacity maps where drawn). Run from the repository root:
 
     python benchmarks/fur_self_shadow.py [--size WxH] [--runs N]
 """
