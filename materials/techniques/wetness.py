@@ -296,30 +296,34 @@ class UVSeams:
 
     def copies(self, droplet: Droplet) -> list[tuple[Droplet, int]]:
         """``droplet`` in its own chart and in each chart across a seam within its radius
-        (through that chart's nearest seam edge, its radius scaled as the edge's length is),
-        with the chart each is to wet; a droplet of no known triangle, or on a mesh not
-        :attr:`laid_out`: itself, for any chart."""
+        (through that chart's nearest seam edge, its radius scaled as the edge's length is;
+        from a copy on to the charts across its seams, so charts meeting the droplet's chart
+        at a corner only are reached too), with the chart each is to wet; a droplet of no
+        known triangle, or on a mesh not :attr:`laid_out`: itself, for any chart."""
         if not 0 <= droplet.face < len(self.face_chart) or self.face_chart[droplet.face] < 0 \
                 or not self.laid_out:
             return [(droplet, -1)]
-        chart = int(self.face_chart[droplet.face])
-        out = [(droplet, chart)]
-        near = np.flatnonzero(self.source == chart)
-        if len(near) == 0:
-            return out
-        c = complex(*droplet.centre)
-        a, b = self.a[near], self.b[near]
-        edge = b - a
-        along = np.clip(((c - a) * edge.conj()).real / np.maximum(np.abs(edge) ** 2, 1e-24),
-                        0.0, 1.0)
-        distance = np.abs(c - (a + along * edge))
-        reach = distance <= droplet.radius
-        for target in np.unique(self.target[near[reach]]):
-            candidates = np.flatnonzero(reach & (self.target[near] == target))
-            record = int(near[candidates[np.argmin(distance[candidates])]])
-            centre = self.carry(record, droplet.centre)
-            radius = droplet.radius * float(np.abs(self.scale[record]))
-            out.append((Droplet(centre, radius, droplet.wetness, droplet.face), int(target)))
+        out = [(droplet, int(self.face_chart[droplet.face]))]
+        reached = {out[0][1]}
+        for here, chart in out:  # grows as charts are reached
+            near = np.flatnonzero((self.source == chart)
+                                  & ~np.isin(self.target, list(reached)))
+            if len(near) == 0:
+                continue
+            c = complex(*here.centre)
+            a, b = self.a[near], self.b[near]
+            edge = b - a
+            along = np.clip(((c - a) * edge.conj()).real
+                            / np.maximum(np.abs(edge) ** 2, 1e-24), 0.0, 1.0)
+            distance = np.abs(c - (a + along * edge))
+            reach = distance <= here.radius
+            for target in np.unique(self.target[near[reach]]):
+                candidates = np.flatnonzero(reach & (self.target[near] == target))
+                record = int(near[candidates[np.argmin(distance[candidates])]])
+                centre = self.carry(record, here.centre)
+                radius = here.radius * float(np.abs(self.scale[record]))
+                out.append((Droplet(centre, radius, here.wetness, here.face), int(target)))
+                reached.add(int(target))
         return out
 
     @property

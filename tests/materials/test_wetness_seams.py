@@ -272,3 +272,49 @@ def test_rendered_clumps_continue_across_the_seam(render, tmp_path, monkeypatch)
     monkeypatch.setattr(wetness.UVSeams, "laid_out", property(lambda self: False))
     cut, _ = seam_mismatch(render, tmp_path)
     assert cut > across + 0.2, (cut, across)
+
+
+def quadrant_uv(x: np.ndarray, z: np.ndarray, qx: int, qz: int) -> np.ndarray:
+    """Quadrant (qx, qz)'s chart: turned half a turn, in the UV slot diagonally opposite."""
+    return np.stack([0.95 - 0.5 * (1 - qx) - 0.8 * (x - 0.5 * qx),
+                     0.95 - 0.5 * (1 - qz) - 0.8 * (z - 0.5 * qz)], -1)
+
+
+def test_a_droplet_reaches_a_chart_meeting_its_own_at_a_corner():
+    """The unit square in four charts, one a quadrant: a droplet on the corner where they meet
+    wets all four, the quadrant diagonally opposite (which shares no edge with the droplet's)
+    through a chart beside both."""
+    positions, uvs, indices = [], [], []
+    half = CELLS // 2
+    for qx in (0, 1):
+        for qz in (0, 1):
+            base = len(positions)
+            for j in range(half + 1):
+                for i in range(half + 1):
+                    x, z = (qx * half + i) / CELLS, (qz * half + j) / CELLS
+                    positions.append((x, 0.0, z))
+                    uvs.append(quadrant_uv(np.array(x), np.array(z), qx, qz))
+            for j in range(half):
+                for i in range(half):
+                    a = base + j * (half + 1) + i
+                    b, c, d = a + 1, a + half + 1, a + half + 2
+                    indices += [(a, c, b), (b, c, d)]
+    mesh = build_mesh("quadrants", np.array(positions), np.array(indices),
+                      uvs=np.array(uvs, np.float64))
+    seams = UVSeams(mesh)
+    assert seams.chart_count == 4 and seams.laid_out
+    centre = quadrant_uv(np.array(0.49), np.array(0.49), 0, 0)
+    droplet = Droplet(tuple(centre), 0.08, 0.6, face_at(mesh, 0.49, 0.49))
+    copies = seams.copies(droplet)
+    assert len(copies) == 4 and len({chart for _, chart in copies}) == 4
+    mask = dry_mask(256)
+    seams.blend(mask, droplet)
+    for qx in (0, 1):
+        for qz in (0, 1):
+            x = 0.5 + (0.03 if qx else -0.03)
+            z = 0.5 + (0.03 if qz else -0.03)
+            texel = lookup(mask, quadrant_uv(np.array(x), np.array(z), qx, qz))
+            assert texel[3] == pytest.approx(0.6), (qx, qz)
+            # the clump's centre: the droplet's surface point in this chart's UVs
+            np.testing.assert_allclose(texel[:2], quadrant_uv(np.array(0.49), np.array(0.49),
+                                                              qx, qz), atol=1e-6)
