@@ -2,6 +2,9 @@
 where the planes' weights overlap: the fur is as bright in a blend zone as on an axis (mixing
 the planes' coverages would make coarse fur brighter there)."""
 
+from pathlib import Path
+
+import moderngl
 import numpy as np
 import pytest
 
@@ -34,3 +37,53 @@ def test_blend_zone_is_as_bright_as_an_axis(render, material, pipeline):
         blend = mean_luminance(render, material, rotation, pipeline)
         print(f"{material} {pipeline} {rotation}: {blend / axis - 1.0:+.1%}")
         assert abs(blend / axis - 1.0) < 0.05
+
+
+def test_no_cut_at_a_cell_border(gl):
+    """Along lines crossing the selection cells' border x = 0 in a y/z blend zone (each cell
+    picks the y or the z plane), the strands' coverage changes across the border no more than
+    between any two neighbouring samples inside a cell: a cell whose neighbour picked the other
+    plane blends into it instead of cutting its strands along a straight line (which curled
+    fur showed as a crack down Fig. 7 (d)'s ball)."""
+    from deferred.gl.shaderlib import ShaderLibrary
+    from deferred.materials.techniques.fur_volume import (
+        pattern,
+        strand_volume,
+        volume_texture,
+    )
+
+    ctx = gl.ctx
+    lib = ShaderLibrary(ctx, 330)
+    lib.add_root(Path(__file__).parents[1] / "fixtures" / "fur_selection_harness")
+    program = ctx.program(vertex_shader=lib.assemble("select.vert").text,
+                          varyings=["out_strands"])
+    volume = volume_texture(ctx, strand_volume(pattern("coarse")))
+    volume.use(0)
+    program["u_fur_volume"] = 0
+    program["u_fur_tiles"] = 1.0
+    rng = np.random.default_rng(7)
+    lines, steps = 96, 161
+    x = np.linspace(-0.04, 0.04, steps)  # tile units: the border between samples 80 and 81
+    x = x + 0.5 * (x[1] - x[0])
+    yz = rng.uniform(-20.0, 20.0, (lines, 2))  # each line through other cells
+    positions = np.zeros((lines, steps, 3), np.float32)
+    positions[..., 0] = x
+    positions[..., 1:] = yz[:, None, :]
+    normals = np.broadcast_to(np.array([0.0, 1.0, 1.0], np.float32) / np.sqrt(2.0),
+                              positions.shape).astype(np.float32)
+    data = np.concatenate([positions, normals], -1).reshape(-1, 6)
+    gl.park()
+    vbo = ctx.buffer(np.ascontiguousarray(data).tobytes())
+    out = ctx.buffer(reserve=lines * steps * 8)
+    vao = ctx.vertex_array(program, [(vbo, "3f 3f", "in_position", "in_normal")])
+    vao.transform(out, moderngl.POINTS, vertices=lines * steps)
+    coverage = np.frombuffer(out.read(), np.float32).reshape(lines, steps, 2)[..., 0]
+    for thing in (vao, out, vbo, volume, program):
+        thing.release()
+    lib.release()
+    jumps = np.abs(np.diff(coverage, axis=1))
+    border = steps // 2 - 1  # between the samples either side of x = 0
+    inside = np.delete(jumps, border, axis=1)
+    print(f"largest jump at the border {jumps[:, border].max():.3f}, inside "
+          f"{inside.max():.3f}")
+    assert jumps[:, border].max() <= 1.5 * inside.max()
