@@ -309,3 +309,14 @@ shadow_resolution = 1024
     done = run_cli("render", str(path), "--pipeline", "forward", "--view",
                    "shell_fur.opacity_shadow", "-o", str(tmp_path / "x.png"))
     assert done.returncode == 2 and "no light of this scene casts shadows" in done.stderr
+
+
+def test_shell_fur_deferred_fins_shadow_themselves(gl):
+    """shell_fur's deferred fins (lit along the chord, no re-shading along a curl) still take
+    each shadowed light's transmittance: the lit side with fins is within 1% of without."""
+    direction = [1.0, -0.3, -0.5]
+    lit = [side_means(*luminance(gl, fur_scene("shell_fur", 0.5, direction=direction,
+                                                fins=fins), "deferred"))[0]
+           for fins in (False, True)]
+    print("lit side without, with fins", lit)
+    assert lit[1] == pytest.approx(lit[0], rel=0.01)

@@ -14,17 +14,17 @@
 #include "materials/shell_fur/layer.glsl"
 #include "materials/shell_fur/color.glsl"
 #include "materials/shell_fur/debug.glsl"
-#ifndef STRAND_CHORD
-// The layers (not the fins, lit along the chord like the base surface) shade again with their
-// own tangent: the curl's light and dark bands (layer_light)
-#define FUR_LAYER_RESHADE
+#if !defined(STRAND_CHORD) || (defined(SHADOWS) && defined(OPACITY_SHADOWS) \
+                               && defined(OPACITY_RECEIVER))
+// The lights evaluated again in the fragment: the layers re-shade along their own tangent
+// (layer_light; not the fins, lit along the chord like the base surface), and with deep opacity
+// maps layers and fins shadow themselves (self_shadowed)
 #include "common/light_buffer.glsl"
 #include "generated/lights.glsl"
 #include "techniques/strand_tangent.glsl"
 in vec3 v_position;
 in vec3 v_normal;
-in vec3 v_strand_tangent;  // this layer's, along the curl (fur.vert)
-in vec3 v_strand_chord;    // the strand's chord, as the base surface was lit
+in vec3 v_strand_tangent;  // this layer's, along the curl (fur.vert); the fins' chord
 uniform float u_specular_intensity;  // K_s
 uniform float u_specular_exponent;   // p_phong
 #ifdef FUR_MARSCHNER
@@ -48,6 +48,12 @@ Surface layer_surface(vec3 albedo, float wetness, vec3 tangent) {
     return s;
 }
 
+#endif
+
+#ifndef STRAND_CHORD
+#define FUR_LAYER_RESHADE
+in vec3 v_strand_chord;  // the strand's chord, as the base surface was lit (fur.vert)
+
 // The light read at the root (irradiance, before gamma) re-shaded along this layer's tangent:
 // the full-screen lights (ambient, directional) evaluated here along the chord (c, as the root
 // was lit) and along the layer's curled tangent (t), per channel. Where c is a share of the
@@ -69,8 +75,7 @@ vec3 layer_light(vec3 irradiance, vec3 albedo, float wetness) {
 }
 #endif
 
-#if defined(SHADOWS) && defined(OPACITY_SHADOWS) && defined(OPACITY_RECEIVER) \
-    && defined(FUR_LAYER_RESHADE)
+#if defined(SHADOWS) && defined(OPACITY_SHADOWS) && defined(OPACITY_RECEIVER)
 // Self-shadowing (deep opacity maps, lights/shadows.glsl): the summed light read at the root
 // holds each shadowed light whole; each is evaluated again at this layer (Kajiya-Kay along the
 // layer's tangent) for the transmittance-weighted share to scale (self_shadowed), gamma(h)
