@@ -15,19 +15,18 @@
 #include "techniques/accumulated_light.glsl"
 #if defined(SHADOWS) && defined(OPACITY_SHADOWS) && defined(OPACITY_RECEIVER)
 // Self-shadowing (deep opacity maps, lights/shadows.glsl): the light read at the base and
-// stipple samples holds each shadowed light whole; each is evaluated again at this shell (the
-// surface the samples were lit with: the grain normal, and with FUR_STIPPLE the rim-bent one,
-// the brighter, as the forward shells) for the transmittance-weighted share to scale
-// (self_shadowed), gamma(h) staying on the rest (the forward shells' split)
+// stipple samples holds each shadowed light whole; each is evaluated again at this shell, with
+// the grain normal the base sample was lit with, for the transmittance-weighted share to scale
+// (self_shadowed), gamma(h) staying on the rest (the forward shells' split). Not with the
+// stipple sample's rim-bent normal too (the forward shells' brighter of the two): that doubles
+// the shadow lookups; where the rim's light dominates, the share is smaller and the fur there
+// darkens less.
 #define FUR_LAYER_SELF_SHADOW
 #include "common/light_buffer.glsl"
 #include "generated/lights.glsl"
-#include "techniques/rim.glsl"
 // material_surface (the grain normal) and u_albedo_tip
 #include SURFACE_FILE
 in vec2 v_uv;
-uniform float u_rim_strength;
-uniform float u_rim_falloff;
 #else
 uniform vec3 u_albedo_tip;
 #endif
@@ -75,11 +74,6 @@ vec3 self_shadowed(vec3 irradiance, float gamma) {
     Surface s = material_surface(i);
     s.shading_model = surface_shading_model(u_surface_id);
     s.occlusion = 1.0;
-#if defined(FUR_STIPPLE) && !defined(FUR_MARSCHNER)  // the stipple sample's rim-bent normal
-    Surface rim = s;
-    rim.normal = rim_bend(i.normal, s.normal, normalize(v_position), u_rim_strength,
-                          u_rim_falloff);
-#endif
     vec3 V = normalize(-v_position);
     vec3 inverse_albedo = 1.0 / max(s.albedo, vec3(1.0 / 255.0));
     const vec3 LUMA = vec3(0.2126, 0.7152, 0.0722);
@@ -91,16 +85,18 @@ vec3 self_shadowed(vec3 irradiance, float gamma) {
         LightRecord light = fetch_light(k);
 #ifdef FUR_AMBIENT_LIGHT
         if (int(light.color.w + 0.5) == FUR_AMBIENT_LIGHT) {
-            ambient += dot(evaluate_light(light, s, v_position, V) * inverse_albedo, LUMA);
+            // lights/ambient.glsl's hemisphere, inline: through evaluate_light's dispatch
+            // llvmpipe runs every light type's code, shadow lookups included
+            float sky = 0.5 + 0.5 * dot(s.normal, light.direction.xyz);
+            vec3 hemisphere = mix(light.extra.rgb, light.color.rgb, sky);
+            ambient += dot(shade_ambient(s, hemisphere) * inverse_albedo, LUMA);
             continue;
         }
 #endif
         if (light.extra.w < 0.5) continue;  // no shadow slot: gamma(h) stays
         opacity_last = 1.0;
         vec3 lit = evaluate_light(light, s, v_position, V);
-#if defined(FUR_STIPPLE) && !defined(FUR_MARSCHNER)
-        lit = max(lit, evaluate_light(light, rim, v_position, V));
-#endif
+
         float e = dot(lit * inverse_albedo, LUMA);
         total += e;
         kept += e * opacity_last / max(gamma, 1e-3);
