@@ -17,10 +17,9 @@ from __future__ import annotations
 import argparse
 import statistics
 import sys
-import time
 from pathlib import Path
 
-from deferred.bench.timing import time_passes
+from deferred.bench.timing import interleaved_rounds
 from deferred.errors import DeferredError
 from deferred.gl.context import create_context
 from deferred.render.renderer import Renderer
@@ -70,19 +69,7 @@ def main(argv: list[str] | None = None) -> int:
                     renderer.shaders.add_root(root, first=True)
                 renderer.render(readback=False)  # compiles
                 renderers.append(renderer)
-            frames: list[list[float]] = [[] for _ in renderers]
-            passes: list[dict[str, list[float]]] = [{} for _ in renderers]
-            order = list(zip(renderers, frames, passes, strict=True))
-            for round_index in range(args.rounds):
-                shift = round_index % len(order)  # no variant always runs first
-                for renderer, times, by_pass in order[shift:] + order[:shift]:
-                    gl.ctx.finish()
-                    start = time.perf_counter()
-                    renderer.render(readback=False)
-                    gl.ctx.finish()
-                    times.append((time.perf_counter() - start) * 1000.0)
-                    for name, ms in time_passes(renderer, 1).items():
-                        by_pass.setdefault(name, []).append(ms)
+            frames, passes = interleaved_rounds(renderers, args.rounds)
             for (label, _, _), times, by_pass in zip(VARIANTS, frames, passes, strict=True):
                 fur = ", ".join(f"{name} {statistics.median(ms):.1f}"
                                 for name, ms in by_pass.items()

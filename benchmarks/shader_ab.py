@@ -21,11 +21,10 @@ from __future__ import annotations
 import argparse
 import statistics
 import sys
-import time
 from pathlib import Path
 
 from deferred.bench.scenes import with_extra_lights
-from deferred.bench.timing import time_passes
+from deferred.bench.timing import interleaved_rounds
 from deferred.errors import DeferredError
 from deferred.gl.context import create_context
 from deferred.render.renderer import Renderer
@@ -66,20 +65,7 @@ def main(argv: list[str] | None = None) -> int:
     except DeferredError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
-    frames: list[list[float]] = [[] for _ in renderers]
-    passes: list[dict[str, list[float]]] = [{} for _ in renderers]
-    order = list(zip(renderers, frames, passes, strict=True))
-    for round_index in range(args.rounds):
-        # each round starts from the next variant: none is always first after the others
-        shift = round_index % len(order)
-        for renderer, times, by_pass in order[shift:] + order[:shift]:
-            gl.ctx.finish()
-            start = time.perf_counter()
-            renderer.render(readback=False)
-            gl.ctx.finish()
-            times.append((time.perf_counter() - start) * 1000.0)
-            for name, ms in time_passes(renderer, 1).items():
-                by_pass.setdefault(name, []).append(ms)
+    frames, passes = interleaved_rounds(renderers, args.rounds)
     for variant, times, by_pass in zip(args.variants, frames, passes, strict=True):
         medians = ", ".join(f"{name} {statistics.median(ms):.2f}" for name, ms in by_pass.items()
                             if not name.endswith((".gbuffer", ".clear")))

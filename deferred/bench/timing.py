@@ -113,3 +113,25 @@ def time_passes(renderer, runs: int) -> dict[str, float]:
 
 def medians(samples: dict[str, list[float]]) -> dict[str, float]:
     return {name: statistics.median(values) for name, values in samples.items() if values}
+
+
+def interleaved_rounds(renderers: list, rounds: int
+                       ) -> tuple[list[list[float]], list[dict[str, list[float]]]]:
+    """Frame times (ms, wall clock around ``ctx.finish()``) and per-pass times of each of
+    ``renderers`` (variants on one context) over ``rounds``; each round starts from the next
+    variant, so none always runs first after the others (A/B comparisons)."""
+    frames: list[list[float]] = [[] for _ in renderers]
+    passes: list[dict[str, list[float]]] = [{} for _ in renderers]
+    order = list(zip(renderers, frames, passes, strict=True))
+    for round_index in range(rounds):
+        shift = round_index % len(order)
+        for renderer, times, by_pass in order[shift:] + order[:shift]:
+            ctx = renderer.gl.ctx
+            ctx.finish()
+            start = time.perf_counter()
+            renderer.render(readback=False)
+            ctx.finish()
+            times.append((time.perf_counter() - start) * 1000.0)
+            for name, ms in time_passes(renderer, 1).items():
+                by_pass.setdefault(name, []).append(ms)
+    return frames, passes
