@@ -45,10 +45,7 @@ def demo_scene(size: tuple[int, int], material: str, taa: bool):
                     color=tuple(obj.material.params.albedo_tip)))
     if taa:
         scene.effects.append(TAA())
-    camera = scene.camera
-    target = np.array(camera.target)
-    position = target + PULL_BACK * (np.array(camera.position) - target)
-    scene.camera = replace(camera, position=tuple(position))
+    scene.camera = scene.camera.pulled_back(PULL_BACK)
     return scene
 
 

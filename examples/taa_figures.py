@@ -6,7 +6,6 @@ so the history has built up). Run from the repository root: python examples/taa_
 
 from __future__ import annotations
 
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -24,10 +23,7 @@ STILL_FRAMES = 16
 def far_demo():
     """The demo with the camera three times as far from its target (benchmarks/crawl.py's)."""
     scene = load_scene()
-    camera = scene.camera
-    target = np.array(camera.target)
-    scene.camera = replace(camera, position=tuple(
-        target + 3.0 * (np.array(camera.position) - target)))
+    scene.camera = scene.camera.pulled_back(3.0)
     return scene
 
 

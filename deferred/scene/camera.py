@@ -6,7 +6,7 @@ column-major, which is ``M.T`` in numpy's row-major memory: use :func:`gl_bytes`
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import pyrr
@@ -55,6 +55,12 @@ class Camera:
     @kept_while()
     def inverse_projection(self, aspect: float) -> np.ndarray:
         return _read_only(np.linalg.inv(self.projection(aspect)))
+
+    def pulled_back(self, factor: float) -> Camera:
+        """This camera ``factor`` times as far from its target, looking the same way."""
+        target = np.asarray(self.target, np.float64)
+        position = target + factor * (np.asarray(self.position, np.float64) - target)
+        return replace(self, position=tuple(float(v) for v in position))
 
 
 def _read_only(matrix: np.ndarray) -> np.ndarray:

@@ -136,3 +136,13 @@ def test_an_event_on_one_object_leaves_another_sharing_its_material_alone(render
     assert right.material is shared and left.material is not shared
     assert shared.params.color == (0.8, 0.2, 0.2)
     assert left.material.params.color == (0.1, 0.7, 0.1)
+
+
+def test_a_camera_pulled_back_keeps_its_direction_and_scales_its_distance():
+    from deferred.scene.camera import Camera
+
+    camera = Camera(position=(1.0, 2.0, 4.0), target=(1.0, 0.5, 0.0), fov=30.0)
+    far = camera.pulled_back(3.0)
+    offset, far_offset = (np.subtract(c.position, c.target) for c in (camera, far))
+    np.testing.assert_allclose(far_offset, 3.0 * offset)
+    assert (far.target, far.up, far.fov) == (camera.target, camera.up, camera.fov)

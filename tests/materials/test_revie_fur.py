@@ -292,16 +292,12 @@ def test_obliteration_restores_the_floor_not_the_sky_beside_a_silhouette(gl):
     above it, whose pixels all agree: no pixel the floor held before the stipple ends as the
     background colour once the samples are erased (the dots of sky along the fur's top
     edge)."""
-    from dataclasses import replace
 
     from deferred.render.renderer import Renderer
     from deferred.scene.loader import load_scene
 
     scene = load_scene()  # the demo, its objects far away: the torus's top meets the horizon
-    camera = scene.camera
-    target = np.array(camera.target)
-    scene.camera = replace(camera, position=tuple(
-        target + 3.0 * (np.array(camera.position) - target)))
+    scene.camera = scene.camera.pulled_back(3.0)
     seen = {}
 
     def after(render_pass, frame):
@@ -355,17 +351,13 @@ def test_no_dark_stipple_dots_inside_the_fur_seen_from_afar(gl):
     dots of one pixel in four, far darker than the forward frame. Restored between an
     opposite pair (colour and depth interpolated), no pixel of the stipple's class inside the
     fur is more than 25 levels darker than the forward pipeline's."""
-    from dataclasses import replace
 
     from deferred.render.renderer import Renderer
     from deferred.scene.loader import load_scene
 
     def far_demo():
         scene = load_scene()
-        camera = scene.camera
-        target = np.array(camera.target)
-        scene.camera = replace(camera, position=tuple(
-            target + 3.0 * (np.array(camera.position) - target)))
+        scene.camera = scene.camera.pulled_back(3.0)
         return scene
 
     images = {}
