@@ -12,25 +12,23 @@ from __future__ import annotations
 
 import argparse
 
-import tomllib
 from shadows import timed  # benchmarks/shadows.py
 
 from deferred.gl.context import create_context
 from deferred.render.renderer import Renderer
-from deferred.scene.loader import scene_from_dict
+from deferred.scene.loader import load_scene
 
 DEMO = "examples/shadows_demo.toml"
 
 
 def demo(density: float | None):
     """The demo, its fur's self_shadow_density set (None: the default)."""
-    with open(DEMO, "rb") as file:
-        data = tomllib.load(file)
+    scene = load_scene(DEMO)
     if density is not None:
-        for obj in data["object"]:
-            if obj.get("material") in ("revie_fur", "shell_fur"):
-                obj["params"]["self_shadow_density"] = density
-    return scene_from_dict(data)
+        for obj in scene.objects:
+            if obj.material.name in ("revie_fur", "shell_fur"):
+                obj.set_params(self_shadow_density=density)
+    return scene
 
 
 def main() -> None:

@@ -11,11 +11,11 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-import tomllib
 from PIL import Image, ImageDraw
 
 from deferred.render.renderer import Renderer
-from deferred.scene.loader import scene_from_dict
+from deferred.scene.loader import load_scene
+from deferred.scene.model import Scene
 
 ROOT = Path(__file__).parents[1]
 FIGURES = ROOT / "docs" / "figures"
@@ -24,14 +24,14 @@ SIZE = (1280, 720)
 CROP = (170, 200, 550, 520)  # the ball, x0, y0, x1, y1 at SIZE
 
 
-def demo(density: float | None) -> object:
-    with open(DEMO, "rb") as file:
-        data = tomllib.load(file)
+def demo(density: float | None) -> Scene:
+    """The demo with shadows, its fur's self_shadow_density set (None: the default)."""
+    scene = load_scene(DEMO)
     if density is not None:
-        for obj in data["object"]:
-            if obj.get("material") in ("revie_fur", "shell_fur"):
-                obj["params"]["self_shadow_density"] = density
-    return scene_from_dict(data, str(DEMO), DEMO.parent)
+        for obj in scene.objects:
+            if obj.material.name in ("revie_fur", "shell_fur"):
+                obj.set_params(self_shadow_density=density)
+    return scene
 
 
 def labelled(image: np.ndarray, text: str) -> np.ndarray:
