@@ -18,6 +18,7 @@ from deferred.api import (
     Phase,
     Pipeline,
     RenderPass,
+    Scene,
     TargetSpec,
     effects,
 )
@@ -47,7 +48,7 @@ class Edges(Effect):
     Params = EdgesParams
     pipelines = (Pipeline.DEFERRED,)  # reads the G-buffer
 
-    def passes(self, scene, pipeline: str) -> list[RenderPass]:
+    def passes(self, scene: Scene, pipeline: str) -> list[RenderPass]:
         inputs = {"u_linear_depth": LINEAR_DEPTH, "u_normal_exponent_id": NORMAL_EXPONENT_ID}
         defines = {}
         if STRAND_ID in scene.gbuffer_layout().data:

@@ -15,6 +15,7 @@ from deferred.api import (
     Order,
     Phase,
     RenderPass,
+    Scene,
     copy_pass,
     effects,
 )
@@ -35,7 +36,7 @@ class FXAA(Effect):
     name = "fxaa"
     Params = FXAAParams
 
-    def passes(self, scene, pipeline: str) -> list[RenderPass]:
+    def passes(self, scene: Scene, pipeline: str) -> list[RenderPass]:
         return [
             copy_pass("post.fxaa_source", Phase.POST, FINAL, FXAA_SOURCE, FINAL_SPEC,
                       order=Order.LAST),

@@ -19,6 +19,7 @@ from deferred.api import (
     Phase,
     Pipeline,
     RenderPass,
+    Scene,
     TargetSpec,
     effects,
 )
@@ -39,7 +40,7 @@ class SSAO(Effect):
     Params = SSAOParams
     pipelines = (Pipeline.DEFERRED,)  # the forward pipeline has no G-buffer to sample
 
-    def passes(self, scene, pipeline: str) -> list[RenderPass]:
+    def passes(self, scene: Scene, pipeline: str) -> list[RenderPass]:
         """Raw hemisphere SSAO, then a depth-aware blur into the ``ssao`` target."""
         return [
             FullscreenPass("screen.ssao", Phase.SCREEN, "screen/ssao.frag",
