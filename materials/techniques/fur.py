@@ -10,6 +10,9 @@ units, level of detail and self-shadowing. ``revie_fur`` and ``shell_fur`` build
   ``n - 1`` sit at the middles of the ``n - 1`` slabs the layer is cut into, each as opaque as
   its slab (``1 - (1 - coverage)^(slices / (n - 1))``). Silva et al.'s shadow factor
   ``gamma(h) = (K - 1 + h) / K`` (``self_shadow`` = K) darkens every shell toward the roots.
+- **Self-shadowing**: under a shadowed light, every shell, the root shell (the skin) too,
+  takes the light through the fur in front of it instead, from deep opacity maps
+  (``self_shadow_density``; :meth:`FurMaterial.draw_opacity`, ``lights/shadows.glsl``).
 - **Level of detail**: the shell count follows the fur layer's projected thickness,
   ``n = clamp(pixels / lod_error, min_shells, shells)``, continuous; the depths move with it and
   the outermost fades by the fraction, so a dolly never pops (:func:`shell_count`).
@@ -245,9 +248,17 @@ class FurMaterial(Material):
         from the light (:data:`SHADOW_CASTER_DEFINES`), each kept by a dither under its
         opacity (``shadows/fur_caster.frag``), so the floor darkens with the fur's density.
         The vertex shader pushes them a strand's length away from the light: the fur shadows
-        other surfaces and the far side of its own body, not its own skin through its own
-        shells (the deferred shells take their light from the skin's pixels, which would make
-        the whole fur as dark as its roots); its self-shadowing stays gamma(h)."""
+        other surfaces and the far side of its own body, and its own skin and shells through
+        the deep opacity maps (:meth:`draw_opacity`). The skin is the root shell, a
+        receiver of the maps like every shell: under a shadowed light it keeps the
+        transmittance of the whole fur in front of it, in both pipelines (the deferred root
+        shell scales that light's share of the light it reads, as the other shells do), and
+        gamma(h) stays for unshadowed lights and with ``self_shadow_density`` 0. Unpushed,
+        the dithered casters would shadow the skin's pixels in the light pass, twice with the
+        maps, and the deferred shells reading those pixels would go as dark as the roots.
+        Pushed along the light, a shell at height h still reaches a flat skin under it where
+        the light meets the skin at more than arccos(h) from its normal: toward the
+        terminator the outer shells shadow the skin in the depth map too."""
         params = self.params
         if params.shells == 0 or not self.fur_vertex:
             super().draw_shadow(frame, obj, view)
