@@ -91,9 +91,9 @@ void main() {
     v_tip_position = tip_view.xyz;
 #if defined(SHADOW_CASTER) && !defined(OPACITY_CASTER)
     // drawn from the light (deferred.api.SHADOW_CASTER_DEFINES): the fur casts a strand's
-    // length further from the light, onto other surfaces but not onto its own skin (the root
-    // shell) and shells, whose self-shadowing is the deep opacity maps' (OPACITY_CASTER: drawn
-    // where it is; deferred.lighting.shadows) or gamma(h) (techniques/fur.glsl)
+    // length further from the light, onto other surfaces but not onto its own skin and
+    // shells, whose self-shadowing is the deep opacity maps' (OPACITY_CASTER: drawn where it
+    // is; deferred.lighting.shadows) or gamma(h) (techniques/fur.glsl)
     position.z -= v_fur_extent;
 #endif
     gl_Position = u_projection * position;
