@@ -32,7 +32,9 @@ LUMA = np.array([0.2126, 0.7152, 0.0722])
 
 
 def skin_scene(material: str, density: float, shadows: bool = True):
-    params = {"fur_length": FUR_LENGTH, "shells": SHELLS, "self_shadow": K_SHADOW,
+    # lod_error: every shell drawn, whatever the fur's size on screen
+    params = {"fur_length": FUR_LENGTH, "shells": SHELLS, "lod_error": 0.1,
+              "self_shadow": K_SHADOW,
               "self_shadow_density": density, "shell_range": [0.0, 0.0], "fins": False,
               **FUR[material]}
     return scene_from_dict({
@@ -62,10 +64,11 @@ def fur_optical_depth() -> tuple[float, float]:
     """numpy: the optical depth of the fur in front of the skin for a light along the normal,
     as the deep opacity maps hold it. The maps draw OPACITY_SHELLS shells over the skin, each
     adding -ln(1 - opacity) of the volume's mean coverage at its height (a map texel spans a
-    few strands), into the layers ending OPACITY_LAYERS strand lengths behind the outermost.
-    The skin lies that shell's height behind it, between the ends of layers 2 and 3, and reads
-    them interpolated linearly (Yuksel and Keyser 2008, 3.2): the first value, less than all
-    the shells' (the second), which the skin has in front of it."""
+    few strands), into the layers ending OPACITY_LAYERS strand lengths behind the fur's front.
+    With the front at the outermost shell, the skin lies that shell's height behind it,
+    between the ends of layers 2 and 3, and reads them interpolated linearly (Yuksel and
+    Keyser 2008, 3.2): the first value; with the front at the tips, all the shells' (the
+    second)."""
     params = FurParams(fur_length=FUR_LENGTH, shells=SHELLS)
     coverage = strand_volume(fur_pattern(params))[..., 0].mean(axis=(1, 2))
     count = min(SHELLS, OPACITY_SHELLS) + 1
