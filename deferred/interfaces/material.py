@@ -326,8 +326,9 @@ class Material:
     def draw_opacity(self, frame: Frame, obj: SceneObjectLike, view: ShadowView,
                      stage: str) -> None:
         """Draw ``obj``'s volume into the deep opacity maps of ``view`` (materials with
-        ``opacity_shadows``): ``stage`` "first", the light-view depth of its front into an R32F
-        target with a depth test; "density", its optical depth added into the four layers
+        ``opacity_shadows``): ``stage`` "first", the light-view depth of its front (its outer
+        surface, which every point it draws lies inside) into an R32F target with a depth test;
+        "density", its optical depth added into the four layers
         behind that front (``u_opacity_first``, ``u_opacity_layers``), blended additively."""
 
     def passes(self, phase: Phase, obj: SceneObjectLike) -> list[RenderPass]:

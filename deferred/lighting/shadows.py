@@ -25,7 +25,9 @@ that reads it; programs only read it where the scene has a shadowed light (the d
 
 **Deep opacity maps** (Yuksel and Keyser 2008), where an object's material draws a volume
 (``Material.opacity_shadows``: fur; in the deferred pipeline ``deferred_opacity`` too): beside
-the atlas, two textures of half its size over the same atlas coordinates: ``opacity_first``,
+the atlas, two textures over the square of the atlas the lights' maps take (from its corner,
+:func:`opacity_extent`), at ``opacity_scale`` (a ``[shadows]`` key) of its resolution:
+``opacity_first``,
 the light-view depth of the first volume fragment each texel sees (the volume's own front, not
 the depth atlas's casters), and ``opacity``, four layers (RGBA) of the volume's optical depth
 accumulated from that front up to ``OPACITY_LAYERS`` x the thickest volume's layer
@@ -92,21 +94,34 @@ def scene_has_opacity(scene: Scene, pipeline: str) -> bool:
         for obj in scene.objects)
 
 
-def opacity_size(atlas_size: int) -> int:
-    """Texels on a side of the opacity maps: half the atlas (the volume's shadow is soft)."""
-    return max(atlas_size // 2, 1)
+def opacity_extent(scene: Scene) -> int:
+    """Texels on a side of the square, from the atlas's corner, that the maps of the scene's
+    shadowed lights take (as :func:`plan_atlas` places them: largest first, from the corner):
+    the part of the atlas the deep opacity maps cover."""
+    budget = scene.shadow_budget
+    plan, _ = plan_atlas(scene.lights, budget.atlas_size, budget.max_shadowed_lights)
+    return max((max(x, y) + size for _, squares in plan.values() for x, y, size in squares),
+               default=1)
 
 
-def atlas_memory(budget: Any, opacity: bool = False) -> dict[str, int]:
+def opacity_size(scene: Scene, pipeline: str) -> int:
+    """Texels on a side of the scene's deep opacity maps (0: none drawn): the atlas's square
+    its lights' maps take (:func:`opacity_extent`) at the budget's ``opacity_scale`` (the
+    volume's shadow is soft: the opacity maps need fewer texels than the depth maps)."""
+    if not scene_has_opacity(scene, pipeline):
+        return 0
+    return max(round(opacity_extent(scene) * scene.shadow_budget.opacity_scale), 1)
+
+
+def atlas_memory(budget: Any, opacity_size: int = 0) -> dict[str, int]:
     """What the shadow atlas of a scene's budget holds, for the memory budget: its depths
-    (4 bytes a texel) and its records; with ``opacity``, the opacity maps (first depth 4 +
-    depth 4 + four half-float layers 8 bytes a texel)."""
+    (4 bytes a texel) and its records; with an ``opacity_size`` (:func:`opacity_size`), the
+    opacity maps (first depth 4 + depth 4 + four half-float layers 8 bytes a texel)."""
     size = budget.atlas_size
     held = {f"shadow atlas {size}^2": size * size * 4 +
             RECORD_TEXELS * 16 * budget.max_shadowed_lights}
-    if opacity:
-        half = opacity_size(size)
-        held[f"opacity shadow maps {half}^2"] = half * half * 16
+    if opacity_size:
+        held[f"opacity shadow maps {opacity_size}^2"] = opacity_size * opacity_size * 16
     return held
 
 
@@ -285,7 +300,9 @@ class ShadowAtlas:
     """The shadow atlas, its records texture and this frame's tiles (a binding source)."""
 
     def __init__(self, ctx: moderngl.Context, atlas_size: int, max_lights: int,
-                 opacity: bool = False):
+                 opacity_size: int = 0, opacity_extent: int = 0):
+        """``opacity_size``: texels on a side of the deep opacity maps (0: none), covering the
+        atlas's square of ``opacity_extent`` texels from its corner."""
         self.ctx = ctx
         self.size = atlas_size
         self.max_lights = max_lights
@@ -305,12 +322,15 @@ class ShadowAtlas:
         self._uniforms: dict[str, Any] = {}
         self.opacity = None
         self.opacity_layer = 0.0  # world units: the thickest opacity volume's layer
-        if opacity:
-            half = opacity_size(atlas_size)
-            self.opacity_first = ctx.texture((half, half), 1, dtype="f4")
+        self.opacity_extent = opacity_extent
+        # opacity-map texels per atlas texel (the tiles' rectangles there: theirs times this)
+        self.opacity_scale = opacity_size / opacity_extent if opacity_size else 0.0
+        if opacity_size:
+            side = opacity_size
+            self.opacity_first = ctx.texture((side, side), 1, dtype="f4")
             self.opacity_first.filter = (moderngl.NEAREST, moderngl.NEAREST)
-            self.opacity_depth = ctx.depth_texture((half, half))
-            self.opacity = ctx.texture((half, half), 4, dtype="f2")
+            self.opacity_depth = ctx.depth_texture((side, side))
+            self.opacity = ctx.texture((side, side), 4, dtype="f2")
             self.opacity.filter = (moderngl.LINEAR, moderngl.LINEAR)
             for texture in (self.opacity_first, self.opacity):
                 texture.repeat_x = texture.repeat_y = False
@@ -400,6 +420,7 @@ class ShadowAtlas:
                                      default=0.0)
             self._uniforms["u_opacity_layers"] = tuple(b * self.opacity_layer
                                                        for b in OPACITY_LAYERS)
+            self._uniforms["u_opacity_from_atlas"] = self.size / self.opacity_extent
         return self.slots
 
     def _cascades(self, light: Light, scene: Scene, view: np.ndarray, inverse_view: np.ndarray,
@@ -484,8 +505,9 @@ class ShadowAtlas:
                 texture.use(location=texture_unit)
                 uniforms.set_one(name, texture_unit)
                 texture_unit += 1
-        if "u_opacity_layers" in uniforms.members:
-            uniforms.set_one("u_opacity_layers", self._uniforms["u_opacity_layers"])
+        for name in ("u_opacity_layers", "u_opacity_from_atlas"):
+            if name in uniforms.members:
+                uniforms.set_one(name, self._uniforms[name])
         return texture_unit
 
     def read_depth(self) -> np.ndarray:
@@ -494,12 +516,13 @@ class ShadowAtlas:
         return data.reshape(self.size, self.size)
 
     def read_opacity(self) -> tuple[np.ndarray, np.ndarray]:
-        """The opacity maps: the first light-view depth (half, half) and the four layers'
-        optical depths (half, half, 4), float32, rows bottom-up."""
-        half = self.opacity.size[0]
+        """The opacity maps: the first light-view depth (side, side) and the four layers'
+        optical depths (side, side, 4), float32, rows bottom-up; a tile's texels there are its
+        atlas rectangle times ``opacity_scale``."""
+        side = self.opacity.size[0]
         first = np.frombuffer(self.opacity_first.read(alignment=1), dtype=np.float32)
         layers = np.frombuffer(self.opacity.read(alignment=1), dtype=np.float16)
-        return first.reshape(half, half), layers.reshape(half, half, 4).astype(np.float32)
+        return first.reshape(side, side), layers.reshape(side, side, 4).astype(np.float32)
 
     def release(self) -> None:
         parts = [self.framebuffer, self.texture, self.records]
@@ -562,7 +585,7 @@ class ShadowPass(RenderPass):
     def _opacity(frame: Frame, atlas: ShadowAtlas, reached) -> None:
         """The deep opacity maps of each tile: the volume's first depth (nearest wins), then its
         optical depth added into the layers behind that depth (Yuksel and Keyser 2008, 3.1-3.2)."""
-        scale = atlas.opacity.size[0] / atlas.size
+        scale = atlas.opacity_scale
         stages = ((atlas.first_framebuffer, "first", dict(depth_test=True, depth_func="less")),
                   (atlas.opacity_framebuffer, "density", dict(depth_test=False, blend="add")))
         for fbo, stage, state in stages:

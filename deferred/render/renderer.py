@@ -41,6 +41,8 @@ from deferred.lighting.shadows import (
     SHADOWS_DEFINE,
     ShadowAtlas,
     atlas_memory,
+    opacity_extent,
+    opacity_size,
     scene_casts_shadows,
     scene_has_opacity,
 )
@@ -150,7 +152,7 @@ def renderer_holdings(scene: Scene, pipeline: str, size: tuple[int, int]) -> dic
     textures and state, the shadow atlas and opacity maps, the effects' histories."""
     held = held_memory(scene)
     if scene_casts_shadows(scene.lights):
-        held.update(atlas_memory(scene.shadow_budget, scene_has_opacity(scene, pipeline)))
+        held.update(atlas_memory(scene.shadow_budget, opacity_size(scene, pipeline)))
     for effect in scene.effects:
         held.update(effect.held_memory(size))
     return held
@@ -267,13 +269,14 @@ class Renderer:
     def _scene_structure(self) -> tuple:
         """What the passes, targets and programs are built from, apart from parameters: which
         objects (their meshes, their materials' types), which lights and effects, whether a
-        light casts shadows, whether a material draws opacity maps and the shadow budget (the
-        shadow pass, the atlas and the SHADOWS and OPACITY_SHADOWS defines), the clear colour,
-        the tone mapping operator, the light path and the size asked for."""
+        light casts shadows, whether a material draws opacity maps and their size (with the
+        lights' shadow resolutions) and the shadow budget (the shadow pass, the atlas and the
+        SHADOWS and OPACITY_SHADOWS defines), the clear colour, the tone mapping operator, the
+        light path and the size asked for."""
         scene = self.scene
         return (tuple((id(obj), id(obj.mesh), type(obj.material)) for obj in scene.objects),
                 tuple(map(type, scene.lights)), scene_casts_shadows(scene.lights),
-                scene_has_opacity(scene, self.pipeline_name), scene.shadow_budget,
+                opacity_size(scene, self.pipeline_name), scene.shadow_budget,
                 tuple(map(id, scene.effects)),
                 tuple(scene.background), scene.tonemap,
                 scene.light_path if self._light_path_arg is None else None,
@@ -377,7 +380,7 @@ class Renderer:
         self.light_lists = LightLists(ctx) if features.compute_shaders else None
         budget = scene.shadow_budget
         self.shadow_atlas = ShadowAtlas(ctx, budget.atlas_size, budget.max_shadowed_lights,
-                                        scene_has_opacity(scene, pipeline)) \
+                                        opacity_size(scene, pipeline), opacity_extent(scene)) \
             if scene_casts_shadows(scene.lights) else None
         # The per-frame GPU resources every frame is given: by name on its blackboard (for the
         # passes that fill or read them), and those that bind themselves to every program as

@@ -31,6 +31,7 @@ from deferred.names import LightPath
 from deferred.scene.camera import Camera, model_matrix
 from deferred.scene.meshes import load_mesh
 from deferred.scene.model import (
+    OPACITY_SCALES,
     CameraModel,
     Scene,
     SceneObject,
@@ -135,6 +136,15 @@ class ShadowsModel(_Strict):
                                               "of two, 256..16384)")
     max_shadowed_lights: int = Field(16, ge=1, le=64, description="lights given shadow maps, "
                                      "in scene order; the rest are unshadowed")
+    opacity_scale: float = Field(0.25, description="texels on a side of the fur's deep "
+                                 "opacity maps per shadow-map texel (1, 0.5, .. 1/16)")
+
+    @field_validator("opacity_scale")
+    @classmethod
+    def _fraction(cls, value: float) -> float:
+        if value not in OPACITY_SCALES:
+            raise ValueError("must be 1, 0.5, 0.25, 0.125 or 0.0625")
+        return value
 
     @field_validator("atlas_size")
     @classmethod
@@ -231,7 +241,8 @@ def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
                   size=model.size, background=model.background, exposure=model.exposure,
                   tonemap=model.tonemap, light_path=model.light_path, source=name,
                   shadow_budget=ShadowBudget(model.shadows.atlas_size,
-                                             model.shadows.max_shadowed_lights))
+                                             model.shadows.max_shadowed_lights,
+                                             model.shadows.opacity_scale))
     meshes: dict[str, MeshData | None] = {}
     # label -> (the object, or None where it is not made; its material class, where known)
     labels: dict[str, tuple[SceneObject | None, type[Material] | None]] = {}

@@ -53,6 +53,7 @@ SHADOW_CASTER_FRAGMENT = "shadows/fur_caster.frag"
 SHADOW_SHELLS = 8  # most shells a fur object casts its shadow with (with its root shell)
 OPACITY_FRAGMENT = "shadows/fur_opacity.frag"
 OPACITY_SHELLS = 12  # most shells the fur draws into the deep opacity maps (without the skin)
+OPACITY_ENVELOPE = 1.0  # the shell depth of the fur's front in the opacity maps: the tips
 
 
 class FurParams(MaterialParams):
@@ -284,11 +285,24 @@ class FurMaterial(Material):
         """The fur's world thickness: a strand's length."""
         return float(self.params.fur_length * object_scale(obj).max())
 
+    def opacity_shells(self, frame: Frame, obj: SceneObject) -> int:
+        """How many outer shells the fur draws into the deep opacity maps this frame: as many
+        as it draws in view (:func:`shell_count`, rounded up; the root shell is the skin's,
+        the depth atlas's), at most ``OPACITY_SHELLS``. Far away the fur's self-shadowing
+        takes few pixels and few shells; each shell then stands for more of the volume, so the
+        optical depth summed through the fur stays the same."""
+        params = self.params
+        wanted = math.ceil(shell_count(frame, obj, params) - 1e-9)
+        return max(1, min(wanted, params.shells, OPACITY_SHELLS))
+
     def draw_opacity(self, frame: Frame, obj: SceneObject, view: ShadowView,
                      stage: str) -> None:
-        """The fur's shells in the deep opacity maps, where they are (not pushed away as the
-        depth casters are): up to ``OPACITY_SHELLS`` outer shells, each adding the optical depth
-        of the opacity it draws (``shadows/fur_opacity.frag``); the skin is the depth atlas's."""
+        """The fur in the deep opacity maps, where it is (not pushed away as the depth casters
+        are). Stage "first": the fur's envelope, the shell through its strands' tips, which every
+        shell drawn in view lies inside, so the front is where the fur begins along each texel
+        (an inner shell there left the tips beyond it out of the maps, with no fur in front).
+        Stage "density": :meth:`opacity_shells` outer shells, each adding the optical depth of
+        the opacity it draws (``shadows/fur_opacity.frag``)."""
         params = self.params
         if params.shells == 0 or not self.fur_vertex:
             return
@@ -296,15 +310,17 @@ class FurMaterial(Material):
         if stage == "first":
             defines["OPACITY_FIRST"] = "1"
         program = frame.shaders.program(self.fur_vertex, OPACITY_FRAGMENT, defines=defines)
-        count = min(params.shells, OPACITY_SHELLS) + 1.0  # as the shells: a root and slabs
-        frame.bind(program, {**self.vertex_constants(obj, shell_depth(1, count)),
+        count = self.opacity_shells(frame, obj) + 1.0  # as the shells: a root and slabs
+        depths = [OPACITY_ENVELOPE] if stage == "first" else \
+            [shell_depth(k, count) for k in range(1, int(count))]
+        frame.bind(program, {**self.vertex_constants(obj, depths[0]),
                              "u_shell_weight": VOLUME_LAYERS / (count - 1.0)},
                    self.shadow_textures(frame, obj),
                    offered={**frame.object_uniforms(obj), **view.camera_uniforms},
                    material=frame.material_inputs(self))
-        for k in range(1, int(count)):
-            if k > 1:
-                frame.set_uniforms(program, {"u_shell_depth": shell_depth(k, count)})
+        for k, depth in enumerate(depths):
+            if k:
+                frame.set_uniforms(program, {"u_shell_depth": depth})
             frame.draw_mesh(obj.mesh, program)
 
     @staticmethod

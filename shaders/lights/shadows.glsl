@@ -15,7 +15,8 @@
 // read nothing.
 //
 // Deep opacity maps (OPACITY_SHADOWS: a volume such as fur draws them; Yuksel and Keyser 2008):
-// over the same atlas coordinates, u_opacity_first holds the light-view depth of the volume's
+// over the atlas's square its lights' maps take (atlas coordinates times u_opacity_from_atlas),
+// at a coarser resolution, u_opacity_first holds the light-view depth of the volume's
 // front and u_opacity four layers of optical depth accumulated from it up to u_opacity_layers
 // behind. A receiver compiled with OPACITY_RECEIVER (the volume's own shading) multiplies each
 // shadowed light by the transmittance exp(-u_self_shadow_density x optical depth) at its depth,
@@ -67,6 +68,7 @@ const vec2 SHADOW_POISSON[16] = vec2[](
 uniform sampler2D u_opacity_first;  // R32F: light-view depth of the volume's front
 uniform sampler2D u_opacity;        // RGBA16F: optical depth up to each layer's far end
 uniform vec4 u_opacity_layers;      // the layers' far ends behind the front, world units
+uniform float u_opacity_from_atlas; // atlas -> opacity-map coordinates (their square's scale)
 #ifndef SELF_SHADOW_DENSITY  // declared once, here or by the receiver's own GLSL (fur.glsl)
 #define SELF_SHADOW_DENSITY
 uniform float u_self_shadow_density;  // k: transmittance exp(-k x optical depth)
@@ -79,14 +81,39 @@ float shadow_view_depth(float window_z, vec4 size) {
     return 2.0 * n * f / (f + n - (2.0 * window_z - 1.0) * (f - n));
 }
 
+// The nearest front of the 3x3 texels around uv in the tile (OPACITY_FAR: none), where the
+// texel at uv holds none. The front is drawn where a texel's centre lies inside the volume as the
+// light sees it; where the light grazes the volume, one texel stretches along its surface, and a
+// point there whose texel's centre missed the volume, though deep in it, would see nothing in
+// front and stay lit beside points in shadow. With a neighbour's front, the layers (filtered
+// linearly, nothing in this texel) fade out over the edge instead.
+float opacity_edge_front(vec2 uv, vec4 rect) {
+    vec2 size = vec2(textureSize(u_opacity_first, 0));
+    ivec2 centre = ivec2(uv * size);
+    ivec2 low = ivec2(rect.xy * u_opacity_from_atlas * size + 0.5);
+    ivec2 high = ivec2(rect.zw * u_opacity_from_atlas * size - 0.5);
+    float first = 3.0e38;
+    for (int y = -1; y <= 1; ++y) {
+        for (int x = -1; x <= 1; ++x) {
+            ivec2 texel = clamp(centre + ivec2(x, y), low, high);
+            first = min(first, texelFetch(u_opacity_first, texel, 0).r);
+        }
+    }
+    return first;
+}
+
 // The volume's optical depth in front of view-space P along the tile's light: the layers
 // interpolated linearly at P's depth behind the front (0 at the front; the last layer beyond).
 float opacity_depth_at(mat4 to_atlas, vec4 rect, vec4 size, vec3 P) {
     vec4 clip = to_atlas * vec4(P, 1.0);
     vec3 uvz = clip.xyz / clip.w;
-    vec2 uv = clamp(uvz.xy, rect.xy, rect.zw);
+    vec2 uv = clamp(uvz.xy, rect.xy, rect.zw) * u_opacity_from_atlas;
     float first = textureLod(u_opacity_first, uv, 0.0).r;
-    if (first > 1.0e37) return 0.0;  // no volume along this texel
+    if (first > 1.0e37) first = opacity_edge_front(uv, rect);
+    if (first > 1.0e37) {  // no volume along this texel or beside it
+        if (opacity_seen.x < 0.0) opacity_seen = vec3(0.0);  // the view shows this light's
+        return 0.0;
+    }
     float behind = shadow_view_depth(uvz.z, size) - first;
     vec4 layers = textureLod(u_opacity, uv, 0.0);
     if (opacity_seen.x < 0.0) opacity_seen = 1.0 - exp(-u_self_shadow_density * layers.xyw);
