@@ -250,16 +250,18 @@ class FurMaterial(Material):
         opacity (``shadows/fur_caster.frag``), so the floor darkens with the fur's density.
         The vertex shader pushes them a strand's length away from the light: the fur shadows
         other surfaces and the far side of its own body, and its own skin and shells through
-        the deep opacity maps (:meth:`draw_opacity`). The skin is the root shell, a
-        receiver of the maps like every shell: under a shadowed light it keeps the
-        transmittance of the whole fur in front of it, in both pipelines (the deferred root
-        shell scales that light's share of the light it reads, as the other shells do), and
-        gamma(h) stays for unshadowed lights and with ``self_shadow_density`` 0. Unpushed,
-        the dithered casters would shadow the skin's pixels in the light pass, twice with the
-        maps, and the deferred shells reading those pixels would go as dark as the roots.
-        Pushed along the light, a shell at height h still reaches a flat skin under it where
-        the light meets the skin at more than arccos(h) from its normal: toward the
-        terminator the outer shells shadow the skin in the depth map too."""
+        the deep opacity maps (:meth:`draw_opacity`). The skin is the root shell, a receiver
+        of the maps like every shell: under a shadowed light it keeps the transmittance of the
+        whole fur in front of it, in both pipelines (the deferred root shell scales that
+        light's share of the light it reads, as the other shells do), and gamma(h) stays for
+        unshadowed lights and with ``self_shadow_density`` 0. Unpushed, the dithered casters
+        would shadow the skin's pixels in the light pass, twice with the maps, and the
+        deferred shells reading those pixels would go as dark as the roots. Toward the
+        terminator the push is not enough: a shell at height h still reaches a flat skin under
+        it where the light meets the skin at more than arccos(h) from its normal, and light
+        coming in at a grazing angle crosses the fur nearer the light, whose shells cast too.
+        There the fur is shadowed by the maps and the depth casters both, and the deferred
+        shells inherit the casters' shadow from the skin's pixels."""
         params = self.params
         if params.shells == 0 or not self.fur_vertex:
             super().draw_shadow(frame, obj, view)
