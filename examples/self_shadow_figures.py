@@ -11,8 +11,9 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from PIL import Image, ImageDraw
+from PIL import Image
 
+from deferred.debug.preview import labelled
 from deferred.render.renderer import Renderer
 from deferred.scene.loader import load_scene
 from deferred.scene.model import Scene
@@ -32,14 +33,6 @@ def demo(density: float | None) -> Scene:
             if obj.material.name in ("revie_fur", "shell_fur"):
                 obj.set_params(self_shadow_density=density)
     return scene
-
-
-def labelled(image: np.ndarray, text: str) -> np.ndarray:
-    picture = Image.fromarray(image)
-    draw = ImageDraw.Draw(picture)
-    draw.rectangle((0, 0, 8 + 6 * len(text), 14), fill=(0, 0, 0))
-    draw.text((4, 2), text, fill=(255, 255, 255))
-    return np.asarray(picture)
 
 
 def main() -> None:

@@ -9,8 +9,9 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from PIL import Image, ImageDraw
+from PIL import Image
 
+from deferred.debug.preview import labelled
 from deferred.effects.taa import TAA
 from deferred.render.renderer import Renderer
 from deferred.scene.loader import load_scene
@@ -38,14 +39,6 @@ def frame(scene_path, pipeline: str, mode: str, size: tuple[int, int]) -> np.nda
         for k in range(STILL_FRAMES if mode == "taa" else 1):
             image = renderer.render(time=0.0 if mode == "one" else k / 24.0).image[..., :3]
         return image
-
-
-def labelled(image: np.ndarray, text: str) -> Image.Image:
-    picture = Image.fromarray(image)
-    draw = ImageDraw.Draw(picture)
-    draw.rectangle((0, 0, 8 + 6 * len(text), 14), fill=(0, 0, 0))
-    draw.text((4, 2), text, fill=(255, 255, 255))
-    return picture
 
 
 def comparison(scene_path, name: str, size: tuple[int, int], crop: tuple[int, int, int, int],
@@ -80,7 +73,7 @@ def turntable(frames: int = 48, size: tuple[int, int] = (320, 180)) -> None:
                 if k >= frames:
                     images.append(image)
         columns.append(images)
-    pictures = [labelled(np.concatenate([a, b], axis=1), "one frame | taa")
+    pictures = [Image.fromarray(labelled(np.concatenate([a, b], axis=1), "one frame | taa"))
                 for a, b in zip(*columns, strict=True)]
     pictures[0].save(FIGURES / "taa_turntable.gif", save_all=True,
                      append_images=pictures[1:], duration=1000 // 24, loop=0)

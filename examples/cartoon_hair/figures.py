@@ -13,8 +13,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from PIL import Image, ImageDraw
 
+from deferred.debug import preview
 from deferred.io.images import write_image
 from deferred.materials.techniques.hatching import TamSettings, tonal_art_map
 from deferred.render.renderer import Renderer
@@ -47,9 +47,7 @@ def render(scene, pipeline="deferred", targets=()) -> tuple[np.ndarray, dict]:
 
 
 def labelled(image: np.ndarray, label: str) -> np.ndarray:
-    picture = Image.fromarray(np.ascontiguousarray(image))
-    ImageDraw.Draw(picture).text((6, 4), label, fill=(0, 0, 0))
-    return np.asarray(picture)
+    return preview.labelled(image, label, color=(0, 0, 0), box=None)
 
 
 def row(*panels: np.ndarray) -> np.ndarray:

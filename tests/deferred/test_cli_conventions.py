@@ -270,6 +270,31 @@ def test_previews_need_no_plotting_library(monkeypatch):
     assert mask is not None and 8 <= mask.shape[0] <= 16 and mask.max() > 0.9
 
 
+@pytest.mark.parametrize("pixels", [10, 12, 16])
+def test_labels_keep_their_spaces(pixels):
+    """The bundled font's space is 2 pixels at label sizes ("withoutself-shadowing" in the
+    figures): words in a label stand at least a third of the text's height apart, and a
+    labelled figure shows the text in its corner on its box."""
+    from deferred.debug.preview import labelled, text_mask
+
+    mask = text_mask("without self", pixels)
+    columns = mask.max(axis=0) > 0.1
+    gaps, run = [], 0
+    for inked in columns:
+        if inked:
+            if run:
+                gaps.append(run)
+            run = 0
+        else:
+            run += 1
+    assert max(gaps) >= pixels / 3.0
+    assert mask.shape[1] > text_mask("withoutself", pixels).shape[1] + pixels / 3.0
+    image = labelled(np.full((40, 200, 3), 128, np.uint8), "without self", pixels)
+    assert image.dtype == np.uint8 and image.shape == (40, 200, 3)
+    assert image[1, 1].tolist() == [0, 0, 0] and image[:, :mask.shape[1]].max() > 240
+    assert (image[-5:] == 128).all()
+
+
 def test_the_declared_dependencies_and_extras():
     project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
     core = {re.match(r"[\w.-]+", d).group(0).lower() for d in project["dependencies"]}
