@@ -102,13 +102,39 @@ float opacity_edge_front(vec2 uv, vec4 rect) {
     return first;
 }
 
+// The front at uv, interpolated bilinearly between the four texels around it that hold one
+// (OPACITY_FAR: none of them). Each texel holds the front at its centre: read nearest, the front
+// is flat over a texel and steps at its edges, so under a front at a slant to the light the
+// depth behind it jumps at every texel's edge, and so does the transmittance there (contour
+// bands across the skin of a fur ball, a texel of the maps apart).
+float opacity_front(vec2 uv, vec4 rect) {
+    vec2 size = vec2(textureSize(u_opacity_first, 0));
+    vec2 st = uv * size - 0.5;
+    ivec2 corner = ivec2(floor(st));
+    vec2 f = st - vec2(corner);
+    ivec2 low = ivec2(rect.xy * u_opacity_from_atlas * size + 0.5);
+    ivec2 high = ivec2(rect.zw * u_opacity_from_atlas * size - 0.5);
+    float sum = 0.0;
+    float weight = 0.0;
+    for (int k = 0; k < 4; ++k) {
+        ivec2 o = ivec2(k & 1, k >> 1);
+        float front = texelFetch(u_opacity_first, clamp(corner + o, low, high), 0).r;
+        float w = mix(1.0 - f.x, f.x, float(o.x)) * mix(1.0 - f.y, f.y, float(o.y));
+        if (front < 1.0e37) {
+            sum += w * front;
+            weight += w;
+        }
+    }
+    return weight > 0.0 ? sum / weight : 3.0e38;
+}
+
 // The volume's optical depth in front of view-space P along the tile's light: the layers
 // interpolated linearly at P's depth behind the front (0 at the front; the last layer beyond).
 float opacity_depth_at(mat4 to_atlas, vec4 rect, vec4 size, vec3 P) {
     vec4 clip = to_atlas * vec4(P, 1.0);
     vec3 uvz = clip.xyz / clip.w;
     vec2 uv = clamp(uvz.xy, rect.xy, rect.zw) * u_opacity_from_atlas;
-    float first = textureLod(u_opacity_first, uv, 0.0).r;
+    float first = opacity_front(uv, rect);
     if (first > 1.0e37) first = opacity_edge_front(uv, rect);
     if (first > 1.0e37) {  // no volume along this texel or beside it
         if (opacity_seen.x < 0.0) opacity_seen = vec3(0.0);  // the view shows this light's
