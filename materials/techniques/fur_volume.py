@@ -2,11 +2,12 @@
 "Real-Time Fur over Arbitrary Surfaces": the shells are slices of a volume texture made from a
 geometric model of a patch of hair).
 
-Strands are generated, seeded, on a jittered grid over a square tile. Each strand has a root
-position, a length (1 minus up to ``length_variation``), a random lean, a brightness and a
-diameter that tapers linearly from ``thickness_base`` at the root to ``thickness_tip`` at the tip
-(both relative to the mean spacing between strands). Slice ``k`` of ``layers`` is the cut through
-the patch at height ``(k + 0.5) / layers`` of the fur layer: each texel holds the strand's
+Strands are generated, seeded, over a square tile, their roots spread as blue noise
+(:func:`strand_roots`). Each strand has a root position, a length (1 minus up to
+``length_variation``), a random lean, a brightness and a diameter that tapers linearly from
+``thickness_base`` at the root to ``thickness_tip`` at the tip (both relative to the mean spacing
+between strands). Slice ``k`` of ``layers`` is the cut through the patch at height
+``(k + 0.5) / layers`` of the fur layer: each texel holds the strand's
 coverage of it (anti-aliased disc edges) and the strand's brightness.
 
 The texture is a 2D array (a slice per layer) of RGBA8 holding brightness * coverage in R and
@@ -24,6 +25,7 @@ N = 16 and 64 and every power of two).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import moderngl
 import numpy as np
@@ -36,7 +38,7 @@ SUBSLICES = 4  # texture slices per interval between two generated slices (linea
 class FurPattern:
     """How a tile of strands is made (see the module documentation)."""
 
-    strands: int = 1024  # per tile, on a sqrt(strands) jittered grid
+    strands: int = 1024  # per tile (rounded to a square number)
     thickness_base: float = 0.8  # diameter at the root / mean strand spacing
     thickness_tip: float = 0.15  # diameter at the tip / mean strand spacing
     length_variation: float = 0.35  # lengths are uniform in [1 - variation, 1]
@@ -73,6 +75,32 @@ def _tileable_noise(rng: np.random.Generator, size: int, cells: int) -> np.ndarr
     return rows * (1 - f)[:, None] + rows1 * f[:, None]
 
 
+ROOT_CANDIDATES = 20  # candidates per root in strand_roots
+
+
+@lru_cache(maxsize=16)
+def strand_roots(count: int, seed: int) -> np.ndarray:
+    """(count, 2) root positions in the unit tile, spread as blue noise: Mitchell's best
+    candidate, each root the one of ``ROOT_CANDIDATES`` random points farthest from the roots
+    so far, distances measured across the tile's wrap. Seeded, read-only.
+
+    Not a jittered grid: roots kept inside the cells of a grid would leave straight lanes along
+    every grid line, which the triplanar mapping lines up with the object's axes (and the UV
+    mapping with the UV axes), so fur seen along an axis would show a straight parting down
+    to the skin (down the front of Silva Fig. 7's curled ball). Blue noise keeps the roots
+    apart as evenly, with no lanes in any direction."""
+    rng = np.random.default_rng([seed, 0x5EED])
+    roots = np.empty((count, 2))
+    roots[0] = rng.uniform(0.0, 1.0, 2)
+    for i in range(1, count):
+        trial = rng.uniform(0.0, 1.0, (ROOT_CANDIDATES, 2))
+        d = np.abs(trial[:, None, :] - roots[None, :i, :])
+        d = np.minimum(d, 1.0 - d)  # the tile wraps
+        roots[i] = trial[np.argmax((d * d).sum(-1).min(axis=1))]
+    roots.flags.writeable = False
+    return roots
+
+
 def strand_volume(p: FurPattern) -> np.ndarray:
     """(layers, size, size, 2) float32: coverage and brightness of each slice, tileable, the
     same for the same pattern (``seed``)."""
@@ -80,9 +108,7 @@ def strand_volume(p: FurPattern) -> np.ndarray:
     grid = max(1, round(np.sqrt(p.strands)))
     count = grid * grid
     spacing = 1.0 / grid  # tile units
-    cells = (np.stack(np.meshgrid(np.arange(grid), np.arange(grid), indexing="ij"), -1)
-             .reshape(-1, 2))
-    roots = (cells + rng.uniform(0.1, 0.9, (count, 2))) * spacing  # (y, x) in [0, 1)
+    roots = strand_roots(count, p.seed)  # (y, x) in [0, 1)
     lengths = 1.0 - p.length_variation * rng.uniform(0.0, 1.0, count)
     if p.patches > 0.0:
         noise = _tileable_noise(rng, p.size, 4)
