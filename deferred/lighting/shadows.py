@@ -27,11 +27,11 @@ that reads it; programs only read it where the scene has a shadowed light (the d
 (``Material.opacity_shadows``: fur; in the deferred pipeline ``deferred_opacity`` too): beside
 the atlas, two textures over the square of the atlas the lights' maps take (from its corner,
 :func:`opacity_extent`), at ``opacity_scale`` (a ``[shadows]`` key) of its resolution:
-``opacity_first``,
-the light-view depth of the first volume fragment each texel sees (the volume's own front, not
-the depth atlas's casters), and ``opacity``, four layers (RGBA) of the volume's optical depth
-accumulated from that front up to ``OPACITY_LAYERS`` x the thickest volume's layer
-(``Material.opacity_layer``). Each material draws both stages
+``opacity_first``, the light-view depth of the first volume fragment each texel sees (the
+volume's own front, not the depth atlas's casters; grown by a texel where a texel's centre
+missed the volume, ``shadows/opacity_front.frag``), and ``opacity``, four layers (RGBA) of
+the volume's optical depth accumulated from that front up to ``OPACITY_LAYERS`` x the thickest
+volume's layer (``Material.opacity_layer``). Each material draws both stages
 (:meth:`~deferred.interfaces.material.Material.draw_opacity`); a receiver compiled with
 ``OPACITY_RECEIVER`` multiplies a shadowed light by the transmittance there
 (``lights/shadows.glsl``, ``opacity_transmittance``). Programs see ``OPACITY_SHADOWS``.
@@ -66,6 +66,8 @@ OPACITY_SHADOWS_DEFINE = "OPACITY_SHADOWS"
 # volume's front, where light falls fastest (Yuksel and Keyser 2008, section 3: layer sizes)
 OPACITY_LAYERS = (0.25, 0.5, 1.0, 2.0)
 OPACITY_FAR = 3.0e38  # the first-depth map's clear value: no volume along the texel
+# grows each tile's fronts by a texel where a texel's centre missed the volume
+OPACITY_FRONT_FRAGMENT = "shadows/opacity_front.frag"
 RECORD_TEXELS = 40  # texels a slot's row: 4 + 6 tiles x 6 (lights/shadows.glsl)
 MAX_TILES = 6
 CASCADE_BLEND = 0.1  # the fraction of a cascade blended into the next at its far end
@@ -121,7 +123,7 @@ def atlas_memory(budget: Any, opacity_size: int = 0) -> dict[str, int]:
     held = {f"shadow atlas {size}^2": size * size * 4 +
             RECORD_TEXELS * 16 * budget.max_shadowed_lights}
     if opacity_size:
-        held[f"opacity shadow maps {opacity_size}^2"] = opacity_size * opacity_size * 16
+        held[f"opacity shadow maps {opacity_size}^2"] = opacity_size * opacity_size * 20
     return held
 
 
@@ -327,16 +329,21 @@ class ShadowAtlas:
         self.opacity_scale = opacity_size / opacity_extent if opacity_size else 0.0
         if opacity_size:
             side = opacity_size
+            # the fronts as drawn, and grown by a texel into opacity_first (what is read)
+            self.opacity_drawn = ctx.texture((side, side), 1, dtype="f4")
             self.opacity_first = ctx.texture((side, side), 1, dtype="f4")
-            self.opacity_first.filter = (moderngl.NEAREST, moderngl.NEAREST)
             self.opacity_depth = ctx.depth_texture((side, side))
             self.opacity = ctx.texture((side, side), 4, dtype="f2")
             self.opacity.filter = (moderngl.LINEAR, moderngl.LINEAR)
-            for texture in (self.opacity_first, self.opacity):
+            for texture in (self.opacity_drawn, self.opacity_first, self.opacity):
                 texture.repeat_x = texture.repeat_y = False
-            self.first_framebuffer = ctx.framebuffer([self.opacity_first], self.opacity_depth)
+            for texture in (self.opacity_drawn, self.opacity_first):
+                texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            self.first_framebuffer = ctx.framebuffer([self.opacity_drawn], self.opacity_depth)
+            self.front_framebuffer = ctx.framebuffer([self.opacity_first])
             self.opacity_framebuffer = ctx.framebuffer([self.opacity])
             self.first_framebuffer.clear(OPACITY_FAR, 0.0, 0.0, 0.0, depth=1.0)
+            self.front_framebuffer.clear(OPACITY_FAR, 0.0, 0.0, 0.0)
             self.opacity_framebuffer.clear(0.0, 0.0, 0.0, 0.0)
 
     # -- per frame ---------------------------------------------------------------------------
@@ -527,8 +534,8 @@ class ShadowAtlas:
     def release(self) -> None:
         parts = [self.framebuffer, self.texture, self.records]
         if self.opacity is not None:
-            parts += [self.first_framebuffer, self.opacity_framebuffer, self.opacity_first,
-                      self.opacity_depth, self.opacity]
+            parts += [self.first_framebuffer, self.front_framebuffer, self.opacity_framebuffer,
+                      self.opacity_drawn, self.opacity_first, self.opacity_depth, self.opacity]
         for part in parts:
             part.release()
 
@@ -583,27 +590,37 @@ class ShadowPass(RenderPass):
 
     @staticmethod
     def _opacity(frame: Frame, atlas: ShadowAtlas, reached) -> None:
-        """The deep opacity maps of each tile: the volume's first depth (nearest wins), then its
-        optical depth added into the layers behind that depth (Yuksel and Keyser 2008, 3.1-3.2)."""
+        """The deep opacity maps of each tile: the volume's first depth (nearest wins), grown by
+        a texel (``shadows/opacity_front.frag``), then its optical depth added into the layers
+        behind that depth (Yuksel and Keyser 2008, 3.1-3.2)."""
         scale = atlas.opacity_scale
+        tiles = [(tile, tuple(round(v * scale) for v in (tile.x, tile.y, tile.size, tile.size)),
+                  [obj for obj in reached(tile) if obj.material.opacity_shadows])
+                 for tile in atlas.tiles]
         stages = ((atlas.first_framebuffer, "first", dict(depth_test=True, depth_func="less")),
+                  (atlas.front_framebuffer, "front", {}),
                   (atlas.opacity_framebuffer, "density", dict(depth_test=False, blend="add")))
+        front = frame.shaders.program("post/fullscreen.vert", OPACITY_FRONT_FRAGMENT)
         for fbo, stage, state in stages:
             frame.gl_call(fbo.use)
             frame.set_state(cull=None, **state)
             try:
-                for tile in atlas.tiles:
-                    volumes = [obj for obj in reached(tile) if obj.material.opacity_shadows]
-                    rect = tuple(round(v * scale) for v in (tile.x, tile.y, tile.size,
-                                                              tile.size))
+                for tile, rect, volumes in tiles:
                     fbo.viewport = rect
-                    if stage == "first":
-                        frame.gl_call(lambda f=fbo, r=rect: f.clear(OPACITY_FAR, 0.0, 0.0, 0.0,
-                                                                    depth=1.0, viewport=r))
-                    else:
+                    if stage == "front" and volumes:
+                        x, y, size, _ = rect
+                        frame.bind(front, {"u_tile": (x, y, x + size - 1, y + size - 1)},
+                                   {"u_opacity_drawn": atlas.opacity_drawn})
+                        frame.draw_fullscreen(front)
+                        continue
+                    if stage == "density":
                         frame.gl_call(lambda f=fbo, r=rect: f.clear(0.0, 0.0, 0.0, 0.0,
                                                                     viewport=r))
-                    for obj in volumes:
-                        obj.material.draw_opacity(frame, obj, tile.view, stage)
+                    else:
+                        frame.gl_call(lambda f=fbo, r=rect: f.clear(OPACITY_FAR, 0.0, 0.0, 0.0,
+                                                                    depth=1.0, viewport=r))
+                    if stage != "front":
+                        for obj in volumes:
+                            obj.material.draw_opacity(frame, obj, tile.view, stage)
             finally:
                 fbo.viewport = (0, 0, *atlas.opacity.size)

@@ -81,27 +81,6 @@ float shadow_view_depth(float window_z, vec4 size) {
     return 2.0 * n * f / (f + n - (2.0 * window_z - 1.0) * (f - n));
 }
 
-// The nearest front of the 3x3 texels around uv in the tile (OPACITY_FAR: none), where the
-// texel at uv holds none. The front is drawn where a texel's centre lies inside the volume as the
-// light sees it; where the light grazes the volume, one texel stretches along its surface, and a
-// point there whose texel's centre missed the volume, though deep in it, would see nothing in
-// front and stay lit beside points in shadow. With a neighbour's front, the layers (filtered
-// linearly, nothing in this texel) fade out over the edge instead.
-float opacity_edge_front(vec2 uv, vec4 rect) {
-    vec2 size = vec2(textureSize(u_opacity_first, 0));
-    ivec2 centre = ivec2(uv * size);
-    ivec2 low = ivec2(rect.xy * u_opacity_from_atlas * size + 0.5);
-    ivec2 high = ivec2(rect.zw * u_opacity_from_atlas * size - 0.5);
-    float first = 3.0e38;
-    for (int y = -1; y <= 1; ++y) {
-        for (int x = -1; x <= 1; ++x) {
-            ivec2 texel = clamp(centre + ivec2(x, y), low, high);
-            first = min(first, texelFetch(u_opacity_first, texel, 0).r);
-        }
-    }
-    return first;
-}
-
 // The front at uv, interpolated bilinearly between the four texels around it that hold one
 // (OPACITY_FAR: none of them). Each texel holds the front at its centre: read nearest, the front
 // is flat over a texel and steps at its edges, so under a front at a slant to the light the
@@ -135,8 +114,7 @@ float opacity_depth_at(mat4 to_atlas, vec4 rect, vec4 size, vec3 P) {
     vec3 uvz = clip.xyz / clip.w;
     vec2 uv = clamp(uvz.xy, rect.xy, rect.zw) * u_opacity_from_atlas;
     float first = opacity_front(uv, rect);
-    if (first > 1.0e37) first = opacity_edge_front(uv, rect);
-    if (first > 1.0e37) {  // no volume along this texel or beside it
+    if (first > 1.0e37) {  // no volume around (the fronts are grown by a texel)
         if (opacity_seen.x < 0.0) opacity_seen = vec3(0.0);  // the view shows this light's
         return 0.0;
     }
