@@ -406,3 +406,74 @@ def test_the_shell_dither_stops_while_taa_follows_a_moving_object(gl, moving):
     assert dithers[0] and all(d == 0.0 for d in dithers[0])  # a history's first frame
     later = [d for frame in dithers[1:] for d in frame]
     assert all(d == 0.0 for d in later) if moving else all(d != 0.0 for d in later)
+
+
+def test_grain_normals_are_listing_2_5_on_the_demo_ball(gl):
+    """The G-buffer's grain normals on the demo's ball (its camera, default comb [0, -1, 0])
+    are Revie's Listing 2.5 in numpy: the normal perpendicular to the comb (projected onto the
+    tangent plane), coplanar with it and the eye vector, faded to the surface normal where the
+    eye looks along the grain. The ball's dark lower front under `classic` comes from this
+    formula, not from the comb field or a fault in the shader: there the comb recedes from
+    the eye, so the grain normal faces the eye and tilts away from the key light above
+    (n_g . L 0.04 against the surface normal's 0.10; the paper's forward lighting, Listing 2.4
+    along the same grain, 0.27); lit about the strands' own leaning direction it is 0.93."""
+    from deferred.debug.capture import capture_frame
+    from deferred.render.renderer import Renderer
+
+    size = (320, 180)
+    centre, radius = np.array([-0.85, 0.55, -0.2]), 0.5
+    eye, target = np.array([0.0, 1.3, 3.6]), np.array([0.0, 0.45, 0.0])
+    scene = scene_from_dict({
+        "size": list(size), "camera": {"position": eye.tolist(), "target": target.tolist(),
+                                       "fov": 38.0},
+        "object": [{"name": "ball", "mesh": "builtin:sphere", "material": "revie_fur",
+                    "position": centre.tolist(), "scale": radius,
+                    "params": {"shells": 0, "stipple": False, "fur_length": 0.12}}],
+        "light": [{"type": "directional", "direction": [-0.6, -0.9, -0.5]}]})
+    with Renderer(scene, "deferred", gl=gl) as renderer:
+        g = capture_frame(renderer).gbuffer()
+    rendered = np.stack([g["N.X"], g["N.Y"], g["N.Z"]], -1)
+
+    # the rays through the pixel centres, world space
+    forward = (target - eye) / np.linalg.norm(target - eye)
+    right = np.cross(forward, [0.0, 1.0, 0.0])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    w, h = size
+    tan = np.tan(np.radians(38.0) / 2.0)
+    ys, xs = np.mgrid[0:h, 0:w]
+    ray = (((xs + 0.5) / w * 2.0 - 1.0) * tan * w / h)[..., None] * right + \
+        ((1.0 - (ys + 0.5) / h * 2.0) * tan)[..., None] * up + forward
+    ray /= np.linalg.norm(ray, axis=-1, keepdims=True)
+    oc = eye - centre
+    b = ray @ oc
+    disc = b * b - (oc @ oc - radius * radius)
+    hit = disc > 0.0
+    point = eye + (-b - np.sqrt(np.maximum(disc, 0.0)))[..., None] * ray
+    n = (point - centre) / radius
+    # Listing 2.5
+    comb = np.array([0.0, -1.0, 0.0])
+    grain = comb - (n @ comb)[..., None] * n
+    strength = np.linalg.norm(grain, axis=-1)
+    grain /= np.maximum(strength, 1e-9)[..., None]
+    plane = np.cross(ray, grain)
+    across = np.linalg.norm(plane, axis=-1)
+    bent = np.cross(plane, grain)
+    bent /= np.maximum(np.linalg.norm(bent, axis=-1), 1e-9)[..., None]
+    view = np.stack([right, up, -forward])  # world to view space
+    expected = bent @ view.T
+    # away from the rim (pixel footprints), the poles (the comb field's crowns) and the fade
+    inside = hit & (np.einsum("ijk,ijk->ij", n, -ray) > 0.35) & (strength > 0.6) & (across > 0.45)
+    inside &= np.linalg.norm(rendered, axis=-1) > 0.5
+    angle = np.degrees(np.arccos(np.clip(np.einsum("ijk,ijk->ij", rendered, expected),
+                                         -1.0, 1.0)))[inside]
+    print(f"{inside.sum()} pixels: grain normal against Listing 2.5, median "
+          f"{np.median(angle):.1f} deg, 95th percentile {np.percentile(angle, 95):.1f} deg")
+    assert inside.sum() > 2000
+    assert np.median(angle) < 3.0 and np.percentile(angle, 95) < 8.0
+    # the lower front: the grain normal faces the eye and lies far from the surface normal
+    lower = inside & (n[..., 1] < -0.45)
+    surface = n @ view.T
+    turned = np.degrees(np.arccos(np.clip(np.einsum("ijk,ijk->ij", expected, surface),
+                                          -1.0, 1.0)))
+    assert lower.sum() > 200 and np.median(turned[lower]) > 20.0
