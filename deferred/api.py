@@ -129,6 +129,9 @@ GLSL_INCLUDES: dict[str, str] = {
     "techniques/accumulated_light.glsl": "a fur layer's light from the light accumulation "
                                          "(Revie 2.4.4, Listing 2.2)",
     "techniques/fur_light.glsl": "a fur layer's light from a fur_light gather",
+    "techniques/fur_relight.glsl": "a fur layer's full-screen light moved from its sample to "
+                                   "the layer (after common/light_buffer.glsl and "
+                                   "generated/lights.glsl)",
     "techniques/strand_tangent.glsl": "a strand tangent as G-buffer data (Kajiya-Kay)",
     "techniques/hatching.glsl": "tonal-art-map hatching, on the surface (Praun et al.) or "
                                 "projected on the screen (Lake et al.; Costigan 4.3.8)",

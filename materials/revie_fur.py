@@ -33,7 +33,6 @@ from deferred.api import (
     NonZeroVec3,
     Phase,
     RenderPass,
-    lights,
     materials,
 )
 
@@ -173,9 +172,6 @@ class RevieFurMaterial(FurMaterial):
             defines["FUR_OCCLUSION_TEST"] = "1"
         if self.params.shading == "marschner":
             defines["FUR_MARSCHNER"] = "1"
-        ambient = dict(lights.items()).get("ambient")
-        if ambient is not None:  # the light self-shadowing leaves in the shells (shell.frag)
-            defines["FUR_AMBIENT_LIGHT"] = str(ambient.type_id)
         return {**defines, **debug_defines(self.params)}
 
     # -- passes ------------------------------------------------------------------------------

@@ -28,6 +28,8 @@ def light_range_uniform(light_type: type[Light]) -> str:
 def light_dispatch_glsl(light_types: list[type[Light]]) -> str:
     """GLSL of the light dispatch (and the shading models' dispatch, which the lights call):
 
+    - ``LIGHT_RANGE_<name>``: each type's range uniform (first record, count), defined for
+      the scene's types whose name is an identifier;
     - ``evaluate_light``: one light of any type, a switch on its type id;
     - ``evaluate_volume_light``: the same over the volume types only (the lists' lights);
     - ``evaluate_fullscreen_lights``, ``evaluate_volume_lights``: every full-screen (or volume)
@@ -42,6 +44,10 @@ def light_dispatch_glsl(light_types: list[type[Light]]) -> str:
              f'#include "{FULLSCREEN_LIGHTS_FILE}"']
     lines += [f'#include "{cls.glsl_file}"' for cls in light_types]
     lines += [f"uniform ivec2 {light_range_uniform(cls)};" for cls in light_types]
+    # a type's range by its name, where the name is a GLSL identifier: `#ifdef LIGHT_RANGE_x`
+    # holds where the scene has lights of type x (a material's own loop over one type)
+    lines += [f"#define LIGHT_RANGE_{cls.name} {light_range_uniform(cls)}"
+              for cls in light_types if cls.name.isidentifier() and cls.name.isascii()]
 
     def switch(name: str, types: list[type[Light]]) -> list[str]:
         body = [f"vec3 {name}(LightRecord light, Surface s, vec3 P, vec3 V) {{",

@@ -24,6 +24,7 @@ in float vs_shell_depth[];
 in vec3 vs_fur_position[];
 in vec3 vs_fur_normal[];
 in vec3 vs_tip_position[];
+in vec3 vs_base_position[];
 #ifdef FIN_STRAND_TANGENT
 in vec3 vs_strand_tangent[];
 out vec3 v_strand_tangent;
@@ -45,6 +46,8 @@ out float v_fur_extent;
 out float v_shell_depth;
 out vec3 v_fur_position;
 out vec3 v_fur_normal;
+out vec3 v_tip_position;
+out vec3 v_base_position;
 out float v_fin_fade;
 
 void emit(int i, bool tip, float fade) {
@@ -62,6 +65,8 @@ void emit(int i, bool tip, float fade) {
     v_shell_depth = tip ? 1.0 : 0.0;
     v_fur_position = vs_fur_position[i];
     v_fur_normal = vs_fur_normal[i];
+    v_tip_position = vs_tip_position[i];
+    v_base_position = vs_base_position[i];
     v_fin_fade = fade;
 #ifdef FIN_STRAND_TANGENT
     v_strand_tangent = vs_strand_tangent[i];

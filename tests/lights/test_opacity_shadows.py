@@ -143,10 +143,8 @@ def test_fur_light_falls_with_depth_along_the_light(gl):
 def test_lit_and_far_sides_differ_more(gl, material):
     """Under a light from the left, self-shadowing darkens the far side (the light crosses the
     whole fur to reach it) much more than the side facing the light: the ratio of the two
-    grows by 1.4 or more (forward: its shells light the far side's strands, across the light,
-    by their tangent; the deferred layers take the far side's light from its unlit skin and
-    have little of it to lose). revie_fur's grain normal lights little of the near side of a
-    light square to the view."""
+    grows by 1.4 or more (forward; the deferred fur follows it, as the next test shows).
+    revie_fur's grain normal lights little of the near side of a light square to the view."""
     with_ = side_means(*luminance(gl, fur_scene(material, 0.5)))
     without = side_means(*luminance(gl, fur_scene(material, 0.0)))
     print(material, "with", with_, "without", without)
@@ -154,60 +152,38 @@ def test_lit_and_far_sides_differ_more(gl, material):
     assert with_[0] / with_[1] > 1.4 * without[0] / without[1]
 
 
-@pytest.mark.parametrize("direction", [SIDE, [1.0, -0.3, -0.5]])
-def test_shell_fur_deferred_layers_agree_with_forward_on_the_lit_side(gl, direction):
-    """shell_fur's deferred layers take each shadowed light's transmittance as the forward
-    layers do (the light they read at the root, corrected light by light): the lit side's
-    fur agrees within 2%, and self-shadowing brings the two pipelines' images closer."""
-    images = {(k, p): luminance(gl, fur_scene("shell_fur", k, direction=direction), p)
-              for k in (0.0, 0.5) for p in ("forward", "deferred")}
-    lit = {key: side_means(*image)[0] for key, image in images.items()}
-    assert lit[(0.5, "deferred")] == pytest.approx(lit[(0.5, "forward")], rel=0.02)
-    assert lit[(0.5, "deferred")] < 0.9 * lit[(0.0, "deferred")]
-
-    def psnr(a, b):
-        return 10.0 * np.log10(1.0 / np.mean((np.clip(a, 0, 1) - np.clip(b, 0, 1)) ** 2))
-
-    with_ = psnr(images[(0.5, "forward")][0], images[(0.5, "deferred")][0])
-    without = psnr(images[(0.0, "forward")][0], images[(0.0, "deferred")][0])
-    print("forward vs deferred PSNR", without, "->", with_)
-    assert with_ > without
+FRONT_LEFT = [1.0, -0.3, -0.5]
 
 
-@pytest.mark.parametrize("direction", [SIDE, [1.0, -0.3, -0.5]])
-def test_revie_fur_deferred_shells_shadow_themselves(gl, direction):
-    """revie_fur's deferred shells take each shadowed light's transmittance (the light read at
-    their base sample, corrected light by light). From the front left the far side darkens and
-    the lit/far ratio grows; under the side light the far side's samples hold the ambient
-    alone (the deferred shells have none of the light the forward shells' grain normals catch
-    there), and self-shadowing leaves it (nothing turns black past the terminator). The lit
-    side loses its light in the same proportion as the forward shells' (the pipelines' lit
-    sides keep their ratio within 5%; under the side light, where they agree without
-    self-shadowing, within 3% of each other), and the two images come closer."""
-    images = {(k, p): luminance(gl, fur_scene("revie_fur", k, direction=direction), p)
+def luminance_psnr(a, b):
+    return 10.0 * np.log10(1.0 / np.mean((np.clip(a, 0, 1) - np.clip(b, 0, 1)) ** 2))
+
+
+@pytest.mark.parametrize("material", ["shell_fur", "revie_fur"])
+@pytest.mark.parametrize("direction", [SIDE, FRONT_LEFT], ids=["side", "front_left"])
+def test_deferred_fur_shadows_itself_as_the_forward_fur(gl, material, direction):
+    """The deferred layers move their samples' full-screen light to where they are
+    (techniques/fur_relight.glsl): the far side's strands standing out of the skin's shadow are
+    lit along their own direction, and each shadowed light reaches them through the fur in front,
+    as in the forward pipeline. Without and with self-shadowing, the lit and far sides' fur is
+    within 4% of the forward fur's, self-shadowing darkens the far side in both (under the side
+    light below 0.7 of its light, as test_lit_and_far_sides_differ_more), and the two images
+    agree to 39 dB or more (41.4-47.2 measured; before the move 19.3-28.8: the deferred far side
+    held its unlit skin's light)."""
+    images = {(k, p): luminance(gl, fur_scene(material, k, direction=direction), p)
               for k in (0.0, 0.5) for p in ("forward", "deferred")}
     sides = {key: side_means(*image) for key, image in images.items()}
-    print(direction, sides)
-    with_, without = sides[(0.5, "deferred")], sides[(0.0, "deferred")]
-    if direction == SIDE:
-        assert with_[1] == pytest.approx(without[1], rel=0.02)
-    else:
-        assert with_[1] < 0.85 * without[1]
-        assert with_[0] / with_[1] > 1.04 * without[0] / without[1]
-        assert with_[0] < 0.9 * without[0]
-    lit = {key: side[0] for key, side in sides.items()}
-    assert lit[(0.5, "deferred")] / lit[(0.5, "forward")] == pytest.approx(
-        lit[(0.0, "deferred")] / lit[(0.0, "forward")], rel=0.05)
-    if direction == SIDE:
-        assert lit[(0.5, "deferred")] == pytest.approx(lit[(0.5, "forward")], rel=0.03)
-
-    def psnr(a, b):
-        return 10.0 * np.log10(1.0 / np.mean((np.clip(a, 0, 1) - np.clip(b, 0, 1)) ** 2))
-
-    with_psnr = psnr(images[(0.5, "forward")][0], images[(0.5, "deferred")][0])
-    without_psnr = psnr(images[(0.0, "forward")][0], images[(0.0, "deferred")][0])
-    print("forward vs deferred PSNR", without_psnr, "->", with_psnr)
-    assert with_psnr > without_psnr
+    print(material, direction, sides)
+    for k in (0.0, 0.5):
+        for side in (0, 1):
+            assert sides[(k, "deferred")][side] == pytest.approx(sides[(k, "forward")][side],
+                                                                 rel=0.04)
+        value = luminance_psnr(images[(k, "forward")][0], images[(k, "deferred")][0])
+        print(f"{material} {direction} density {k}: forward vs deferred {value:.1f} dB")
+        assert value > 39.0
+    for pipeline in ("forward", "deferred"):
+        darkened = sides[(0.5, pipeline)][1] / sides[(0.0, pipeline)][1]
+        assert darkened < (0.7 if direction == SIDE else 0.75)
 
 
 def test_gamma_stays_without_shadows(gl):
@@ -314,14 +290,16 @@ shadow_resolution = 1024
 
 
 def test_shell_fur_deferred_fins_shadow_themselves(gl):
-    """shell_fur's deferred fins (lit along the chord, no re-shading along a curl) still take
-    each shadowed light's transmittance: the lit side with fins is within 1% of without."""
-    direction = [1.0, -0.3, -0.5]
-    lit = [side_means(*luminance(gl, fur_scene("shell_fur", 0.5, direction=direction,
-                                                fins=fins), "deferred"))[0]
-           for fins in (False, True)]
-    print("lit side without, with fins", lit)
-    assert lit[1] == pytest.approx(lit[0], rel=0.01)
+    """shell_fur's deferred fins (lit along the chord) take each shadowed light's
+    transmittance too: with fins, the lit side is within 1.5% of the forward fur's with fins
+    (0.8% measured; fins without transmittance made it 2.5% brighter), as it is without."""
+    lit = {(fins, pipeline): side_means(*luminance(gl, fur_scene("shell_fur", 0.5,
+                                                                  direction=FRONT_LEFT,
+                                                                  fins=fins), pipeline))[0]
+           for fins in (False, True) for pipeline in ("forward", "deferred")}
+    print("lit side", lit)
+    for fins in (False, True):
+        assert lit[(fins, "deferred")] == pytest.approx(lit[(fins, "forward")], rel=0.015)
 
 
 def test_far_fur_draws_fewer_opacity_shells(gl, monkeypatch):

@@ -36,6 +36,7 @@ uniform vec3 u_fur_scale;       // object axes to world units (the model matrix'
 #define v_fur_position vs_fur_position
 #define v_fur_normal vs_fur_normal
 #define v_tip_position vs_tip_position
+#define v_base_position vs_base_position
 #endif
 
 out vec3 v_position;
@@ -53,6 +54,7 @@ out float v_shell_depth;
 out vec3 v_fur_position;  // the base point in world-scaled object space (fur volume lookups)
 out vec3 v_fur_normal;    // object-space normal (triplanar weights)
 out vec3 v_tip_position;  // view space (fins)
+out vec3 v_base_position; // view space: the root (the deferred layers relight from it)
 
 invariant gl_Position;
 
@@ -89,6 +91,7 @@ void main() {
     v_fur_position = in_position * u_fur_scale;
     v_fur_normal = in_normal;
     v_tip_position = tip_view.xyz;
+    v_base_position = base_view.xyz;
 #if defined(SHADOW_CASTER) && !defined(OPACITY_CASTER)
     // drawn from the light (deferred.api.SHADOW_CASTER_DEFINES): the fur casts a strand's
     // length further from the light, onto other surfaces but not onto its own skin and

@@ -13,23 +13,29 @@
 #include "techniques/fur.glsl"
 #include "materials/revie_fur/slab.glsl"
 #include "techniques/accumulated_light.glsl"
-#if defined(SHADOWS) && defined(OPACITY_SHADOWS) && defined(OPACITY_RECEIVER)
-// Self-shadowing (deep opacity maps, lights/shadows.glsl): the light read at the base and
-// stipple samples holds each shadowed light whole; each is evaluated again at this shell, with
-// the grain normal the base sample was lit with, for the transmittance-weighted share to scale
-// (self_shadowed), gamma(h) staying on the rest (the forward shells' split). Not with the
-// stipple sample's rim-bent normal too (the forward shells' brighter of the two): that doubles
-// the shadow lookups; where the rim's light dominates, the share is smaller and the fur there
-// darkens less.
-#define FUR_LAYER_SELF_SHADOW
 #include "common/light_buffer.glsl"
 #include "generated/lights.glsl"
-// material_surface (the grain normal) and u_albedo_tip
+#include "techniques/fur_relight.glsl"
+#include "techniques/rim.glsl"
+// material_surface (the grain normal, or marschner's strand) and u_albedo_tip
 #include SURFACE_FILE
-in vec2 v_uv;
-#else
-uniform vec3 u_albedo_tip;
+#if defined(SHADOWS) && defined(OPACITY_SHADOWS) && defined(OPACITY_RECEIVER)
+// Self-shadowing (deep opacity maps, lights/shadows.glsl): the full-screen lights at the shell
+// reach it through the fur in front (shell_light), the volume lights' share of the samples'
+// light is scaled by their transmittance (fur_volume_self_shadowed), gamma(h) staying on the
+// rest (the forward shells' split)
+#define FUR_LAYER_SELF_SHADOW
 #endif
+#if defined(FUR_STIPPLE) && !defined(FUR_MARSCHNER)
+// the stipple sample's light came through the rim-bent normal (stipple.frag), and the forward
+// shells take the brighter of the grain and the rim-bent normal's light
+#define FUR_RIM
+uniform float u_rim_strength;
+uniform float u_rim_falloff;
+#endif
+in vec2 v_uv;
+in vec3 v_base_position;  // view space: the base point, the base sample's
+in vec3 v_tip_position;   // view space: the outermost shell's point, the stipple sample's
 
 uniform vec3 u_albedo_base;
 uniform float u_shell_fade;    // the outermost shell fades in with the level of detail
@@ -56,16 +62,11 @@ in float v_fin_fade;
 
 out vec4 out_color;
 
-#ifdef FUR_LAYER_SELF_SHADOW
-// The light read from the samples (irradiance, before gamma) with the shadowed lights' share of
-// it scaled by their transmittance here: each shadowed light evaluated again at this shell
-// (e_i), f = sum(e_i T_i / gamma) / sum(e_i), and the share sum(e_i) / irradiance, at most what
-// the ambient (FUR_AMBIENT_LIGHT, evaluated here too) leaves of it: where the shell sees more of
-// a light than its samples did, past their terminator, the ambient in their light is kept, so
-// the fur there falls to its ambient light and turns no black
-vec3 self_shadowed(vec3 irradiance, float gamma) {
+// The fur's surface at a view-space point on this fragment's strand, as the lights shade it:
+// the grain normal (or marschner's strand), and with rim the stipple sample's rim bending.
+Surface strand_surface(vec3 position, bool rim) {
     SurfaceInput i;
-    i.position = v_position;
+    i.position = position;
     i.normal = normalize(v_normal);
     i.tangent = normalize(v_tangent);
     i.binormal = normalize(v_binormal);
@@ -74,38 +75,40 @@ vec3 self_shadowed(vec3 irradiance, float gamma) {
     Surface s = material_surface(i);
     s.shading_model = surface_shading_model(u_surface_id);
     s.occlusion = 1.0;
-    vec3 V = normalize(-v_position);
-    vec3 inverse_albedo = 1.0 / max(s.albedo, vec3(1.0 / 255.0));
-    const vec3 LUMA = vec3(0.2126, 0.7152, 0.0722);
-    float total = 0.0;
-    float kept = 0.0;
-    float ambient = 0.0;
-    opacity_split = true;
-    for (int k = 0; k < u_light_count; ++k) {
-        LightRecord light = fetch_light(k);
-#ifdef FUR_AMBIENT_LIGHT
-        if (int(light.color.w + 0.5) == FUR_AMBIENT_LIGHT) {
-            // lights/ambient.glsl's hemisphere, inline: through evaluate_light's dispatch
-            // llvmpipe runs every light type's code, shadow lookups included
-            float sky = 0.5 + 0.5 * dot(s.normal, light.direction.xyz);
-            vec3 hemisphere = mix(light.extra.rgb, light.color.rgb, sky);
-            ambient += dot(shade_ambient(s, hemisphere) * inverse_albedo, LUMA);
-            continue;
-        }
-#endif
-        if (light.extra.w < 0.5) continue;  // no shadow slot: gamma(h) stays
-        opacity_last = 1.0;
-        vec3 lit = evaluate_light(light, s, v_position, V);
-
-        float e = dot(lit * inverse_albedo, LUMA);
-        total += e;
-        kept += e * opacity_last / max(gamma, 1e-3);
+    s.view_depth = -position.z;
+#ifdef FUR_RIM
+    if (rim) {
+        s.normal = rim_bend(i.normal, s.normal, normalize(position), u_rim_strength,
+                            u_rim_falloff);
     }
-    float read = max(dot(irradiance, LUMA), 1e-6);
-    float share = clamp(total / read, 0.0, max(1.0 - ambient / read, 0.0));
-    return irradiance * mix(1.0, kept / max(total, 1e-6), share);
-}
 #endif
+    return s;
+}
+
+// The light read at the base and stipple samples (irradiance, before gamma) moved to this
+// shell (techniques/fur_relight.glsl): the full-screen lights at each sample's point, with its
+// surface as it was lit (c), swapped for those at the shell (t) with the grain normal (the base
+// sample's) and the rim-bent one (the stipple sample's), lit through one shadow lookup. With
+// deep opacity maps the shadowed ones reach the shell through the fur in front of it and
+// gamma(h) stays on the rest, as in the forward shells (divided out here: the caller
+// multiplies by it); `fullscreen` returns the brighter t.
+void shell_light(inout vec3 base_light, inout vec3 tip_light, float gamma,
+                 out vec3 fullscreen) {
+    Surface grain = strand_surface(v_position, false);
+    vec3 inverse_albedo = 1.0 / max(grain.albedo, vec3(1.0 / 255.0));
+    vec3 t_grain, t_rim;
+    fur_layer_lights(grain, strand_surface(v_position, true), v_position, gamma, t_grain, t_rim);
+    t_grain *= inverse_albedo;
+    t_rim *= inverse_albedo;
+    vec3 c = fur_sample_light(strand_surface(v_base_position, false), v_base_position)
+           * inverse_albedo;
+    base_light = fur_relit(base_light, c, t_grain);
+#ifdef FUR_STIPPLE
+    c = fur_sample_light(strand_surface(v_tip_position, true), v_tip_position) * inverse_albedo;
+    tip_light = fur_relit(tip_light, c, t_rim);
+#endif
+    fullscreen = max(t_grain, t_rim);
+}
 
 void main() {
 #ifdef FUR_FINS
@@ -157,17 +160,28 @@ void main() {
                      tip_valid ? 1.0 : 0.0, 1.0);  // own pixel: yellow
     return;
 #endif
-    if (!base_valid && !tip_valid && !own_valid) discard;  // the strand's light is unknown
+    float gamma = fur_shadow(v_shell_depth);
+    vec3 fullscreen;
+    shell_light(base_light, tip_light, gamma, fullscreen);
+    // Neither sample (the base off-screen or hidden, the tip too: a fin at a back-lit
+    // silhouette): the full-screen lights' light at the shell, or the brighter of it and the
+    // light of the fur at the fragment's own pixel (another point of the fur, lit its own way:
+    // it brings the volume lights)
     vec3 irradiance = base_valid && tip_valid ? max(base_light, tip_light)
-                    : (base_valid ? base_light : (tip_valid ? tip_light : irradiance_at(own)));
+                    : (tip_valid ? tip_light
+                                 : (base_valid ? base_light
+                                               : (own_valid ? max(irradiance_at(own), fullscreen)
+                                                            : fullscreen)));
 #ifdef FUR_LAYER_SELF_SHADOW
-    irradiance = self_shadowed(irradiance, fur_shadow(v_shell_depth));
+    irradiance = fur_volume_self_shadowed(irradiance, fullscreen,
+                                          strand_surface(v_position, false), v_position,
+                                          normalize(-v_position), gamma);
 #ifdef FUR_DEBUG_OPACITY_SHADOW
     out_color = vec4(max(opacity_seen, vec3(0.0)), 1.0);
     return;
 #endif
 #endif
     float brightness = strand_brightness(strands);
-    vec3 albedo = mix(u_albedo_base, u_albedo_tip, v_shell_depth) * fur_shadow(v_shell_depth);
+    vec3 albedo = mix(u_albedo_base, u_albedo_tip, v_shell_depth) * gamma;
     out_color = vec4(irradiance * strand_tint(albedo, strands) * brightness, alpha);
 }

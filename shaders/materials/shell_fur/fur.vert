@@ -44,6 +44,7 @@ uniform sampler2D u_strand_tips;  // RGBA32F: per vertex p - p_0, curl u, curl v
 #define v_fur_position vs_fur_position
 #define v_fur_normal vs_fur_normal
 #define v_tip_position vs_tip_position
+#define v_base_position vs_base_position
 #define v_strand_tangent vs_strand_tangent
 #endif
 
@@ -62,6 +63,7 @@ out float v_shell_depth;
 out vec3 v_fur_position;  // the root in world-scaled object space (fur volume lookups)
 out vec3 v_fur_normal;    // object-space normal (triplanar weights)
 out vec3 v_tip_position;  // view space (fins)
+out vec3 v_base_position; // view space: the root (the deferred layers relight from it)
 out vec3 v_strand_tangent;  // view space
 #if !defined(STRAND_CHORD) && !defined(FUR_FINS)
 out vec3 v_strand_chord;    // view space: the chord, as the base surface was lit (shell.frag)
@@ -119,6 +121,7 @@ void main() {
     v_fur_position = in_position * u_fur_scale;
     v_fur_normal = in_normal;
     v_tip_position = tip_view.xyz;
+    v_base_position = base_view.xyz;
     v_strand_tangent = normalize(mat3(model_view) * direction);
 #if !defined(STRAND_CHORD) && !defined(FUR_FINS)
     vec3 chord = tip - in_position;
