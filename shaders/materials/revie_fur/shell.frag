@@ -86,12 +86,15 @@ Surface strand_surface(vec3 position, bool rim) {
 }
 
 // The light read at the base and stipple samples (irradiance, before gamma) moved to this
-// shell (techniques/fur_relight.glsl): the full-screen lights at each sample's point, with its
-// surface as it was lit (c), swapped for those at the shell (t) with the grain normal (the base
-// sample's) and the rim-bent one (the stipple sample's), lit through one shadow lookup. With
-// deep opacity maps the shadowed ones reach the shell through the fur in front of it and
-// gamma(h) stays on the rest, as in the forward shells (divided out here: the caller
-// multiplies by it); `fullscreen` returns the brighter t.
+// shell (techniques/fur_relight.glsl) where a light casts shadows: the full-screen lights at
+// each sample's point, with its surface as it was lit (c), swapped for those at the shell (t)
+// with the grain normal (the base sample's) and the rim-bent one (the stipple sample's), lit
+// through one shadow lookup. With deep opacity maps the shadowed ones reach the shell through
+// the fur in front of it and gamma(h) stays on the rest, as in the forward shells (divided out
+// here: the caller multiplies by it). `fullscreen` returns the brighter t. Without shadows the
+// samples' light is kept as read: a shell's normals are its base's, the light changes between
+// them with the view direction alone, and moving it brought the demo no closer to the forward
+// image (benchmarks/README.md); t is then only the light of a fragment with no sample.
 void shell_light(inout vec3 base_light, inout vec3 tip_light, float gamma,
                  out vec3 fullscreen) {
     Surface grain = strand_surface(v_position, false);
@@ -100,6 +103,8 @@ void shell_light(inout vec3 base_light, inout vec3 tip_light, float gamma,
     fur_layer_lights(grain, strand_surface(v_position, true), v_position, gamma, t_grain, t_rim);
     t_grain *= inverse_albedo;
     t_rim *= inverse_albedo;
+    fullscreen = max(t_grain, t_rim);
+#ifdef SHADOWS
     vec3 c = fur_sample_light(strand_surface(v_base_position, false), v_base_position)
            * inverse_albedo;
     base_light = fur_relit(base_light, c, t_grain);
@@ -107,7 +112,7 @@ void shell_light(inout vec3 base_light, inout vec3 tip_light, float gamma,
     c = fur_sample_light(strand_surface(v_tip_position, true), v_tip_position) * inverse_albedo;
     tip_light = fur_relit(tip_light, c, t_rim);
 #endif
-    fullscreen = max(t_grain, t_rim);
+#endif
 }
 
 void main() {
