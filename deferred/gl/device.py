@@ -31,7 +31,10 @@ BLEND_MODES = {
     "premultiplied": (moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA),
     # colour times the source (a tint over what is there); alpha kept
     "multiply": (moderngl.DST_COLOR, moderngl.ZERO, moderngl.ZERO, moderngl.ONE),
+    # the smaller of source and destination, channel by channel (the factors play no part)
+    "min": (moderngl.ONE, moderngl.ONE),
 }
+BLEND_EQUATIONS = {"min": moderngl.MIN}
 DEPTH_FUNCS = {"less": "<", "lequal": "<=", "gequal": ">=", "greater": ">", "equal": "==",
                "always": "1"}
 
@@ -142,7 +145,7 @@ class Device:
         if blend:
             flags |= moderngl.BLEND
             self.ctx.blend_func = BLEND_MODES[blend]
-            self.ctx.blend_equation = moderngl.FUNC_ADD
+            self.ctx.blend_equation = BLEND_EQUATIONS.get(blend, moderngl.FUNC_ADD)
         self.ctx.enable_only(flags)
 
     def set_depth_offset(self, depth_offset: tuple[float, float]) -> None:

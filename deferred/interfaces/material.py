@@ -101,12 +101,16 @@ class ShadowView:
     """One shadow map being drawn (:meth:`Material.draw_shadow`): the light's world -> view
     and view -> clip matrices, where the light is (a world position, or ``None`` for a
     directional light) and the direction it shines (world, unit), for casters that shape
-    themselves to it."""
+    themselves to it. ``opacity_maps``: the light has deep opacity maps this frame, which
+    every material with ``opacity_shadows`` draws itself into (:meth:`Material.draw_opacity`)
+    and through which the other surfaces take its shadow (``lights/shadows.glsl``): such a
+    volume may leave its translucent part out of the depth map."""
 
     view: np.ndarray
     projection: np.ndarray
     position: np.ndarray | None
     direction: np.ndarray
+    opacity_maps: bool = False
 
     @property
     def uniforms(self) -> dict[str, Any]:
@@ -326,10 +330,12 @@ class Material:
     def draw_opacity(self, frame: Frame, obj: SceneObjectLike, view: ShadowView,
                      stage: str) -> None:
         """Draw ``obj``'s volume into the deep opacity maps of ``view`` (materials with
-        ``opacity_shadows``): ``stage`` "first", the light-view depth of its front (its outer
-        surface, which every point it draws lies inside) into an R32F target with a depth test;
-        "density", its optical depth added into the four layers
-        behind that front (``u_opacity_first``, ``u_opacity_layers``), blended additively."""
+        ``opacity_shadows``): ``stage`` "first", the light-view depth of its outer surface
+        (which every point it draws lies inside) as (depth, -depth, 0, 0) into an RG32F target
+        with min blending, no depth test: its front and its back along each texel; "density",
+        its optical depth times the volume's density factor (what lies behind it keeps
+        exp(-the layers' sum) of the light), added into the four layers behind that front
+        (``u_opacity_first``, ``u_opacity_layers``), blended additively."""
 
     def passes(self, phase: Phase, obj: SceneObjectLike) -> list[RenderPass]:
         hooks = {Phase.GEOMETRY: self.geometry_passes, Phase.SCREEN: self.screen_passes,

@@ -27,14 +27,19 @@ that reads it; programs only read it where the scene has a shadowed light (the d
 (``Material.opacity_shadows``: fur; in the deferred pipeline ``deferred_opacity`` too): beside
 the atlas, two textures over the square of the atlas the lights' maps take (from its corner,
 :func:`opacity_extent`), at ``opacity_scale`` (a ``[shadows]`` key) of its resolution:
-``opacity_first``, the light-view depth of the first volume fragment each texel sees (the
-volume's own front, not the depth atlas's casters; grown by a texel where a texel's centre
-missed the volume, ``shadows/opacity_front.frag``), and ``opacity``, four layers (RGBA) of
-the volume's optical depth accumulated from that front up to ``OPACITY_LAYERS`` x the thickest
-volume's layer (``Material.opacity_layer``). Each material draws both stages
-(:meth:`~deferred.interfaces.material.Material.draw_opacity`); a receiver compiled with
-``OPACITY_RECEIVER`` multiplies a shadowed light by the transmittance there
-(``lights/shadows.glsl``, ``opacity_transmittance``). Programs see ``OPACITY_SHADOWS``.
+``opacity_first``, the light-view depths of the nearest and the farthest volume fragment each
+texel sees (the volume's own front and back, not the depth atlas's casters; min blending of
+(depth, -depth); grown by a texel where a texel's centre missed the volume,
+``shadows/opacity_front.frag``), and ``opacity``, four layers (RGBA) of the volume's optical
+depth (times its density factor) accumulated from that front up to ``OPACITY_LAYERS`` x the
+thickest volume's layer (``Material.opacity_layer``). Each material draws both stages
+(:meth:`~deferred.interfaces.material.Material.draw_opacity`) and leaves its translucent part
+out of the depth atlas (``ShadowView.opacity_maps``): a receiver compiled with
+``OPACITY_RECEIVER`` (the volume's own) multiplies a shadowed light by the transmittance at
+its depth (``lights/shadows.glsl``, ``opacity_transmittance``), any other surface by the
+transmittance through the whole volume where it lies beyond the volume's back
+(``opacity_beyond``). Programs see ``OPACITY_SHADOWS``, so a scene without such a volume
+compiles neither lookup.
 """
 
 from __future__ import annotations
@@ -118,12 +123,13 @@ def opacity_size(scene: Scene, pipeline: str) -> int:
 def atlas_memory(budget: Any, opacity_size: int = 0) -> dict[str, int]:
     """What the shadow atlas of a scene's budget holds, for the memory budget: its depths
     (4 bytes a texel) and its records; with an ``opacity_size`` (:func:`opacity_size`), the
-    opacity maps (first depth 4 + depth 4 + four half-float layers 8 bytes a texel)."""
+    opacity maps (the front and back depths as drawn 8 + grown 8 + four half-float layers 8
+    bytes a texel)."""
     size = budget.atlas_size
     held = {f"shadow atlas {size}^2": size * size * 4 +
             RECORD_TEXELS * 16 * budget.max_shadowed_lights}
     if opacity_size:
-        held[f"opacity shadow maps {opacity_size}^2"] = opacity_size * opacity_size * 20
+        held[f"opacity shadow maps {opacity_size}^2"] = opacity_size * opacity_size * 24
     return held
 
 
@@ -329,21 +335,21 @@ class ShadowAtlas:
         self.opacity_scale = opacity_size / opacity_extent if opacity_size else 0.0
         if opacity_size:
             side = opacity_size
-            # the fronts as drawn, and grown by a texel into opacity_first (what is read)
-            self.opacity_drawn = ctx.texture((side, side), 1, dtype="f4")
-            self.opacity_first = ctx.texture((side, side), 1, dtype="f4")
-            self.opacity_depth = ctx.depth_texture((side, side))
+            # the fronts (R) and minus the backs (G) as drawn, kept by min blending, and grown
+            # by a texel into opacity_first (what is read)
+            self.opacity_drawn = ctx.texture((side, side), 2, dtype="f4")
+            self.opacity_first = ctx.texture((side, side), 2, dtype="f4")
             self.opacity = ctx.texture((side, side), 4, dtype="f2")
             self.opacity.filter = (moderngl.LINEAR, moderngl.LINEAR)
             for texture in (self.opacity_drawn, self.opacity_first, self.opacity):
                 texture.repeat_x = texture.repeat_y = False
             for texture in (self.opacity_drawn, self.opacity_first):
                 texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
-            self.first_framebuffer = ctx.framebuffer([self.opacity_drawn], self.opacity_depth)
+            self.first_framebuffer = ctx.framebuffer([self.opacity_drawn])
             self.front_framebuffer = ctx.framebuffer([self.opacity_first])
             self.opacity_framebuffer = ctx.framebuffer([self.opacity])
-            self.first_framebuffer.clear(OPACITY_FAR, 0.0, 0.0, 0.0, depth=1.0)
-            self.front_framebuffer.clear(OPACITY_FAR, 0.0, 0.0, 0.0)
+            self.first_framebuffer.clear(OPACITY_FAR, OPACITY_FAR, 0.0, 0.0)
+            self.front_framebuffer.clear(OPACITY_FAR, OPACITY_FAR, 0.0, 0.0)
             self.opacity_framebuffer.clear(0.0, 0.0, 0.0, 0.0)
 
     # -- per frame ---------------------------------------------------------------------------
@@ -415,7 +421,7 @@ class ShadowAtlas:
                 direction = unit(-light_view[2, :3])
                 self.tiles.append(ShadowTile(light, slot, x, y, size, view_projection,
                                              ShadowView(light_view, light_projection, position,
-                                                        direction),
+                                                        direction, self.opacity is not None),
                                              reach))
             self.slots[id(light)] = slot
         self.records.write(records.tobytes())
@@ -529,13 +535,21 @@ class ShadowAtlas:
         side = self.opacity.size[0]
         first = np.frombuffer(self.opacity_first.read(alignment=1), dtype=np.float32)
         layers = np.frombuffer(self.opacity.read(alignment=1), dtype=np.float16)
-        return first.reshape(side, side), layers.reshape(side, side, 4).astype(np.float32)
+        return first.reshape(side, side, 2)[..., 0], \
+            layers.reshape(side, side, 4).astype(np.float32)
+
+    def read_opacity_back(self) -> np.ndarray:
+        """The light-view depth of the volumes' back (side, side), float32, rows bottom-up
+        (-OPACITY_FAR: no volume along the texel)."""
+        side = self.opacity.size[0]
+        first = np.frombuffer(self.opacity_first.read(alignment=1), dtype=np.float32)
+        return -first.reshape(side, side, 2)[..., 1]
 
     def release(self) -> None:
         parts = [self.framebuffer, self.texture, self.records]
         if self.opacity is not None:
             parts += [self.first_framebuffer, self.front_framebuffer, self.opacity_framebuffer,
-                      self.opacity_drawn, self.opacity_first, self.opacity_depth, self.opacity]
+                      self.opacity_drawn, self.opacity_first, self.opacity]
         for part in parts:
             part.release()
 
@@ -590,14 +604,15 @@ class ShadowPass(RenderPass):
 
     @staticmethod
     def _opacity(frame: Frame, atlas: ShadowAtlas, reached) -> None:
-        """The deep opacity maps of each tile: the volume's first depth (nearest wins), grown by
-        a texel (``shadows/opacity_front.frag``), then its optical depth added into the layers
-        behind that depth (Yuksel and Keyser 2008, 3.1-3.2)."""
+        """The deep opacity maps of each tile: the volume's first and last depths (min blending
+        of the depth and its negative), grown by a texel (``shadows/opacity_front.frag``), then
+        its optical depth added into the layers behind the first (Yuksel and Keyser 2008,
+        3.1-3.2)."""
         scale = atlas.opacity_scale
         tiles = [(tile, tuple(round(v * scale) for v in (tile.x, tile.y, tile.size, tile.size)),
                   [obj for obj in reached(tile) if obj.material.opacity_shadows])
                  for tile in atlas.tiles]
-        stages = ((atlas.first_framebuffer, "first", dict(depth_test=True, depth_func="less")),
+        stages = ((atlas.first_framebuffer, "first", dict(depth_test=False, blend="min")),
                   (atlas.front_framebuffer, "front", {}),
                   (atlas.opacity_framebuffer, "density", dict(depth_test=False, blend="add")))
         front = frame.shaders.program("post/fullscreen.vert", OPACITY_FRONT_FRAGMENT)
@@ -617,8 +632,8 @@ class ShadowPass(RenderPass):
                         frame.gl_call(lambda f=fbo, r=rect: f.clear(0.0, 0.0, 0.0, 0.0,
                                                                     viewport=r))
                     else:
-                        frame.gl_call(lambda f=fbo, r=rect: f.clear(OPACITY_FAR, 0.0, 0.0, 0.0,
-                                                                    depth=1.0, viewport=r))
+                        frame.gl_call(lambda f=fbo, r=rect: f.clear(OPACITY_FAR, OPACITY_FAR,
+                                                                    0.0, 0.0, viewport=r))
                     if stage != "front":
                         for obj in volumes:
                             obj.material.draw_opacity(frame, obj, tile.view, stage)

@@ -244,24 +244,26 @@ class FurMaterial(Material):
         return {}
 
     def draw_shadow(self, frame: Frame, obj: SceneObject, view: ShadowView) -> None:
-        """The fur casts from its shells: the root shell (the skin) and up to
-        ``SHADOW_SHELLS`` shells above it through the material's own fur vertex shader seen
-        from the light (:data:`SHADOW_CASTER_DEFINES`), each kept by a dither under its
-        opacity (``shadows/fur_caster.frag``), so the floor darkens with the fur's density.
-        The vertex shader pushes them a strand's length away from the light: the fur shadows
-        other surfaces and the far side of its own body, and its own skin and shells through
-        the deep opacity maps (:meth:`draw_opacity`). The skin is the root shell, a receiver
-        of the maps like every shell: under a shadowed light it keeps the transmittance of the
-        whole fur in front of it, in both pipelines (the deferred root shell scales that
-        light's share of the light it reads, as the other shells do), and gamma(h) stays for
-        unshadowed lights and with ``self_shadow_density`` 0. Unpushed, the dithered casters
-        would shadow the skin's pixels in the light pass, twice with the maps, and the
-        deferred shells reading those pixels would go as dark as the roots. Toward the
-        terminator the push is not enough: a shell at height h still reaches a flat skin under
-        it where the light meets the skin at more than arccos(h) from its normal, and light
-        coming in at a grazing angle crosses the fur nearer the light, whose shells cast too.
-        There the fur is shadowed by the maps and the depth casters both, and the deferred
-        shells inherit the casters' shadow from the skin's pixels."""
+        """The fur's depth from a light, through the material's own fur vertex shader seen from
+        it (:data:`SHADOW_CASTER_DEFINES`), which pushes it a strand's length away from the
+        light (so its own skin, lit through the fur in front, does not shadow itself at the
+        roots).
+
+        Where the light has deep opacity maps (``view.opacity_maps``) and the fur is in them
+        (``self_shadow_density`` above 0), only the root shell (the skin, opaque) casts depth:
+        the body shadows its own far side and what lies behind it, and the fur's translucent
+        shadow, on other surfaces as on itself, is the maps' alone (``lights/shadows.glsl``:
+        a surface beyond the fur's back keeps exp(-k x the fur's optical depth) there, the
+        fur's own shells and skin the transmittance at their depth). Dithered shells in the
+        depth map too would shadow the fur twice: toward the terminator a shell at height h
+        reaches a flat skin under it where the light meets the skin at more than arccos(h)
+        from its normal, however far it is pushed, and the deferred shells read their light
+        from the skin's pixels.
+
+        Otherwise (``self_shadow_density`` 0, or a pipeline that draws no maps) the root shell
+        and up to ``SHADOW_SHELLS`` shells above it cast, each kept by a dither under its
+        opacity (``shadows/fur_caster.frag``), so the floor darkens with the fur's density;
+        gamma(h) is the fur's own self-shadowing then."""
         params = self.params
         if params.shells == 0 or not self.fur_vertex:
             super().draw_shadow(frame, obj, view)
@@ -269,6 +271,7 @@ class FurMaterial(Material):
         program = frame.shaders.program(self.fur_vertex, SHADOW_CASTER_FRAGMENT,
                                         defines={**self.defines(obj), **SHADOW_CASTER_DEFINES})
         count = min(params.shells, SHADOW_SHELLS) + 1.0  # the root shell and the slabs above
+        drawn = 1 if view.opacity_maps and self.opacity_shadows else int(count)
         # the light's matrices offered, not set: the shader declares them under the camera's
         # names (renamed by the defines), which is what strict mode reads
         frame.bind(program, {**self.vertex_constants(obj), "u_shell_depth": 0.0,
@@ -277,7 +280,7 @@ class FurMaterial(Material):
                    self.shadow_textures(frame, obj),
                    offered={**frame.object_uniforms(obj), **view.camera_uniforms},
                    material=frame.material_inputs(self))
-        for k in range(int(count)):
+        for k in range(drawn):
             if k:
                 frame.set_uniforms(program, {"u_shell_depth": shell_depth(k, count),
                                              "u_root_shell": False})

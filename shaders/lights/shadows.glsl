@@ -16,12 +16,19 @@
 //
 // Deep opacity maps (OPACITY_SHADOWS: a volume such as fur draws them; Yuksel and Keyser 2008):
 // over the atlas's square its lights' maps take (atlas coordinates times u_opacity_from_atlas),
-// at a coarser resolution, u_opacity_first holds the light-view depth of the volume's
-// front and u_opacity four layers of optical depth accumulated from it up to u_opacity_layers
-// behind. A receiver compiled with OPACITY_RECEIVER (the volume's own shading) multiplies each
-// shadowed light by the transmittance exp(-u_self_shadow_density x optical depth) at its depth,
-// and takes opacity_fallback (the volume's cheap stand-in, set before the lights are evaluated)
-// for a light without a shadow slot.
+// at a coarser resolution, u_opacity_first holds the light-view depths of the volume's front
+// (R) and of its back (-G), and u_opacity four layers of optical depth (times the volume's
+// density factor) accumulated from the front up to u_opacity_layers behind. A volume draws
+// there its translucent part, and leaves it out of the depth atlas (deferred.api.ShadowView's
+// opacity_maps), so each surface takes the volume's shadow from these maps once:
+// - a receiver compiled with OPACITY_RECEIVER (the volume's own shading) multiplies each
+//   shadowed light by the transmittance exp(-optical depth) at its depth, and takes
+//   opacity_fallback (the volume's cheap stand-in, set before the lights are evaluated) for a
+//   light without a shadow slot;
+// - any other surface multiplies it by the transmittance through the whole volume where it
+//   lies beyond the volume's back along the light, and by nothing where it lies inside: the
+//   volume's own surfaces lit by the generic light passes (a deferred fur's skin, whose light
+//   the shells read and scale by their own transmittance) keep their whole light.
 #include "common/lighting.glsl"
 
 #ifdef OPACITY_RECEIVER
@@ -64,15 +71,11 @@ const vec2 SHADOW_POISSON[16] = vec2[](
     vec2(-0.2419, 0.9971), vec2(-0.8141, 0.9144), vec2(0.1998, 0.7864),
     vec2(0.1438, -0.1410));
 
-#if defined(OPACITY_RECEIVER) && defined(OPACITY_SHADOWS)
-uniform sampler2D u_opacity_first;  // R32F: light-view depth of the volume's front
+#ifdef OPACITY_SHADOWS
+uniform sampler2D u_opacity_first;  // RG32F: light-view depth of the volume's front, - its back
 uniform sampler2D u_opacity;        // RGBA16F: optical depth up to each layer's far end
 uniform vec4 u_opacity_layers;      // the layers' far ends behind the front, world units
 uniform float u_opacity_from_atlas; // atlas -> opacity-map coordinates (their square's scale)
-#ifndef SELF_SHADOW_DENSITY  // declared once, here or by the receiver's own GLSL (fur.glsl)
-#define SELF_SHADOW_DENSITY
-uniform float u_self_shadow_density;  // k: transmittance exp(-k x optical depth)
-#endif
 
 // The light-view depth of a depth-buffer value of a tile (near, far; perspective or not).
 float shadow_view_depth(float window_z, vec4 size) {
@@ -80,6 +83,37 @@ float shadow_view_depth(float window_z, vec4 size) {
     if (size.y < 0.5) return n + window_z * (f - n);
     return 2.0 * n * f / (f + n - (2.0 * window_z - 1.0) * (f - n));
 }
+#endif
+
+#if defined(OPACITY_SHADOWS) && !defined(OPACITY_RECEIVER)
+// The light a surface other than the volume's own keeps at view-space P: the transmittance
+// through the whole volume along the tile's light (its last layer, filtered) where P lies
+// beyond the volume's back less half the thinnest layer's end (u_opacity_layers.y: half a
+// strand), else 1 (in front of the volume, or inside it: the volume's own surfaces). The
+// volume's own surfaces lie at least its thickness before its back (a point within that
+// distance of the skin is in the volume), and a floor the fur dips into near its back takes
+// the shadow too (left at 1, the fur's contact with it showed lit specks). The back is the
+// farthest of the four texels around P's, so a surface inside the volume is not taken for
+// one beyond it where the back slopes within a texel.
+float opacity_beyond(mat4 to_atlas, vec4 rect, vec4 size, vec3 P) {
+    vec4 clip = to_atlas * vec4(P, 1.0);
+    vec3 uvz = clip.xyz / clip.w;
+    vec2 uv = clamp(uvz.xy, rect.xy, rect.zw) * u_opacity_from_atlas;
+    vec2 texels = vec2(textureSize(u_opacity_first, 0));
+    ivec2 corner = ivec2(floor(uv * texels - 0.5));
+    ivec2 low = ivec2(rect.xy * u_opacity_from_atlas * texels + 0.5);
+    ivec2 high = ivec2(rect.zw * u_opacity_from_atlas * texels - 0.5);
+    float back = -3.0e38;
+    for (int k = 0; k < 4; ++k) {
+        ivec2 texel = clamp(corner + ivec2(k & 1, k >> 1), low, high);
+        back = max(back, -texelFetch(u_opacity_first, texel, 0).g);
+    }
+    if (shadow_view_depth(uvz.z, size) <= back - u_opacity_layers.y) return 1.0;
+    return exp(-textureLod(u_opacity, uv, 0.0).w);
+}
+#endif
+
+#if defined(OPACITY_RECEIVER) && defined(OPACITY_SHADOWS)
 
 // The front at uv, interpolated bilinearly between the four texels around it that hold one
 // (OPACITY_FAR: none of them). Each texel holds the front at its centre: read nearest, the front
@@ -120,7 +154,7 @@ float opacity_depth_at(mat4 to_atlas, vec4 rect, vec4 size, vec3 P) {
     }
     float behind = shadow_view_depth(uvz.z, size) - first;
     vec4 layers = textureLod(u_opacity, uv, 0.0);
-    if (opacity_seen.x < 0.0) opacity_seen = 1.0 - exp(-u_self_shadow_density * layers.xyw);
+    if (opacity_seen.x < 0.0) opacity_seen = 1.0 - exp(-layers.xyw);
     vec4 b = u_opacity_layers;
     // piecewise linear through (0, 0), (b.x, layers.x) .. (b.w, layers.w)
     float t0 = clamp(behind / b.x, 0.0, 1.0);
@@ -132,7 +166,7 @@ float opacity_depth_at(mat4 to_atlas, vec4 rect, vec4 size, vec3 P) {
 }
 
 float opacity_transmittance(mat4 to_atlas, vec4 rect, vec4 size, vec3 P) {
-    return exp(-u_self_shadow_density * opacity_depth_at(to_atlas, rect, size, P));
+    return exp(-opacity_depth_at(to_atlas, rect, size, P));
 }
 #endif
 
@@ -184,6 +218,8 @@ float shadow_tile(int row, int tile, vec4 header, vec4 biases, vec3 P, vec3 N, v
     float transmittance = opacity_transmittance(to_atlas, rect, size, P);
     opacity_last = transmittance;
     return shadow_filter(uvz, rect, header) * (opacity_split ? 1.0 : transmittance);
+#elif defined(OPACITY_SHADOWS)
+    return shadow_filter(uvz, rect, header) * opacity_beyond(to_atlas, rect, size, P);
 #else
     return shadow_filter(uvz, rect, header);
 #endif

@@ -11,10 +11,7 @@
 uniform sampler2DArray u_fur_volume;  // slices of the strand volume, mip-mapped (alpha = coverage)
 uniform float u_fur_tiles;            // volume tiles per world unit
 uniform float u_self_shadow;          // Silva's K_shadow >= 1: fur darkens toward the roots
-#ifndef SELF_SHADOW_DENSITY  // declared once, here or by lights/shadows.glsl
-#define SELF_SHADOW_DENSITY
-uniform float u_self_shadow_density;  // k of the deep opacity maps (lights/shadows.glsl)
-#endif
+uniform float u_self_shadow_density;  // k: the deep opacity maps hold k x optical depth
 
 // Coverage (x) and brightness * coverage (y) of the volume at height h: the generated slices
 // around h, interpolated. The texture holds SUBSLICES interpolated slices per interval between

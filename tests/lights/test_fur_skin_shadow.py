@@ -1,9 +1,10 @@
 """Fur shadows its own skin (#27): the root shell, the skin between the strands' roots, is a
 receiver of the deep opacity maps like every shell, so a shadowed light reaches it through the
-whole fur in front. The fur's depth casters stay pushed a strand's length away from the light
-(FurMaterial.draw_shadow), so the skin is not shadowed twice, once by the dithered depth casters
-and once by the maps. Measured on the skin alone (shell_range (0, 0), no fins), lit from the
-camera: at the middle of the ball the light crosses the fur along the normal."""
+whole fur in front. With the maps, only the fur's skin casts in the depth map (pushed a strand's
+length away from the light; FurMaterial.draw_shadow), so the skin is not shadowed twice, once by
+the dithered depth casters and once by the maps. Measured on the skin alone (shell_range (0, 0),
+no fins), lit from the camera: at the middle of the ball the light crosses the fur along the
+normal."""
 
 from __future__ import annotations
 
@@ -133,10 +134,12 @@ def test_skin_transmittance_has_no_steps_at_coarse_maps(gl, material):
     light without) varies smoothly: the fur's front is interpolated between the maps' texels
     (lights/shadows.glsl, opacity_front). Read nearest, the front stepped at every texel's edge
     and so did the depth behind it: 4-5% of neighbouring pixels differed by more than 0.04,
-    contour bands across the ball. Now under 1.5%; the mean transmittance stays as it was."""
+    contour bands across the ball. Now under 2.5% against the skin with no shadow map (the fur's
+    dithered shells cast in the depth map without self-shadowing, FurMaterial.draw_shadow; with
+    it only its skin does): what is left are the maps' own streaks along the light."""
     scene = {"direction": (1.0, -0.3, -0.5), "size": (192, 144), "opacity_scale": 0.25}
     with_ = skin_luminance(gl, material, 0.5, "forward", **scene)
-    without = skin_luminance(gl, material, 0.0, "forward", **scene)
+    without = skin_luminance(gl, material, 0.0, "forward", shadows=False, **scene)
     lit = without > 0.05
     transmittance = np.where(lit, with_ / np.maximum(without, 1e-6), 0.0)
     steps = np.concatenate([
@@ -145,5 +148,5 @@ def test_skin_transmittance_has_no_steps_at_coarse_maps(gl, material):
     print(material, "steps over 0.04", (steps > 0.04).mean(), "mean",
           transmittance[lit].mean())
     assert lit.sum() > 5000
-    assert (steps > 0.04).mean() < 0.015
+    assert (steps > 0.04).mean() < 0.025
     assert 0.2 < transmittance[lit].mean() < 0.35
