@@ -85,6 +85,14 @@ Surface strand_surface(vec3 position, bool rim) {
     return s;
 }
 
+#if defined(SHADOWS) || defined(FUR_FINS)
+// The full-screen lights at the shell (t): where a light casts shadows, what the samples' light
+// moves to; in fins, also the light of a fragment with no sample (a fin at a back-lit
+// silhouette, its base and tip hidden, where TT glows)
+#define FUR_SHELL_LIGHT
+#endif
+
+#ifdef FUR_SHELL_LIGHT
 // The light read at the base and stipple samples (irradiance, before gamma) moved to this
 // shell (techniques/fur_relight.glsl) where a light casts shadows: the full-screen lights at
 // each sample's point, with its surface as it was lit (c), swapped for those at the shell (t)
@@ -94,7 +102,7 @@ Surface strand_surface(vec3 position, bool rim) {
 // here: the caller multiplies by it). `fullscreen` returns the brighter t. Without shadows the
 // samples' light is kept as read: a shell's normals are its base's, the light changes between
 // them with the view direction alone, and moving it brought the demo no closer to the forward
-// image (benchmarks/README.md); t is then only the light of a fragment with no sample.
+// image (benchmarks/README.md).
 void shell_light(inout vec3 base_light, inout vec3 tip_light, float gamma,
                  out vec3 fullscreen) {
     Surface grain = strand_surface(v_position, false);
@@ -114,6 +122,7 @@ void shell_light(inout vec3 base_light, inout vec3 tip_light, float gamma,
 #endif
 #endif
 }
+#endif
 
 void main() {
 #ifdef FUR_FINS
@@ -166,17 +175,21 @@ void main() {
     return;
 #endif
     float gamma = fur_shadow(v_shell_depth);
+#ifdef FUR_SHELL_LIGHT
     vec3 fullscreen;
     shell_light(base_light, tip_light, gamma, fullscreen);
     // Neither sample (the base off-screen or hidden, the tip too: a fin at a back-lit
     // silhouette): the full-screen lights' light at the shell, or the brighter of it and the
     // light of the fur at the fragment's own pixel (another point of the fur, lit its own way:
     // it brings the volume lights)
+    vec3 unsampled = own_valid ? max(irradiance_at(own), fullscreen) : fullscreen;
+#else
+    // a shell with no sample: the light of the fur at its own pixel, else unknown
+    if (!base_valid && !tip_valid && !own_valid) discard;
+    vec3 unsampled = irradiance_at(own);
+#endif
     vec3 irradiance = base_valid && tip_valid ? max(base_light, tip_light)
-                    : (tip_valid ? tip_light
-                                 : (base_valid ? base_light
-                                               : (own_valid ? max(irradiance_at(own), fullscreen)
-                                                            : fullscreen)));
+                    : (tip_valid ? tip_light : (base_valid ? base_light : unsampled));
 #ifdef FUR_LAYER_SELF_SHADOW
     irradiance = fur_volume_self_shadowed(irradiance, fullscreen,
                                           strand_surface(v_position, false), v_position,
