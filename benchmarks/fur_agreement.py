@@ -1,12 +1,12 @@
 """How closely the fur's deferred shells match its forward shells: PSNR, forward against
-deferred, of a fur ball (both furs) under a side light and a light from the front left, without
-and with self-shadowing (deep opacity maps, ``self_shadow_density``), and back-lit with
-``shading = "marschner"`` (the scenes of tests/lights/test_opacity_shadows.py and
-tests/materials/test_marschner.py). Printed per scene: the PSNR of the luminance (as the tests
-measure it) and of the colour, both HDR clipped to [0, 1]. With ``--out DIR`` each scene is also
+deferred, of a fur ball (both furs; revie_fur also with its stipple sample) under a side light
+and a light from the front left, without and with self-shadowing (deep opacity maps,
+``self_shadow_density``), and back-lit with ``shading = "marschner"`` (the scenes of
+tests/lights/test_opacity_shadows.py and tests/materials/test_marschner.py). Printed per
+scene: the PSNR of the luminance (as the tests measure it) and of the colour, both HDR clipped
+to [0, 1]. With ``--out DIR`` each scene is also
 written as one PNG: forward, deferred (gamma 2.2) and their difference (linear, x 4 about
-grey), side by side. Run from the
-repository root:
+grey), side by side. Run from the repository root:
 
     python benchmarks/fur_agreement.py [--scale N] [--out DIR]
 """
@@ -34,14 +34,17 @@ FUR = {"revie_fur": {"fur_length": 0.35, "shells": 16, "stipple": False, "self_s
 LUMA = np.array([0.2126, 0.7152, 0.0722])
 
 
-def lit_ball(material: str, direction: list[float], density: float, scale: int) -> dict:
-    """tests/lights/test_opacity_shadows.py's fur_scene: a fur ball, one shadowed light."""
+def lit_ball(material: str, direction: list[float], density: float, scale: int,
+             stipple: bool = False) -> dict:
+    """tests/lights/test_opacity_shadows.py's fur_scene: a fur ball, one shadowed light
+    (revie_fur: with its stipple sample or not)."""
+    extra = {"stipple": True} if stipple else {}
     return {
         "size": [128 * scale, 96 * scale], "tonemap": "none", "background": [0.0, 0.0, 0.0],
         "camera": {"position": [0.0, 0.0, 2.0], "target": [0.0, 0.0, 0.0], "fov": 40.0},
         "shadows": {"atlas_size": 1024},
         "object": [{"mesh": "builtin:sphere", "scale": 0.45, "material": material,
-                    "params": {**FUR[material], "self_shadow_density": density}}],
+                    "params": {**FUR[material], "self_shadow_density": density, **extra}}],
         "light": [AMBIENT, {"type": "directional", "direction": direction, "intensity": 2.0,
                             "cascades": 1, "shadows": True, "shadow_resolution": 1024,
                             "shadow_distance": 8.0}]}
@@ -65,11 +68,12 @@ def back_lit_ball(material: str, scale: int) -> dict:
 
 def scenes(scale: int) -> list[tuple[str, dict]]:
     out = []
-    for material in ("shell_fur", "revie_fur"):
+    for material, stipple in (("shell_fur", False), ("revie_fur", False), ("revie_fur", True)):
+        name = f"{material}{' stippled' if stipple else ''}"
         for label, direction in (("side light", SIDE), ("front left", FRONT_LEFT)):
             for density in (0.0, 0.5):
-                out.append((f"{material}, {label}, self_shadow_density {density}",
-                            lit_ball(material, direction, density, scale)))
+                out.append((f"{name}, {label}, self_shadow_density {density}",
+                            lit_ball(material, direction, density, scale, stipple)))
     for material in ("shell_fur", "revie_fur"):
         out.append((f"{material}, back-lit, marschner", back_lit_ball(material, scale)))
     return out

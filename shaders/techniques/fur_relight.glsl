@@ -17,6 +17,8 @@
 // Each type is a loop over its own range, calling its function: llvmpipe runs every branch of a
 // switch on the light type (shadow lookups included) for every light.
 
+uniform int u_global_light_count;  // the full-screen lights, first in the light buffer
+
 // The full-screen lights at P: la for surface a, lb for surface b, b's lit through a's shadow
 // lookups (their normal offset: a's normal). A caller with one surface passes it twice; the
 // compiler merges the two shadings.
@@ -79,15 +81,18 @@ vec3 fur_sample_light(Surface s, vec3 P) {
 
 // The light read from a sample (irradiance) with the full-screen lights' share swapped, per
 // channel: c, those lights at the sample as it was lit, for t, at the layer. Where c lies
-// within what was read, read - c + t; where the sample read less (its ambient occlusion, or a
+// within what was read, read - c + t (t alone without volume lights); where the sample read less (its ambient occlusion, or a
 // neighbour's pixel in a shadow c does not see), the read light scaled by t / c. Never
 // negative, continuous where read = c.
 vec3 fur_relit(vec3 read, vec3 c, vec3 t) {
-    return mix(read * t / max(c, vec3(1e-6)), read - c + t, step(c, read));
+    // with no volume light in the frame all the light read is the full-screen lights': what it
+    // holds beyond c is the sample's pixel showing another point than c's (a neighbour's, at a
+    // silhouette), not light
+    vec3 rest = u_light_count > u_global_light_count ? read - c : vec3(0.0);
+    return mix(read * t / max(c, vec3(1e-6)), rest + t, step(c, read));
 }
 
 #if defined(SHADOWS) && defined(OPACITY_SHADOWS) && defined(OPACITY_RECEIVER)
-uniform int u_global_light_count;  // the full-screen lights, first in the light buffer
 
 // Self-shadowing from the volume lights (deep opacity maps, lights/shadows.glsl): the light
 // read from a sample holds each shadowed volume light whole (the full-screen ones are t's,

@@ -183,7 +183,7 @@ def test_forward_and_deferred_agree_with_marschner(render, material):
     b = np.clip(forward.hdr[..., :3], 0.0, 1.0)
     value = psnr(a, b)
     print(f"{material} marschner forward vs deferred PSNR {value:.1f} dB")
-    # measured 40.1 dB (revie_fur) and 35.5 dB (shell_fur); 23.4 / 35.3 before the deferred
+    # measured 40.8 dB (revie_fur) and 40.0 dB (shell_fur); 23.5 / 35.5 before the deferred
     # layers moved their samples' full-screen light to where they are and lit a fin with no
     # sample there (techniques/fur_relight.glsl): revie_fur's back-lit fins glowed half as much
-    assert value > {"revie_fur": 38.0, "shell_fur": 33.0}[material]
+    assert value > 38.0
