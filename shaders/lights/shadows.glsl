@@ -88,13 +88,15 @@ float shadow_view_depth(float window_z, vec4 size) {
 #if defined(OPACITY_SHADOWS) && !defined(OPACITY_RECEIVER)
 // The light a surface other than the volume's own keeps at view-space P: the transmittance
 // through the whole volume along the tile's light (its last layer, filtered) where P lies
-// beyond the volume's back less half the thinnest layer's end (u_opacity_layers.y: half a
-// strand), else 1 (in front of the volume, or inside it: the volume's own surfaces). The
-// volume's own surfaces lie at least its thickness before its back (a point within that
-// distance of the skin is in the volume), and a floor the fur dips into near its back takes
-// the shadow too (left at 1, the fur's contact with it showed lit specks). The back is the
-// farthest of the four texels around P's, so a surface inside the volume is not taken for
-// one beyond it where the back slopes within a texel.
+// beyond the volume's back, none of it where P lies a layer's thickness (u_opacity_layers.z:
+// the thickest volume's) or more before the back (in front of the volume, or inside it: the
+// volume's own surfaces), faded in between. A lit surface of the volume's own lies farther
+// than that from the back: its light goes on into the body it covers and out through the
+// volume beyond. A surface the volume dips into (a floor under fur) lies within it and takes
+// part of the shadow (left at 1 there, the fur's contact with a floor showed lit patches,
+// stepped at the maps' texels). The back is the farthest of the four texels around P's, so a
+// surface inside the volume is not taken for one beyond it where the back slopes within a
+// texel.
 float opacity_beyond(mat4 to_atlas, vec4 rect, vec4 size, vec3 P) {
     vec4 clip = to_atlas * vec4(P, 1.0);
     vec3 uvz = clip.xyz / clip.w;
@@ -108,8 +110,9 @@ float opacity_beyond(mat4 to_atlas, vec4 rect, vec4 size, vec3 P) {
         ivec2 texel = clamp(corner + ivec2(k & 1, k >> 1), low, high);
         back = max(back, -texelFetch(u_opacity_first, texel, 0).g);
     }
-    if (shadow_view_depth(uvz.z, size) <= back - u_opacity_layers.y) return 1.0;
-    return exp(-textureLod(u_opacity, uv, 0.0).w);
+    vec4 b = u_opacity_layers;
+    float beyond = clamp((shadow_view_depth(uvz.z, size) - back + b.z) / (b.z - b.x), 0.0, 1.0);
+    return mix(1.0, exp(-textureLod(u_opacity, uv, 0.0).w), beyond);
 }
 #endif
 
