@@ -115,7 +115,10 @@ void shell_light(inout vec3 base_light, inout vec3 tip_light, float gamma,
 #ifdef SHADOWS
     vec3 c = fur_sample_light(strand_surface(v_base_position, false), v_base_position)
            * inverse_albedo;
-    base_light = fur_relit(base_light, c, t_grain);
+    // the forward shells take the brighter of the grain and the rim-bent normal's light, at
+    // every shell: the base sample's moves to that, not to the grain's alone (its rim light
+    // would be the stipple sample's, only where that is not hidden)
+    base_light = fur_relit(base_light, c, fullscreen);
 #ifdef FUR_STIPPLE
     c = fur_sample_light(strand_surface(v_tip_position, true), v_tip_position) * inverse_albedo;
     tip_light = fur_relit(tip_light, c, t_rim);
