@@ -123,7 +123,7 @@ float opacity_beyond(mat4 to_atlas, vec4 rect, vec4 size, vec3 P) {
 // is flat over a texel and steps at its edges, so under a front at a slant to the light the
 // depth behind it jumps at every texel's edge, and so does the transmittance there (contour
 // bands across the skin of a fur ball, a texel of the maps apart).
-float opacity_front(vec2 uv, vec4 rect) {
+float interpolated_front(vec2 uv, vec4 rect) {
     vec2 size = vec2(textureSize(u_opacity_first, 0));
     vec2 st = uv * size - 0.5;
     ivec2 corner = ivec2(floor(st));
@@ -150,7 +150,7 @@ float opacity_depth_at(mat4 to_atlas, vec4 rect, vec4 size, vec3 P) {
     vec4 clip = to_atlas * vec4(P, 1.0);
     vec3 uvz = clip.xyz / clip.w;
     vec2 uv = clamp(uvz.xy, rect.xy, rect.zw) * u_opacity_from_atlas;
-    float first = opacity_front(uv, rect);
+    float first = interpolated_front(uv, rect);
     if (first > 1.0e37) {  // no volume around (the fronts are grown by a texel)
         if (opacity_seen.x < 0.0) opacity_seen = vec3(0.0);  // the view shows this light's
         return 0.0;
