@@ -115,8 +115,10 @@ GLSL_INCLUDES: dict[str, str] = {
                             "GLSL function)",
     "lights/shadows.glsl": "light_shadow_cascades, _perspective, _cube: the lit fraction of "
                            "a shadowed light at a point (a light's GLSL function multiplies "
-                           "by its projection's); with OPACITY_RECEIVER, times the "
-                           "transmittance through the deep opacity maps",
+                           "by its projection's); with deep opacity maps "
+                           "(OPACITY_SHADOWS), times the transmittance through them: at the "
+                           "point's depth for an OPACITY_RECEIVER (the volume's own shading), "
+                           "through the whole volume beyond its back for any other surface",
     "common/forward_lighting.glsl": "every light of the frame at one surface point (forward "
                                     "passes)",
     "gbuffer/layout.glsl": "the G-buffer's encoding and decoding",

@@ -28,7 +28,10 @@
 // - any other surface multiplies it by the transmittance through the whole volume where it
 //   lies beyond the volume's back along the light, and by nothing where it lies inside: the
 //   volume's own surfaces lit by the generic light passes (a deferred fur's skin, whose light
-//   the shells read and scale by their own transmittance) keep their whole light.
+//   the shells read and scale by their own transmittance) keep their whole light. Where one
+//   lies beyond the back (the skin under an open sheet of fur) it takes the whole
+//   transmittance, and the deferred layer reading it finds that again through the same lookup
+//   (opacity_as_light_pass) before it swaps the sample's light for its own.
 #include "common/lighting.glsl"
 
 #ifdef OPACITY_RECEIVER
@@ -40,6 +43,11 @@ vec3 opacity_seen = vec3(-1.0);
 // opacity_last (a deferred fur layer corrects the summed light it read by it, light by light)
 bool opacity_split = false;
 float opacity_last = 1.0;
+// opacity_as_light_pass: shadowed lights return what the generic light passes' lookup gives
+// at P (the depth shadow times opacity_beyond): a deferred fur layer's light at its sample as
+// the light pass lit it, a sample that may lie beyond the volume's back (the skin under an
+// open sheet of fur, whose front and back are its tips)
+bool opacity_as_light_pass = false;
 #endif
 
 #ifdef OPACITY_RECEIVER
@@ -85,7 +93,7 @@ float shadow_view_depth(float window_z, vec4 size) {
 }
 #endif
 
-#if defined(OPACITY_SHADOWS) && !defined(OPACITY_RECEIVER)
+#ifdef OPACITY_SHADOWS
 // The light a surface other than the volume's own keeps at view-space P: the transmittance
 // through the whole volume along the tile's light (its last layer, filtered) where P lies
 // beyond the volume's back, none of it where P lies a layer's thickness (u_opacity_layers.z:
@@ -220,7 +228,9 @@ float shadow_tile(int row, int tile, vec4 header, vec4 biases, vec3 P, vec3 N, v
 #if defined(OPACITY_RECEIVER) && defined(OPACITY_SHADOWS)
     float transmittance = opacity_transmittance(to_atlas, rect, size, P);
     opacity_last = transmittance;
-    return shadow_filter(uvz, rect, header) * (opacity_split ? 1.0 : transmittance);
+    float lit = shadow_filter(uvz, rect, header);
+    if (opacity_as_light_pass) return lit * opacity_beyond(to_atlas, rect, size, P);
+    return lit * (opacity_split ? 1.0 : transmittance);
 #elif defined(OPACITY_SHADOWS)
     return shadow_filter(uvz, rect, header) * opacity_beyond(to_atlas, rect, size, P);
 #else

@@ -68,14 +68,19 @@ void fur_layer_lights(Surface a, Surface b, vec3 P, float gamma, out vec3 la, ou
 }
 
 // The full-screen lights at a sample's point P with its surface s, as the light pass lit it (c):
-// a shadowed light by its depth shadow alone (the light pass knows no opacity maps).
+// a shadowed light by its depth shadow and, where P lies beyond a volume's back, the volume's
+// whole transmittance (lights/shadows.glsl opacity_beyond, the generic passes' lookup).
 vec3 fur_sample_light(Surface s, vec3 P) {
 #if defined(SHADOWS) && defined(OPACITY_SHADOWS) && defined(OPACITY_RECEIVER)
     opacity_split = true;
+    opacity_as_light_pass = true;
     opacity_fallback = 1.0;
 #endif
     vec3 la, lb;
     fur_fullscreen_lights(s, s, P, normalize(-P), la, lb);
+#if defined(SHADOWS) && defined(OPACITY_SHADOWS) && defined(OPACITY_RECEIVER)
+    opacity_as_light_pass = false;
+#endif
     return la;
 }
 

@@ -150,3 +150,40 @@ def test_skin_transmittance_has_no_steps_at_coarse_maps(gl, material):
     assert lit.sum() > 5000
     assert (steps > 0.04).mean() < 0.025
     assert 0.2 < transmittance[lit].mean() < 0.35
+
+
+def sheet_luminance(gl, material: str, density: float, pipeline: str,
+                    skin_only: bool) -> np.ndarray:
+    """A sheet of fur (builtin:plane) seen from above at a slant, lit from above through it."""
+    params = {"fur_length": 0.2, "shells": SHELLS, "lod_error": 0.1, "self_shadow": K_SHADOW,
+              "self_shadow_density": density, "fins": False, **FUR[material],
+              **({"shell_range": [0.0, 0.0]} if skin_only else {})}
+    scene = scene_from_dict({
+        "size": [W, H], "tonemap": "none", "background": [0.0, 0.0, 0.0],
+        "camera": {"position": [0.0, 1.6, 1.2], "target": [0.0, 0.0, 0.0], "fov": 40.0},
+        "shadows": {"atlas_size": 1024},
+        "object": [{"mesh": "builtin:plane", "scale": 0.6, "material": material,
+                    "params": params}],
+        "light": [{"type": "directional", "direction": [0.0, -1.0, -0.2], "intensity": 2.0,
+                   "cascades": 1, "shadows": True, "shadow_resolution": 1024,
+                   "shadow_distance": 8.0}]})
+    with Renderer(scene, pipeline, gl=gl) as renderer:
+        hdr = renderer.render(hdr=True).hdr
+    return hdr[..., :3].astype(np.float64) @ LUMA
+
+
+@pytest.mark.parametrize("material", ["revie_fur", "shell_fur"])
+@pytest.mark.parametrize("skin_only", [True, False])
+def test_open_sheet_of_fur_is_shadowed_once_in_deferred(gl, material, skin_only):
+    """On an open mesh the maps' front and back are both the fur's tips, so the skin lies beyond
+    the back and the generic light pass gives it the fur's whole transmittance; the deferred
+    layers reading that skin must find the same lookup in the light they swap out, or the fur
+    is darkened twice (without it deferred keeps about 0.42 of forward's light)."""
+    box = np.zeros((H, W), bool)
+    box[24:48, 32:64] = True
+    forward = sheet_luminance(gl, material, 0.25, "forward", skin_only)
+    deferred = sheet_luminance(gl, material, 0.25, "deferred", skin_only)
+    unshadowed = sheet_luminance(gl, material, 0.0, "forward", skin_only)
+    box &= unshadowed > 1e-3
+    assert np.median(forward[box]) < 0.9 * np.median(unshadowed[box])  # the fur shadows
+    assert np.median(deferred[box]) == pytest.approx(np.median(forward[box]), rel=0.05)
