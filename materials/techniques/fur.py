@@ -305,7 +305,7 @@ class FurMaterial(Material):
         """The fur in the deep opacity maps, where it is (not pushed away as the depth casters
         are). Stage "first": the fur's envelope, the shell through its strands' tips, which every
         shell drawn in view lies inside, so the front is where the fur begins along each texel
-        (an inner shell there left the tips beyond it out of the maps, with no fur in front).
+        (an inner shell would leave the tips beyond it out of the maps, with no fur in front).
         Stage "density": :meth:`opacity_shells` outer shells, each adding the optical depth of
         the opacity it draws (``shadows/fur_opacity.frag``)."""
         params = self.params

@@ -101,10 +101,9 @@ float shadow_view_depth(float window_z, vec4 size) {
 // volume's own surfaces), faded in between. A lit surface of the volume's own lies farther
 // than that from the back: its light goes on into the body it covers and out through the
 // volume beyond. A surface the volume dips into (a floor under fur) lies within it and takes
-// part of the shadow (left at 1 there, the fur's contact with a floor showed lit patches,
-// stepped at the maps' texels). The back is the farthest of the four texels around P's, so a
-// surface inside the volume is not taken for one beyond it where the back slopes within a
-// texel.
+// part of the shadow, so where it meets the fur it shows no lit patches stepped at the maps'
+// texels. The back is the farthest of the four texels around P's, so a surface inside the
+// volume is not taken for one beyond it where the back slopes within a texel.
 float opacity_beyond(mat4 to_atlas, vec4 rect, vec4 size, vec3 P) {
     vec4 clip = to_atlas * vec4(P, 1.0);
     vec3 uvz = clip.xyz / clip.w;
@@ -119,7 +118,8 @@ float opacity_beyond(mat4 to_atlas, vec4 rect, vec4 size, vec3 P) {
         back = max(back, -texelFetch(u_opacity_first, texel, 0).g);
     }
     vec4 b = u_opacity_layers;
-    float beyond = clamp((shadow_view_depth(uvz.z, size) - back + b.z) / (b.z - b.x), 0.0, 1.0);
+    float beyond = clamp((shadow_view_depth(uvz.z, size) - back + b.z) / max(b.z - b.x, 1e-6),
+                         0.0, 1.0);
     return mix(1.0, exp(-textureLod(u_opacity, uv, 0.0).w), beyond);
 }
 #endif

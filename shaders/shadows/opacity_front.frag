@@ -1,10 +1,11 @@
 // The fronts of a tile of the deep opacity maps grown by a texel (deferred.lighting.shadows,
 // ShadowPass._opacity): a texel where no volume was drawn takes the nearest front and the
-// farthest back of its 3x3 neighbours in the tile. A front is drawn where a texel's centre lies inside the volume as the
-// light sees it; where the light grazes the volume, one texel stretches along its surface, and
-// a point there whose texel's centre missed the volume, though deep in it, would see nothing in
-// front and stay lit beside points in shadow. With a neighbour's front, the layers (filtered
-// linearly, nothing drawn in this texel) fade out over the edge instead.
+// farthest back of its 3x3 neighbours in the tile. A front is drawn where a texel's centre lies
+// inside the volume as the light sees it; where the light grazes the volume, one texel
+// stretches along its surface, and a point there whose texel's centre missed the volume,
+// though deep in it, would see nothing in front and stay lit beside points in shadow. With a
+// neighbour's front, the layers (filtered linearly, nothing drawn in this texel) fade out over
+// the edge instead.
 uniform sampler2D u_opacity_drawn;  // RG32F: the fronts and minus the backs as drawn (3e38: none)
 uniform ivec4 u_tile;               // the tile's first and last texels (x0, y0, x1, y1)
 

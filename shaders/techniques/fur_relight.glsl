@@ -86,9 +86,9 @@ vec3 fur_sample_light(Surface s, vec3 P) {
 
 // The light read from a sample (irradiance) with the full-screen lights' share swapped, per
 // channel: c, those lights at the sample as it was lit, for t, at the layer. Where c lies
-// within what was read, read - c + t (t alone without volume lights); where the sample read less (its ambient occlusion, or a
-// neighbour's pixel in a shadow c does not see), the read light scaled by t / c. Never
-// negative, continuous where read = c.
+// within what was read, read - c + t (t alone without volume lights); where the sample read
+// less (its ambient occlusion, or a neighbour's pixel in a shadow c does not see), the read
+// light scaled by t / c. Never negative, continuous where read = c.
 vec3 fur_relit(vec3 read, vec3 c, vec3 t) {
     // with no volume light in the frame all the light read is the full-screen lights': what it
     // holds beyond c is the sample's pixel showing another point than c's (a neighbour's, at a
