@@ -14,6 +14,7 @@ import argparse
 
 from shadows import timed  # benchmarks/shadows.py
 
+from deferred.bench.scenes import set_self_shadow_density
 from deferred.gl.context import create_context
 from deferred.render.renderer import Renderer
 from deferred.scene.loader import load_scene
@@ -24,11 +25,7 @@ DEMO = "examples/shadows_demo.toml"
 def demo(density: float | None):
     """The demo, its fur's self_shadow_density set (None: the default)."""
     scene = load_scene(DEMO)
-    if density is not None:
-        for obj in scene.objects:
-            if obj.material.name in ("revie_fur", "shell_fur"):
-                obj.set_params(self_shadow_density=density)
-    return scene
+    return scene if density is None else set_self_shadow_density(scene, density)
 
 
 def main() -> None:

@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
+from deferred.bench.scenes import set_self_shadow_density
 from deferred.debug.preview import labelled
 from deferred.render.renderer import Renderer
 from deferred.scene.loader import load_scene
@@ -28,11 +29,7 @@ CROP = (170, 200, 550, 520)  # the ball, x0, y0, x1, y1 at SIZE
 def demo(density: float | None) -> Scene:
     """The demo with shadows, its fur's self_shadow_density set (None: the default)."""
     scene = load_scene(DEMO)
-    if density is not None:
-        for obj in scene.objects:
-            if obj.material.name in ("revie_fur", "shell_fur"):
-                obj.set_params(self_shadow_density=density)
-    return scene
+    return scene if density is None else set_self_shadow_density(scene, density)
 
 
 def main() -> None:

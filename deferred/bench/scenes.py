@@ -1,6 +1,6 @@
 """The bench's scene variants: extra point lights placed where the camera sees them, each
-with a radius covering a fixed share of the view at its depth, and a shell count set on every
-object whose material has one (``revie_fur``)."""
+with a radius covering a fixed share of the view at its depth, a shell count set on every
+object whose material has one (``revie_fur``), and a fur self-shadowing density likewise."""
 
 from __future__ import annotations
 
@@ -23,6 +23,7 @@ LIGHT_VIEW_SHARE = 0.3
 LIGHT_INTENSITY = 2.0
 SHELLS = "shells"
 MIN_SHELLS = "min_shells"
+SELF_SHADOW_DENSITY = "self_shadow_density"
 
 
 def world_bounds(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
@@ -123,3 +124,12 @@ def with_shells(scene: Scene, shells: int, where: str = "--shells") -> Scene:
             obj = obj.with_material(type(material)(new_params, material.base_dir), overrides)
         objects.append(obj)
     return replace(scene, objects=objects)
+
+
+def set_self_shadow_density(scene: Scene, density: float) -> Scene:
+    """``scene`` with ``self_shadow_density`` set (validated, in place) on every object whose
+    material has that parameter: the fur's deep opacity maps, 0 for gamma(h) alone."""
+    for obj in scene.objects:
+        if SELF_SHADOW_DENSITY in type(obj.material.params).model_fields:
+            obj.set_params(**{SELF_SHADOW_DENSITY: density})
+    return scene

@@ -10,7 +10,13 @@ import pytest
 
 from deferred.bench.harness import Sweep, run_bench
 from deferred.bench.report import COLUMNS
-from deferred.bench.scenes import extra_point_lights, shell_objects, with_extra_lights, with_shells
+from deferred.bench.scenes import (
+    extra_point_lights,
+    set_self_shadow_density,
+    shell_objects,
+    with_extra_lights,
+    with_shells,
+)
 from deferred.cli import main
 from deferred.errors import InputError
 from deferred.io.images import read_image
@@ -180,6 +186,19 @@ def test_shells_applied_to_fur_objects_only(render, shells):
 def test_shells_out_of_the_materials_range_is_bad_input():
     with pytest.raises(InputError, match=r"^--shells: .*256.* for torus \(revie_fur\), got 999"):
         with_shells(load_scene(None), 999)
+
+
+def test_self_shadow_density_set_on_every_fur_and_nothing_else():
+    scene = load_scene(Path(__file__).parents[2] / "examples" / "shadows_demo.toml")
+    before = {obj.label: obj.material.params for obj in scene.objects}
+    set_self_shadow_density(scene, 0.0)
+    furs = [obj for obj in scene.objects if "self_shadow_density" in type(obj.params).model_fields]
+    assert sorted(obj.material.name for obj in furs) == ["revie_fur", "revie_fur"]
+    assert all(obj.params.self_shadow_density == 0.0 for obj in furs)
+    assert all(obj.material.params == before[obj.label]
+               for obj in scene.objects if obj not in furs)
+    with pytest.raises(InputError, match=r"self_shadow_density: Input should be greater"):
+        set_self_shadow_density(scene, -1.0)
 
 
 @pytest.mark.parametrize("args, fragment", [
