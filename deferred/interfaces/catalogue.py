@@ -1,7 +1,7 @@
 """Every registered type (material, light, effect, shading model) and its parameters, as data
 read from the pydantic ``Params`` models: name, type, default, range, choices and description.
-``deferred params`` prints it (``--json`` as it is here); ``deferred schema`` builds on the
-same registries.
+``deferred params`` prints it (``--json`` as it is here; :mod:`deferred.cli.params` formats
+it as text); ``deferred schema`` builds on the same registries.
 """
 
 from __future__ import annotations
@@ -156,62 +156,6 @@ def choices(annotation: Any) -> list[Any] | None:
     return None
 
 
-def range_text(row: dict[str, Any]) -> str:
-    """``>= 0, <= 1`` (``each >= 0, <= 1`` for every item of a list)."""
-    text = ", ".join(f"{symbol} {_number(row['range'][key])}" for key, symbol in BOUNDS
-                     if key in row["range"])
-    return f"each {text}" if text and row["each"] else text
-
-
-def default_text(row: dict[str, Any]) -> str:
-    """The default as a scene file writes it (``[0.8, 0.8, 0.8]``, ``"aces"``, ``true``);
-    ``required`` where there is none, ``none`` for ``None`` (leave the key out)."""
-    if row["required"]:
-        return "required"
-    if row["default"] is None:
-        return "none"
-    return json.dumps(row["default"])
-
-
-def plain_lines(entries: list[dict[str, Any]]) -> list[str]:
-    """The listing as plain text at full width: a heading per type, then one line per
-    parameter in aligned columns, the description last and whole (nothing cut, whatever the
-    terminal: for pipes and files)."""
-    lines: list[str] = []
-    headers = ("parameter", "type", "default", "range", "description")
-    for entry in entries:
-        if lines:
-            lines.append("")
-        lines.append(heading(entry))
-        if entry["summary"]:
-            lines.append(f"  {entry['summary']}")
-        if not entry["params"]:
-            lines.append("  (no parameters)")
-            continue
-        rows = [(row["name"], row["type"], default_text(row), range_text(row),
-                 row["description"]) for row in entry["params"]]
-        widths = [max(len(r[i]) for r in [headers, *rows]) for i in range(4)]
-        for row in [headers, *rows]:
-            cells = [cell.ljust(width) for cell, width in zip(row[:4], widths, strict=True)]
-            lines.append(("  " + "  ".join([*cells, row[4]])).rstrip())
-    return lines
-
-
-def heading(entry: dict[str, Any]) -> str:
-    """``material standard (id 1, shading model blinn_phong, deferred.materials.standard)``."""
-    details = [f"id {entry['id']}"] if entry.get("id") else []
-    if entry.get("shading_model"):
-        details.append(f"shading model {entry['shading_model']}")
-    if entry.get("volume"):
-        details.append(f"volume {entry['volume']}")
-    if entry.get("glsl_file"):
-        details.append(entry["glsl_file"])
-    if "materials" in entry:
-        details.append(f"used by {', '.join(entry['materials']) or 'no material'}")
-    details.append(entry["module"])
-    return f"{entry['kind']} {entry['name']}  ({', '.join(details)})"
-
-
 def _summary(cls: type | None) -> str:
     """The first sentence of the class's own docstring (not one it inherits)."""
     doc = cls.__dict__.get("__doc__") if cls is not None else None
@@ -269,7 +213,3 @@ def _jsonable(value: Any) -> Any:
 
 def _value_text(value: Any) -> str:
     return json.dumps(_jsonable(value))
-
-
-def _number(value: Any) -> str:
-    return f"{value:g}" if isinstance(value, float) else str(value)

@@ -145,15 +145,15 @@ def test_bench_refuses_a_bad_sweep_before_saying_its_size(capsys, tmp_path, monk
 # -- warnings -------------------------------------------------------------------------------------
 
 def test_a_warning_is_one_line_without_a_source_path(tmp_path, capsys, monkeypatch):
-    import deferred.cli as cli_module
+    import deferred.cli.render as render_module
 
-    load = cli_module._scene
+    load = render_module.load_scene
 
     def warning_load(path):
         warnings.warn("something odd\nover two lines", UserWarning, stacklevel=1)
         return load(path)
 
-    monkeypatch.setattr(cli_module, "_scene", warning_load)
+    monkeypatch.setattr(render_module, "load_scene", warning_load)
     code, _, err = run(capsys, "render", "--size", "32x18", "-o", tmp_path / "a.png")
     assert code == 0, err
     assert err.splitlines()[0] == "warning: something odd\\nover two lines"

@@ -652,10 +652,10 @@ def test_a_dump_past_the_memory_budget_is_refused_before_the_frame(tmp_path, cap
                              "--size, or --passes to capture fewer passes"), err
     assert not out.exists()
     # a budget the render's targets and a dump of one pass fit in, and the whole dump does not
-    from deferred.cli import _scene
     from deferred.debug.dump import dump_memory
+    from deferred.scene.loader import load_scene
 
-    with Renderer(_scene(None), "deferred", (96, 64), gl=gl) as demo:
+    with Renderer(load_scene(None), "deferred", (96, 64), gl=gl) as demo:
         whole, one = dump_memory(demo), dump_memory(demo, ["post.tonemap"])
     assert one < whole
     monkeypatch.setenv("DEFERRED_TARGET_MEMORY", str((one + whole) // 2))

@@ -12,7 +12,8 @@ from pathlib import Path
 import jsonschema
 import pytest
 
-from deferred.cli import MAX_PROBLEM_LINES, main
+from deferred.cli import main
+from deferred.cli.exits import MAX_PROBLEM_LINES
 from deferred.errors import InputError, InputErrors
 from deferred.interfaces import registry
 from deferred.scene.loader import builtin_scenes, scene_from_dict, scene_from_toml
@@ -300,8 +301,8 @@ def test_a_newline_in_a_problem_stays_on_its_line(capsys):
     # the error itself is one line, from Python as from the command line
     assert [str(p) for p in problems.problems] == ["a.toml: x: bad\\nvalue", "b: worse"]
     assert str(problems).splitlines() == ["a.toml: x: bad\\nvalue", "b: worse"]
-    from deferred.cli import _fail
-    _fail(*(f"error: {p}" for p in problems.problems))
+    from deferred.cli.exits import fail
+    fail(*(f"error: {p}" for p in problems.problems))
     assert capsys.readouterr().err.splitlines() == ["error: a.toml: x: bad\\nvalue",
                                                     "error: b: worse"]
 

@@ -1,0 +1,39 @@
+"""``deferred info``: the GL context, its optional features, the registered types and a scene's
+G-buffer layout."""
+
+from __future__ import annotations
+
+import click
+from rich.console import Console
+
+from deferred.cli.options import scene_argument
+from deferred.interfaces import registry
+from deferred.scene.loader import load_scene
+
+
+@click.command()
+@scene_argument
+def info(scene: str | None) -> None:
+    """GL vendor, renderer, version, the optional features in use, and the G-buffer layout of
+    SCENE (the built-in demo when omitted)."""
+    from deferred.gl.context import create_context
+
+    layout = load_scene(scene).gbuffer_layout()  # bad input fails before GL start-up
+    gl = create_context()
+    try:
+        console = Console(soft_wrap=True, markup=False)  # one line per entry; [..] is text
+        console.print(f"gbuffer: {layout.bytes_per_pixel} bytes per pixel")
+        for name, entry in layout.describe().items():
+            channels = f"  [{' '.join(entry['channels'])}]" if "channels" in entry else ""
+            console.print(f"  {name:<20} {entry['format']:<8} {entry['bytes_per_pixel']:>2} B  "
+                          f"{entry['description']}{channels}")
+        for key, value in gl.info.items():
+            console.print(f"{key:>16}: {value}")
+        for key, value in gl.features.names().items():
+            console.print(f"{key:>16}: {'on' if value else 'off'}")
+        for what, reg in (("lights", registry.lights), ("materials", registry.materials),
+                          ("shading models", registry.shading_models),
+                          ("effects", registry.effects)):
+            console.print(f"{what:>16}: {', '.join(reg)}")
+    finally:
+        gl.release()

@@ -1,0 +1,269 @@
+"""``deferred render``: a scene to an image, a numbered image sequence or a video. Every option
+is checked before the scene loads where it can be, and before the renderer starts where it
+needs the scene."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import click
+
+from deferred.cli.options import (
+    FiniteFloat,
+    check_not_inputs,
+    light_path_option,
+    parse_size_option,
+    pipeline_option,
+    scene_argument,
+    size_option,
+    stderr,
+    strict_option,
+    time_option,
+)
+from deferred.cli.view_option import (
+    LISTING,
+    RENDER_HELP,
+    capture_view,
+    check_one_buffer,
+    material_view,
+    print_view_names,
+    view_option,
+    view_pass,
+    write_captured_view,
+)
+from deferred.errors import InputError
+from deferred.io.images import write_image
+from deferred.io.paths import check_output_path
+from deferred.io.progress import Progress
+from deferred.scene.loader import load_scene
+
+if TYPE_CHECKING:
+    from deferred.render.renderer import Renderer
+    from deferred.scene import Scene
+
+
+@dataclass(frozen=True)
+class RenderJob:
+    """What one ``render`` asked for, its options checked as far as they can be without the
+    scene."""
+
+    scene: str | None
+    out: Path
+    kind: str  # image, sequence or video (deferred.io.paths.output_kind)
+    pipeline: str
+    size: str | None  # as given: read once the scene has loaded, as the scene's size is
+    times: list[float]
+    fps: float
+    start_time: float
+    turntable: int | None
+    samples: int
+    light_path: str | None
+    strict: bool
+    view_name: str | None
+
+    @property
+    def frames(self) -> int:
+        return len(self.times)
+
+
+@dataclass(frozen=True)
+class Rendered:
+    """What the summary line says of a finished render."""
+
+    size: tuple[int, int]
+    light_path: str
+    written: str
+    frame_ms: list[float]
+
+
+@click.command()
+@scene_argument
+@click.option("-o", "--output", default="render.png", show_default=True,
+              help="Output: an image, .png (sRGB 8-bit) or .exr (linear float); a numbered "
+                   "sequence, out_####.png (the run of # becomes the frame number); or a "
+                   "video, .mp4 (H.264) or .gif.")
+@pipeline_option
+@size_option()
+@click.option("--frames", type=click.IntRange(min=1, max=100_000), default=1, show_default=True,
+              help="Render this many frames, frame i at --time + i / --fps seconds, to a "
+                   "numbered sequence (a # pattern) or a video: one image holds one frame.")
+@click.option("--fps", type=FiniteFloat(min=0.0, min_open=True, max=1000.0), default=24.0,
+              show_default=True, help="Frames per second: the time step and the video's rate.")
+@time_option("Time of the first frame (the scene's [[event]] timeline, animated materials).")
+@click.option("--turntable", type=click.IntRange(min=1, max=100_000), metavar="N",
+              help="Orbit the camera once about the vertical through its target over N frames "
+                   "(the times --frames N gives; frame N would be frame 0 again), to a # "
+                   "pattern or a video.")
+@click.option("--samples", type=click.IntRange(min=1, max=1024), default=1, show_default=True,
+              help="Average each frame over this many renders moved by sub-pixel offsets "
+                   "(Halton 2, 3), in linear light: anti-aliasing that converges to a "
+                   "supersampled frame.")
+@light_path_option
+@strict_option
+@view_option(RENDER_HELP)
+def render(scene: str | None, output: str, pipeline: str, size: str | None, frames: int,
+           fps: float, start_time: float, turntable: int | None, samples: int,
+           light_path: str | None, strict: bool, view_name: str | None) -> None:
+    """Render SCENE (a TOML file; the built-in demo when omitted) to an image, a numbered
+    image sequence or a video."""
+    if view_name == LISTING:
+        print_view_names(scene, pipeline, light_path)
+        return
+    job = render_job(scene, output, pipeline, size, frames, fps, start_time, turntable, samples,
+                     light_path, strict, view_name)
+    with Progress("render", stderr) as progress:
+        rendered = run_render(job, progress)
+    stderr.print(summary(job, rendered), markup=False, highlight=False)
+
+
+def render_job(scene: str | None, output: str, pipeline: str, size: str | None, frames: int,
+               fps: float, start_time: float, turntable: int | None, samples: int,
+               light_path: str | None, strict: bool, view_name: str | None) -> RenderJob:
+    """The options as a :class:`RenderJob`; ``InputError`` for any that cannot go together."""
+    from deferred.io.paths import output_kind
+    from deferred.io.video import check_video_writer, frame_times
+
+    out = check_output_path(output)
+    kind = output_kind(out)
+    if turntable is not None:
+        frames = _turntable_frames(out, kind, frames, turntable)
+    times = frame_times(frames, fps, start_time)
+    check_one_buffer(view_name, kind, samples, frames)
+    if kind == "image" and frames > 1:
+        raise InputError(f"{frames} frames cannot go to one image, {out.name}: use a # pattern "
+                         f"such as {out.stem}_####{out.suffix}, or .mp4/.gif", "--frames")
+    if kind == "video":
+        check_video_writer(out)  # a missing extra is said before the scene loads
+    return RenderJob(scene=scene, out=out, kind=kind, pipeline=pipeline, size=size, times=times,
+                     fps=fps, start_time=start_time, turntable=turntable, samples=samples,
+                     light_path=light_path, strict=strict, view_name=view_name)
+
+
+def _turntable_frames(out: Path, kind: str, frames: int, turntable: int) -> int:
+    """--turntable N renders N frames, to a sequence or a video."""
+    source = click.get_current_context().get_parameter_source("frames")
+    if source != click.core.ParameterSource.DEFAULT and frames != turntable:
+        raise InputError(f"--turntable {turntable} renders {turntable} frames; leave "
+                         "--frames out", "--frames")
+    if kind == "image":
+        raise InputError(f"a turntable is {turntable} frames and {out.name} holds one "
+                         f"image: use a # pattern such as {out.stem}_####{out.suffix}, or "
+                         ".mp4/.gif", "--turntable")
+    return turntable
+
+
+def run_render(job: RenderJob, progress: Progress) -> Rendered:
+    """Load the scene, render every frame of ``job`` and write them."""
+    from deferred.render.renderer import Renderer
+
+    progress.status(f"loading {job.scene or 'the demo scene'} (meshes, UV unwraps)")
+    loaded, size = _load(job)
+    loaded, buffer = material_view(loaded, job.view_name, job.pipeline)
+    progress.status("starting the renderer")
+    with Renderer(loaded, job.pipeline, size, strict=job.strict or None,
+                  light_path=job.light_path) as renderer:
+        renderer.check_times(job.times)  # a simulation cannot reach the last frame: refuse now
+        if job.kind == "image":
+            written, frame_ms = str(job.out), _render_image(renderer, loaded, job, buffer,
+                                                            progress)
+        else:
+            written, frame_ms = _render_animation(renderer, job, progress)
+    return Rendered(renderer.size, renderer.light_path, written, frame_ms)
+
+
+def _load(job: RenderJob) -> tuple[Scene, tuple[int, int] | None]:
+    """The scene, set up as ``job`` asks, and the size that overrides its own; ``InputError``
+    where an output would replace one of its files or a video cannot hold its frames."""
+    from deferred.io.video import check_animation_memory, check_video_size
+
+    loaded = load_scene(job.scene)
+    if job.turntable is not None:
+        loaded.set_turntable(job.turntable / job.fps, job.start_time)
+    check_not_inputs(_outputs(job), loaded, job.scene, "-o")
+    size = parse_size_option(job.size)
+    if job.kind == "video":
+        check_video_size(job.out, size or loaded.size)
+        check_animation_memory(job.out, size or loaded.size, job.frames)
+    return loaded, size
+
+
+def _outputs(job: RenderJob) -> list[Path]:
+    """Every file ``render -o`` writes: a sequence's frames, or the one file."""
+    if job.kind != "sequence":
+        return [job.out]
+    from deferred.io.paths import expand_pattern
+
+    return [expand_pattern(job.out, index) for index in range(job.frames)]
+
+
+def _render_image(renderer: Renderer, loaded: Scene, job: RenderJob, buffer: str | None,
+                  progress: Progress) -> list[float]:
+    """The one frame to ``job.out``, the final image or the buffer ``buffer``: its time in ms.
+    Written while the renderer lives: the result may read its buffers lazily."""
+    captured_after = view_pass(renderer, buffer) if buffer is not None else None  # bad names fail
+    progress.status("rendering the frame (shaders compile, simulations settle)")
+    at = job.times[0]
+    start = time.perf_counter()
+    if buffer is not None:
+        capture = capture_view(renderer, loaded, captured_after, at, job.fps)
+    elif job.samples > 1:
+        result = renderer.render_samples(job.samples, at)
+    else:
+        result = renderer.render(readback=True, time=at)
+    renderer.gl.ctx.finish()
+    frame_ms = [(time.perf_counter() - start) * 1000.0]
+    if buffer is not None:
+        write_captured_view(job.out, capture, buffer)
+    elif job.out.suffix.lower() == ".exr":
+        write_image(job.out, result.hdr, channels=("R", "G", "B", "A"))
+    else:
+        write_image(job.out, result.image)
+    return frame_ms
+
+
+def _render_animation(renderer: Renderer, job: RenderJob,
+                      progress: Progress) -> tuple[str, list[float]]:
+    """Every frame of ``job`` to its sequence or video, each averaged over ``job.samples``
+    sub-pixel renders: (what was written, the frame times in ms)."""
+    from deferred.io.video import AnimationWriter, check_animation_memory, describe_written
+
+    if job.kind == "video":  # the frames a GIF holds with what the renderer holds
+        check_animation_memory(job.out, renderer.size, job.frames,
+                               renderer_bytes=renderer.memory_bytes())
+    out, frame_ms = job.out, []
+    with AnimationWriter(out, job.fps) as writer:
+        progress.count(job.frames, "frames", f"rendering {out.name}")
+        for index, at in enumerate(job.times):
+            start = time.perf_counter()
+            if job.samples > 1:
+                averaged = renderer.render_samples(job.samples, at)
+                frame_ms.append((time.perf_counter() - start) * 1000.0)
+                writer.write(averaged.hdr if writer.wants_hdr else averaged.image)
+            else:
+                renderer.render(readback=False, time=at)
+                renderer.gl.ctx.finish()
+                frame_ms.append((time.perf_counter() - start) * 1000.0)
+                writer.write(renderer.read_hdr() if writer.wants_hdr else renderer.read_final())
+            progress.advance(index + 1, f"rendering {out.name}")
+        progress.status(f"writing {out.name}")
+        written = writer.close()
+    return describe_written(written), frame_ms
+
+
+def summary(job: RenderJob, rendered: Rendered) -> str:
+    """``wrote OUT (WxH, PIPELINE, PATH lights[, view V][, t = ...], TIMING)``."""
+    frame_ms = rendered.frame_ms
+    timing = f"{min(frame_ms):.1f} ms" if job.frames == 1 else \
+        f"median {sorted(frame_ms)[len(frame_ms) // 2]:.1f} ms over {job.frames} frames"
+    shown = f", view {job.view_name}" if job.view_name is not None else ""
+    clock = ""
+    if job.frames > 1 or job.start_time > 0.0:
+        times = job.times
+        clock = f", t = {times[0]:g}" + (f"..{times[-1]:g} s at {job.fps:g} fps"
+                                         if job.frames > 1 else " s")
+    width, height = rendered.size
+    return (f"wrote {rendered.written} ({width}x{height}, {job.pipeline}, "
+            f"{rendered.light_path} lights{shown}{clock}, {timing})")
