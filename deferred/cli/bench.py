@@ -11,13 +11,8 @@ from typing import TYPE_CHECKING
 import click
 from rich.console import Console
 
-from deferred.cli.options import (
-    check_not_inputs,
-    parse_size_option,
-    scene_argument,
-    size_option,
-    stderr,
-)
+from deferred.cli import options
+from deferred.cli.options import check_not_inputs, parse_size_option, stderr
 from deferred.errors import RenderError
 from deferred.io.progress import Progress, duration
 from deferred.scene.loader import load_scene
@@ -30,13 +25,13 @@ OUTPUT_OPTIONS = ("--json", "--csv", "--plot")
 
 
 @click.command()
-@scene_argument
+@options.scene_argument
 @click.option("--lights", default="1,16,64,256,1024", show_default=True, metavar="N,...",
               help="Extra point lights added to the scene's own, one sweep point each.")
 @click.option("--shells", metavar="N,...",
               help="Shell counts for every object whose material has 'shells'. Default: the "
                    "scene's own (0 where no object has shells).")
-@size_option()
+@options.size_option()
 @click.option("--runs", type=click.IntRange(min=1, max=10_000), default=10, show_default=True,
               help="Rounds per point: in each, its frames timed back to back for 100 ms (1 to "
                    "4 counted), then one with each pass timed and one of CPU time.")

@@ -9,35 +9,28 @@ import click
 from rich.console import Console
 from rich.table import Table
 
-from deferred.cli.options import (
-    light_path_option,
-    parse_size_option,
-    pipeline_option,
-    scene_argument,
-    size_option,
-    stderr,
-    strict_option,
-)
+from deferred.cli import options
+from deferred.cli.options import parse_size_option, stderr
 from deferred.errors import InputError
 from deferred.io.progress import Progress
 from deferred.scene.loader import load_scene
 
 
 @click.command()
-@scene_argument
+@options.scene_argument
 @click.option("-o", "--output", metavar="DIR",
               help="Dump folder (created if missing). With --compare: where difference images "
                    "go (default DIR_B-diff next to DIR_B).")
-@pipeline_option
-@size_option()
+@options.pipeline_option
+@options.size_option()
 @click.option("--passes", metavar="NAME,...",
               help="Write only these passes' buffers (names or globs such as 'ball.*'); every "
                    "pass still runs.")
 @click.option("--pixel", metavar="X,Y",
               help="Print every pass that wrote this pixel (top-down coordinates) and what it "
                    "wrote; recorded in the manifest too.")
-@light_path_option
-@strict_option
+@options.light_path_option
+@options.strict_option
 @click.option("--compare", nargs=2, type=click.Path(), metavar="DIR_A DIR_B",
               help="Compare two dumps: per-buffer max/mean differences and difference images. "
                    "Exit status as diff's: 0 the same, 1 they differ, 2 bad input.")

@@ -11,18 +11,8 @@ from typing import TYPE_CHECKING
 
 import click
 
-from deferred.cli.options import (
-    FiniteFloat,
-    check_not_inputs,
-    light_path_option,
-    parse_size_option,
-    pipeline_option,
-    scene_argument,
-    size_option,
-    stderr,
-    strict_option,
-    time_option,
-)
+from deferred.cli import options
+from deferred.cli.options import FiniteFloat, check_not_inputs, parse_size_option, stderr
 from deferred.cli.view_option import (
     LISTING,
     RENDER_HELP,
@@ -80,19 +70,20 @@ class Rendered:
 
 
 @click.command()
-@scene_argument
+@options.scene_argument
 @click.option("-o", "--output", default="render.png", show_default=True,
               help="Output: an image, .png (sRGB 8-bit) or .exr (linear float); a numbered "
                    "sequence, out_####.png (the run of # becomes the frame number); or a "
                    "video, .mp4 (H.264) or .gif.")
-@pipeline_option
-@size_option()
+@options.pipeline_option
+@options.size_option()
 @click.option("--frames", type=click.IntRange(min=1, max=100_000), default=1, show_default=True,
               help="Render this many frames, frame i at --time + i / --fps seconds, to a "
                    "numbered sequence (a # pattern) or a video: one image holds one frame.")
 @click.option("--fps", type=FiniteFloat(min=0.0, min_open=True, max=1000.0), default=24.0,
               show_default=True, help="Frames per second: the time step and the video's rate.")
-@time_option("Time of the first frame (the scene's [[event]] timeline, animated materials).")
+@options.time_option("Time of the first frame (the scene's [[event]] timeline, animated "
+                     "materials).")
 @click.option("--turntable", type=click.IntRange(min=1, max=100_000), metavar="N",
               help="Orbit the camera once about the vertical through its target over N frames "
                    "(the times --frames N gives; frame N would be frame 0 again), to a # "
@@ -101,8 +92,8 @@ class Rendered:
               help="Average each frame over this many renders moved by sub-pixel offsets "
                    "(Halton 2, 3), in linear light: anti-aliasing that converges to a "
                    "supersampled frame.")
-@light_path_option
-@strict_option
+@options.light_path_option
+@options.strict_option
 @view_option(RENDER_HELP)
 def render(scene: str | None, output: str, pipeline: str, size: str | None, frames: int,
            fps: float, start_time: float, turntable: int | None, samples: int,

@@ -5,16 +5,8 @@ from __future__ import annotations
 
 import click
 
-from deferred.cli.options import (
-    check_not_inputs,
-    light_path_option,
-    parse_size_option,
-    pipeline_option,
-    scene_argument,
-    size_option,
-    stderr,
-    time_option,
-)
+from deferred.cli import options
+from deferred.cli.options import check_not_inputs, parse_size_option, stderr
 from deferred.cli.view_option import (
     LISTING,
     VIEWER_HELP,
@@ -28,11 +20,11 @@ from deferred.render.pipeline import PIPELINES
 
 
 @click.command("view")
-@scene_argument
-@pipeline_option
-@light_path_option
-@size_option("WIDTHxHEIGHT of the frame, overrides the scene's size.")
-@time_option("The timeline's time at start.")
+@options.scene_argument
+@options.pipeline_option
+@options.light_path_option
+@options.size_option("WIDTHxHEIGHT of the frame, overrides the scene's size.")
+@options.time_option("The timeline's time at start.")
 @view_option(VIEWER_HELP)
 @click.option("--split", type=click.Choice(sorted(PIPELINES)),
               help="Split view: this pipeline on the right of the frame.")
