@@ -1,7 +1,7 @@
 """Light evaluations per second: the tiled path against this machine's brute-force limit.
 
 Brute force is the tiled path's full-screen pass looping every point light at every covered
-pixel, with no lists and no early-out (``ALL_LIGHTS`` in ``lights/list_shading.frag``): its
+pixel, with no lists and no early-out (``ALL_LIGHTS`` in ``lighting/list_shading.frag``): its
 rate is pixel-light evaluations per second of the light code itself. The tiled path's rate is
 the work it really does, the length of each pixel's tile list summed over covered pixels, per
 second of its shading pass. Run from the repository root:

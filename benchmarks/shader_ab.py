@@ -2,7 +2,7 @@
 process: the way to see a 5% change on a machine whose speed moves by 30% in minutes.
 
 Each VARIANT is a folder laid out like ``deferred/shaders`` holding only the files it changes
-(``lights/listed_lights.glsl``, say); ``-`` is the shaders as they are. One renderer is built
+(``lighting/listed_lights.glsl``, say); ``-`` is the shaders as they are. One renderer is built
 per variant on one GL context, and every round renders, for each variant in turn, one frame
 timed by wall clock around ``render()`` and ``finish()`` and one with every pass fenced
 (``deferred.bench.timing.time_passes``); each round starts from the next variant. Printed: each

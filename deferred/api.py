@@ -113,30 +113,34 @@ GLSL_INCLUDES: dict[str, str] = {
                           "object-space point (motion vectors; vertex shaders)",
     "common/lighting.glsl": "struct LightRecord and the shading-model interface (a light's "
                             "GLSL function)",
-    "lights/shadows.glsl": "light_shadow_cascades, _perspective, _cube: the lit fraction of "
-                           "a shadowed light at a point (a light's GLSL function multiplies "
-                           "by its projection's); with deep opacity maps "
-                           "(OPACITY_SHADOWS), times the transmittance through them: at the "
-                           "point's depth for an OPACITY_RECEIVER (the volume's own shading), "
-                           "through the whole volume beyond its back for any other surface",
+    "lighting/shadows.glsl": "light_shadow_cascades, _perspective, _cube: the lit fraction of "
+                            "a shadowed light at a point (a light's GLSL function multiplies "
+                            "by its projection's); with deep opacity maps "
+                            "(OPACITY_SHADOWS), times the transmittance through them: at the "
+                            "point's depth for an OPACITY_RECEIVER (the volume's own shading), "
+                            "through the whole volume beyond its back for any other surface",
     "common/forward_lighting.glsl": "every light of the frame at one surface point (forward "
                                     "passes)",
     "gbuffer/layout.glsl": "the G-buffer's encoding and decoding",
     "gbuffer/write.glsl": "the G-buffer's outputs and gbuffer_write (G-buffer passes)",
-    "techniques/stipple.glsl": "stipple patterns (Revie 2.3.4, Listing 2.6)",
-    "techniques/rim.glsl": "rim scattering by bent normals (Revie 2.3.2, Listing 2.3)",
-    "techniques/grain_normal.glsl": "the anisotropic grain normal (Revie 2.3.3, Listing 2.5)",
-    "techniques/shells.glsl": "concentric shell offsets (Revie 2.3.1, Listing 2.1)",
-    "techniques/fur.glsl": "the fur volume's coverage and brightness lookups",
-    "techniques/accumulated_light.glsl": "a fur layer's light from the light accumulation "
-                                         "(Revie 2.4.4, Listing 2.2)",
-    "techniques/fur_light.glsl": "a fur layer's light from a fur_light gather",
-    "techniques/fur_relight.glsl": "a fur layer's full-screen light moved from its sample to "
-                                   "the layer (after common/light_buffer.glsl and "
-                                   "generated/lights.glsl)",
-    "techniques/strand_tangent.glsl": "a strand tangent as G-buffer data (Kajiya-Kay)",
-    "techniques/hatching.glsl": "tonal-art-map hatching, on the surface (Praun et al.) or "
-                                "projected on the screen (Lake et al.; Costigan 4.3.8)",
+    "materials/techniques/stipple.glsl": "stipple patterns (Revie 2.3.4, Listing 2.6)",
+    "materials/techniques/rim.glsl": "rim scattering by bent normals (Revie 2.3.2, Listing 2.3)",
+    "materials/techniques/grain_normal.glsl": "the anisotropic grain normal (Revie 2.3.3, "
+                                              "Listing 2.5)",
+    "materials/techniques/shells.glsl": "concentric shell offsets (Revie 2.3.1, Listing 2.1)",
+    "materials/techniques/fur.glsl": "the fur volume's coverage and brightness lookups",
+    "materials/techniques/accumulated_light.glsl": "a fur layer's light from the light "
+                                                   "accumulation (Revie 2.4.4, Listing 2.2)",
+    "materials/techniques/fur_light.glsl": "a fur layer's light from a fur_light gather",
+    "materials/techniques/fur_relight.glsl": "a fur layer's full-screen light moved from its "
+                                             "sample to the layer (after "
+                                             "common/light_buffer.glsl and "
+                                             "generated/lights.glsl)",
+    "materials/techniques/strand_tangent.glsl": "a strand tangent as G-buffer data "
+                                                "(Kajiya-Kay)",
+    "materials/techniques/hatching.glsl": "tonal-art-map hatching, on the surface (Praun et "
+                                          "al.) or projected on the screen (Lake et al.; "
+                                          "Costigan 4.3.8)",
 }
 
 __all__ = [

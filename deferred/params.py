@@ -24,7 +24,7 @@ RESERVED_UNIFORMS = frozenset({
     "u_model_normal_matrix", "u_surface_id", "u_light_count", "u_lights",
     "u_model_view", "u_normal_matrix",  # the names before the view and model were apart
     "u_light_offset", "u_volume_scale",
-    # motion vectors and per-sample patterns (common/motion.glsl, techniques/stipple.glsl)
+    # motion vectors and per-sample patterns (common/motion.glsl, materials/techniques/stipple.glsl)
     "u_previous_model", "u_view_projection", "u_previous_view_projection", "u_sample_index"})
 
 

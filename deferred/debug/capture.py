@@ -256,7 +256,7 @@ def capture_frame(renderer: Renderer, passes: Sequence[str] | None = None,
 
 
 def cascade_of(depth: np.ndarray, splits: np.ndarray) -> np.ndarray:
-    """The cascade (1-based) a linear view depth falls in, as ``lights/shadows.glsl`` picks it
+    """The cascade (1-based) a linear view depth falls in, as ``lighting/shadows.glsl`` picks it
     (the first whose far depth lies beyond it); 0 for no surface or beyond the last."""
     index = np.searchsorted(np.asarray(splits, np.float64), depth, side="left") + 1
     return np.where((depth > 0.0) & (index <= len(splits)), index, 0).astype(np.float32)

@@ -1,9 +1,13 @@
 """The shader library: GLSL files with ``#include``, injected defines, cached programs.
 
-GLSL lives in ``.glsl`` files under the ``shaders`` package (found with ``importlib.resources``) or
-under extra roots a plugin adds. A file may ``#include "path/from/a/root.glsl"``; the argument may
-also be the name of an injected define whose value is a quoted path (``#include SURFACE_FILE``),
-which is how a generic pass pulls in a material's surface function. Each file is included once per
+GLSL lives in ``.glsl`` files (found with ``importlib.resources``): the framework's shared files in
+the ``deferred.shaders`` package (``common/``, ``gbuffer/``, ``lighting/``, ``post/``...), each
+built-in material's, light's and effect's beside its Python in its own package, named from the
+feature package (``materials/revie_fur/shell.frag`` is ``shell.frag`` of
+``deferred.materials.revie_fur``), and a plugin's under the roots it adds. A file may
+``#include "path/from/a/root.glsl"``; the argument may also be the name of an injected define
+whose value is a quoted path (``#include SURFACE_FILE``), which is how a generic pass pulls in a
+material's surface function. Each file is included once per
 program (include-once), nesting is limited to ``MAX_INCLUDE_DEPTH``, and a cycle is an error.
 
 The assembled source keeps a line map, so a compile error reported by the driver as ``0:57(3)``
@@ -58,6 +62,53 @@ class Source:
         return ("<generated>", line)
 
 
+# The first folder of a built-in feature's shader name -> the package holding the feature's
+# folders (a material's GLSL sits beside its Python, as a plugin's does).
+FEATURE_PACKAGES = {"materials": "deferred.materials", "lights": "deferred.lights",
+                    "effects": "deferred.effects"}
+GLSL_SUFFIXES = (".glsl", ".vert", ".frag", ".geom", ".comp")
+
+
+class FrameworkShaders:
+    """The framework's GLSL as one root: a name's first folder picks a feature package
+    (``FEATURE_PACKAGES``), any other name is a file of ``deferred.shaders``."""
+
+    def __init__(self) -> None:
+        self.shared: Traversable = resources.files("deferred.shaders")
+        self.features: dict[str, Traversable] = {
+            folder: resources.files(package) for folder, package in FEATURE_PACKAGES.items()}
+
+    def joinpath(self, *parts: str) -> Traversable:
+        feature = self.features.get(parts[0]) if len(parts) > 1 else None
+        if feature is not None:
+            return feature.joinpath(*parts[1:])
+        return self.shared.joinpath(*parts)
+
+    def is_dir(self) -> bool:
+        return True
+
+    def folders(self) -> list[Traversable]:
+        """The folders holding its files: the shared one and each feature package's."""
+        return [self.shared, *self.features.values()]
+
+    def __str__(self) -> str:
+        return ", ".join(str(folder) for folder in self.folders())
+
+
+# Include names of the framework's public GLSL (deferred.api's GLSL_INCLUDES) as a plugin may
+# still spell them -> the name to write: the error says so.
+RENAMED_INCLUDES = {"lights/shadows.glsl": "lighting/shadows.glsl",
+                    "techniques/": "materials/techniques/"}
+
+
+def renamed_include(name: str) -> str | None:
+    """The framework's name for an include spelled by its former name, else None."""
+    for old, new in RENAMED_INCLUDES.items():
+        if name == old or (old.endswith("/") and name.startswith(old)):
+            return new + name[len(old):]
+    return None
+
+
 _registered_roots: list[Traversable | Path] = []
 
 
@@ -81,8 +132,8 @@ class ShaderLibrary:
         self.ctx = ctx
         self.glsl_version = glsl_version
         self.global_defines = dict(defines or {})
-        self.roots: list[Traversable | Path] = [resources.files("deferred.shaders"),
-                                                *_registered_roots]
+        self.roots: list[Traversable | Path | FrameworkShaders] = [FrameworkShaders(),
+                                                                   *_registered_roots]
         self.virtual_files: dict[str, str] = {}
         self._programs: dict[tuple, moderngl.Program] = {}
         self._declared: dict[int, frozenset[str]] = {}  # program glo -> declared uniform names
@@ -133,8 +184,15 @@ class ShaderLibrary:
                 if index:  # not the framework's own: errors name the plugin
                     self._origins[name] = root
                 return candidate.read_text(encoding="utf-8")
+        renamed = renamed_include(name)
+        if renamed is not None and renamed != name and self._exists(renamed):
+            raise ShaderError(f'shader file not found: {name}: the framework names it '
+                              f'{renamed}; write #include "{renamed}"')
         searched = ", ".join(str(root) for root in self.roots)
         raise ShaderError(f"shader file not found: {name} (searched: {searched})")
+
+    def _exists(self, name: str) -> bool:
+        return any(root.joinpath(*name.split("/")).is_file() for root in self.roots)
 
     def assemble(self, name: str, defines: dict[str, str] | None = None) -> Source:
         """Resolve includes of ``name`` and inject ``#version`` and defines."""
@@ -352,11 +410,12 @@ class ShaderLibrary:
         self._uniforms.clear()
 
 
-def _folder_entries(root: Traversable | Path, folder: str) -> list[Traversable]:
+def _folder_entries(root: Traversable | Path | FrameworkShaders, folder: str) -> list[Traversable]:
     directory = root.joinpath(*folder.split("/"))
     if not directory.is_dir():
         return []
-    return [entry for entry in directory.iterdir() if entry.is_file()]
+    return [entry for entry in directory.iterdir()
+            if entry.is_file() and entry.name.endswith(GLSL_SUFFIXES)]
 
 
 def _without_comments(text: str) -> str:

@@ -77,7 +77,7 @@ class Light:
     ``shadow_projection`` casts shadows when ``shadows = true``: the framework writes the
     light's shadow slot into its record's ``extra.w`` (so a record leaves ``extra.w`` alone),
     and the GLSL function multiplies what it returns by its projection's
-    ``light_shadow_<projection>(...)`` (``lights/shadows.glsl``).
+    ``light_shadow_<projection>(...)`` (``lighting/shadows.glsl``).
     """
 
     name: ClassVar[str]

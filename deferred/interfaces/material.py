@@ -103,7 +103,7 @@ class ShadowView:
     directional light) and the direction it shines (world, unit), for casters that shape
     themselves to it. ``opacity_maps``: the light has deep opacity maps this frame, which
     every material with ``opacity_shadows`` draws itself into (:meth:`Material.draw_opacity`)
-    and through which the other surfaces take its shadow (``lights/shadows.glsl``): such a
+    and through which the other surfaces take its shadow (``lighting/shadows.glsl``): such a
     volume may leave its translucent part out of the depth map."""
 
     view: np.ndarray

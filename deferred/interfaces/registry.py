@@ -191,7 +191,7 @@ class Registry(Generic[T]):
 
 materials: Registry = Registry("material", "deferred.materials", "deferred.materials",
                                max_id=MAX_MATERIAL_ID)
-# a listed light's colour texel holds its type id in w's low 8 bits (lights/light_lists.glsl)
+# a listed light's colour texel holds its type id in w's low 8 bits (lighting/light_lists.glsl)
 lights: Registry = Registry("light", "deferred.lights", "deferred.lights", max_id=255)
 shading_models: Registry = Registry("shading model", "deferred.shading_models",
                                     "deferred.materials.shading_models",

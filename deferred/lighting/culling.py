@@ -72,9 +72,9 @@ class LightCullPass(RenderPass):
         if self.clustered:
             defines["LIGHT_LISTS_CLUSTERED"] = "1"
             defines["LIST_SLICES"] = str(grid.slices)
-            shader = frame.shaders.compute("lights/cull_clusters.comp", defines)
+            shader = frame.shaders.compute("lighting/cull_clusters.comp", defines)
         else:
-            shader = frame.shaders.compute("lights/cull_tiles.comp",
+            shader = frame.shaders.compute("lighting/cull_tiles.comp",
                                            {**defines, "CULL_CANDIDATES": "1",
                                             **({"LIST_QUADRANTS": "1"} if split == 2
                                                else {})})
@@ -89,7 +89,7 @@ class LightCullPass(RenderPass):
                                                       frame.height)
             # coarse tiles against every light, then the tiles against their coarse tile's
             coarse = light_lists.coarse_uniforms()
-            first = frame.shaders.compute("lights/cull_tiles.comp",
+            first = frame.shaders.compute("lighting/cull_tiles.comp",
                                           {**defines, "CULL_COARSE": "1"})
             dispatches = [(first, {**coarse["first"], **counts}, coarse_grid(grid).count),
                           (shader, {**coarse["second"], **counts}, culling_tiles(grid))]
@@ -136,4 +136,4 @@ def list_shading_pass(name: str, clustered: bool, gbuffer: tuple[str, ...],
     if composite:
         creates[COMPOSITE] = COMPOSITE_SPEC
         defines["WRITE_COMPOSITE"] = "1"
-    return surface_pass(name, "lights/list_shading.frag", inputs, creates, background, defines)
+    return surface_pass(name, "lighting/list_shading.frag", inputs, creates, background, defines)

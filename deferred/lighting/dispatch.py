@@ -7,7 +7,7 @@ from deferred.interfaces.light import Light
 from deferred.names import LightVolume
 
 DISPATCH_FILE = "generated/lights.glsl"
-LISTED_DISPATCH_FILE = "generated/listed_lights.glsl"  # after lights/light_lists.glsl only
+LISTED_DISPATCH_FILE = "generated/listed_lights.glsl"  # after lighting/light_lists.glsl only
 SHADING_DISPATCH_FILE = "generated/shading_models.glsl"
 RANGE_UNIFORM_PREFIX = "u_light_range_"
 # Full-screen lights a frame may have: their records are also a uniform array
@@ -84,7 +84,7 @@ def light_dispatch_glsl(light_types: list[type[Light]]) -> str:
 
 def listed_dispatch_glsl(light_types: list[type[Light]]) -> str:
     """GLSL of ``evaluate_listed_slots(first, length, s, P, V)``: the volume lights of one light
-    list (``lights/listed_lights.glsl``), a do-while loop per volume type in type order.
+    list (``lighting/listed_lights.glsl``), a do-while loop per volume type in type order.
 
     A list holds its lights in light order (the culling's), and the light buffer its types in
     type order (:class:`~deferred.lighting.buffer.LightBuffer`), so each type's entries follow one

@@ -5,7 +5,7 @@ hold.
 The culling shaders write the lists for the shading in an RGBA32UI texture of a texel a slot,
 the light's sphere (its radius a half float) and index (:meth:`LightLists.entries`); the list
 loops read one texel a listed light, plus the colour of each light reaching the pixel from
-the light buffer (``lights/light_lists.glsl``). A storage buffer holds each list's count,
+the light buffer (``lighting/light_lists.glsl``). A storage buffer holds each list's count,
 then (tiled) the coarse tiles' lists of light indices, a count and ``coarse_capacity`` slots
 each. A list's capacity is the most volume lights the side planes of any of its tiles can hold
 (the 8x8 list tiles, the coarse tiles; clustered: any tile and depth slice), counted on the
@@ -357,7 +357,7 @@ class LightLists:
 
 def depth_slice(depth: np.ndarray, near: float, scale: float, slices: int) -> np.ndarray:
     """The clustered lists' depth slice of each linear ``depth`` (float, whole numbers): the
-    numpy twin of ``light_list_slice`` in lights/light_lists.glsl, ``scale`` being slices /
+    numpy twin of ``light_list_slice`` in lighting/light_lists.glsl, ``scale`` being slices /
     log(far / near)."""
     return np.clip(np.floor(np.log(np.maximum(depth, near) / near) * scale), 0, slices - 1)
 
@@ -367,11 +367,11 @@ def list_capacity(spheres: np.ndarray, inverse_projection: np.ndarray, width: in
     """The most of ``spheres`` (view-space centre xyz, radius w; the frame's volume lights) that
     touch the four side planes of any tile of ``tile`` pixels: the lists' capacity. Every list
     holds only lights whose sphere touches its tile's side planes (the culling shaders test
-    them: ``lights/tile_frustum.glsl``, and each 8x8 quadrant's edge planes in
-    ``lights/cull_tiles.comp``), so counted over the lists' own tiles no list overflows; the
+    them: ``lighting/tile_frustum.glsl``, and each 8x8 quadrant's edge planes in
+    ``lighting/cull_tiles.comp``), so counted over the lists' own tiles no list overflows; the
     coarse lists are counted over the coarse tiles. With ``slices`` (near, far,
     count: the clustered lists), the most in any tile and depth slice: a light goes to the
-    slices its sphere's depth range covers (``lights/cull_clusters.comp``).
+    slices its sphere's depth range covers (``lighting/cull_clusters.comp``).
 
     Planes through the eye along a column (row) edge of pixels are shared by the tiles above
     and below, so each sphere's columns and rows come from its signed distances to the edges'

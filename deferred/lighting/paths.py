@@ -7,13 +7,13 @@ Deferred:
   full-screen triangle), re-reading the G-buffer and blending into the light accumulation for
   every pixel it covers. Needs GL 3.3 only.
 - ``tiled``: a compute pass culls the volume lights per 16x16 tile against the tile's frustum,
-  depth bounds and the view-space box of its points (``lights/cull_tiles.comp``), in two
+  depth bounds and the view-space box of its points (``lighting/cull_tiles.comp``), in two
   dispatches: coarse tiles of 4x4 tiles against every light, then each tile against its
   coarse tile's lights, and the lights that touch the tile against each of its 8x8 quadrants,
   which have the lists; one full-screen pass then reads the G-buffer once per pixel and loops
-  the full-screen lights and its quadrant's list (``lights/list_shading.frag``).
+  the full-screen lights and its quadrant's list (``lighting/list_shading.frag``).
 - ``clustered``: the same shading, from lists of view-space clusters (32x32 tiles x 16
-  exponential depth slices) filled tile by tile (``lights/cull_clusters.comp``).
+  exponential depth slices) filled tile by tile (``lighting/cull_clusters.comp``).
 
 Forward:
 

@@ -18,7 +18,7 @@ order up to the scene's ``max_shadowed_lights``, is given a *slot* and square ti
 
 The light's record carries its slot in ``extra.w`` (the light lists keep a light's index, so
 every light path and both pipelines read the slot with the record); the slot's row of the
-records texture holds its matrices from view space to the atlas (``lights/shadows.glsl``
+records texture holds its matrices from view space to the atlas (``lighting/shadows.glsl``
 documents the layout). The atlas is one binding source of the frame, bound to every program
 that reads it; programs only read it where the scene has a shadowed light (the define
 ``SHADOWS``), so a scene without shadows pays nothing.
@@ -36,7 +36,7 @@ thickest volume's layer (``Material.opacity_layer``). Each material draws both s
 (:meth:`~deferred.interfaces.material.Material.draw_opacity`) and leaves its translucent part
 out of the depth atlas (``ShadowView.opacity_maps``): a receiver compiled with
 ``OPACITY_RECEIVER`` (the volume's own) multiplies a shadowed light by the transmittance at
-its depth (``lights/shadows.glsl``, ``opacity_transmittance``), any other surface by the
+its depth (``lighting/shadows.glsl``, ``opacity_transmittance``), any other surface by the
 transmittance through the whole volume where it lies beyond the volume's back
 (``opacity_beyond``). Programs see ``OPACITY_SHADOWS``, so a scene without such a volume
 compiles neither lookup.
@@ -73,7 +73,7 @@ OPACITY_LAYERS = (0.25, 0.5, 1.0, 2.0)
 OPACITY_FAR = 3.0e38  # the first-depth map's clear value: no volume along the texel
 # grows each tile's fronts by a texel where a texel's centre missed the volume
 OPACITY_FRONT_FRAGMENT = "shadows/opacity_front.frag"
-RECORD_TEXELS = 40  # texels a slot's row: 4 + 6 tiles x 6 (lights/shadows.glsl)
+RECORD_TEXELS = 40  # texels a slot's row: 4 + 6 tiles x 6 (lighting/shadows.glsl)
 MAX_TILES = 6
 CASCADE_BLEND = 0.1  # the fraction of a cascade blended into the next at its far end
 # the caster pass's slope-scaled depth offset (glPolygonOffset factor, units): with the
@@ -501,7 +501,7 @@ class ShadowAtlas:
 
     # -- binding source ----------------------------------------------------------------------
     def bind(self, uniforms: ProgramUniforms, texture_unit: int) -> int:
-        """The atlas and records where a program reads them (lights/shadows.glsl), and the
+        """The atlas and records where a program reads them (lighting/shadows.glsl), and the
         opacity maps where it reads those (the opacity stage reads the first depth only)."""
         if "u_shadow_records" in uniforms.members:
             uniforms.set_shared("shadows", self._uniforms)

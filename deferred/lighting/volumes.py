@@ -83,13 +83,13 @@ class LightTypePass(RenderPass):
         if count == 0:
             return
         sphere = self.light_type.volume == LightVolume.SPHERE
-        vertex = "lights/volume.vert" if sphere else "lights/fullscreen.vert"
+        vertex = "lighting/volume.vert" if sphere else "lighting/fullscreen.vert"
         defines = {"LIGHT_FUNCTION": self.light_type.glsl_function}
         if self.occlusion:
             defines["HAS_SSAO"] = "1"
         if not sphere:
             defines["FULLSCREEN_AT_FAR"] = "1"
-        program = frame.shaders.program(vertex, "lights/accumulate.frag", defines=defines)
+        program = frame.shaders.program(vertex, "lighting/accumulate.frag", defines=defines)
         frame.use_framebuffer((LIGHT_ACCUMULATION,), DEPTH, depth_write=False)
         textures = frame.target_samplers(self.gbuffer)
         if self.occlusion:

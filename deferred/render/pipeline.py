@@ -208,7 +208,7 @@ class DeferredPipeline(Pipeline):
         if self.light_path == names.LightPath.VOLUMES:
             # the light accumulation starts as 0 on surfaces and the background elsewhere
             # (its clear); each light type's pass adds into it
-            background = surface_pass("lighting.background", "lights/background.frag",
+            background = surface_pass("lighting.background", "lighting/background.frag",
                                       {"u_normal_exponent_id": NORMAL_EXPONENT_ID},
                                       {LIGHT_ACCUMULATION: LIGHT_ACCUMULATION_SPEC},
                                       scene.background)

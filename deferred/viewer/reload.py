@@ -6,9 +6,9 @@ from __future__ import annotations
 
 import time
 from collections.abc import Iterable
-from importlib import resources
 from pathlib import Path
 
+from deferred.gl.shaderlib import FrameworkShaders
 from deferred.io.safety import scene_inputs
 from deferred.scene.model import Scene
 
@@ -17,8 +17,8 @@ GLSL_SUFFIXES = (".glsl", ".vert", ".frag", ".geom", ".comp")
 
 
 def shader_files(scene: Scene) -> list[Path]:
-    """Every GLSL file the framework's shader folder and the scene's plugins' roots hold."""
-    roots = [Path(str(resources.files("deferred.shaders")))]
+    """Every GLSL file the framework's shader folders and the scene's plugins' roots hold."""
+    roots = [Path(str(folder)) for folder in FrameworkShaders().folders()]
     classes = [*(type(obj.material) for obj in scene.objects), *scene.light_types(),
                *scene.shading_models(), *(type(effect) for effect in scene.effects)]
     roots += [Path(str(cls.shader_root)) for cls in classes if cls.shader_root is not None]

@@ -21,5 +21,5 @@
   metrics (Costigan 4.3.3-4.3.6, after Barla et al.)
 - :mod:`.hatching`: tonal art maps and their tone blend (Costigan 4.3.8, after Praun et al.)
 
-Their GLSL lives in ``shaders/techniques/``.
+Their GLSL lives beside them, in this folder.
 """

@@ -1,7 +1,7 @@
 """Fins (Lengyel et al. 2001): strips extruded from silhouette edges along the fur direction and
 textured with the fur volume, so fur seen edge-on reads as strands rather than the stacked rims
-of shells. ``techniques/fins.geom`` builds them from each edge and its two faces; this module
-finds the edges (:func:`edge_adjacency`) and draws them (:class:`FinPass`).
+of shells. ``materials/techniques/fins.geom`` builds them from each edge and its two faces; this
+module finds the edges (:func:`edge_adjacency`) and draws them (:class:`FinPass`).
 """
 
 from __future__ import annotations
@@ -60,10 +60,10 @@ def fin_geometry(ctx: moderngl.Context, gpu_mesh: GpuMesh,
 
 
 class FinPass(ObjectPass):
-    """Fins of an object: ``geometry = "techniques/fins.geom"`` over the material's fur vertex
-    shader compiled with ``FUR_FINS``; blended like shells, never culled."""
+    """Fins of an object: ``geometry = "materials/techniques/fins.geom"`` over the material's fur
+    vertex shader compiled with ``FUR_FINS``; blended like shells, never culled."""
 
-    geometry = "techniques/fins.geom"
+    geometry = "materials/techniques/fins.geom"
     depth = DEPTH
     depth_test = True
     depth_func = "lequal"

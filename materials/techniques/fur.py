@@ -1,5 +1,5 @@
 """The shared fur technique: the parameters every shell fur has, the mip-mapped fur volume its
-shells and fins sample (``fur_volume.py``, ``shaders/techniques/fur.glsl``), density in world
+shells and fins sample (``fur_volume.py``, ``materials/techniques/fur.glsl``), density in world
 units, level of detail and self-shadowing. ``revie_fur`` and ``shell_fur`` build on it
 (:class:`FurMaterial`): they differ in how fur is lit and shaped, not in how shells are drawn.
 
@@ -12,7 +12,7 @@ units, level of detail and self-shadowing. ``revie_fur`` and ``shell_fur`` build
   ``gamma(h) = (K - 1 + h) / K`` (``self_shadow`` = K) darkens every shell toward the roots.
 - **Self-shadowing**: under a shadowed light, every shell, the root shell (the skin) too,
   takes the light through the fur in front of it instead, from deep opacity maps
-  (``self_shadow_density``; :meth:`FurMaterial.draw_opacity`, ``lights/shadows.glsl``).
+  (``self_shadow_density``; :meth:`FurMaterial.draw_opacity`, ``lighting/shadows.glsl``).
 - **Level of detail**: the shell count follows the fur layer's projected thickness,
   ``n = clamp(pixels / lod_error, min_shells, shells)``, continuous; the depths move with it and
   the outermost fades by the fraction, so a dolly never pops (:func:`shell_count`).
@@ -49,9 +49,9 @@ if TYPE_CHECKING:
 
 # A heightfield image tile counts as this many strands when density converts to tiles per unit.
 IMAGE_TILE_STRANDS = 1024
-SHADOW_CASTER_FRAGMENT = "shadows/fur_caster.frag"
+SHADOW_CASTER_FRAGMENT = "materials/techniques/fur_caster.frag"
 SHADOW_SHELLS = 8  # most shells a fur object casts its shadow with (with its root shell)
-OPACITY_FRAGMENT = "shadows/fur_opacity.frag"
+OPACITY_FRAGMENT = "materials/techniques/fur_opacity.frag"
 OPACITY_SHELLS = 12  # most shells the fur draws into the deep opacity maps (without the skin)
 OPACITY_ENVELOPE = 1.0  # the shell depth of the fur's front in the opacity maps: the tips
 
@@ -200,7 +200,7 @@ class FurMaterial(Material):
 
     def motion_extent(self, obj: SceneObject) -> float:
         """The shells and fins reach fur_length beyond the mesh (along the comb-bent normal:
-        techniques/shells.glsl)."""
+        materials/techniques/shells.glsl)."""
         return float(self.params.fur_length)
 
     def held_memory(self, obj: SceneObject) -> dict[str, int]:
@@ -222,7 +222,7 @@ class FurMaterial(Material):
                 "u_fur_volume": fur_volume_texture(frame, self.params, self.heightfield_path())}
 
     def defines(self, obj: SceneObject) -> dict[str, str]:
-        """The fur's programs receive the deep opacity maps (lights/shadows.glsl) unless
+        """The fur's programs receive the deep opacity maps (lighting/shadows.glsl) unless
         ``self_shadow_density`` is 0: where the scene draws them, a shadowed light reaches a
         forward shell through the fur in front."""
         defines = super().defines(obj)
@@ -252,7 +252,7 @@ class FurMaterial(Material):
         Where the light has deep opacity maps (``view.opacity_maps``) and the fur is in them
         (``self_shadow_density`` above 0), only the root shell (the skin, opaque) casts depth:
         the body shadows its own far side and what lies behind it, and the fur's translucent
-        shadow, on other surfaces as on itself, is the maps' alone (``lights/shadows.glsl``:
+        shadow, on other surfaces as on itself, is the maps' alone (``lighting/shadows.glsl``:
         a surface beyond the fur's back keeps exp(-k x the fur's optical depth) there, the
         fur's own shells and skin the transmittance at their depth). Dithered shells in the
         depth map too would shadow the fur twice: toward the terminator a shell at height h
@@ -262,8 +262,8 @@ class FurMaterial(Material):
 
         Otherwise (``self_shadow_density`` 0, or a pipeline that draws no maps) the root shell
         and up to ``SHADOW_SHELLS`` shells above it cast, each kept by a dither under its
-        opacity (``shadows/fur_caster.frag``), so the floor darkens with the fur's density;
-        gamma(h) is the fur's own self-shadowing then."""
+        opacity (``materials/techniques/fur_caster.frag``), so the floor darkens with the fur's
+        density; gamma(h) is the fur's own self-shadowing then."""
         params = self.params
         if params.shells == 0 or not self.fur_vertex:
             super().draw_shadow(frame, obj, view)
@@ -307,7 +307,7 @@ class FurMaterial(Material):
         shell drawn in view lies inside, so the front is where the fur begins along each texel
         (an inner shell would leave the tips beyond it out of the maps, with no fur in front).
         Stage "density": :meth:`opacity_shells` outer shells, each adding the optical depth of
-        the opacity it draws (``shadows/fur_opacity.frag``)."""
+        the opacity it draws (``materials/techniques/fur_opacity.frag``)."""
         params = self.params
         if params.shells == 0 or not self.fur_vertex:
             return

@@ -3,7 +3,8 @@ per layer fragment).
 
 A fur layer fragment takes the light of the base-mesh point under it from the light
 accumulation, divided by the G-buffer albedo: the first of that pixel and its 8 neighbours that
-holds the fur at the expected depth (``techniques/accumulated_light.glsl``'s search). Done by
+holds the fur at the expected depth (``materials/techniques/accumulated_light.glsl``'s search).
+Done by
 every fragment of every layer, the search was half a layer's cost on a CPU rasteriser (up to 9
 pixels of 4 G-buffer reads each; a SIMD rasteriser runs every branch). This scene pass does
 the part that does not depend on the layer once per pixel, into two targets:
@@ -12,8 +13,8 @@ the part that does not depend on the layer once per pixel, into two targets:
   and where it came from (alpha 1: the pixel itself, -1: a neighbour, 0: none);
 - ``<target>_depths``: the least and greatest linear depth of the fur over the 3x3 pixels.
 
-A layer fragment (``techniques/fur_light.glsl``) reads both texels at its base pixel and takes
-the light where the expected depth lies within the depth range, widened by its tolerance. That
+A layer fragment (``materials/techniques/fur_light.glsl``) reads both texels at its base pixel and
+takes the light where the expected depth lies within the depth range, widened by its tolerance. That
 accepts every fragment the search accepted; it also accepts one whose expected depth falls
 between two parts of the fur seen in the 3x3 pixels (along an edge where the fur occludes
 itself), with the first pixel's light, where the search took the light of the pixel at the right
@@ -42,7 +43,7 @@ from deferred.api import (
 if TYPE_CHECKING:
     from deferred.api import Frame
 
-FUR_LIGHT_FRAGMENT = "techniques/fur_light.frag"
+FUR_LIGHT_FRAGMENT = "materials/techniques/fur_light.frag"
 
 
 def fur_light_targets(target: str) -> tuple[str, str]:
@@ -52,7 +53,7 @@ def fur_light_targets(target: str) -> tuple[str, str]:
 
 class FurLightReader:
     """Mixin for an ``ObjectPass`` whose shader reads a fur_light gather through
-    ``techniques/fur_light.glsl``: give its name as ``fur_light`` and its targets
+    ``materials/techniques/fur_light.glsl``: give its name as ``fur_light`` and its targets
     (:func:`fur_light_targets`) among ``extra_reads`` (the pass graph orders the passes by
     them); they are bound as ``u_fur_light`` and ``u_fur_light_depths``."""
 

@@ -17,8 +17,8 @@ going bald (thresholding) or noisy (no filtering).
 
 A shell at height h reads the volume between two slices, interpolated. The texture holds
 ``SUBSLICES`` interpolated slices per interval between two generated ones, so a shell reads one
-(the nearest, ``techniques/fur.glsl``) instead of two: half the filtered lookups, for heights
-rounded to a quarter of the slice spacing (Silva's h = (1 + n)/N falls exactly on one for
+(the nearest, ``materials/techniques/fur.glsl``) instead of two: half the filtered lookups, for
+heights rounded to a quarter of the slice spacing (Silva's h = (1 + n)/N falls exactly on one for
 N = 16 and 64 and every power of two).
 """
 

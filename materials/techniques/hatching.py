@@ -26,7 +26,7 @@ about the same ink. Generation is deterministic for a seed and cached on disk
 
 For the GPU the TAM is one 2D texture, an atlas of the tones side by side, each cell padded by a
 wrapped gutter so that hardware filtering tiles seamlessly at every level
-(:meth:`ToneArtMap.atlas`, :func:`tam_texture`); ``shaders/techniques/hatching.glsl`` blends the
+(:meth:`ToneArtMap.atlas`, :func:`tam_texture`); ``materials/techniques/hatching.glsl`` blends the
 two tones nearest a lit tone, on the surface (Praun et al.) or in screen space (Lake et al.,
 Fig. 4.20a). :func:`blend_tones` is the same blend in numpy.
 """
@@ -491,7 +491,7 @@ def tone_blend(tone: np.ndarray, tones: int) -> tuple[np.ndarray, np.ndarray, np
 def blend_tones(tam: ToneArtMap, tone: np.ndarray, uv: np.ndarray, level: int = 0) -> np.ndarray:
     """Ink of the TAM at lit ``tone`` (n,) and texture coordinates ``uv`` (n, 2) at mip level
     ``level``: the two nearest tones, each sampled bilinearly with wrapping, mixed linearly
-    (the blend of ``hatching_ink`` in ``techniques/hatching.glsl``)."""
+    (the blend of ``hatching_ink`` in ``materials/techniques/hatching.glsl``)."""
     tone = np.asarray(tone, np.float64)
     uv = np.asarray(uv, np.float64)
     lighter, darker, weight = tone_blend(tone, tam.tones)

@@ -2,7 +2,7 @@
 out, blended. The count follows the level of detail of the fur technique (``fur.shell_count``):
 the first shell lies on the root, the others at the middles of the slabs of the layer
 (``fur.shell_depth``), the outermost fades with the fraction of ``n``; the vertex shader offsets
-them with ``shell_offset`` (``techniques/shells.glsl``, Listing 2.1).
+them with ``shell_offset`` (``materials/techniques/shells.glsl``, Listing 2.1).
 """
 
 from __future__ import annotations

@@ -3,7 +3,7 @@
 A stipple pass writes a mesh into the G-buffer at one pixel in two or four; the lighting phase
 lights those samples like any other; a material-phase pass then reads them back and erases them
 from the composition buffer. ``STIPPLE_PATTERN`` (2 or 4) selects the pattern in
-``techniques/stipple.glsl``.
+``materials/techniques/stipple.glsl``.
 
 Obliteration restores what the composition holds, not the raw light: after every material's own
 opaque pass (``Order.OPAQUE``), one scene-wide pass snapshots the composition
@@ -42,8 +42,8 @@ def stipple_scene_passes(phase: Phase) -> list[RenderPass]:
 
 
 def pattern_defines(pattern: int, parity: tuple[int, int] = (0, 0)) -> dict[str, str]:
-    """Defines of ``techniques/stipple.glsl``: the pattern (1 in 2 or 1 in 4) and the parity
-    class of the user (Revie 2.3.4: different users interleave instead of overwriting each
+    """Defines of ``materials/techniques/stipple.glsl``: the pattern (1 in 2 or 1 in 4) and the
+    parity class of the user (Revie 2.3.4: different users interleave instead of overwriting each
     other's samples; fur takes (0, 0), glass (1, 1) or the odd checkerboard)."""
     if pattern not in PATTERNS:
         raise ValueError(f"stipple pattern must be one of {PATTERNS}, got {pattern}")
@@ -59,13 +59,13 @@ class StipplePass(GBufferPass):
 class StippleObliterationPass(ObjectPass):
     """Material phase: where this mesh's stipple samples sit in the composition buffer, copy the
     neighbouring pixel's composition (from the snapshot) and depth over them
-    (``techniques/stipple_obliterate.frag``).
+    (``materials/techniques/stipple_obliterate.frag``).
 
     Drawn with the same vertex shader and uniforms as the stipple pass; a pixel is treated as a
     stipple sample only if the G-buffer there holds this material at this fragment's depth.
     """
 
-    fragment = "techniques/stipple_obliterate.frag"
+    fragment = "materials/techniques/stipple_obliterate.frag"
     colors = (COMPOSITE,)
     depth = DEPTH
     depth_test = True

@@ -14,7 +14,7 @@ projected back into the region of Eq. 3: no farther than ``L_0`` from the root a
 the surface, ``(p - p_root) . n >= 0``; its velocity is what the projected step moved it.
 
 The layers of the fur follow a quadratic Bezier from ``p_root`` to ``p`` (the vertex shader,
-``shaders/materials/shell_fur/strand.glsl``). The shader receives each vertex's tip deflection
+``materials/shell_fur/strand.glsl``). The shader receives each vertex's tip deflection
 ``p - p_0``: the area-weighted mean of its triangles', in object space.
 
 All positions are world space, vectorised over triangles (numpy).

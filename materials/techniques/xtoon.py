@@ -14,7 +14,7 @@ holds from its position up to the following one's, a quantised gradient) or read
 the right, y up: the image's top row is y = 1). The toon shading model
 (:mod:`deferred.materials.shading_models`) gathers every ramp of the scene's materials into one
 texture array; a material writes its ramp's layer (:func:`ramp_layer`) into the G-buffer datum
-``toon_ramp``, and the lights look the ramp up by it (``shaders/shading_models/toon.glsl``).
+``toon_ramp``, and the lights look the ramp up by it (``materials/shading_models/toon.glsl``).
 """
 
 from __future__ import annotations

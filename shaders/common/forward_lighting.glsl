@@ -5,7 +5,7 @@
 #include "common/light_buffer.glsl"
 #include "generated/lights.glsl"
 #ifdef FORWARD_PLUS
-#include "lights/listed_lights.glsl"
+#include "lighting/listed_lights.glsl"
 
 vec3 forward_lighting(Surface s, vec3 P, vec3 V) {
     s.view_depth = -P.z;

@@ -1,5 +1,5 @@
 // One triangle covering the screen, from gl_VertexID 0..2 (post/fullscreen.vert, and
-// lights/fullscreen.vert instanced a light a copy). FULLSCREEN_AT_FAR puts it on the far plane
+// lighting/fullscreen.vert instanced a light a copy). FULLSCREEN_AT_FAR puts it on the far plane
 // (depth 1), where a depth test "greater" against the scene's depth passes on its surfaces only
 // (deferred.lighting.volumes: surface_pass, LightTypePass): on llvmpipe the blocks of pixels
 // that fail it are skipped, which an `if` in the fragment shader cannot do.

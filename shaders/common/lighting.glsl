@@ -6,7 +6,7 @@
 //   position  xyz = position, w = radius (volume lights)
 //   direction xyz = direction the light travels, w = type-specific (spot: cos outer angle)
 //   extra     type-specific (spot: x = cos inner angle; ambient: rgb = ground colour); w = the
-//             shadow slot, written by the framework (lights/shadows.glsl; 0: no shadow)
+//             shadow slot, written by the framework (lighting/shadows.glsl; 0: no shadow)
 struct LightRecord {
     vec4 color;
     vec4 position;

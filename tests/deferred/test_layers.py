@@ -171,6 +171,8 @@ def test_a_plugin_reaching_past_the_api_is_caught(tmp_path):
 
 def test_the_glsl_a_plugin_may_include_exists():
     from deferred.api import GLSL_INCLUDES
+    from deferred.gl.shaderlib import FrameworkShaders
 
-    shaders = ROOT / "shaders"
-    assert [name for name in GLSL_INCLUDES if not (shaders / name).is_file()] == []
+    shaders = FrameworkShaders()
+    assert [name for name in GLSL_INCLUDES
+            if not shaders.joinpath(*name.split("/")).is_file()] == []

@@ -111,8 +111,8 @@ def test_every_packaged_shader_program_compiles(gl):
                    "GBUFFER_DATA_WRITE": '"generated/gbuffer_write/none.glsl"'}
         lib.program("common/mesh.vert", "gbuffer/geometry.frag", defines=surface)
         lib.program("common/mesh.vert", "forward/lit.frag", defines=surface)
-        lib.program("lights/volume.vert", "lights/accumulate.frag")
-        lib.program("lights/fullscreen.vert", "lights/accumulate.frag")
+        lib.program("lighting/volume.vert", "lighting/accumulate.frag")
+        lib.program("lighting/fullscreen.vert", "lighting/accumulate.frag")
         lib.program("post/fullscreen.vert", "post/tonemap.frag")
         lib.release()
 

@@ -132,8 +132,8 @@ def test_skin_transmittance_has_no_steps_at_coarse_maps(gl, material):
     """With deep opacity maps a quarter of the shadow map's resolution (a texel spans about
     the fur's thickness here), the skin's transmittance (its light with self-shadowing over its
     light without) varies smoothly: the fur's front is interpolated between the maps' texels
-    (lights/shadows.glsl, interpolated_front). Read nearest, the front stepped at every texel's edge
-    and so did the depth behind it: 4-5% of neighbouring pixels differed by more than 0.04,
+    (lighting/shadows.glsl, interpolated_front). Read nearest, the front stepped at every texel's
+    edge and so did the depth behind it: 4-5% of neighbouring pixels differed by more than 0.04,
     contour bands across the ball. Now under 2.5% against the skin with no shadow map (the fur's
     dithered shells cast in the depth map without self-shadowing, FurMaterial.draw_shadow; with
     it only its skin does): what is left are the maps' own streaks along the light."""

@@ -216,7 +216,8 @@ def luminance_psnr(a, b):
 @pytest.mark.parametrize("direction", [SIDE, FRONT_LEFT], ids=["side", "front_left"])
 def test_deferred_fur_shadows_itself_as_the_forward_fur(gl, material, extra, direction):
     """The deferred layers move their samples' full-screen light to where they are
-    (techniques/fur_relight.glsl): the far side's strands standing out of the skin's shadow are
+    (materials/techniques/fur_relight.glsl): the far side's strands standing out of the skin's
+    shadow are
     lit along their own direction, and each shadowed light reaches them through the fur in front,
     as in the forward pipeline. Without and with self-shadowing, the lit and far sides' fur is
     within 6% of the forward fur's (measured 0.95-1.03), self-shadowing darkens the far side as

@@ -445,7 +445,7 @@ def test_fur_casts_a_shadow_from_its_shells(gl, material, density):
     not just its skin): a ring just outside the bare sphere's shadow is shaded. Without
     self-shadowing (density 0) the shells cast in the depth map, dithered; with it only the
     skin does, and the floor beyond the fur keeps exp(-k x the fur's optical depth) from the
-    deep opacity maps (lights/shadows.glsl, opacity_beyond)."""
+    deep opacity maps (lighting/shadows.glsl, opacity_beyond)."""
     points, _ = plane_points()
     centre = -0.9 * FUR_LIGHT[0] / FUR_LIGHT[1]  # where the light's ray through the centre lands
     stretch = np.linalg.norm(FUR_LIGHT) / abs(FUR_LIGHT[1])  # the shadow's ellipse along x

@@ -132,7 +132,7 @@ HARNESS = Path(__file__).parents[1] / "fixtures" / "fur_harness"
 
 
 def test_the_glsl_subslice_count_is_the_volumes():
-    source = (Path(__file__).parents[2] / "shaders" / "techniques" / "fur.glsl").read_text()
+    source = (Path(__file__).parents[2] / "materials" / "techniques" / "fur.glsl").read_text()
     assert f"#define FUR_SUBSLICES {SUBSLICES:.1f}" in source
 
 

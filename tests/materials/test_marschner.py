@@ -1,5 +1,6 @@
-"""The marschner shading model: its GLSL (techniques/hair_bsdf.glsl) against an independent numpy
-reference of the same lobes, and what it does to fur in both pipelines (back-lit tips glow)."""
+"""The marschner shading model: its GLSL (materials/techniques/hair_bsdf.glsl) against an
+independent numpy reference of the same lobes, and what it does to fur in both pipelines (back-lit
+tips glow)."""
 
 from pathlib import Path
 
@@ -185,5 +186,6 @@ def test_forward_and_deferred_agree_with_marschner(render, material):
     print(f"{material} marschner forward vs deferred PSNR {value:.1f} dB")
     # measured 40.8 dB (revie_fur) and 40.0 dB (shell_fur); 23.5 / 35.5 before the deferred
     # layers moved their samples' full-screen light to where they are and lit a fin with no
-    # sample there (techniques/fur_relight.glsl): revie_fur's back-lit fins glowed half as much
+    # sample there (materials/techniques/fur_relight.glsl): revie_fur's back-lit fins glowed
+    # half as much
     assert value > 38.0

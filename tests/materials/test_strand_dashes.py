@@ -1,5 +1,5 @@
 """revie_fur's shells sample the strands twice across their slab, along the view ray
-(shaders/materials/revie_fur/slab.glsl): strands seen at a slant are less a chain of dashes
+(materials/revie_fur/slab.glsl): strands seen at a slant are less a chain of dashes
 (Revie Figure 2.20), and the fur keeps its mean brightness."""
 
 from pathlib import Path

@@ -159,8 +159,8 @@ def test_wet_wind_outlines_both_move_and_do_not_repeat(render):
                                                ("shell_fur", "forward")])
 def test_strands_differ_in_hue(render, material, pipeline):
     """Under white light the lit strands' blue-to-red ratio varies from strand to strand (each
-    strand's tint, techniques/fur.glsl): one ratio for all of them (std 0.0002 to 0.002) when
-    only their brightness varied."""
+    strand's tint, materials/techniques/fur.glsl): one ratio for all of them (std 0.0002 to 0.002)
+    when only their brightness varied."""
     scene = scene_from_dict({
         "size": [200, 200], "background": [0.0, 0.0, 0.0], "tonemap": "none",
         "camera": {"position": [0.0, 0.0, 3.0], "target": [0.0, 0.0, 0.0], "fov": 30.0},

@@ -1,4 +1,4 @@
-"""The fur volume's triplanar lookup (shaders/techniques/fur.glsl) picks one plane per cell
+"""The fur volume's triplanar lookup (materials/techniques/fur.glsl) picks one plane per cell
 where the planes' weights overlap: the fur is as bright in a blend zone as on an axis (mixing
 the planes' coverages would make coarse fur brighter there)."""
 

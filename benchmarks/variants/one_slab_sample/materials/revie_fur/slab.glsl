@@ -1,7 +1,7 @@
 // benchmarks/fur_shading.py's cut-out of materials/revie_fur/slab.glsl: one sample at the shell's
 // own height (revie_fur before the slab's box filter), to time what the second sample costs.
 #include "common/object_transform.glsl"
-#include "techniques/fur.glsl"
+#include "materials/techniques/fur.glsl"
 
 #include "materials/revie_fur/comb.glsl"
 

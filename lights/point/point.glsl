@@ -1,0 +1,14 @@
+// Point light: distance_falloff to zero at the radius (position.w); shadowed through six cube
+// tiles where it casts shadows (lighting/shadows.glsl).
+#include "common/lighting.glsl"
+#include "lighting/shadows.glsl"
+
+vec3 point_light(LightRecord light, Surface s, vec3 P, vec3 V) {
+    vec3 to_light = light.position.xyz - P;
+    float d = length(to_light);
+    float falloff = distance_falloff(d, light.position.w);
+    if (falloff <= 0.0) return vec3(0.0);
+    vec3 L = to_light / d;
+    falloff *= light_shadow_cube(light, P, s.normal, L);
+    return shade_light(s, L, V, light.color.rgb * falloff);
+}

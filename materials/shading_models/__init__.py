@@ -1,0 +1,138 @@
+"""Built-in shading models (see :mod:`deferred.interfaces.shading`); importing this module
+registers them.
+
+- ``blinn_phong``: the standard model (albedo, specular intensity and exponent).
+- ``kajiya_kay``: strands (Silva et al. Eq. 6; Kajiya and Kay 1989): diffuse |T x L|, specular
+  ((T.L)(T.E) + |T x L||T x E|)^p along the strand tangent T, stored as G-buffer data.
+- ``marschner``: hair (Marschner et al. 2003 in Karis's 2016 real-time form): R, TT and TRT
+  lobes about the strand tangent (G-buffer data ``strand_tangent``, root to tip) and a
+  multiple-scattering lobe, which also answers the ambient; ``specular_exponent`` carries the
+  longitudinal roughness (radians), ``specular_intensity`` scales R.
+- ``toon``: N.L through a ramp texture (a row per ramp, chosen per pixel by G-buffer data) and
+  a hard-edged specular band (X-toon, Costigan's cartoon shading).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import moderngl
+import numpy as np
+
+from deferred.api import GBufferData, ShadingModel, shading_models
+
+from ..techniques.xtoon import RAMP_HEIGHT, RAMP_WIDTH, XToonRamp, ramp_layer, scene_ramps
+
+if TYPE_CHECKING:
+    from deferred.api import Frame
+
+STRAND_TANGENT = GBufferData(
+    "strand_tangent", "RG16F", ("u", "v"),
+    "strand tangent, view space, octahedral (kajiya_kay: materials/techniques/strand_tangent.glsl)")
+TOON_RAMP = GBufferData("toon_ramp", "R8", ("row",), "row of the toon ramp texture / 255")
+
+
+@shading_models.register
+class BlinnPhong(ShadingModel):
+    name = "blinn_phong"
+    glsl_file = "materials/shading_models/blinn_phong.glsl"
+    glsl_function = "blinn_phong"
+
+
+@shading_models.register
+class KajiyaKay(ShadingModel):
+    name = "kajiya_kay"
+    glsl_file = "materials/shading_models/kajiya_kay.glsl"
+    glsl_function = "kajiya_kay"
+    gbuffer_data = (STRAND_TANGENT,)
+
+
+def _ramp(values: np.ndarray, dark, light) -> np.ndarray:
+    return np.asarray(dark)[None, :] * (1.0 - values[:, None]) + \
+        np.asarray(light)[None, :] * values[:, None]
+
+
+def toon_ramps(width: int = 256) -> dict[str, np.ndarray]:
+    """The built-in ramps, (width, 3) linear RGB over N.L from -1 (left) to 1 (right)."""
+    n_dot_l = np.linspace(-1.0, 1.0, width)
+
+    def steps(edges, tones, softness=0.02):
+        out = np.full(width, tones[0])
+        for edge, low, high in zip(edges, tones, tones[1:], strict=False):
+            t = np.clip((n_dot_l - edge) / softness + 0.5, 0.0, 1.0)
+            out = out + (high - low) * t
+        return out
+
+    soft = np.clip((n_dot_l + 0.2) / 0.8, 0.0, 1.0)
+    grey = (1.0, 1.0, 1.0)
+    return {
+        "two_tone": _ramp(steps([0.1], [0.12, 1.0]), (0, 0, 0), grey),
+        "three_tone": _ramp(steps([0.0, 0.5], [0.05, 0.4, 1.0]), (0, 0, 0), grey),
+        "soft": _ramp(soft * soft * (3.0 - 2.0 * soft), (0, 0, 0), grey),
+        "warm_cool": _ramp(steps([0.15], [0.0, 1.0], 0.1), (0.10, 0.14, 0.32), (1.0, 0.92, 0.78)),
+    }
+
+
+TOON_RAMP_NAMES = tuple(toon_ramps())
+
+
+@shading_models.register
+class Toon(ShadingModel):
+    """N.L through a ramp: the built-in 1D ramps (layers 0 .. 3 of ``u_toon_ramps``, over N.L
+    from -1 to 1, filtered) and the scene's X-toon ramps after them (2D, over max(N.L, 0) and a
+    metric, fetched unfiltered: :mod:`deferred.materials.techniques.xtoon`). A material writes
+    its ramp's layer into the G-buffer datum ``toon_ramp``; ``u_toon_ramp_constants`` holds a
+    row per layer: metric, its two constants, and whether the layer is an X-toon ramp."""
+
+    name = "toon"
+    glsl_file = "materials/shading_models/toon.glsl"
+    glsl_function = "toon"
+    gbuffer_data = (TOON_RAMP,)
+
+    @classmethod
+    def textures(cls, frame: Frame) -> dict[str, moderngl.Texture]:
+        ramps = scene_ramps(frame.scene)
+        key = ("toon_ramps", tuple(ramps))
+
+        def create(ctx: moderngl.Context) -> moderngl.Texture:
+            layers = [np.repeat(row[None, :, :], RAMP_HEIGHT, axis=0)
+                      for row in toon_ramps(RAMP_WIDTH).values()]
+            layers += [ramp.texels() for ramp in ramps]
+            data = np.stack(layers).astype(np.float32)  # (layers, height, width, 3)
+            texture = ctx.texture_array((RAMP_WIDTH, RAMP_HEIGHT, len(layers)), 3,
+                                        data.tobytes(), dtype="f4")
+            texture.filter = (moderngl.LINEAR, moderngl.LINEAR)
+            texture.repeat_x = texture.repeat_y = False
+            return texture
+
+        def create_constants(ctx: moderngl.Context) -> moderngl.Texture:
+            rows = [(0.0, 0.0, 0.0, 0.0)] * len(TOON_RAMP_NAMES)
+            rows += [ramp.constants() for ramp in ramps]
+            texture = ctx.texture((len(rows), 1), 4, np.asarray(rows, np.float32).tobytes(),
+                                  dtype="f4")
+            texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            return texture
+
+        # one array at a time: a ramp edited between frames replaces it
+        return {"u_toon_ramps": frame.resources.current("toon_ramps", key, create),
+                "u_toon_ramp_constants": frame.resources.current(
+                    "toon_ramp_constants", key, create_constants)}
+
+    @staticmethod
+    def ramp_row(name: str) -> float:
+        """The ``toon_ramp`` value selecting built-in ramp ``name``."""
+        return TOON_RAMP_NAMES.index(name) / 255.0
+
+    @staticmethod
+    def xtoon_row(scene, ramp: XToonRamp) -> float:
+        """The ``toon_ramp`` value selecting X-toon ``ramp`` in ``scene``."""
+        return ramp_layer(scene, ramp, len(TOON_RAMP_NAMES)) / 255.0
+
+
+@shading_models.register
+class Marschner(ShadingModel):
+    name = "marschner"
+    glsl_file = "materials/shading_models/marschner.glsl"
+    glsl_function = "marschner"
+    ambient_function = "marschner_ambient"
+    gbuffer_data = (STRAND_TANGENT,)

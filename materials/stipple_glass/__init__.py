@@ -1,0 +1,94 @@
+"""Screen-door transparency in a deferred pipeline (Revie 2.3.4, Figure 2.14).
+
+The glass is written into the G-buffer at one pixel in two or four (``pattern``), so the pixels
+between keep the scene behind it; both are lit by the lighting phase as usual. In the material
+phase the glass's stipple samples are obliterated with the rest of the opaque scene, and later,
+with the transparent passes (far to near), each glass pixel blends its tile's glass sample by
+``opacity`` over whatever the composition buffer holds. The forward technique is an ordinary
+alpha-blended lit pass.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Literal
+
+from pydantic import Field
+
+from deferred.api import (
+    COMPOSITE,
+    LIGHT_ACCUMULATION,
+    LINEAR_DEPTH,
+    NORMAL_EXPONENT_ID,
+    Albedo,
+    BlinnPhongParams,
+    Material,
+    ObjectPass,
+    Order,
+    Phase,
+    RenderPass,
+    materials,
+)
+
+from ..techniques.stipple import (
+    StippleObliterationPass,
+    StipplePass,
+    pattern_defines,
+    stipple_scene_passes,
+)
+
+if TYPE_CHECKING:
+    from deferred.api import SceneObject
+
+
+class StippleGlassParams(BlinnPhongParams):
+    color: Albedo = Field((0.55, 0.75, 0.85), description="glass tint, each in [0, 1]")
+    opacity: float = Field(0.35, ge=0.0, le=1.0, description="glass over the scene behind")
+    pattern: Literal[2, 4] = Field(4, description="stipple density: 1 in 2 or 1 in 4 pixels")
+    specular_intensity: float = Field(0.9, ge=0.0, le=1.0, description="Blinn-Phong intensity")
+    specular_exponent: float = Field(96.0, ge=1.0, le=2048.0, description="Blinn-Phong exponent")
+
+
+class DeinterlacePass(ObjectPass):
+    """Blend each glass pixel's tile sample over the composition buffer."""
+
+    fragment = "materials/stipple_glass/deinterlace.frag"
+    colors = (COMPOSITE,)
+    depth_func = "lequal"
+    depth_write = False
+    blend = "alpha"
+    order = Order.TRANSPARENT
+    extra_reads = (LIGHT_ACCUMULATION, NORMAL_EXPONENT_ID, LINEAR_DEPTH)
+
+
+@materials.register
+class StippleGlassMaterial(Material):
+    name = "stipple_glass"
+    Params = StippleGlassParams
+    surface_shader = "materials/stipple_glass/surface.glsl"
+    uniform_overrides = {"pattern": None}  # a define (STIPPLE_PATTERN)
+
+    def defines(self, obj: SceneObject) -> dict[str, str]:
+        # the other parity classes than fur's (0, 0), so glass and fur samples coexist
+        parity = (1, 1) if self.params.pattern == 4 else (1, 0)
+        return {**super().defines(obj), **pattern_defines(self.params.pattern, parity)}
+
+    @classmethod
+    def scene_passes(cls, objects: list[SceneObject], phase: Phase) -> list[RenderPass]:
+        return stipple_scene_passes(phase)
+
+    def geometry_passes(self, obj: SceneObject) -> list[RenderPass]:
+        return []  # transparent: nothing in the opaque G-buffer phase
+
+    def stipple_passes(self, obj: SceneObject) -> list[RenderPass]:
+        return [StipplePass(f"{obj.label}.stipple", Phase.STIPPLE, obj,
+                            fragment="materials/stipple_glass/stipple.frag")]
+
+    def material_passes(self, obj: SceneObject) -> list[RenderPass]:
+        return [StippleObliterationPass(f"{obj.label}.stipple_obliteration", Phase.MATERIAL,
+                                        obj),
+                DeinterlacePass(f"{obj.label}.deinterlace", Phase.MATERIAL, obj)]
+
+    def forward_passes(self, obj: SceneObject) -> list[RenderPass]:
+        return [ObjectPass(f"{obj.label}.forward", Phase.FORWARD, obj,
+                           fragment="materials/stipple_glass/forward.frag", colors=(COMPOSITE,),
+                           depth_write=False, blend="alpha", order=Order.TRANSPARENT)]
