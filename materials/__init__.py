@@ -1,3 +1,24 @@
-"""Built-in materials; importing this package registers them (see deferred.interfaces.registry)."""
+"""Built-in materials, a package each holding its Python and its GLSL, and the shading models.
 
-from . import cartoon_hair, revie_fur, shell_fur, standard, stipple_glass  # noqa: F401
+The registries (:mod:`deferred.interfaces.registry`) find them by name through these catalogues,
+as they find a plugin through its entry points (``module:Class``): a scene imports only the
+materials it uses. A catalogue's order gives the type ids (1, 2, ...; the G-buffer's id channel
+holds them), so a new built-in goes at the end.
+"""
+
+BUILTINS = {
+    "cartoon_hair": "deferred.materials.cartoon_hair:CartoonHairMaterial",
+    "revie_fur": "deferred.materials.revie_fur:RevieFurMaterial",
+    "shell_fur": "deferred.materials.shell_fur:ShellFurMaterial",
+    "standard": "deferred.materials.standard:StandardMaterial",
+    "stipple_glass": "deferred.materials.stipple_glass:StippleGlassMaterial",
+}
+
+# One package for the four: small classes sharing G-buffer data (the strand tangent), loaded
+# together
+SHADING_MODELS = {
+    "blinn_phong": "deferred.materials.shading_models:BlinnPhong",
+    "kajiya_kay": "deferred.materials.shading_models:KajiyaKay",
+    "toon": "deferred.materials.shading_models:Toon",
+    "marschner": "deferred.materials.shading_models:Marschner",
+}

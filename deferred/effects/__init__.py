@@ -1,5 +1,14 @@
-"""Built-in scene effects (``[[effect]]`` in scene files: ssao, fxaa, edges, taa); importing this
-package registers them (see :mod:`deferred.interfaces.effect` and
-:mod:`deferred.interfaces.registry`)."""
+"""Built-in scene effects (``[[effect]]`` in scene files: ssao, fxaa, edges, taa), a package each
+holding its Python and its GLSL (see :mod:`deferred.interfaces.effect`).
 
-from deferred.effects import edges, fxaa, ssao, taa  # noqa: F401
+The effect registry (:mod:`deferred.interfaces.registry`) finds them by name through this
+catalogue, as it finds a plugin through its entry points (``module:Class``): a scene imports only
+the effects it uses. Its order gives the type ids, so a new built-in goes at the end.
+"""
+
+BUILTINS = {
+    "edges": "deferred.effects.edges:Edges",
+    "fxaa": "deferred.effects.fxaa:FXAA",
+    "ssao": "deferred.effects.ssao:SSAO",
+    "taa": "deferred.effects.taa:TAA",
+}

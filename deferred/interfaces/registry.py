@@ -1,19 +1,22 @@
 """Registries of materials, lights, shading models and effects: built-ins plus plugins.
 
-Built-ins register themselves when their package is imported (``deferred.materials``,
-``deferred.lights``, ...). Third-party packages declare an entry point in the group
-``deferred.materials`` (``deferred.lights``, ``deferred.shading_models``, ``deferred.effects``)
-named as the class's ``name`` and pointing at the class; code can also call ``register``.
+Built-ins and plugins are found the same way: by name, through an entry point naming the class
+(``module:Class``), imported only when a scene (or a listing) asks for that name. A plugin
+package declares its entry points in the group ``deferred.materials`` (``deferred.lights``,
+``deferred.shading_models``, ``deferred.effects``), named as the class's ``name``; the built-ins'
+are the catalogue ``BUILTINS`` of their package (``deferred.materials``, ``deferred.lights``,
+``deferred.effects``; the shading models' is ``deferred.materials:SHADING_MODELS``), read without
+importing a built-in. Code can also call ``register``.
 
 The built-in packages are plugins too: they import ``deferred.api``, which sits above this
-layer, so the registry imports them by name when a registry is first asked
-(``importlib.import_module``), as it loads other plugins through their entry points. That is the
-one way a lower layer reaches a higher one: at run time, by name, never by an import statement
-(the layer contract, ``tests/deferred/test_layers.py``, covers import statements).
+layer, so the registry imports them by name (``importlib``), never by an import statement (the
+layer contract, ``tests/deferred/test_layers.py``, covers import statements).
 
-Entry points load lazily: asking for a name loads that plugin only, so a broken plugin fails
-only the scenes that use it. Listing everything (``deferred params``) loads every plugin and
-skips a broken one with a warning naming it.
+A built-in's type id (the G-buffer's id channel holds a material's) is its place in its
+catalogue, whatever is loaded first; a plugin's comes after the built-ins', in the order plugins
+register. Loading a name loads that class only, so a broken plugin fails only the scenes that
+use it. Listing everything (``deferred params``) loads every class and skips a broken plugin
+with a warning naming it.
 """
 
 from __future__ import annotations
@@ -32,8 +35,8 @@ from deferred.validation import closest
 T = TypeVar("T")
 
 
-# Held while a built-in package or a plugin loads (every registry: loading one package may
-# register into several)
+# Held while a built-in or a plugin loads (every registry: loading one module may register into
+# several)
 _loading = threading.RLock()
 
 
@@ -42,18 +45,22 @@ class PluginWarning(UserWarning):
 
 
 class Registry(Generic[T]):
-    def __init__(self, what: str, group: str, builtin_package: str, max_id: int | None = None):
+    """One kind's classes by name. ``catalogue``: ``"package"`` or ``"package:ATTRIBUTE"``,
+    the module and attribute (``BUILTINS`` unless named) holding the built-ins' catalogue, a
+    dict of name to ``"module:Class"`` in the order of their type ids (none: no built-ins)."""
+
+    def __init__(self, what: str, group: str, catalogue: str, max_id: int | None = None):
         self.what = what
         self.group = group
-        self.builtin_package = builtin_package
+        self.catalogue = catalogue
         self.max_id = max_id  # ids are stored in the G-buffer for some registries
         self._classes: dict[str, type[T]] = {}
-        self._builtins_loaded = False
-        self._importing = False  # the built-in package is being imported (by this thread)
+        self._ids: dict[str, int] = {}  # name -> the type id its class was given here
+        self._builtin_entries: dict[str, EntryPoint] | None = None  # read on first use
         self._tried: dict[str, str | None] = {}  # entry point name -> error (None: loaded)
         # entry point name -> (the class's ``name`` it registered, what it is): named otherwise
         self._misnamed: dict[str, tuple[str, str]] = {}
-        self._next_id = 1  # ids are never reused: 0 means "none" in GPU buffers
+        self._next_id: int | None = None  # after the built-ins'; never reused: 0 is "none"
 
     def register(self, cls: type[T]) -> type[T]:
         """Register ``cls`` under ``cls.name``; usable as a class decorator."""
@@ -65,32 +72,48 @@ class Registry(Generic[T]):
             raise ValueError(f"{self.what} '{name}' is already registered by "
                              f"{existing.__module__}.{existing.__qualname__}")
         if existing is None:
-            if self.max_id is not None and self._next_id > self.max_id:
-                raise ValueError(f"cannot register {self.what} '{name}': ids 1..{self.max_id} "
-                                 "are used up (the G-buffer has room for no more)")
+            cls.type_id = self._ids[name] = self._new_id(cls, name)
             self._classes[name] = cls
-            cls.type_id = self._next_id
-            self._next_id += 1
         return cls
+
+    def _new_id(self, cls: type[T], name: str) -> int:
+        builtins = self._builtins()
+        builtin = builtins.get(name)
+        if builtin is not None:
+            if builtin.value != f"{cls.__module__}:{cls.__qualname__}":
+                raise ValueError(f"{self.what} '{name}' is the name of the built-in "
+                                 f"{builtin.value.replace(':', '.')}")
+            return list(builtins).index(name) + 1
+        if self._next_id is None:
+            self._next_id = len(builtins) + 1
+        if self.max_id is not None and self._next_id > self.max_id:
+            raise ValueError(f"cannot register {self.what} '{name}': ids 1..{self.max_id} "
+                             "are used up (the G-buffer has room for no more)")
+        self._next_id += 1
+        return self._next_id - 1
 
     def unregister(self, name: str) -> None:
         self._classes.pop(name, None)
 
     # -- loading -----------------------------------------------------------------------------
-    def _load_builtins(self) -> None:
-        if self._builtins_loaded:
-            return
-        # Another thread asking meanwhile waits for the whole package, not a part of it; the
-        # lock is re-entrant since the package's modules register (and may ask) as they load.
+    def _builtins(self) -> dict[str, EntryPoint]:
+        """The built-ins' entry points by name, in the order of their ids (their package's
+        catalogue, read once; no built-in is imported)."""
+        if self._builtin_entries is None:
+            module, _, attribute = self.catalogue.partition(":")
+            catalogue = getattr(importlib.import_module(module), attribute or "BUILTINS", {})
+            self._builtin_entries = {name: EntryPoint(name, value, self.group)
+                                     for name, value in catalogue.items()}
+        return self._builtin_entries
+
+    def _load_builtin(self, name: str) -> type[T] | None:
+        """The built-in named ``name``, imported and registered; None where there is none.
+        A built-in that fails to import raises: that is the framework's bug, not bad input."""
+        entry = self._builtins().get(name)
+        if entry is None:
+            return None
         with _loading:
-            if self._builtins_loaded or self._importing:  # done, or asked while importing it
-                return
-            self._importing = True
-            try:
-                importlib.import_module(self.builtin_package)
-                self._builtins_loaded = True
-            finally:
-                self._importing = False
+            return self._classes.get(name) or self.register(entry.load())
 
     def _entry_points(self) -> list[EntryPoint]:
         return list(entry_points(group=self.group))
@@ -125,7 +148,8 @@ class Registry(Generic[T]):
                "alone"
 
     def _load_all(self) -> None:
-        self._load_builtins()
+        for name in self._builtins():
+            self._load_builtin(name)
         for entry in self._entry_points():
             first_time = entry.name not in self._tried
             error = self._load_entry(entry)
@@ -136,8 +160,7 @@ class Registry(Generic[T]):
 
     # -- lookup ------------------------------------------------------------------------------
     def get(self, name: str, where: str | None = None) -> type[T]:
-        self._load_builtins()
-        cls = self._classes.get(name)
+        cls = self._classes.get(name) or self._load_builtin(name)
         if cls is not None:
             return cls
         for entry in self._entry_points():
@@ -175,18 +198,21 @@ class Registry(Generic[T]):
         return f"unknown {self.what} {shown} ({hint}choose from {', '.join(self)})"
 
     def builtins(self) -> list[type[T]]:
-        """The classes of the built-in package, whatever plugins are installed."""
-        self._load_builtins()
-        return [cls for cls in self._classes.values()
-                if cls.__module__.startswith(self.builtin_package)]
+        """The built-in classes (each imported), in the order of their ids, whatever plugins
+        are installed."""
+        return [self._load_builtin(name) for name in self._builtins()]
+
+    def _in_id_order(self) -> list[tuple[str, type[T]]]:
+        # the built-ins first, then plugins as they registered, whichever loaded first
+        return sorted(self._classes.items(), key=lambda item: self._ids[item[0]])
 
     def __iter__(self) -> Iterator[str]:
         self._load_all()
-        return iter(list(self._classes))
+        return iter([name for name, _ in self._in_id_order()])
 
     def items(self) -> list[tuple[str, type[T]]]:
         self._load_all()
-        return list(self._classes.items())
+        return self._in_id_order()
 
 
 materials: Registry = Registry("material", "deferred.materials", "deferred.materials",
@@ -194,6 +220,6 @@ materials: Registry = Registry("material", "deferred.materials", "deferred.mater
 # a listed light's colour texel holds its type id in w's low 8 bits (lighting/light_lists.glsl)
 lights: Registry = Registry("light", "deferred.lights", "deferred.lights", max_id=255)
 shading_models: Registry = Registry("shading model", "deferred.shading_models",
-                                    "deferred.materials.shading_models",
+                                    "deferred.materials:SHADING_MODELS",
                                     max_id=MAX_SHADING_MODEL_ID)
 effects: Registry = Registry("effect", "deferred.effects", "deferred.effects")

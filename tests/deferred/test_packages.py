@@ -2,18 +2,26 @@
 user's own ``materials/``, ``lights/`` or ``shaders/`` folder never shadows them; ``deferred info``
 reports the scene's G-buffer layout."""
 
+import fnmatch
 import importlib.util
 import subprocess
 import sys
+from pathlib import Path, PurePosixPath
 
 import numpy as np
 from model_materials import StrandMaterial
 
 from deferred.cli import main
+from deferred.gl.shaderlib import GLSL_SUFFIXES
 from deferred.interfaces import registry
 from deferred.io.images import read_image
 from deferred.render.renderer import Renderer
 from deferred.scene.loader import load_scene
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # Python 3.10
+    import tomli as tomllib
 
 
 def test_nothing_is_importable_as_a_top_level_materials_lights_or_shaders(tmp_path):
@@ -67,3 +75,34 @@ def test_info_on_a_bad_scene_is_bad_input(tmp_path, capsys):
     scene.write_text('[[object]]\nmesh = "builtin:sphere"\nmaterial = "nope"\n')
     assert main(["info", str(scene)]) == 2
     assert "object[0].material: unknown material 'nope'" in capsys.readouterr().err
+
+
+def test_every_package_and_its_glsl_is_in_the_distribution():
+    """pyproject lists every package of the repository's deferred/, materials/, lights/ and
+    shaders/ (a feature's folder is a package of its own), and its package data globs take
+    every GLSL file there, so a non-editable install carries each feature's shaders."""
+    root = Path(__file__).parents[2]
+    setuptools = tomllib.loads((root / "pyproject.toml").read_text())["tool"]["setuptools"]
+    folders = {name: root / folder for name, folder in setuptools["package-dir"].items()}
+    found = {}
+    for top, folder in folders.items():
+        for init in folder.rglob("__init__.py"):
+            parts = init.parent.relative_to(folder).parts
+            found[".".join((top, *parts))] = init.parent
+    assert sorted(setuptools["packages"]) == sorted(found)
+    data = setuptools["package-data"]
+    glsl = [path for folder in folders.values() for path in folder.rglob("*")
+            if path.suffix in GLSL_SUFFIXES]
+    assert len(glsl) > 100
+
+    def shipped(path: Path) -> bool:
+        for package, folder in found.items():
+            if folder in path.parents:
+                relative = path.relative_to(folder).as_posix()
+                globs = [*data.get(package, []), *data.get("*", [])]
+                if any(PurePosixPath(relative).match(glob) if "/" not in glob
+                       else fnmatch.fnmatch(relative, glob) for glob in globs):
+                    return True
+        return False
+
+    assert [str(path.relative_to(root)) for path in glsl if not shipped(path)] == []

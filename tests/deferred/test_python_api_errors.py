@@ -57,17 +57,16 @@ def test_a_frame_time_that_is_not_one_is_named(gl, time):
         assert renderer.render(time=0.0).image is not None  # still renders
 
 
-SLOW_PACKAGE = """
+SLOW_CATALOGUE = 'BUILTINS = {"slow": "slow_builtins.slow:Slow"}\n'
+SLOW_MODULE = """
 import time
-from test_python_api_errors_registry import REGISTRY
 
 
 class Slow:
     name = "slow"
 
 
-time.sleep(0.3)  # a package that takes a while to import, as the built-ins do the first time
-REGISTRY.register(Slow)
+time.sleep(0.3)  # a module that takes a while to import, as the built-ins do the first time
 """
 
 
@@ -79,21 +78,19 @@ def test_a_numpy_size_is_a_size():
 
 
 def test_two_threads_asking_a_registry_first_both_find_its_builtins(tmp_path, monkeypatch):
-    """The first ask loads the built-in package; a second thread asking meanwhile waits for it
-    (it used to find the package marked loaded and half empty: "unknown material 'standard'")."""
+    """The first ask imports the built-in; a second thread asking meanwhile waits for it (it
+    used to find the built-ins marked loaded and half empty: "unknown material 'standard'"),
+    and the class is registered once, with the catalogue's id."""
     (tmp_path / "slow_builtins").mkdir()
-    (tmp_path / "slow_builtins" / "__init__.py").write_text(SLOW_PACKAGE)
-    holder = tmp_path / "test_python_api_errors_registry.py"
-    holder.write_text("REGISTRY = None\n")
+    (tmp_path / "slow_builtins" / "__init__.py").write_text(SLOW_CATALOGUE)
+    (tmp_path / "slow_builtins" / "slow.py").write_text(SLOW_MODULE)
     monkeypatch.syspath_prepend(str(tmp_path))
-    import test_python_api_errors_registry as shared
-
-    shared.REGISTRY = Registry("thing", "deferred.test_things", "slow_builtins")
+    registry = Registry("thing", "deferred.test_things", "slow_builtins")
     found, errors = [], []
 
     def ask() -> None:
         try:
-            found.append(shared.REGISTRY.get("slow").name)
+            found.append(registry.get("slow"))
         except Exception as exc:  # noqa: BLE001 - collected for the assertion
             errors.append(exc)
 
@@ -102,9 +99,10 @@ def test_two_threads_asking_a_registry_first_both_find_its_builtins(tmp_path, mo
         thread.start()
     for thread in threads:
         thread.join()
+    monkeypatch.delitem(sys.modules, "slow_builtins.slow")
     monkeypatch.delitem(sys.modules, "slow_builtins")
-    monkeypatch.delitem(sys.modules, "test_python_api_errors_registry")
-    assert errors == [] and found == ["slow"] * 4
+    assert errors == [] and len(found) == 4 and len(set(found)) == 1
+    assert found[0].name == "slow" and found[0].type_id == 1
 
 
 def test_non_finite_vertex_colours_are_refused():

@@ -117,6 +117,33 @@ def test_every_packaged_shader_program_compiles(gl):
         lib.release()
 
 
+def test_a_public_include_by_its_former_name_says_what_to_write(gl):
+    library = ShaderLibrary(gl.ctx, 330)
+    with pytest.raises(ShaderError, match='techniques/stipple.glsl: the framework names it '
+                                          'materials/techniques/stipple.glsl; write #include '
+                                          '"materials/techniques/stipple.glsl"'):
+        library.read("techniques/stipple.glsl")
+    with pytest.raises(ShaderError, match='write #include "lighting/shadows.glsl"'):
+        library.read("lights/shadows.glsl")
+    with pytest.raises(ShaderError, match="shader file not found: techniques/nope.glsl "
+                                          "\\(searched: "):
+        library.read("techniques/nope.glsl")
+
+
+def test_builtin_features_glsl_is_found_beside_their_python(gl):
+    """A name's first folder materials/, lights/ or effects/ is the feature package's: the
+    files sit beside the Python; any other name is a file of deferred.shaders."""
+    from importlib import resources
+
+    library = ShaderLibrary(gl.ctx, 330)
+    for name, package, file in (
+            ("materials/revie_fur/shell.frag", "deferred.materials.revie_fur", "shell.frag"),
+            ("lights/point/point.glsl", "deferred.lights.point", "point.glsl"),
+            ("effects/ssao/ssao.frag", "deferred.effects.ssao", "ssao.frag"),
+            ("lighting/shadows.glsl", "deferred.shaders", "lighting/shadows.glsl")):
+        assert library.read(name) == resources.files(package).joinpath(file).read_text("utf-8")
+
+
 def test_missing_file_lists_the_roots_searched(library, tmp_path):
     with pytest.raises(ShaderError, match=f"shader file not found: nope.glsl \\(searched: "
                                           f"{tmp_path}\\)"):
