@@ -13,8 +13,8 @@ from pathlib import Path
 
 import grimp
 import pytest
+from locations import ROOT
 
-ROOT = Path(__file__).resolve().parents[2]
 # packages of plugins: they import deferred.api, their own modules and nothing else of deferred
 PLUGIN_FOLDERS = {"materials": "deferred.materials", "lights": "deferred.lights",
                   "deferred/effects": "deferred.effects",

@@ -9,10 +9,11 @@ import re
 from pathlib import Path
 
 import pytest
+from locations import ROOT
 
 pytest.importorskip("pdoc")
 
-BUILD_SCRIPT = Path(__file__).resolve().parents[2] / "docs" / "build_api.py"
+BUILD_SCRIPT = ROOT / "docs" / "build_api.py"
 
 
 def load_build_script():

@@ -1,15 +1,15 @@
 """Every example scene loads and renders (small) in both pipelines."""
 
-from pathlib import Path
 
 import numpy as np
 import pytest
+from locations import ROOT
 
 from deferred.gl.context import Features, GLContext
 from deferred.render.renderer import Renderer
 from deferred.scene.loader import load_scene
 
-EXAMPLES = sorted((Path(__file__).parents[2] / "examples").glob("*.toml"))
+EXAMPLES = sorted((ROOT / "examples").glob("*.toml"))
 
 
 @pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.stem)

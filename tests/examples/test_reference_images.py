@@ -2,21 +2,20 @@
 
 Regenerate after an intended change of the images (and look at them before committing):
 
-    DEFERRED_UPDATE_REFERENCES=1 python -m pytest tests/deferred/test_reference_images.py
+    DEFERRED_UPDATE_REFERENCES=1 python -m pytest tests/examples/test_reference_images.py
 
 On a mismatch the rendered image and an amplified difference are written to tests/_failures/.
 """
 
 import os
-from pathlib import Path
 
 import numpy as np
 import pytest
+from locations import ROOT
 
 from deferred.io.images import read_image, write_image
 from deferred.scene.loader import load_scene
 
-ROOT = Path(__file__).parents[2]
 REFERENCES = ROOT / "tests" / "reference"
 FAILURES = ROOT / "tests" / "_failures"
 EXAMPLES = sorted((ROOT / "examples").glob("*.toml"))

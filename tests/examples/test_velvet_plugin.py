@@ -5,14 +5,13 @@ type and effect, in both pipelines; and what a broken plugin may and may not bre
 import shutil
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
+from locations import ROOT
 
 from deferred.io.images import read_image
 
-ROOT = Path(__file__).parents[2]
 PLUGIN = ROOT / "examples" / "plugins" / "deferred-velvet"
 FRAMEWORK = [ROOT / "deferred", ROOT / "materials", ROOT / "lights", ROOT / "shaders"]
 

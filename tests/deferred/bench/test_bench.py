@@ -3,10 +3,10 @@
 import csv
 import json
 from collections import Counter
-from pathlib import Path
 
 import numpy as np
 import pytest
+from locations import ROOT
 
 from deferred.bench.harness import Sweep, run_bench
 from deferred.bench.report import COLUMNS
@@ -23,7 +23,7 @@ from deferred.io.images import read_image
 from deferred.render.pipeline import PIPELINES
 from deferred.scene.loader import load_scene, scene_from_dict
 
-LIGHTS_SCENE = Path(__file__).parents[2] / "benchmarks" / "lights.toml"
+LIGHTS_SCENE = ROOT / "benchmarks" / "lights.toml"
 FAST = ["--size", "64x36", "--runs", "2", "--warmup", "1"]
 
 
@@ -189,7 +189,7 @@ def test_shells_out_of_the_materials_range_is_bad_input():
 
 
 def test_self_shadow_density_set_on_every_fur_and_nothing_else():
-    scene = load_scene(Path(__file__).parents[2] / "examples" / "shadows_demo.toml")
+    scene = load_scene(ROOT / "examples" / "shadows_demo.toml")
     before = {obj.label: obj.material.params for obj in scene.objects}
     set_self_shadow_density(scene, 0.0)
     furs = [obj for obj in scene.objects if "self_shadow_density" in type(obj.params).model_fields]

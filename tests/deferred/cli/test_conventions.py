@@ -8,10 +8,10 @@ import re
 import subprocess
 import sys
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
+from locations import ROOT
 from rich.console import Console
 
 import deferred.io.progress as progress_module
@@ -24,7 +24,6 @@ if sys.version_info >= (3, 11):
 else:
     import tomli as tomllib
 
-ROOT = Path(__file__).parents[2]
 LIGHTS_SCENE = ROOT / "benchmarks" / "lights.toml"
 
 

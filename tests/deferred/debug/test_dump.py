@@ -6,6 +6,7 @@ import os
 import numpy as np
 import OpenImageIO as oiio
 import pytest
+from locations import FIXTURES
 
 from deferred.cli import main
 from deferred.core.passes import FullscreenPass, Phase
@@ -361,7 +362,6 @@ def test_depth_without_a_surface_holds_the_background(gl, light_path):
     """A pixel whose depth was written with no G-buffer surface (a depth-only pass over the
     sky) passes the lighting's depth test; the shaders then write the background there, as
     the clear does on the rest of the sky."""
-    from pathlib import Path
 
     from deferred.gbuffer.layout import DEPTH
 
@@ -369,7 +369,7 @@ def test_depth_without_a_surface_holds_the_background(gl, light_path):
     scene.background = (0.25, 0.5, 0.75)
     r = Renderer(scene, "deferred", gl=gl, light_path=light_path)
     try:
-        r.shaders.add_root(Path(__file__).parents[1] / "fixtures" / "depth_only")
+        r.shaders.add_root(FIXTURES / "depth_only")
         depth_only = FullscreenPass("test.depth_only", Phase.GEOMETRY, "depth_only.frag", {},
                                     (), depth=DEPTH, depth_test=True, depth_func="always",
                                     depth_write=True)  # GL writes depth only when testing it

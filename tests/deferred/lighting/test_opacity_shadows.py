@@ -8,17 +8,16 @@ from __future__ import annotations
 
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
+from locations import ROOT
 
 from deferred.interfaces import registry
 from deferred.lighting.shadows import OPACITY_LAYERS
 from deferred.render.renderer import Renderer
 from deferred.scene.loader import scene_from_dict
 
-ROOT = Path(__file__).parents[2]
 W, H = 128, 96
 AMBIENT = {"type": "ambient", "color": [0.05, 0.05, 0.05], "ground": [0.05, 0.05, 0.05]}
 

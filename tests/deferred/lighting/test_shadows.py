@@ -413,7 +413,7 @@ def test_shadow_views_and_the_dump_show_the_atlas(tmp_path):
 
 
 # self-shadowing (deep opacity maps) off: these tests compare shadowed and unshadowed scenes,
-# and the fur's own shadow is tests/lights/test_opacity_shadows.py's
+# and the fur's own shadow is tests/deferred/lighting/test_opacity_shadows.py's
 FUR = {"revie_fur": {"fur_length": 0.5, "shells": 12, "stipple": False,
                      "self_shadow_density": 0.0},
        "shell_fur": {"fur_length": 0.5, "shells": 12, "self_shadow_density": 0.0}}

@@ -7,10 +7,10 @@ from __future__ import annotations
 import json
 import sys
 from importlib import resources
-from pathlib import Path
 
 import jsonschema
 import pytest
+from locations import ROOT
 
 from deferred.cli import main
 from deferred.cli.exits import MAX_PROBLEM_LINES
@@ -24,7 +24,6 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover
     import tomli as tomllib
 
-ROOT = Path(__file__).parents[2]
 PLUGIN = ROOT / "examples" / "plugins" / "deferred-velvet"
 EXAMPLES = sorted(path for path in (ROOT / "examples").rglob("*.toml")
                   if path.name != "pyproject.toml" and PLUGIN not in path.parents)

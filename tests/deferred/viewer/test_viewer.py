@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from conftest import psnr
+from locations import ROOT
 
 pytest.importorskip("moderngl_window")
 pytest.importorskip("imgui_bundle")
@@ -264,7 +265,7 @@ def test_scrubbing_to_t_equals_render_at_t(scene_file, make_viewer, gl):
 
 
 def test_scrubbing_back_through_a_simulation_equals_render_at_t(make_viewer, gl):
-    scene = Path(__file__).resolve().parents[2] / "examples" / "shell_fur" / "wet_wind.toml"
+    scene = ROOT / "examples" / "shell_fur" / "wet_wind.toml"
     viewer = make_viewer(scene, size=SIZE)
     viewer.timeline.scrub(1.5)
     viewer.update(force_full=True)

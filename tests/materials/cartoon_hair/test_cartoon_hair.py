@@ -4,10 +4,9 @@ edges effect outlines overlapping strands by (4.3.7)."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
+from locations import ROOT
 
 from deferred.cli import main
 from deferred.render.renderer import Renderer
@@ -185,7 +184,7 @@ def test_two_heads_have_their_own_strand_ids(gl):
     assert second.max() <= 32768 + 30
 
 
-EXAMPLES = sorted((Path(__file__).parents[2] / "examples" / "cartoon_hair").glob("*.toml"))
+EXAMPLES = sorted((ROOT / "examples" / "cartoon_hair").glob("*.toml"))
 
 
 @pytest.mark.parametrize("path", EXAMPLES, ids=[p.stem for p in EXAMPLES])

@@ -2,14 +2,12 @@
 (materials/revie_fur/slab.glsl): strands seen at a slant are less a chain of dashes
 (Revie Figure 2.20), and the fur keeps its mean brightness."""
 
-from pathlib import Path
 
 import numpy as np
 import pytest
+from locations import ROOT
 
 from deferred.scene.loader import load_scene
-
-ROOT = Path(__file__).parents[2]
 
 
 @pytest.mark.parametrize("pipeline", ["deferred", "forward"])

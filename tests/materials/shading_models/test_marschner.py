@@ -2,11 +2,11 @@
 independent numpy reference of the same lobes, and what it does to fur in both pipelines (back-lit
 tips glow)."""
 
-from pathlib import Path
 
 import moderngl
 import numpy as np
 import pytest
+from locations import FIXTURES
 
 from deferred.gl.shaderlib import ShaderLibrary
 from deferred.scene.loader import scene_from_dict
@@ -58,7 +58,7 @@ def unit(v):
     return v / np.linalg.norm(v)
 
 
-HARNESS = Path(__file__).parents[1] / "fixtures" / "hair_bsdf_harness"
+HARNESS = FIXTURES / "hair_bsdf_harness"
 
 
 def glsl_values(gl, rows):

@@ -9,6 +9,7 @@ from pathlib import Path
 import moderngl
 import numpy as np
 import pytest
+from locations import FIXTURES, ROOT
 
 from deferred.gl.shaderlib import ShaderLibrary
 from deferred.io.images import write_image
@@ -31,7 +32,7 @@ from deferred.materials.techniques.wetness import (
 from deferred.scene.builtin_meshes import builtin_plane, builtin_sphere
 from deferred.scene.loader import scene_from_dict
 
-HARNESS = Path(__file__).parents[1] / "fixtures" / "shell_fur_harness"
+HARNESS = FIXTURES / "shell_fur_harness"
 
 
 # -- Algorithm 1 ------------------------------------------------------------------------------
@@ -959,7 +960,7 @@ def test_fur_over_the_screen_border_is_lit_as_inside(render):
     than inside (``fig12_word``: a furry square filling the frame)."""
     from deferred.scene.loader import load_scene
 
-    scene = load_scene(Path(__file__).parents[2] / "examples" / "shell_fur" / "fig12_word.toml")
+    scene = load_scene(ROOT / "examples" / "shell_fur" / "fig12_word.toml")
     deferred, _ = render(scene, size=(320, 240))  # roots 1 pixel off the screen
     forward, _ = render(scene, "forward", size=(320, 240))
     error = ((deferred.image[..., :3] / 255.0 - forward.image[..., :3] / 255.0) ** 2).sum(-1)

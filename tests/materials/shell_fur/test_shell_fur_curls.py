@@ -2,10 +2,10 @@
 layers shade along each layer's curled tangent (shell.frag's layer_light), so the curl's light
 and dark bands show in the deferred pipeline as in the forward one."""
 
-from pathlib import Path
 
 import numpy as np
 import pytest
+from locations import ROOT
 
 from deferred.scene.loader import scene_from_dict
 
@@ -14,7 +14,7 @@ try:
 except ImportError:  # Python 3.10
     import tomli as tomllib
 
-FIG7 = Path(__file__).parents[2] / "examples" / "shell_fur"
+FIG7 = ROOT / "examples" / "shell_fur"
 LUMA = np.array([0.2126, 0.7152, 0.0722])
 
 

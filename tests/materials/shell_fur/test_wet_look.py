@@ -5,6 +5,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from locations import ROOT
 
 from deferred.io.images import write_image
 from deferred.scene.loader import scene_from_dict
@@ -14,7 +15,6 @@ try:
 except ImportError:  # Python 3.10
     import tomli as tomllib  # type: ignore[no-redef]
 
-ROOT = Path(__file__).parents[2]
 LIGHTS = [{"type": "ambient", "color": [0.05, 0.05, 0.06]},
           {"type": "directional", "direction": [-0.3, -0.2, -1.0], "intensity": 1.5}]
 

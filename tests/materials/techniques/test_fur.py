@@ -2,11 +2,11 @@
 supersampled render, level of detail without popping, the root shell and self-shadowing, fins,
 density without seams, and the stipple fixes (no dot grid, no teeth)."""
 
-from pathlib import Path
 
 import moderngl
 import numpy as np
 import pytest
+from locations import FIXTURES, ROOT
 
 from deferred.debug.views import with_material_view
 from deferred.gl.shaderlib import ShaderLibrary
@@ -128,11 +128,11 @@ def test_subslices_interpolate_between_the_generated_slices():
     np.testing.assert_array_equal(data[::4], np.rint(rgba * 255.0))  # the generated ones
 
 
-HARNESS = Path(__file__).parents[1] / "fixtures" / "fur_harness"
+HARNESS = FIXTURES / "fur_harness"
 
 
 def test_the_glsl_subslice_count_is_the_volumes():
-    source = (Path(__file__).parents[2] / "materials" / "techniques" / "fur.glsl").read_text()
+    source = (ROOT / "materials" / "techniques" / "fur.glsl").read_text()
     assert f"#define FUR_SUBSLICES {SUBSLICES:.1f}" in source
 
 

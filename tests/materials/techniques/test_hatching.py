@@ -9,6 +9,7 @@ from pathlib import Path
 import moderngl
 import numpy as np
 import pytest
+from locations import FIXTURES
 from PIL import Image
 
 from deferred.errors import InputError
@@ -255,7 +256,7 @@ def test_the_cache_folder_follows_the_environment(tmp_path, monkeypatch, counted
 GLSL_TAM = TamSettings(size=64, tones=4, mips=3, strokes=24, candidates=4, seed=7,
                        stroke_length=0.3, stroke_width=2.0)
 
-HARNESS = Path(__file__).parents[1] / "fixtures" / "hatching_harness"
+HARNESS = FIXTURES / "hatching_harness"
 
 
 @pytest.fixture(scope="module")

@@ -2,10 +2,10 @@
 that varies over the surface and never repeats, curls in different phases; and the outlines of
 examples/shell_fur/wet_wind.toml in the wind."""
 
-from pathlib import Path
 
 import numpy as np
 import pytest
+from locations import ROOT
 
 from deferred.materials.techniques.strands import (
     StrandForces,
@@ -23,7 +23,6 @@ try:
 except ImportError:  # Python 3.10
     import tomli as tomllib  # type: ignore[no-redef]
 
-ROOT = Path(__file__).parents[2]
 
 
 def sphere_strands(count=400, seed=3):

@@ -2,11 +2,11 @@
 where the planes' weights overlap: the fur is as bright in a blend zone as on an axis (mixing
 the planes' coverages would make coarse fur brighter there)."""
 
-from pathlib import Path
 
 import moderngl
 import numpy as np
 import pytest
+from locations import FIXTURES
 
 from deferred.scene.loader import scene_from_dict
 
@@ -54,7 +54,7 @@ def test_no_cut_at_a_cell_border(gl):
 
     ctx = gl.ctx
     lib = ShaderLibrary(ctx, 330)
-    lib.add_root(Path(__file__).parents[1] / "fixtures" / "fur_selection_harness")
+    lib.add_root(FIXTURES / "fur_selection_harness")
     program = ctx.program(vertex_shader=lib.assemble("select.vert").text,
                           varyings=["out_strands"])
     volume = volume_texture(ctx, strand_volume(pattern("coarse")))

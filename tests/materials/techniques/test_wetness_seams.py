@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from locations import ROOT
 
 from deferred.materials.techniques.topology import weld
 from deferred.materials.techniques.wetness import (
@@ -23,7 +24,7 @@ from deferred.scene.builtin_meshes import builtin_cube, builtin_plane, builtin_s
 from deferred.scene.geometry import build_mesh
 from deferred.scene.meshes import load_mesh
 
-BUNNY = Path(__file__).parents[2] / "examples" / "meshes" / "bunny.ply"
+BUNNY = ROOT / "examples" / "meshes" / "bunny.ply"
 CELLS = 8  # grid cells a side of the two-chart square
 
 
