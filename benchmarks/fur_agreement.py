@@ -1,11 +1,11 @@
-"""How closely the fur's deferred shells match its forward shells: PSNR, forward against
-deferred, of a fur ball (both furs; revie_fur also with its stipple sample) under a side light
-and a light from the front left, without and with self-shadowing (deep opacity maps,
-``self_shadow_density``), and back-lit with ``shading = "marschner"`` (the scenes of
-tests/lights/test_opacity_shadows.py and tests/materials/test_marschner.py). Printed per
-scene: the PSNR of the luminance (as the tests measure it) and of the colour, both HDR clipped
-to [0, 1]. With ``--out DIR`` each scene is also
-written as one PNG: forward, deferred (gamma 2.2) and their difference (linear, x 4 about
+"""How closely the fur's deferred shells match its forward shells: PSNR, forward against deferred,
+of a fur ball (both furs; revie_fur also with its stipple sample) under a side light and a light
+from the front left, without and with self-shadowing (deep opacity maps, ``self_shadow_density``),
+and back-lit with ``shading = "marschner"`` (the scenes of
+tests/deferred/lighting/test_opacity_shadows.py and
+tests/materials/shading_models/test_marschner.py). Printed per scene: the PSNR of the luminance (as
+the tests measure it) and of the colour, both HDR clipped to [0, 1]. With ``--out DIR`` each scene
+is also written as one PNG: forward, deferred (gamma 2.2) and their difference (linear, x 4 about
 grey), side by side. Run from the repository root:
 
     python benchmarks/fur_agreement.py [--scale N] [--out DIR]
@@ -36,7 +36,7 @@ LUMA = np.array([0.2126, 0.7152, 0.0722])
 
 def lit_ball(material: str, direction: list[float], density: float, scale: int,
              stipple: bool = False) -> dict:
-    """tests/lights/test_opacity_shadows.py's fur_scene: a fur ball, one shadowed light
+    """tests/deferred/lighting/test_opacity_shadows.py's fur_scene: a fur ball, one shadowed light
     (revie_fur: with its stipple sample or not)."""
     extra = {"stipple": True} if stipple else {}
     return {
@@ -51,8 +51,8 @@ def lit_ball(material: str, direction: list[float], density: float, scale: int,
 
 
 def back_lit_ball(material: str, scale: int) -> dict:
-    """tests/materials/test_marschner.py's forward/deferred scene: marschner, a light behind
-    the ball, a fill and a key light from the front."""
+    """tests/materials/shading_models/test_marschner.py's forward/deferred scene: marschner, a
+    light behind the ball, a fill and a key light from the front."""
     colour = {"albedo_tip": [0.8, 0.55, 0.3]} if material == "revie_fur" else \
         {"color": [0.8, 0.55, 0.3], "settle": 0.0}
     return {

@@ -5,7 +5,7 @@ It documents what users and plugins import: the ``deferred`` package root (``Ren
 material, light, shading model or effect imports). The other modules are internal and left
 out. The output (default ``docs/api/``, not committed) is plain HTML: open ``index.html``.
 Docstrings are reStructuredText-flavoured (``:class:`Material```), which pdoc renders.
-``tests/deferred/test_api_docs.py`` builds it and fails on any warning pdoc gives.
+``tests/docs/test_api_docs.py`` builds it and fails on any warning pdoc gives.
 """
 
 from __future__ import annotations

@@ -15,7 +15,7 @@
 // the view's projections onto that plane, theta_h = (theta_i + theta_r) / 2 and
 // theta_d = (theta_r - theta_i) / 2. The result multiplies the light's radiance (this
 // framework's convention: a Lambertian surface answers albedo * N.L, so the lobes carry pi).
-// No includes: tests/materials/test_marschner.py evaluates this file against numpy.
+// No includes: tests/materials/shading_models/test_marschner.py evaluates this file against numpy.
 
 #define HAIR_PI 3.14159265
 #define HAIR_ETA 1.55           // the fibre's index of refraction
