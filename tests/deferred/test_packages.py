@@ -9,6 +9,7 @@ import sys
 from pathlib import Path, PurePosixPath
 
 import numpy as np
+from locations import ROOT
 from model_materials import StrandMaterial
 
 from deferred.cli import main
@@ -81,7 +82,7 @@ def test_every_package_and_its_glsl_is_in_the_distribution():
     """pyproject lists every package of the repository's deferred/, materials/, lights/ and
     shaders/ (a feature's folder is a package of its own), and its package data globs take
     every GLSL file there, so a non-editable install carries each feature's shaders."""
-    root = Path(__file__).parents[2]
+    root = ROOT
     setuptools = tomllib.loads((root / "pyproject.toml").read_text())["tool"]["setuptools"]
     folders = {name: root / folder for name, folder in setuptools["package-dir"].items()}
     found = {}
