@@ -158,8 +158,8 @@ def run_render(job: RenderJob, progress: Progress) -> Rendered:
                   light_path=job.light_path) as renderer:
         renderer.check_times(job.times)  # a simulation cannot reach the last frame: refuse now
         if job.kind == "image":
-            written, frame_ms = str(job.out), _render_image(renderer, loaded, job, buffer,
-                                                            progress)
+            frame_ms = _render_image(renderer, loaded, job, buffer, progress)
+            written = str(job.out)
         else:
             written, frame_ms = _render_animation(renderer, job, progress)
     return Rendered(renderer.size, renderer.light_path, written, frame_ms)
