@@ -9,6 +9,7 @@ import sys
 from pathlib import Path, PurePosixPath
 
 import numpy as np
+import pytest
 from locations import ROOT
 from model_materials import StrandMaterial
 
@@ -34,6 +35,7 @@ def test_nothing_is_importable_as_a_top_level_materials_lights_or_shaders(tmp_pa
     assert importlib.util.find_spec("deferred.materials.standard") is not None
 
 
+@pytest.mark.slow
 def test_render_from_a_folder_with_the_users_own_packages(tmp_path, gl):
     for name in ("materials", "lights", "shaders"):
         (tmp_path / name).mkdir()

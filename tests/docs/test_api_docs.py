@@ -46,6 +46,7 @@ def members(page: Path) -> set[str]:
     return set(re.findall(r'<div id="([^"]+\.[^"]+)"', page.read_text(encoding="utf-8")))
 
 
+@pytest.mark.slow
 def test_reference_has_the_two_public_modules_only(reference):
     pages = sorted(p.relative_to(reference).as_posix() for p in reference.rglob("*.html"))
     assert pages == ["deferred.html", "deferred/api.html", "index.html"]

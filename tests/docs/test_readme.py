@@ -42,6 +42,7 @@ def test_marker_extraction():
     assert marked_blocks(text) == [(3, "print(1)\n")]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("line, code", [
     pytest.param(line, code, id=f"README.md:{line}")
     for line, code in marked_blocks(README.read_text(encoding="utf-8"))])

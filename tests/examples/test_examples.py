@@ -12,6 +12,7 @@ from deferred.scene.loader import load_scene
 EXAMPLES = sorted((ROOT / "examples").glob("*.toml"))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.stem)
 def test_example_renders(gl, path):
     """Both pipelines, both GLSL levels (a GL 4.3 context, one limited to GL 3.3): every

@@ -24,6 +24,7 @@ MEAN_ERROR = 1.0 / 255.0  # mean absolute error over all pixels and channels
 FAR_OFF = 0.01  # at most this fraction of pixels may differ by more than 16/255
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.stem)
 def test_matches_reference(render, path):
     result, _ = render(load_scene(path), size=SIZE)

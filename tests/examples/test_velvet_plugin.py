@@ -39,6 +39,7 @@ def deferred(site, *args, cwd):
                           env=env, capture_output=True, text=True)
 
 
+@pytest.mark.slow
 def test_the_plugin_renders_in_both_pipelines(site, tmp_path):
     images = {}
     for pipeline in ("deferred", "forward"):
@@ -54,6 +55,7 @@ def test_the_plugin_renders_in_both_pipelines(site, tmp_path):
     assert images["deferred"][0, 0].sum() < images["deferred"][5, 120].sum()
 
 
+@pytest.mark.slow
 def test_the_plugin_declares_its_gbuffer_channel(site, tmp_path):
     result = deferred(site, "info", PLUGIN / "scene.toml", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
@@ -70,6 +72,7 @@ def test_no_file_of_the_framework_names_the_plugin():
                 assert "velvet" not in path.read_text(encoding="utf-8").lower(), path
 
 
+@pytest.mark.slow
 def test_a_broken_plugin_fails_only_the_scenes_that_use_it(site, tmp_path):
     result = deferred(site, "render", "--size", "64x48", "-o", tmp_path / "demo.png",
                       cwd=tmp_path)

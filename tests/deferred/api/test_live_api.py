@@ -123,6 +123,7 @@ def test_lights_added_and_removed_between_frames(renderer):
     np.testing.assert_array_equal(r.render().image, first)
 
 
+@pytest.mark.slow
 def test_parameters_that_add_or_remove_passes_rebuild_the_frame(renderer):
     scene = small_scene()
     fur = scene.add_object("builtin:sphere", "revie_fur", label="fur", position=(1.5, 0.0, 0.0),
@@ -297,6 +298,7 @@ def test_assigned_params_move_only_what_they_change_into_the_base(renderer):
     assert ball.params.specular_intensity == 0.9 and ball.params.color == (0.1, 0.9, 0.1)
 
 
+@pytest.mark.slow
 def test_parameters_read_once_remake_the_state_of_a_live_renderer(gl, renderer):
     """shell_fur reads its seed and mask size once: changed with set_params, a live renderer
     starts the simulation over and draws what a fresh renderer draws."""
@@ -331,6 +333,7 @@ def test_scene_values_set_in_python_are_checked_at_the_next_frame(renderer):
     np.testing.assert_array_equal(r.render().image, first)
 
 
+@pytest.mark.slow
 def test_a_frame_at_a_time_already_checked_checks_nothing_again(renderer, monkeypatch):
     """check_times passes for the latest time cover every earlier one while the parameters
     stay (the droplet count was weighed again each frame: 30-50 ms at 10,000 droplets)."""
@@ -359,6 +362,7 @@ def test_hdr_without_readback_is_refused(renderer):
         renderer(small_scene()).render(readback=False, hdr=True)
 
 
+@pytest.mark.slow
 def test_a_plain_png_render_reads_no_composite(tmp_path, capsys, monkeypatch):
     import deferred.render.renderer as renderer_module
     from deferred.cli import main

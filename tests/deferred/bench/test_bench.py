@@ -43,6 +43,7 @@ def standard_scene():
     })
 
 
+@pytest.mark.slow
 def test_cli_sweep_writes_json_csv_plot(tmp_path, capsys):
     out = {s: tmp_path / f"bench.{s}" for s in ("json", "csv", "png")}
     code, stdout, err = run(capsys, "bench", *FAST, "--lights", "3,0", "--shells", "0,4",
@@ -121,6 +122,7 @@ def test_json_dash_goes_to_stdout(tmp_path, capsys, monkeypatch):
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.slow
 def test_scene_without_shells_sweeps_one_value(gl, capsys):
     scene = standard_scene()
     assert shell_objects(scene) == []
@@ -168,6 +170,7 @@ def test_extra_lights_deterministic_nested_and_on_screen():
         assert 0.0 < light.params.radius < 5.0
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("shells", [0, 3, 9])
 def test_shells_applied_to_fur_objects_only(render, shells):
     demo = load_scene(None)

@@ -16,6 +16,7 @@ def run(capsys, *args):
     return code, captured.out, captured.err
 
 
+@pytest.mark.slow
 def test_render_demo_png(tmp_path, capsys):
     out = tmp_path / "demo.png"
     code, stdout, err = run(capsys, "render", "-o", str(out), "--size", "160x90")

@@ -187,6 +187,7 @@ def two_dumps(tmp_path_factory):
     return folder
 
 
+@pytest.mark.slow
 def test_dump_compare_exits_as_diff(two_dumps, capsys, tmp_path):
     import shutil
 
@@ -207,6 +208,7 @@ def test_dump_compare_exits_as_diff(two_dumps, capsys, tmp_path):
     assert "1 they differ" in " ".join(out.split())
 
 
+@pytest.mark.slow
 def test_python_m_deferred_is_the_command(tmp_path):
     done = subprocess.run([sys.executable, "-m", "deferred", "render", "--frames", "2", "-o",
                            str(tmp_path / "x.png")], capture_output=True, text=True,
@@ -333,6 +335,7 @@ def _walk_with_parents(tree):
             stack.append((child, [*parents, node]))
 
 
+@pytest.mark.slow
 def test_the_code_runs_on_python_3_10():
     """requires-python says 3.10: no syntax newer than 3.10 and no module or name 3.11 added
     unless under a version check (tomllib falls back on tomli)."""

@@ -237,6 +237,7 @@ def test_stipple_capture_differs_in_one_parity_class(renderer):
     assert not changed[~ball].any()
 
 
+@pytest.mark.slow
 @pytest.mark.skipif("revie_fur" not in registry.materials,
                     reason="the revie_fur material is not registered (being written)")
 def test_revie_fur_stipple_capture_differs_in_one_parity_class(tmp_path, renderer):
@@ -255,6 +256,7 @@ def test_revie_fur_stipple_capture_differs_in_one_parity_class(tmp_path, rendere
     assert (tmp_path / files["fur.stipple_obliteration"]).is_file()
 
 
+@pytest.mark.slow
 def test_compare_same_scene_is_zero_and_a_change_stays_on_the_object(tmp_path, renderer):
     first, same, changed = tmp_path / "a", tmp_path / "b", tmp_path / "c"
     write_dump(capture_frame(renderer(small_scene())), first)
@@ -441,6 +443,7 @@ def run(capsys, *args):
     return code, captured.out, captured.err
 
 
+@pytest.mark.slow
 def test_cli_dump_writes_the_folder(tmp_path, capsys):
     out = tmp_path / "dump"
     code, stdout, err = run(capsys, "dump", "-o", out, "--size", "96x64")
@@ -492,6 +495,7 @@ def test_cli_forward_dump_has_no_gbuffer(tmp_path, capsys):
     assert (tmp_path / "final.exr").is_file()
 
 
+@pytest.mark.slow
 def test_cli_compare(tmp_path, capsys):
     for name in ("a", "b"):
         assert run(capsys, "dump", "-o", tmp_path / name, "--size", "64x36")[0] == 0
@@ -502,6 +506,7 @@ def test_cli_compare(tmp_path, capsys):
     assert (tmp_path / "b-diff" / "compare.json").is_file()
 
 
+@pytest.mark.slow
 def test_cli_compare_output_is_whole_and_never_a_folder_of_other_files(tmp_path, capsys):
     for name in ("a", "b"):
         assert run(capsys, "dump", "-o", tmp_path / name, "--size", "64x36")[0] == 0
@@ -567,6 +572,7 @@ def test_bad_input_exits_2_with_one_line_and_no_files(tmp_path, capsys, monkeypa
     assert list(work.iterdir()) == []
 
 
+@pytest.mark.slow
 def test_cli_render_view(tmp_path, capsys):
     scene = tmp_path / "scene.toml"
     scene.write_text(SCENE_TOML)
@@ -608,6 +614,7 @@ def test_write_image_keeps_written_channel_order(tmp_path):
     assert attributes == {"z_channel": 2, "alpha_channel": 3}
 
 
+@pytest.mark.slow
 def test_cli_compare_never_replaces_a_folder_holding_the_dumps(tmp_path, capsys):
     out = tmp_path / "cmp"
     for name in ("a", "b"):
@@ -618,6 +625,7 @@ def test_cli_compare_never_replaces_a_folder_holding_the_dumps(tmp_path, capsys)
     assert (out / "a" / "manifest.json").is_file() and (out / "b" / "manifest.json").is_file()
 
 
+@pytest.mark.slow
 def test_a_dump_of_a_list_path_holds_the_light_lists(tmp_path, renderer, gl):
     if not gl.features.compute_shaders:
         pytest.skip("the driver has no compute shaders")
@@ -640,6 +648,7 @@ def test_a_dump_of_a_list_path_holds_the_light_lists(tmp_path, renderer, gl):
     assert "light_lists" not in write_dump(volumes, tmp_path / "other")["files"]
 
 
+@pytest.mark.slow
 def test_a_dump_past_the_memory_budget_is_refused_before_the_frame(tmp_path, capsys, gl,
                                                                     monkeypatch):
     """A dump holds every captured pass's buffers and the files being written, several times
@@ -685,6 +694,7 @@ def test_the_dump_estimate_covers_what_the_capture_holds(renderer):
             renderer.graph.targets.values(), *renderer.size)
 
 
+@pytest.mark.slow
 def test_a_dump_prepares_no_more_files_than_its_writers_take(tmp_path, renderer, monkeypatch):
     """Files wait for a writer with their float buffers in memory: no more than one queued for
     each writer, whatever the number of passes."""

@@ -179,6 +179,7 @@ def start_dump(out: Path, size: str) -> subprocess.Popen:
                             stderr=subprocess.PIPE, text=True)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("signum, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
 def test_interrupted_dump_leaves_a_whole_dump(tmp_path, signum, code):
     out = tmp_path / "d"
@@ -208,6 +209,7 @@ def test_interrupted_dump_leaves_a_whole_dump(tmp_path, signum, code):
     pytest.fail("the dump always finished before the signal")
 
 
+@pytest.mark.slow
 def test_two_dumps_into_one_folder_leave_one_whole_dump(tmp_path):
     out = tmp_path / "d"
     children = [start_dump(out, size) for size in ("96x54", "128x72")]

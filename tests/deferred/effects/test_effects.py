@@ -49,6 +49,7 @@ def psnr(a, b):
     return 10.0 * np.log10(1.0 / np.mean((a - b) ** 2))
 
 
+@pytest.mark.slow
 def test_fxaa_brings_a_frame_closer_to_its_supersampled_render(gl):
     plain, _, _ = render(gl, scene())
     fxaa, _, names = render(gl, scene([{"type": "fxaa"}]))
@@ -198,6 +199,7 @@ def period2_energy(image):
     return np.abs(core - neighbours).sum(axis=-1)
 
 
+@pytest.mark.slow
 def test_obliteration_restores_what_another_material_made_of_its_pixels(gl):
     """Fur stipple over an object that tints its pixels in the material phase: the stipple
     samples are restored from the tinted composition, so the frame matches the same frame

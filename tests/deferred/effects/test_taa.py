@@ -259,6 +259,7 @@ def test_the_jitter_follows_the_history(gl):
         assert renderer.last_frame.sample_index == 0
 
 
+@pytest.mark.slow
 def test_the_stipple_parity_covers_every_pixel_over_four_samples(gl):
     """Revie's 1-in-4 pattern moves per sample: the pixels the fur's stipple pass writes in
     four samples are four disjoint classes of the 2x2 tile that cover the fur's interior."""

@@ -75,6 +75,7 @@ def whole(path: Path) -> bool:
     return True
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("suffix, extra", [(".png", ()), (".exr", ()),
                                            (".gif", ("--frames", "6")),
                                            (".mp4", ("--frames", "6"))])

@@ -114,6 +114,7 @@ def test_a_comparison_in_bands_is_the_whole_buffers(tmp_path, monkeypatch):
     assert record["buffers"][0]["pixels"] == result.pixels
 
 
+@pytest.mark.slow
 def test_textures_and_material_state_count_against_the_memory_budget(tmp_path, capsys,
                                                                       monkeypatch):
     """Before GL starts, each object's material says what it will hold (held_memory: a texture

@@ -128,6 +128,7 @@ def test_an_error_without_a_message_still_says_why(tmp_path, monkeypatch):
     assert out.read_bytes() == b"the old file"
 
 
+@pytest.mark.slow
 def test_render_on_a_full_disk_exits_1_and_keeps_the_old_image(tmp_path):
     """A real short write: a file size limit makes write(2) fail (EFBIG) as a full disk makes
     it fail (ENOSPC). OIIO's PNG writer reports success from write_image and close."""
@@ -153,6 +154,7 @@ def test_render_on_a_full_disk_exits_1_and_keeps_the_old_image(tmp_path):
     assert leftovers(tmp_path) == []
 
 
+@pytest.mark.slow
 def test_cli_write_failure_exits_1_with_the_reason(tmp_path, capsys, monkeypatch):
     out = old_file(tmp_path, "out.exr")
     monkeypatch.setattr(os, "replace", lambda *a: (_ for _ in ()).throw(
@@ -163,6 +165,7 @@ def test_cli_write_failure_exits_1_with_the_reason(tmp_path, capsys, monkeypatch
     assert out.read_bytes() == b"the old file"
 
 
+@pytest.mark.slow
 def test_bench_csv_write_failure_exits_1(tmp_path, capsys, monkeypatch):
     out = old_file(tmp_path, "bench.csv")
     monkeypatch.setattr(os, "fsync", lambda fd: (_ for _ in ()).throw(
@@ -270,6 +273,7 @@ def test_render_output_name_too_long_exits_2_before_rendering(tmp_path, capsys):
     assert "file name longer than 255 bytes" in one_line(err)
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not os.path.exists("/dev/full"), reason="no /dev/full")
 def test_bench_json_to_a_full_stdout_exits_1(tmp_path):
     with open("/dev/full", "w") as full:

@@ -86,6 +86,7 @@ def fur_optical_depth() -> tuple[float, float]:
     return float(np.interp(front, [0.0, *OPACITY_LAYERS], [0.0, *layers])), float(shells.sum())
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("material", ["revie_fur", "shell_fur"])
 def test_skin_keeps_the_fur_transmittance(gl, material):
     """Lit through dense fur, the skin keeps exp(-k x the fur's optical depth) of the light
@@ -113,6 +114,7 @@ def test_skin_keeps_the_fur_transmittance(gl, material):
                                                             abs=0.01)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("pipeline", ["forward", "deferred"])
 def test_skin_without_self_shadowing_is_the_unshadowed_skin(gl, pipeline):
     """self_shadow_density 0 leaves the skin as without shadows: gamma(h) alone, and no depth
@@ -127,6 +129,7 @@ def test_skin_without_self_shadowing_is_the_unshadowed_skin(gl, pipeline):
     np.testing.assert_allclose(shadowed[inside], unshadowed[inside], rtol=1e-3)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("material", ["revie_fur", "shell_fur"])
 def test_skin_transmittance_has_no_steps_at_coarse_maps(gl, material):
     """With deep opacity maps a quarter of the shadow map's resolution (a texel spans about
@@ -172,6 +175,7 @@ def sheet_luminance(gl, material: str, density: float, pipeline: str,
     return hdr[..., :3].astype(np.float64) @ LUMA
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("material", ["revie_fur", "shell_fur"])
 @pytest.mark.parametrize("skin_only", [True, False])
 def test_open_sheet_of_fur_is_shadowed_once_in_deferred(gl, material, skin_only):

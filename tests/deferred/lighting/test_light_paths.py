@@ -72,6 +72,7 @@ def test_forward_plus_gives_the_naive_image(gl, extra):
     assert psnr(result.hdr[..., :3], reference.hdr[..., :3], peak) >= 40.0
 
 
+@pytest.mark.slow
 def test_forward_plus_lights_fur_shells_in_front_of_the_opaque_depth(gl):
     demo = with_extra_lights(load_scene(None), 24, 16 / 9)
     images = []

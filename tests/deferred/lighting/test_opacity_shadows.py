@@ -113,6 +113,7 @@ def side_means(lum, alpha):
     return lum[left].mean(), lum[right].mean()
 
 
+@pytest.mark.slow
 def test_fur_light_falls_with_depth_along_the_light(gl):
     """revie_fur's single-shell view (forward: the middle shell of shell_range, its strands cut
     opaque and lit) under a light from the camera, where the ball faces it: against the same
@@ -138,6 +139,7 @@ def test_fur_light_falls_with_depth_along_the_light(gl):
     assert kept[0] > kept[1] + 0.05 > kept[2] + 0.1
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("material", ["revie_fur", "shell_fur"])
 def test_lit_and_far_sides_differ_more(gl, material):
     """Under a light from the left, self-shadowing darkens the far side (the light crosses the
@@ -179,6 +181,7 @@ def skin_casts_alone(monkeypatch):
     monkeypatch.setattr(FurMaterial, "draw_shadow", root_shell_only)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("pipeline", ["forward", "deferred"])
 @pytest.mark.parametrize("material", ["revie_fur", "shell_fur"])
 def test_fur_is_not_shadowed_twice(gl, monkeypatch, material, pipeline):
@@ -209,6 +212,7 @@ def luminance_psnr(a, b):
     return 10.0 * np.log10(1.0 / np.mean((np.clip(a, 0, 1) - np.clip(b, 0, 1)) ** 2))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("material,extra", [("shell_fur", {}), ("revie_fur", {}),
                                             ("revie_fur", {"stipple": True})],
                          ids=["shell_fur", "revie_fur", "revie_fur_stippled"])
@@ -240,6 +244,7 @@ def test_deferred_fur_shadows_itself_as_the_forward_fur(gl, material, extra, dir
     assert darkened["deferred"] == pytest.approx(darkened["forward"], abs=0.04)
 
 
+@pytest.mark.slow
 def test_gamma_stays_without_shadows(gl):
     """Without a shadowed light there are no opacity maps: self_shadow_density changes
     nothing (gamma(h) alone darkens the fur)."""
@@ -248,6 +253,7 @@ def test_gamma_stays_without_shadows(gl):
     np.testing.assert_array_equal(a, b)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("pipeline", ["forward", "deferred"])
 def test_self_shadowing_switched_in_python_equals_a_fresh_renderer(gl, pipeline):
     """self_shadow_density set between 0 and a positive value on a live renderer (the maps
@@ -286,6 +292,7 @@ def run_cli(*args):
                           text=True, timeout=300)
 
 
+@pytest.mark.slow
 def test_opacity_shadow_view(tmp_path):
     """--view <fur>.opacity_shadow shows the layers on the shells (shell_fur and revie_fur,
     both pipelines); a scene without shadows refuses it in one line."""
@@ -343,6 +350,7 @@ shadow_resolution = 1024
     assert done.returncode == 2 and "no light of this scene casts shadows" in done.stderr
 
 
+@pytest.mark.slow
 def test_shell_fur_deferred_fins_shadow_themselves(gl):
     """shell_fur's deferred fins (lit along the chord) take each shadowed light's
     transmittance too: with fins, the lit side is within 2.5% of the forward fur's with fins
@@ -356,6 +364,7 @@ def test_shell_fur_deferred_fins_shadow_themselves(gl):
         assert lit[(fins, "deferred")] == pytest.approx(lit[(fins, "forward")], rel=0.025)
 
 
+@pytest.mark.slow
 def test_far_fur_draws_fewer_opacity_shells(gl, monkeypatch):
     """The opacity maps take as many shells as the fur draws in view (its level of detail),
     at most OPACITY_SHELLS: close up 12 of shell_fur's 16, far away its 2 (min_shells); the
@@ -416,6 +425,7 @@ def test_opacity_maps_sized_by_the_lights_maps():
     assert opacity_held(demo) == {}
 
 
+@pytest.mark.slow
 def test_no_gap_in_front_at_the_volumes_edge_seen_from_the_light(gl):
     """Where the light grazes the fur, an opacity texel stretches along it: a shell fragment
     whose texel's centre missed the fur's front (drawn through the strands' tips) takes a

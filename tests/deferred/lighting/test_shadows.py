@@ -372,6 +372,7 @@ def test_bad_shadow_parameters_are_one_line_errors(tmp_path, text, expected):
     assert not (tmp_path / "out.png").exists()
 
 
+@pytest.mark.slow
 def test_shadow_views_and_the_dump_show_the_atlas(tmp_path):
     from deferred.io.images import read_image
 
@@ -438,6 +439,7 @@ def fur_scene(material: str, shadows: bool, *, caster_above: bool = False,
                             "object": objects, "light": [AMBIENT, light]})
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("density", [0.0, 0.5])
 @pytest.mark.parametrize("material", ["revie_fur", "shell_fur"])
 def test_fur_casts_a_shadow_from_its_shells(gl, material, density):
@@ -476,6 +478,7 @@ def test_fur_casts_a_shadow_from_its_shells(gl, material, density):
     assert fur[inside].max() < 0.05 and fur[outside].min() > 0.98
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("pipeline", ["deferred", "forward"])
 @pytest.mark.parametrize("material", ["revie_fur", "shell_fur"])
 def test_fur_receives_shadows(gl, material, pipeline):

@@ -236,6 +236,7 @@ def test_a_pass_keeping_the_hooks_sets_its_constants(gl):
         assert centre[2] > 200 and centre[0] < 10 and centre[1] < 10
 
 
+@pytest.mark.slow
 def test_a_mesh_whose_comb_makes_another_define_gets_another_program(gl):
     """revie_fur's comb field reads the mesh (its comb colours where it has them, the comb
     field texture made again for another mesh): an object given such a mesh between frames is

@@ -59,6 +59,7 @@ def test_forward_equals_deferred_all_lights_and_gl33_path(render, gl):
         assert np.array_equal(renderer.render().image, deferred.image)
 
 
+@pytest.mark.slow
 def test_demo_scene_is_fur_and_renders_in_both_pipelines(render):
     scene = load_scene()
     assert "revie_fur" in {obj.material.name for obj in scene.objects}

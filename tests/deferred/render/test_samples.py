@@ -102,6 +102,7 @@ def test_bad_sample_counts_are_refused(gl):
                 renderer.render_samples(bad)
 
 
+@pytest.mark.slow
 def test_the_command_line_averages_samples(tmp_path, capsys):
     from deferred.cli import main
     from deferred.io.images import read_image

@@ -78,6 +78,7 @@ def test_a_named_file_that_is_a_pipe_is_refused_before_it_blocks(tmp_path, fifo)
         signal.alarm(0)
 
 
+@pytest.mark.slow
 def test_the_cli_refuses_a_pipe_named_by_an_obj_and_writes_nothing(tmp_path):
     os.mkfifo(tmp_path / "tet.mtl")
     obj_with_texture(tmp_path)

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import time
 
+import pytest
+
 import deferred.scene.model as scene_model
 from deferred.scene.loader import scene_from_toml
 
@@ -44,6 +46,7 @@ def test_each_state_of_a_timeline_is_validated_once(monkeypatch):
         assert len(validated) == count  # asking again validates nothing
 
 
+@pytest.mark.slow
 def test_ten_times_the_objects_costs_about_ten_times():
     """Timed with a generous bound (30x for 10x; the quadratic naming took about 100x): the
     best of three loads each."""

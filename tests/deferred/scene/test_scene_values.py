@@ -190,6 +190,7 @@ def test_bad_scene_value_exits_2_naming_the_key(tmp_path, capsys, monkeypatch, k
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out.png", "s.toml"]
 
 
+@pytest.mark.slow
 def test_the_good_scene_renders(tmp_path, capsys, monkeypatch):
     # the cases above fail because of their one edit, not because the scene was bad already
     monkeypatch.chdir(tmp_path)

@@ -264,6 +264,7 @@ def test_scrubbing_to_t_equals_render_at_t(scene_file, make_viewer, gl):
     np.testing.assert_array_equal(shown(viewer), rendered(scene_file, 0.5, gl))
 
 
+@pytest.mark.slow
 def test_scrubbing_back_through_a_simulation_equals_render_at_t(make_viewer, gl):
     scene = ROOT / "examples" / "shell_fur" / "wet_wind.toml"
     viewer = make_viewer(scene, size=SIZE)

@@ -52,6 +52,7 @@ def test_stipple_pass_writes_one_pixel_per_2x2_tile(render):
     assert (before["linear_depth"][..., 0][changed] == 0.0).any()
 
 
+@pytest.mark.slow
 def test_obliteration_leaves_no_stipple_value(render):
     targets = ["composite", "depth", "linear_depth"]
     _, renderer, on = capture(render, fur_scene({"shells": 0}), targets)
@@ -129,6 +130,7 @@ def silhouette_ring(shape, centre, radius, inner=0.8, outer=1.15):
     return (r > inner * radius) & (r < outer * radius)
 
 
+@pytest.mark.slow
 def test_rim_scattering_brightens_the_silhouette_against_a_back_light(render):
     """Revie Fig. 2.4: a back-lit fur sphere glows at its rim only with rim bending."""
     lights = [{"type": "directional", "direction": [0.0, 0.2, 1.0], "intensity": 2.0}]
@@ -144,6 +146,7 @@ def test_rim_scattering_brightens_the_silhouette_against_a_back_light(render):
     assert means[2.0] > 1.5 * means[0.0] + 0.01, means
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("stipple, occlusion_test, red_expected", [
     (True, True, False), (False, True, False), (True, False, True), (False, False, True)])
 def test_shells_take_no_colour_from_an_occluder(render, stipple, occlusion_test, red_expected):
@@ -172,6 +175,7 @@ def test_shells_take_no_colour_from_an_occluder(render, stipple, occlusion_test,
         assert red_pixels.sum() == 0
 
 
+@pytest.mark.slow
 def test_fur_widens_the_silhouette_and_every_shell_runs(render):
     covered = []
     for length in (0.0001, 0.15, 0.3):
@@ -195,6 +199,7 @@ def test_fur_widens_the_silhouette_and_every_shell_runs(render):
     assert forward.draws_by_pass["fur.forward_shells"] == 7
 
 
+@pytest.mark.slow
 def test_positions_only_mesh_renders_fur(render, tmp_path):
     shape = trimesh.creation.icosphere(subdivisions=3, radius=0.9)
     lines = [f"v {x:.6f} {y:.6f} {z:.6f}" for x, y, z in shape.vertices]
@@ -217,6 +222,7 @@ def test_ssao_runs_before_stipple_and_never_sees_it(render):
     assert on["post.tonemap"]["ssao"].min() < 0.9  # it does occlude something
 
 
+@pytest.mark.slow
 def test_heightfield_image_controls_the_strands(render, tmp_path):
     from deferred.io.images import write_image
 
@@ -241,6 +247,7 @@ def test_missing_heightfield_is_a_clear_error(tmp_path):
                         base_dir=tmp_path)
 
 
+@pytest.mark.slow
 def test_vertex_colour_comb_and_length_are_used(render, tmp_path):
     """Revie 2.4.1: RGB combs the fur, A scales its length (per vertex).
 
@@ -345,6 +352,7 @@ def test_the_shell_dither_covers_the_slab_and_keeps_the_colour(gl):
         assert abs(image[covered].mean() - images[0][covered].mean()) < 2.0
 
 
+@pytest.mark.slow
 def test_no_dark_stipple_dots_inside_the_fur_seen_from_afar(gl):
     """Issue #25: a stipple sample at a grazing silhouette took one neighbour's depth, off by
     the fur's thickness there, and the shells failed the depth test over the dark root shell:

@@ -10,6 +10,7 @@ from locations import ROOT
 from deferred.scene.loader import load_scene
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("pipeline", ["deferred", "forward"])
 def test_fig2_20_strands_are_fewer_dashes(render, pipeline):
     result, _ = render(load_scene(ROOT / "examples" / "fig2_20_shells.toml"), pipeline)

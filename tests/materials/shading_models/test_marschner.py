@@ -154,6 +154,7 @@ def silhouette_ring(image):
     return covered & ~inside
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("material", ["revie_fur", "shell_fur"])
 @pytest.mark.parametrize("pipeline", ["deferred", "forward"])
 def test_back_lit_tips_glow(render, pipeline, material):
@@ -171,6 +172,7 @@ def test_back_lit_tips_glow(render, pipeline, material):
     assert glow[0] > glow[2]  # tinted by the fur's colour
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("material", ["revie_fur", "shell_fur"])
 def test_forward_and_deferred_agree_with_marschner(render, material):
     from conftest import psnr

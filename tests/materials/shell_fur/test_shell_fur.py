@@ -543,6 +543,7 @@ def clump_scene(params: dict, size=(128, 128)) -> dict:
     }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("mapping", ["triplanar", "uv"])
 def test_wet_clump_gathers_fur_into_its_centre_and_leaves_dry_fur_alone(render, tmp_path,
                                                                          mapping):
@@ -568,6 +569,7 @@ def test_wet_clump_gathers_fur_into_its_centre_and_leaves_dry_fur_alone(render, 
     assert (covered_wet[outside] == covered_dry[outside]).mean() > 0.999
 
 
+@pytest.mark.slow
 def test_uv_mapping_keeps_the_world_density_on_an_even_unwrap(render):
     """On a plane (UV scale the same everywhere) strands over the UVs cover the layer as much as
     triplanar strands in world units: the density converts through the mean UV scale."""
@@ -581,6 +583,7 @@ def test_uv_mapping_keeps_the_world_density_on_an_even_unwrap(render):
     assert covered["uv"] == pytest.approx(covered["triplanar"], rel=0.15)
 
 
+@pytest.mark.slow
 def test_forward_and_deferred_agree_on_straight_fur(render):
     scene = {
         "size": [160, 120], "background": [0.02, 0.02, 0.03],
@@ -633,6 +636,7 @@ def test_droplets_fall_on_the_timeline_and_dry_at_dry_rate(gl):
     assert wetness[4].max() == 0.0  # dried: at most 1 (overlaps), gone after 2 s at 0.5 / s
 
 
+@pytest.mark.slow
 def test_wind_from_a_time_bends_the_strands_and_time_is_deterministic(gl):
     scene = anim_scene({"gravity": [0.0, 0.0, 0.0], "damping": 0.2},
                        [(1.0, {"wind": [0.05, 0.0, 0.0]})])
@@ -646,6 +650,7 @@ def test_wind_from_a_time_bends_the_strands_and_time_is_deterministic(gl):
     np.testing.assert_array_equal(again[0], after[0])
 
 
+@pytest.mark.slow
 def test_the_state_at_a_time_does_not_depend_on_the_frames_before(gl):
     scene = anim_scene({"wind": [0.04, 0.0, 0.0], "gust": 0.8, "droplets": 5,
                         "dry_rate": 0.3, "droplet_radius": 0.3},
@@ -691,6 +696,7 @@ def test_deflections_come_back_to_object_space(gl):
     state.release()
 
 
+@pytest.mark.slow
 def test_render_at_the_same_time_twice_is_identical(render):
     scene = anim_scene({"droplets": 8, "wind": [0.03, 0.0, 0.0], "gust": 0.5, "shells": 6,
                         "dry_rate": 0.1})
@@ -722,6 +728,7 @@ def shared_material_scene(event: dict | None = None):
     return scene, a, b
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("pipeline", ["deferred", "forward"])
 def test_an_event_on_one_object_leaves_another_sharing_its_material_alone(render, pipeline):
     """Each object's simulation is its own (keyed by the object, not by its material): wind
@@ -751,6 +758,7 @@ def test_an_event_on_one_object_leaves_another_sharing_its_material_alone(render
     assert np.abs(plain_a.vertex_deflections() - plain_b.vertex_deflections()).max() > 1e-3
 
 
+@pytest.mark.slow
 def test_an_event_changing_a_uniform_leaves_another_object_sharing_the_material_alone(render):
     plain, _, _ = shared_material_scene()
     tinted, _, _ = shared_material_scene({"color": [0.1, 0.6, 0.1]})
@@ -859,6 +867,7 @@ def fur_light_reference(irradiance, depth, holds):
     return light, depths
 
 
+@pytest.mark.slow
 def test_the_fur_light_is_each_pixels_own_or_its_first_neighbours(render):
     """The once-per-frame gather the layers read instead of searching the G-buffer themselves,
     against numpy on the frame's own G-buffer, with another surface in front of the fur; and the
@@ -895,6 +904,7 @@ def test_the_fur_light_is_each_pixels_own_or_its_first_neighbours(render):
     assert beyond.sum() > 40
 
 
+@pytest.mark.slow
 def test_without_a_colour_map_the_fur_is_the_tint_as_over_a_white_texture(render, tmp_path):
     """No texture and no pattern: the layers skip the colour lookup (FUR_COLOR_MAP undefined)
     and draw what a white texture gives; a pattern still shows."""
@@ -930,6 +940,7 @@ def test_without_a_colour_map_the_fur_is_the_tint_as_over_a_white_texture(render
         assert psnr(a, c) < 30.0
 
 
+@pytest.mark.slow
 def test_short_fur_keeps_its_silhouette_in_the_deferred_pipeline(render):
     """Fur beyond the skin's silhouette, lit from the skin by the gather, is drawn as much as
     the forward pipeline (which lights each layer fragment itself) draws it: where the surface's
@@ -954,6 +965,7 @@ def test_short_fur_keeps_its_silhouette_in_the_deferred_pipeline(render):
     assert drawn_deferred.sum() >= 0.95 * drawn_forward.sum()
 
 
+@pytest.mark.slow
 def test_fur_over_the_screen_border_is_lit_as_inside(render):
     """Fur whose root lies just off the screen takes the light of the pixels inside, as the
     search did: the deferred image does not differ from the forward one more along the border
@@ -1078,6 +1090,7 @@ def test_a_droplets_work_is_the_texels_under_it():
     assert footprint_texels([Droplet((0.5, 0.5), 3.0, 0.5)], size) == size * size
 
 
+@pytest.mark.slow
 def test_droplet_work_past_the_budget_is_refused_before_a_frame(tmp_path, capsys, monkeypatch):
     """radius^2 x droplets past MAX_DROPLET_TEXELS is refused naming the params or the event
     that asked for the droplets (10,000 droplets of radius 1 on a 4096^2 mask would take hours);
@@ -1114,6 +1127,7 @@ params = { droplets = 40 }
     assert not (tmp_path / "late.png").exists()
 
 
+@pytest.mark.slow
 def test_a_moving_object_carries_its_strands_along(gl):
     """Issue #25: the strands follow the object's transform at each step (model_at), so a
     sphere turned upside down by its track still has its fur hanging down the world's -y,

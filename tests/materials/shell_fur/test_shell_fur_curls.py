@@ -41,6 +41,7 @@ def scene():
     return scene_from_dict(fig7d(200), "fig7 (d)", FIG7)
 
 
+@pytest.mark.slow
 def test_deferred_curls_keep_their_bands(render, scene):
     deferred, _ = render(scene, "deferred")
     forward, _ = render(scene, "forward")

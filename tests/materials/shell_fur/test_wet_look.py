@@ -46,6 +46,7 @@ def highlight(image: np.ndarray) -> tuple[float, float]:
     return peak, float((luminance > 0.5 * peak).sum())
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("shading", ["kajiya_kay", "marschner"])
 @pytest.mark.parametrize("pipeline", ["deferred", "forward"])
 def test_wet_fur_is_darker_with_a_sharper_stronger_highlight(render, tmp_path, pipeline,
@@ -76,6 +77,7 @@ def frame_differences(render, scene, times):
     return [float(np.abs(b - a).mean()) for a, b in zip(frames, frames[1:], strict=False)]
 
 
+@pytest.mark.slow
 def test_wetting_ramps_in_over_soak_time(render):
     """examples/shell_fur/wet_wind.toml at 12 frames a second: the droplets of t = 1 s change
     the image over soak_time (no frame holds more than half of the change), and the largest

@@ -55,6 +55,7 @@ def test_forward_glass_matches_deferred(render):
     assert np.mean(difference < 1e-2) > 0.97
 
 
+@pytest.mark.slow
 def test_object_order_does_not_change_the_image(render):
     """Material-phase composition: obliterations first, then shells and glass far to near."""
     objects = [

@@ -133,6 +133,7 @@ def test_comb_view_is_continuous_into_the_crown(render, camera_y):
     assert lean[ball & (radius > 12.0)].min() > 0.8
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("pipeline", ["deferred", "forward"])
 @pytest.mark.parametrize("camera_y", [2.4, -2.4], ids=["top", "bottom"])
 def test_pole_is_no_spot(render, camera_y, pipeline):
@@ -151,6 +152,7 @@ def test_pole_is_no_spot(render, camera_y, pipeline):
     assert abs(blue[crop].mean() - blue[ring].mean()) < 0.02
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("pipeline", ["deferred", "forward"])
 def test_pole_at_the_silhouette_is_no_spot(render, pipeline):
     """The demo's view of its ball: the top pole just inside the silhouette, under the blue spot

@@ -80,6 +80,7 @@ def test_strands_taper_and_the_volume_is_seeded_and_tileable():
     assert mean_coverage(thin)[0] < 0.5 * coverage[0]
 
 
+@pytest.mark.slow
 def test_no_straight_lanes_through_the_strands():
     """Seen along a tile axis (which the triplanar mapping lines up with an object axis), the
     lower fur has no straight empty lanes: few texel rows or columns of the tile, its lower
@@ -221,6 +222,7 @@ def small_torus():
                      rotation=[60.0, 0.0, 20.0], scale=0.55)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("pipeline", ["deferred", "forward"])
 def test_distant_fur_matches_its_supersampled_render(gl, pipeline):
     """A furry mesh under 100 px tall at 320x240 against the 4x4 supersampled render of the
@@ -237,6 +239,7 @@ def test_distant_fur_matches_its_supersampled_render(gl, pipeline):
     assert 10.0 * np.log10(1.0 / mse) >= 24.0  # measured: 28.1 deferred, 31.2 forward
 
 
+@pytest.mark.slow
 def test_a_dolly_from_near_to_far_never_pops(gl):
     """30 frames from close up (24 shells) to far (3): no frame-to-frame change spikes above 3x
     the median. The change is measured per pixel of the object (the object shrinks as the
@@ -258,6 +261,7 @@ def test_a_dolly_from_near_to_far_never_pops(gl):
     assert changes.max() <= 3.0 * np.median(changes)
 
 
+@pytest.mark.slow
 def test_the_level_of_detail_drops_shells_with_distance(gl):
     counts = []
     for distance in (2.0, 6.0, 20.0):
@@ -269,6 +273,7 @@ def test_the_level_of_detail_drops_shells_with_distance(gl):
 
 # -- close up: roots, skin, fins, stipple ------------------------------------------------------
 
+@pytest.mark.slow
 def test_close_up_the_roots_are_darker_than_the_tips(gl):
     """Under a front light the innermost tenth of the fur layer is darker than the outermost:
     one shell at a time (the single_shell view cuts through the strands, opaque), at each end."""
@@ -310,6 +315,7 @@ def rows_of_fur(gl, fins):
     return band.mean(axis=1)
 
 
+@pytest.mark.slow
 def test_fins_fill_the_gaps_between_shell_tips_at_a_grazing_silhouette(gl):
     with_fins = rows_of_fur(gl, True)
     without = rows_of_fur(gl, False)
@@ -328,6 +334,7 @@ def period2_energy(image):
     return energy
 
 
+@pytest.mark.slow
 def test_a_close_up_past_the_screen_border_has_no_stipple_dot_grid(gl):
     scene = fur_scene({"fur_length": 0.15, "shells": 24},
                       camera={"position": [0.0, 0.0, 1.6], "target": [0.0, 0.0, 0.0],
@@ -376,6 +383,7 @@ def test_fins_come_from_edges_with_two_faces():
     assert np.all(np.linalg.norm(points[:, 0] - points[:, 3], axis=-1) > 0)
 
 
+@pytest.mark.slow
 def test_debug_views_render_in_the_frame(gl):
     base = fur_scene({"shells": 8})
     samples = with_material_view(base, "revie_fur.samples")

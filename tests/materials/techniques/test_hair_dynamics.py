@@ -46,6 +46,7 @@ def test_a_loose_strand_hangs():
     assert np.abs(drop[:, [0, 2]]).max() < 0.02 * LENGTH
 
 
+@pytest.mark.slow
 def test_stiffness_grades_the_sag():
     rest = horizontal_strands(1)
     sags = []
@@ -141,6 +142,7 @@ def test_anchors_move_along_the_keyframes_over_time():
         np.testing.assert_allclose(run(sim, time), key, atol=1e-6)
 
 
+@pytest.mark.slow
 def test_the_same_inputs_give_the_same_bits():
     rest = horizontal_strands(5)
     pose = rest + [0.0, 0.02, 0.0]

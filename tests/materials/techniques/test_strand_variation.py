@@ -136,6 +136,7 @@ def outlines(render, scene, times):
     return np.array(edges, np.float64)
 
 
+@pytest.mark.slow
 def test_wet_wind_outlines_both_move_and_do_not_repeat(render):
     """wet_wind.toml from t = 2.5 s at 12 frames a second (the gust period is 8 frames): the
     windward (left) and leeward (right) outlines both move, and a gust period later the outline
@@ -152,6 +153,7 @@ def test_wet_wind_outlines_both_move_and_do_not_repeat(render):
     assert repeat.min() > 0.5
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("material,pipeline", [("revie_fur", "deferred"),
                                                ("revie_fur", "forward"),
                                                ("shell_fur", "deferred"),

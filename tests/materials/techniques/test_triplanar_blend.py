@@ -28,6 +28,7 @@ def mean_luminance(render, material, rotation, pipeline):
     return float((middle @ np.array([0.2126, 0.7152, 0.0722])).mean())
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("material,pipeline", [("revie_fur", "deferred"),
                                                ("revie_fur", "forward"),
                                                ("shell_fur", "deferred")])

@@ -102,6 +102,7 @@ def test_seam_map_takes_a_chart_to_its_neighbour(mirrored):
         assert bool(seams.mirror[record]) == mirrored
 
 
+@pytest.mark.slow
 def test_seam_map_on_an_unwrapped_mesh():
     """On the bunny's unwrap: each seam record takes its edge's ends to the same ends in the
     chart across, and puts the source's triangle on the far side of the edge there (the
