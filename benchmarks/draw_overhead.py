@@ -30,7 +30,7 @@ from deferred.lights.directional import DirectionalLight
 from deferred.render.renderer import Renderer
 from deferred.scene.camera import Camera
 from deferred.scene.meshes import load_mesh
-from deferred.scene.model import Scene
+from deferred.scene.scene import Scene
 
 PATHS = {"deferred": ("tiled", "clustered", "volumes"), "forward": ("naive", "tiled")}
 

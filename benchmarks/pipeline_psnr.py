@@ -17,7 +17,7 @@ import numpy as np
 
 from deferred.render.renderer import Renderer
 from deferred.scene.loader import load_scene
-from deferred.scene.model import parse_size
+from deferred.scene.size import parse_size
 
 
 def psnr(a: np.ndarray, b: np.ndarray) -> float:

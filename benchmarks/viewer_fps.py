@@ -14,7 +14,7 @@ import argparse
 import statistics
 import time
 
-from deferred.scene.model import parse_size
+from deferred.scene.size import parse_size
 from deferred.viewer.app import Viewer, ViewerOptions, make_window, window_size
 from deferred.viewer.session import Session
 

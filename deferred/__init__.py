@@ -16,14 +16,14 @@ __version__ = "0.1.0"
 
 _LAZY = {
     "Camera": "deferred.scene.camera",
-    "SceneObject": "deferred.scene.model",
+    "SceneObject": "deferred.scene.objects",
     "read_image": "deferred.io.images",
     "write_image": "deferred.io.images",
     "create_context": "deferred.gl.context",
     "Renderer": "deferred.render.renderer",
     "RenderResult": "deferred.render.renderer",
     "render_scene": "deferred.render.renderer",
-    "Scene": "deferred.scene.model",
+    "Scene": "deferred.scene.scene",
     "load_scene": "deferred.scene.loader",
     "scene_from_dict": "deferred.scene.loader",
     "scene_from_toml": "deferred.scene.loader",
@@ -35,7 +35,8 @@ if TYPE_CHECKING:
     from deferred.render.renderer import Renderer, RenderResult, render_scene
     from deferred.scene.camera import Camera
     from deferred.scene.loader import load_scene, scene_from_dict, scene_from_toml
-    from deferred.scene.model import Scene, SceneObject
+    from deferred.scene.objects import SceneObject
+    from deferred.scene.scene import Scene
 
 
 def __getattr__(name: str) -> Any:

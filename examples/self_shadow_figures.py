@@ -17,7 +17,7 @@ from deferred.bench.scenes import set_self_shadow_density
 from deferred.debug.preview import labelled
 from deferred.render.renderer import Renderer
 from deferred.scene.loader import load_scene
-from deferred.scene.model import Scene
+from deferred.scene.scene import Scene
 
 ROOT = Path(__file__).parents[1]
 FIGURES = ROOT / "docs" / "figures"

@@ -60,7 +60,7 @@ from deferred.io.paths import check_output_path
 from deferred.names import LIGHT_PATHS, LightPath, Pipeline
 from deferred.render.pipeline import PIPELINES
 from deferred.render.renderer import Renderer
-from deferred.scene.model import Scene
+from deferred.scene.scene import Scene
 
 DEFAULT_LIGHTS = (1, 16, 64, 256, 1024)
 ROUND_ORDER_SEED = 0  # run_bench: the order of the points in each round

@@ -18,7 +18,7 @@ import numpy as np
 from deferred.gl.context import GLContext
 from deferred.io.images import write_image, write_text
 from deferred.names import LightPath, Pipeline
-from deferred.scene.model import Scene
+from deferred.scene.scene import Scene
 
 COLUMNS = ("pipeline", "light_path", "lights", "shells", "width", "height", "runs", "median_ms",
            "mean_ms", "min_ms", "max_ms", "stddev_ms", "times_ms", "passes_ms", "cpu_ms",

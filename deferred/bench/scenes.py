@@ -13,7 +13,8 @@ from pydantic import ValidationError
 from deferred.errors import InputError
 from deferred.interfaces import registry
 from deferred.interfaces.light import Light
-from deferred.scene.model import Scene, SceneObject
+from deferred.scene.objects import SceneObject
+from deferred.scene.scene import Scene
 
 MAX_LIGHTS = 16384  # the GL 3.3 path keeps one light per row of a texture
 LIGHT_SEED = 0

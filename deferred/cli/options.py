@@ -15,7 +15,7 @@ from rich.console import Console
 from deferred.io import safety
 from deferred.names import LightPath, Pipeline
 from deferred.render.pipeline import PIPELINES
-from deferred.scene.model import parse_size
+from deferred.scene.size import parse_size
 
 if TYPE_CHECKING:
     from deferred.scene import Scene

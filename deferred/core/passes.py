@@ -172,6 +172,11 @@ def copy_pass(name: str, phase: Phase, source: str, target: str, spec: TargetSpe
 class ObjectPass(RenderPass):
     """Draw one scene object's mesh with a program; materials build their passes on this.
 
+    The pass is made for an object (``node``: the user's object, which the frame's state is
+    keyed by) and draws it as each frame has it: :meth:`object` is the object's state in the
+    frame (its world matrix, its material with the parameters at the frame's time). Hooks
+    read the object through it, never a state kept from another frame.
+
     Subclasses (or callers) give the shader files (a geometry shader too, if any), defines, the
     targets and state, and a ``uniforms`` hook. ``draws`` > 1 renders the mesh that many times,
     each draw with its own ``draw_uniforms`` (e.g. one shell per draw; ``None`` skips the draw).
@@ -212,7 +217,8 @@ class ObjectPass(RenderPass):
     def __init__(self, name: str, phase: Phase, obj: SceneObjectLike, **options: Any):
         self.name = name
         self.phase = phase
-        self.obj = obj
+        self.node = obj.node  # what the frame's state is keyed by (the object's identity)
+        self.mesh = obj.mesh  # another mesh is another pass graph
         for key, value in options.items():
             if key.startswith("_") or callable(getattr(type(self), key, None)) or \
                     not hasattr(type(self), key):
@@ -222,8 +228,13 @@ class ObjectPass(RenderPass):
         self.reads, self.writes = drawn_targets(self.samples, self.colors, self.blend,
                                                 self.depth, self.depth_test, self.depth_write)
 
+    def object(self, frame: Frame) -> SceneObjectLike:
+        """The object this pass draws, as ``frame`` has it (its state at the frame's time)."""
+        return frame.scene.object_state(self.node)
+
     def defines(self, frame: Frame) -> dict[str, str]:
-        defines = self.obj.material.defines(self.obj)
+        obj = self.object(frame)
+        defines = obj.material.defines(obj)
         return {**defines, **self.extra_defines} if self.extra_defines else defines
 
     def uniforms(self, frame: Frame) -> dict[str, Any]:
@@ -242,38 +253,39 @@ class ObjectPass(RenderPass):
         return {}
 
     def draw(self, frame: Frame, program: moderngl.Program) -> None:
-        frame.draw_mesh(self.obj.mesh, program)
+        frame.draw_mesh(self.mesh, program)
 
-    def program(self, frame: Frame) -> moderngl.Program:
+    def program(self, frame: Frame, obj: SceneObjectLike | None = None) -> moderngl.Program:
         shaders = frame.shaders
         memo = self._program_memo  # the last lookup: the same defines give the same program
-        material = self.obj.material
+        material = (obj or self.object(frame)).material
         fresh = memo is not None and memo[0] is shaders and memo[1] == shaders.generation
         # Where the pass keeps ObjectPass.defines, its defines are the material's, a function
         # of its params and the object's mesh (Material.defines), and its own fixed ones: while
         # those are the same objects, so is the program (building and comparing the defines
         # was a sixth of a draw's CPU time: benchmarks/README.md).
         if fresh and memo[2] is material and memo[3] is material.params and \
-                memo[4] is self.obj.mesh and not self._own_defines:
+                memo[4] is self.mesh and not self._own_defines:
             return memo[6]
         defines = self.defines(frame)
         program = memo[6] if fresh and memo[5] == defines else \
             shaders.program(self.vertex, self.fragment, self.geometry, defines=defines)
         self._program_memo = (shaders, shaders.generation, material, material.params,
-                              self.obj.mesh, defines, program)
+                              self.mesh, defines, program)
         return program
 
     def execute(self, frame: Frame) -> None:
-        program = self.program(frame)
+        obj = self.object(frame)
+        program = self.program(frame, obj)
         frame.use_framebuffer(self.colors, self.depth, depth_write=self.depth_write)
         frame.set_state(depth_test=self.depth_test, depth_func=self.depth_func, cull=self.cull,
                         blend=self.blend, depth_offset=self.depth_offset)
-        material = frame.material_inputs(self.obj.material)
+        material = frame.material_inputs(obj.material)
         if self._hooks_unchanged and not self.extra_reads:
             # one draw and nothing of the pass's own but its constants (most objects'
             # G-buffer and forward passes): the hooks' empty answers are not asked for
             # (benchmarks/README.md has what asking cost)
-            frame.bind(program, self.constants, None, offered=frame.object_uniforms(self.obj),
+            frame.bind(program, self.constants, None, offered=frame.object_uniforms(obj),
                        material=material)
             self.draw(frame, program)
             return
@@ -281,7 +293,7 @@ class ObjectPass(RenderPass):
         if self.constants:
             uniforms = {**self.constants, **uniforms}
         textures = self.textures(frame)
-        offered = frame.object_uniforms(self.obj)
+        offered = frame.object_uniforms(obj)
         count = self.draws(frame)
         bound = False
         for index in range(count):

@@ -26,19 +26,26 @@ class CameraLike(Protocol):
     def inverse_projection(self, aspect: float) -> np.ndarray: ...
 
 
-class SceneLike(Protocol):
-    """A frame's scene as the core reads it (:class:`deferred.scene.Scene`)."""
-
-    camera: CameraLike
-    objects: list
-
-
 class SceneObjectLike(Protocol):
-    """An object as an object pass draws it (:class:`deferred.scene.SceneObject`)."""
+    """An object as an object pass draws it (:class:`deferred.scene.ObjectState`: the object at
+    the frame's time; a :class:`deferred.scene.SceneObject` has the same attributes). ``node``
+    is the user's object, what the frame's state is keyed by."""
 
+    node: Any
     label: str
     mesh: MeshData
     material: Any  # a Material (deferred.interfaces.material)
+    model: np.ndarray
+
+
+class SceneLike(Protocol):
+    """A frame's scene as the core reads it (:class:`deferred.scene.FrameState`: the scene
+    evaluated at the frame's time)."""
+
+    camera: CameraLike
+    objects: tuple
+
+    def object_state(self, node: Any) -> SceneObjectLike: ...
 
 
 class PassLike(Protocol):

@@ -34,7 +34,7 @@ from deferred.errors import InputError
 from deferred.gbuffer.layout import GBUFFER_COLOR_TARGETS
 from deferred.gl.targets import COMPOSITE, LIGHT_ACCUMULATION
 from deferred.io.images import srgb_encode, write_image
-from deferred.scene.model import Scene
+from deferred.scene.scene import Scene
 
 # Buffer views by name (``deferred render --view``): channels and what they show.
 NAMED_VIEWS: dict[str, tuple[tuple[str, ...], str]] = {

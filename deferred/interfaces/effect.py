@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 from deferred.core.frame import OfferedUniforms
 from deferred.names import Pipeline
 from deferred.params import Params, UniformOverrides, params_uniforms, validate_params
+from deferred.revision import Revisioned
 
 if sys.version_info >= (3, 11):
     from importlib.resources.abc import Traversable
@@ -65,7 +66,7 @@ class EffectParams(Params):
     """Base of every effect's parameter model."""
 
 
-class Effect:
+class Effect(Revisioned):
     """A scene-level effect (``[[effect]]`` in a scene file): a ``name``, a validated
     ``Params`` model and the passes it adds to a pipeline (:meth:`passes`, in any phase).
     ``pipelines`` names the pipelines it applies to; the others skip it with a warning.

@@ -22,6 +22,7 @@ from pydantic import Field, field_validator
 
 from deferred.names import LightVolume, ShadowProjection
 from deferred.params import Params, validate_params
+from deferred.revision import Revisioned
 from deferred.validation import Radiance
 
 if sys.version_info >= (3, 11):
@@ -67,7 +68,7 @@ class ShadowParams(LightParams):
         return value
 
 
-class Light:
+class Light(Revisioned):
     """A light type: a ``name``, a validated ``Params`` model, a GLSL function
     (``glsl_file``, ``glsl_function``: ``vec3 f(LightRecord light, Surface s, vec3 P, vec3 V)``)
     and how it packs itself for the GPU (:meth:`record`: four ``vec4`` in view space).
@@ -89,6 +90,9 @@ class Light:
     shadow_projection: ClassVar[ShadowProjection | None] = None
     shader_root: ClassVar[Traversable | Path | None] = None
     type_id: ClassVar[int] = 0  # set by the registry
+    # a node of the scene graph (or its label) whose space position and direction are in;
+    # None: the world (each frame's state holds the light placed in the world)
+    parent: Any = None
 
     def __init__(self, params: LightParams | None = None):
         self.params = params if params is not None else self.Params()

@@ -39,6 +39,7 @@ from deferred.gl.targets import COMPOSITE
 from deferred.interfaces import registry
 from deferred.memo import kept_while
 from deferred.params import Params, UniformOverrides, params_uniforms, validate_params
+from deferred.revision import Revisioned
 from deferred.validation import require_regular_file
 
 if sys.version_info >= (3, 11):
@@ -124,7 +125,7 @@ class ShadowView:
         return {"u_shadow_view": self.view, "u_shadow_projection": self.projection}
 
 
-class Material:
+class Material(Revisioned):
     """A material: a unique ``name``, a validated ``Params`` model and a GLSL surface function
     (``surface_shader``, ``Surface material_surface(SurfaceInput i)``) lit by ``shading_model``.
 

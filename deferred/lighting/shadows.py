@@ -62,7 +62,8 @@ from deferred.names import Pipeline, ShadowProjection
 if TYPE_CHECKING:
     from deferred.core.frame import Frame
     from deferred.gl.uniforms import ProgramUniforms
-    from deferred.scene.model import Scene, SceneObject
+    from deferred.scene.objects import SceneObject
+from deferred.scene.scene import Scene
 
 SHADOW_ATLAS = "shadow_atlas"  # its name on a frame's blackboard
 SHADOWS_DEFINE = "SHADOWS"

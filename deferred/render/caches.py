@@ -30,7 +30,7 @@ if TYPE_CHECKING:
     from deferred.gl.uniforms import ProgramUniforms
     from deferred.interfaces.material import Material
     from deferred.interfaces.shading import ShadingModel
-    from deferred.scene import Scene, SceneObject
+    from deferred.scene.state import FrameState, ObjectState
 
 
 class KeptMaterialInputs:
@@ -42,7 +42,7 @@ class KeptMaterialInputs:
     def __init__(self) -> None:
         self._kept: dict[int, MaterialInputs] = {}
 
-    def start_frame(self, scene: Scene) -> None:
+    def start_frame(self, scene: FrameState) -> None:
         """Drop the materials no object of ``scene`` has (replaced on their objects), once
         they outnumber the objects: a scene that keeps its materials pays one comparison."""
         if len(self._kept) > len(scene.objects):
@@ -69,40 +69,40 @@ class KeptMaterialInputs:
 class ObjectTransforms:
     """Every object's transform uniforms (``u_model`` and ``u_model_normal_matrix``, the
     inverse transpose of the model's 3x3, as GL bytes; ``u_surface_id``), made for all objects
-    at once and kept while the objects hold. The camera's view is apart (``u_view``,
-    ``shaders/common/object_transform.glsl``), so a camera that moves remakes none of them (the
-    batched inverse and the conversions are most of an object's CPU time when remade)."""
+    at once and kept while the objects' states hold (their versions: a state's world matrix
+    and material are fixed, so the same versions give the same values). The camera's view is
+    apart (``u_view``, ``shaders/common/object_transform.glsl``), so a camera that moves
+    remakes none of them (the batched inverse and the conversions are most of an object's CPU
+    time when remade)."""
 
     def __init__(self) -> None:
         self._key: tuple | None = None
         self._values: dict[int, dict[str, Any]] = {}
 
-    def of(self, objects: list[SceneObject],
+    def of(self, objects: tuple[ObjectState, ...],
            previous: dict[int, np.ndarray] | None = None) -> dict[int, dict[str, Any]]:
-        """id(object) -> its uniforms; ``previous`` the models of the last frame by object id
-        (``u_previous_model``; an object missing there, or with none given, its own model)."""
+        """id(object's node) -> its uniforms; ``previous`` the world matrices of the last
+        frame by node id (``u_previous_model``; an object missing there, or with none given,
+        its own model). Matrices are read-only values: the same array is the same matrix."""
         if not objects:
             return {}
-        surface_ids = [float(obj.material.surface_id()) for obj in objects]
         # the last frame's models where they differ (none without a temporal history)
         befores = None
         if previous:
-            befores = [previous.get(id(obj), obj.model) for obj in objects]
-        # what the values are made of (contents, not identities: a model may be written in
-        # place), and which object each belongs to
-        key = (b"".join([obj.model.tobytes() for obj in objects]), surface_ids,
-               [id(obj) for obj in objects],
-               None if befores is None else
-               b"".join([np.asarray(before, dtype=np.float64).tobytes() for before in befores]))
+            befores = [previous.get(id(obj.node), obj.model) for obj in objects]
+        key = ([obj.version for obj in objects],
+               None if befores is None else [id(before) for before in befores])
         if key != self._key:
             models = np.stack([obj.model for obj in objects])
+            surface_ids = [float(obj.material.surface_id()) for obj in objects]
             self._values = self._make(objects, models, surface_ids,
                                       models if befores is None else np.stack(befores))
             self._key = key
+            self._held = befores  # the arrays whose ids are in the key stay alive with it
         return self._values
 
     @staticmethod
-    def _make(objects: list[SceneObject], models: np.ndarray,
+    def _make(objects: tuple[ObjectState, ...], models: np.ndarray,
               surface_ids: list[float], befores: np.ndarray) -> dict[int, dict[str, Any]]:
         normals = np.transpose(np.linalg.inv(models[:, :3, :3]), (0, 2, 1))
 
@@ -114,7 +114,7 @@ class ObjectTransforms:
         before_bytes = column_major(befores)
         values = {}
         for index, (obj, surface_id) in enumerate(zip(objects, surface_ids, strict=True)):
-            values[id(obj)] = StableValues(  # replaced whole when they change
+            values[id(obj.node)] = StableValues(  # replaced whole when they change
                 u_model=model_bytes[64 * index:64 * index + 64],
                 u_model_normal_matrix=normal_bytes[36 * index:36 * index + 36],
                 u_previous_model=before_bytes[64 * index:64 * index + 64],
@@ -126,7 +126,7 @@ class FrameInputs:
     """One frame's objects' transforms and materials' inputs (each material's made once a
     frame, or kept from the last), for the frame's passes."""
 
-    def __init__(self, scene: Scene, transforms: ObjectTransforms, kept: KeptMaterialInputs,
+    def __init__(self, scene: FrameState, transforms: ObjectTransforms, kept: KeptMaterialInputs,
                  strict: bool = False, previous_models: dict[int, np.ndarray] | None = None):
         self.scene = scene
         self.previous_models = previous_models
@@ -137,12 +137,12 @@ class FrameInputs:
         self._objects: dict[int, dict[str, Any]] | None = None
         self._materials: dict[int, MaterialInputs] = {}
 
-    def object_uniforms(self, obj: SceneObject) -> dict[str, Any]:
+    def object_uniforms(self, obj: ObjectState) -> dict[str, Any]:
         """The object's transforms and id (for every object at once, kept across frames while
-        the objects hold: :class:`ObjectTransforms`)."""
+        the objects' states hold: :class:`ObjectTransforms`)."""
         if self._objects is None:
             self._objects = self._transforms.of(self.scene.objects, self.previous_models)
-        return self._objects[id(obj)]
+        return self._objects[id(obj.node)]
 
     def material_inputs(self, material: Material) -> MaterialInputs:
         """``material``'s uniforms and textures, computed once per frame (or kept from the

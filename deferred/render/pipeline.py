@@ -53,7 +53,7 @@ from deferred.lighting.culling import LightCullPass, list_shading_pass
 from deferred.lighting.shadows import ShadowPass, scene_casts_shadows
 from deferred.lighting.volumes import LightTypePass, surface_pass
 from deferred.memo import overrides
-from deferred.scene.model import Scene, SceneObject
+from deferred.scene.state import FrameState, ObjectState
 
 # what the pass graph checks beyond the core's rules: the G-buffer's
 GRAPH_RULES = (surfaces_need_depth,)
@@ -70,7 +70,7 @@ TONEMAPS = {"none": 0, "reinhard": 1, "aces": 2}
 PIPELINE_PASS, SCENE_PASS, OBJECT_PASS = 0, 1, 2  # groups within one Order rank
 
 
-def tonemap_pass(scene: Scene) -> RenderPass:
+def tonemap_pass(scene: FrameState) -> RenderPass:
     """Exposure, the scene's tone mapping operator (fixed when the passes are built, as the
     background is) and sRGB encoding."""
     return FullscreenPass(
@@ -80,7 +80,7 @@ def tonemap_pass(scene: Scene) -> RenderPass:
         uniforms=lambda frame: {"u_exposure": frame.scene.exposure})
 
 
-def scene_passes(scene: Scene, pipeline: str) -> list[RenderPass]:
+def scene_passes(scene: FrameState, pipeline: str) -> list[RenderPass]:
     """Scene-wide passes of every phase: the effects' (those applying to ``pipeline``), then the
     materials' (once per material class, shared names once)."""
     passes: list[RenderPass] = []
@@ -110,19 +110,19 @@ def scene_passes(scene: Scene, pipeline: str) -> list[RenderPass]:
     return passes
 
 
-def camera_distance(scene: Scene, obj: SceneObject) -> float:
+def camera_distance(scene: FrameState, obj: ObjectState) -> float:
     """How far in front of the camera the centre of ``obj``'s bounds is (its view depth)."""
     low, high = obj.mesh.bounds()
     centre = obj.model @ np.append((low + high) / 2.0, 1.0)
     return float(-(scene.camera.view() @ centre)[2])
 
 
-def sort_blended(passes: list[RenderPass], scene: Scene) -> list[RenderPass]:
+def sort_blended(passes: list[RenderPass], scene: FrameState) -> list[RenderPass]:
     """``passes`` with each run of blended object passes (volumes, transparent surfaces) of
     one phase and rank put far to near for the camera and transforms of this frame (the
     order the passes were built in holds the first frame's): the same list where it already
     is so."""
-    index_of = {id(obj): k for k, obj in enumerate(scene.objects)}
+    index_of = {id(obj.node): k for k, obj in enumerate(scene.objects)}
     out = passes
     start = 0
     while start < len(passes):
@@ -134,9 +134,10 @@ def sort_blended(passes: list[RenderPass], scene: Scene) -> list[RenderPass]:
                 end += 1
             if end - start > 1:
                 run = passes[start:end]
-                distances = {id(p.obj): camera_distance(scene, p.obj) for p in run}
-                ordered = sorted(run, key=lambda p: (-distances[id(p.obj)],
-                                                     index_of.get(id(p.obj), 0)))
+                distances = {id(p.node): camera_distance(scene, scene.object_state(p.node))
+                             for p in run}
+                ordered = sorted(run, key=lambda p: (-distances[id(p.node)],
+                                                     index_of.get(id(p.node), 0)))
                 if ordered != run:
                     if out is passes:
                         out = list(passes)
@@ -147,10 +148,10 @@ def sort_blended(passes: list[RenderPass], scene: Scene) -> list[RenderPass]:
 
 def _blended_object_pass(render_pass: RenderPass) -> bool:
     return render_pass.order >= Order.VOLUME and render_pass.order != Order.LAST and \
-        getattr(render_pass, "obj", None) is not None
+        getattr(render_pass, "node", None) is not None
 
 
-def phase_passes(scene: Scene, phase: Phase, fixed: list[RenderPass],
+def phase_passes(scene: FrameState, phase: Phase, fixed: list[RenderPass],
                  scene_wide: list[RenderPass]) -> list[RenderPass]:
     """Every pass of ``phase``: the pipeline's own (``fixed``), the scene-wide ones of this
     phase and the objects', ranked as the module documentation says."""
@@ -178,14 +179,14 @@ class Pipeline:
             raise InputError(f"the {self.name} pipeline has no light path '{self.light_path}' "
                              f"(choose from {', '.join(self.light_paths)})", "light_path")
 
-    def build(self, scene: Scene) -> list[RenderPass]:
+    def build(self, scene: FrameState) -> list[RenderPass]:
         raise NotImplementedError
 
     def shader_defines(self) -> dict[str, str]:
         """Defines every program of this pipeline gets (the light path's)."""
         return {}
 
-    def passes(self, scene: Scene) -> list[RenderPass]:
+    def passes(self, scene: FrameState) -> list[RenderPass]:
         """The pass list for ``scene``, checked (:func:`check_passes`)."""
         return check_passes(self.build(scene)).passes
 
@@ -194,7 +195,7 @@ class DeferredPipeline(Pipeline):
     name = names.Pipeline.DEFERRED
     light_paths = names.LIGHT_PATHS[names.Pipeline.DEFERRED]
 
-    def build(self, scene: Scene) -> list[RenderPass]:
+    def build(self, scene: FrameState) -> list[RenderPass]:
         layout = scene.gbuffer_layout()
         wide = scene_passes(scene, self.name)
         clear = ClearPass("gbuffer.clear", Phase.GEOMETRY, layout.targets)
@@ -242,7 +243,7 @@ class ForwardPipeline(Pipeline):
     name = names.Pipeline.FORWARD
     light_paths = names.LIGHT_PATHS[names.Pipeline.FORWARD]
 
-    def build(self, scene: Scene) -> list[RenderPass]:
+    def build(self, scene: FrameState) -> list[RenderPass]:
         wide = scene_passes(scene, self.name)
         creates = {COMPOSITE: replace(COMPOSITE_SPEC, clear=(*scene.background, 0.0)),
                    DEPTH: GBUFFER_TARGETS[DEPTH]}
@@ -293,15 +294,15 @@ def depth_prepass(lit: ForwardLitPass) -> RenderPass:
     constants where those are all it sets (most materials: no hooks asked at each draw), else
     a :class:`DepthPrepass`."""
     # an object's lit pass is <label>.forward; a material's other lit passes keep their names
-    stem = lit.name.removesuffix(".forward") if lit.name == f"{lit.obj.label}.forward" \
+    stem = lit.name.removesuffix(".forward") if lit.name == f"{lit.node.label}.forward" \
         else lit.name
     name = f"{stem}.depth_prepass"
     if lit._hooks_unchanged and not overrides(type(lit), RenderPass, "prepare") and \
             not overrides(type(lit), ObjectPass, "draw"):
-        return ObjectPass(name, Phase.FORWARD, lit.obj, vertex=lit.vertex,
+        return ObjectPass(name, Phase.FORWARD, lit, vertex=lit.vertex,
                           fragment=DepthPrepass.fragment, colors=DepthPrepass.colors,
                           constants=lit.constants, order=Order.FIRST)
-    return DepthPrepass(name, Phase.FORWARD, lit.obj, vertex=lit.vertex,
+    return DepthPrepass(name, Phase.FORWARD, lit, vertex=lit.vertex,
                         constants=lit.constants, lit=lit)
 
 

@@ -18,7 +18,7 @@ import numpy as np
 from deferred.interfaces.effect import Effect, FrameMoment
 
 if TYPE_CHECKING:
-    from deferred.scene.model import Scene
+    from deferred.scene.state import FrameState
 
 
 @dataclass
@@ -34,7 +34,7 @@ class FrameHistory:
     previous_models: dict[int, np.ndarray] = field(default_factory=dict)
 
 
-def temporal_effect(scene: Scene) -> Effect | None:
+def temporal_effect(scene: FrameState) -> Effect | None:
     """The scene's first temporal effect, if any."""
     return next((effect for effect in scene.effects if effect.temporal), None)
 
@@ -52,7 +52,7 @@ class TemporalState:
         renders stands alone)."""
         self.moment = None
 
-    def begin(self, scene: Scene, time: float, aspect: float) -> FrameHistory:
+    def begin(self, scene: FrameState, time: float, aspect: float) -> FrameHistory:
         """The frame at ``time``'s place in the history, before it is drawn."""
         camera = scene.camera
         view_projection = np.asarray(camera.projection(aspect)) @ np.asarray(camera.view())
@@ -66,8 +66,9 @@ class TemporalState:
                                 self.models)
         return FrameHistory(False, 0, replace(moment, step=None), view_projection)
 
-    def end(self, history: FrameHistory, scene: Scene) -> None:
-        """Keep the frame just drawn as the last one."""
+    def end(self, history: FrameHistory, scene: FrameState) -> None:
+        """Keep the frame just drawn as the last one (its world matrices are read-only values:
+        kept, not copied)."""
         self.moment = history.moment
         self.index = history.index
-        self.models = {id(obj): np.array(obj.model) for obj in scene.objects}
+        self.models = {id(obj.node): obj.model for obj in scene.objects}

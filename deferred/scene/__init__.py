@@ -1,9 +1,13 @@
-"""The scene: its model (objects, lights, camera, timeline), the loader of scene files, the
-camera and the meshes' loaders."""
+"""The scene: the user's scene (objects, groups, lights, camera, timeline), the loader of scene
+files, the scene graph, and the frame state a frame evaluates it into."""
 
 from deferred.scene.camera import Camera
 from deferred.scene.loader import load_scene, scene_from_dict, scene_from_toml
-from deferred.scene.model import Scene, SceneObject, TimelineEvent
+from deferred.scene.nodes import SceneNode
+from deferred.scene.objects import SceneObject, TimelineEvent
+from deferred.scene.scene import Scene
+from deferred.scene.state import FrameState, ObjectState
+from deferred.scene.transform import Transform
 
-__all__ = ["Camera", "Scene", "SceneObject", "TimelineEvent", "load_scene", "scene_from_dict",
-           "scene_from_toml"]
+__all__ = ["Camera", "FrameState", "ObjectState", "Scene", "SceneNode", "SceneObject",
+           "TimelineEvent", "Transform", "load_scene", "scene_from_dict", "scene_from_toml"]

@@ -1,33 +1,31 @@
-"""Perspective camera and transform helpers (pyrr builds the matrices; column-vector convention).
+"""The perspective camera (pyrr builds the matrices; column-vector convention) and its checks.
 
 Matrices here are numpy (4, 4) arrays acting on column vectors (``p' = M @ p``). GLSL wants them
-column-major, which is ``M.T`` in numpy's row-major memory: use :func:`gl_bytes`.
+column-major, which is ``M.T`` in numpy's row-major memory: use :func:`gl_bytes`. A camera may
+name a ``parent`` node: its position, target and up are then in that node's space, and each
+frame's state holds the camera placed in the world (``deferred.scene.timeline.camera_at``).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 import pyrr
+from pydantic import ConfigDict, Field, model_validator
 
 from deferred.memo import kept_while
+from deferred.scene.transform import model_matrix  # noqa: F401 - where it was first found
+from deferred.validation import StrictValues
+
+Vec3 = tuple[float, float, float]
+MAX_DEPTH_RANGE = 1e7  # far / near
 
 
 def gl_bytes(matrix: np.ndarray) -> bytes:
     """Bytes of a column-vector matrix in the column-major order GLSL expects."""
     return np.ascontiguousarray(np.asarray(matrix, dtype=np.float32).T).tobytes()
-
-
-def model_matrix(position, rotation_degrees, scale) -> np.ndarray:
-    """Translation @ Rz @ Ry @ Rx @ Scale: rotations are applied X first, then Y, then Z."""
-    rx, ry, rz = np.radians(np.asarray(rotation_degrees, dtype=np.float64))
-    rot = (pyrr.matrix44.create_from_z_rotation(-rz).T
-           @ pyrr.matrix44.create_from_y_rotation(-ry).T
-           @ pyrr.matrix44.create_from_x_rotation(-rx).T)
-    scale = np.broadcast_to(np.asarray(scale, dtype=np.float64), (3,))
-    translation = pyrr.matrix44.create_from_translation(np.asarray(position, dtype=np.float64)).T
-    return translation @ rot @ np.diag([*scale, 1.0])
 
 
 @dataclass(frozen=True)
@@ -38,6 +36,8 @@ class Camera:
     fov: float = 45.0  # vertical, degrees
     near: float = 0.05
     far: float = 100.0
+    # a node (or its label) whose space position, target and up are in; None: the world
+    parent: Any = None
 
     # The camera is frozen, so its matrices are made once (pyrr's look-at alone was 8% of a
     # frame's Python time on a small scene) and handed out read-only.
@@ -67,3 +67,39 @@ def _read_only(matrix: np.ndarray) -> np.ndarray:
     matrix = np.ascontiguousarray(matrix)
     matrix.setflags(write=False)
     return matrix
+
+
+def camera_values(camera: Camera) -> dict[str, Any]:
+    """The camera's checked values (what :class:`CameraModel` validates), without its parent."""
+    return {"position": camera.position, "target": camera.target, "up": camera.up,
+            "fov": camera.fov, "near": camera.near, "far": camera.far}
+
+
+class CameraModel(StrictValues):
+    """A scene file's ``[camera]``, checked (the loader's, and every camera the tracks make)."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+    position: Vec3 = (0.0, 1.0, 4.0)
+    target: Vec3 = (0.0, 0.5, 0.0)
+    up: Vec3 = (0.0, 1.0, 0.0)
+    fov: float = Field(45.0, gt=1.0, lt=179.0, description="vertical field of view, degrees")
+    near: float = Field(0.05, gt=0.0)
+    far: float = Field(100.0, gt=0.0)
+
+    @model_validator(mode="after")
+    def _check(self) -> CameraModel:
+        if self.far <= self.near:
+            raise ValueError("far must be greater than near")
+        if self.far / self.near > MAX_DEPTH_RANGE:
+            # measured: at 1e8 the deferred pipeline's depth reconstruction loses the scene
+            raise ValueError(f"far / near is {self.far / self.near:.3g}; at most "
+                             f"{MAX_DEPTH_RANGE:g} (the depth buffer's precision): raise near "
+                             "or lower far")
+        if np.allclose(self.position, self.target):
+            raise ValueError("position and target are the same point")
+        forward = np.subtract(self.target, self.position, dtype=float)
+        side = np.cross(forward / np.linalg.norm(forward), np.asarray(self.up, dtype=float))
+        if np.linalg.norm(side) < 1e-6:
+            raise ValueError("up is parallel to the view direction (or zero); "
+                             "choose another up vector")
+        return self

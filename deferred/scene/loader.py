@@ -1,8 +1,13 @@
 """Scene files: TOML (README.md, "Scene files") or a dict, validated into a
-:class:`~deferred.scene.model.Scene`; ``deferred render`` with no scene loads the built-in demo.
+:class:`~deferred.scene.scene.Scene`; ``deferred render`` with no scene loads the built-in demo.
 
 Validation names the file, the key and the problem in one line
 (``demo.toml: object[1].params.shells: Input should be greater than or equal to 0 (got -3)``).
+Every problem of a file is found before one is raised. The tables' models are
+:mod:`deferred.scene.tables`; :class:`SceneBuilder` makes the scene from them, a table kind at a
+time: objects and groups (the scene graph's nodes), lights, effects, then the timeline (events
+and tracks), and last the parents (every node, light and the camera naming one that exists,
+with no cycle).
 """
 from __future__ import annotations
 
@@ -11,167 +16,41 @@ import sys
 from collections.abc import Callable
 from importlib import resources
 from pathlib import Path
-from typing import Any, Literal, TypeVar
+from typing import Any, TypeVar
 
-import numpy as np
-from pydantic import (
-    BaseModel,
-    ConfigDict,
-    Field,
-    ValidationError,
-    field_validator,
-    model_validator,
-)
+from pydantic import BaseModel, ValidationError
 
 from deferred.errors import InputError, input_error
 from deferred.gl.meshes import MeshData
 from deferred.interfaces import registry
 from deferred.interfaces.material import Material
-from deferred.names import LightPath
-from deferred.scene.camera import Camera, model_matrix
+from deferred.scene.camera import Camera
+from deferred.scene.graph import Hierarchy
 from deferred.scene.meshes import load_mesh
-from deferred.scene.model import (
-    OPACITY_SCALES,
-    CameraModel,
-    Scene,
-    SceneObject,
-    ShadowBudget,
-    Transform,
-    check_light_name,
-    check_size,
-    unique_label,
+from deferred.scene.nodes import SceneNode
+from deferred.scene.objects import SceneObject
+from deferred.scene.scene import Scene, ShadowBudget, check_light_name, unique_label
+from deferred.scene.size import check_size
+from deferred.scene.tables import (
+    LISTS,
+    EventModel,
+    GroupModel,
+    ObjectModel,
+    SceneModel,
+    TrackModel,
+    TypedModel,
 )
-from deferred.scene.tracks import (
-    INTERPOLATIONS,
-    MIN_SCALE,
-    make_track,
-    parse_target,
-    scale_too_small,
-)
-from deferred.validation import (
-    Radiance,
-    StrictValues,
-    closest,
-    require_regular_file,
-    validation_problems,
-)
+from deferred.scene.tracks import make_track, parse_target
+from deferred.validation import closest, require_regular_file, validation_problems
 
 if sys.version_info >= (3, 11):
     import tomllib
 else:  # pragma: no cover
     import tomli as tomllib
 
-Vec3 = tuple[float, float, float]
 DEMO_SCENE = "demo.toml"
 T = TypeVar("T")
 M = TypeVar("M", bound=BaseModel)
-
-
-class _Strict(StrictValues):
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
-
-
-class ObjectModel(_Strict):
-    name: str | None = Field(None, max_length=1000,
-                             description="label: printable, no control characters")
-    mesh: str
-    material: str = "standard"
-    position: Vec3 = (0.0, 0.0, 0.0)
-    rotation: Vec3 = Field((0.0, 0.0, 0.0), description="degrees, applied X, then Y, then Z")
-    scale: float | Vec3 = 1.0
-    params: dict[str, Any] = Field(default_factory=dict)
-
-    @field_validator("name")
-    @classmethod
-    def _printable(cls, name: str | None) -> str | None:
-        # a label goes into file names, messages and contact sheets
-        if name is not None and (not name or any(ord(c) < 32 or ord(c) == 127 for c in name)):
-            raise ValueError("must be printable text: no control characters (newline, tab, "
-                             "NUL) and not empty")
-        return name
-
-    @model_validator(mode="after")
-    def _check_scale(self) -> ObjectModel:
-        scale = np.broadcast_to(np.asarray(self.scale, dtype=float), (3,))
-        if np.any(scale == 0.0):
-            raise ValueError("scale must not be zero")
-        if scale_too_small(scale):  # its normal matrix would overflow float32
-            raise ValueError(f"scale must be at least {MIN_SCALE:g} in size")
-        return self
-
-
-class EventModel(_Strict):
-    """An ``[[event]]`` table: from ``time`` on, ``object``'s material takes ``params``."""
-
-    time: float = Field(ge=0.0, allow_inf_nan=False, description="seconds")
-    object: str = Field(description="the name (label) of a scene object")
-    params: dict[str, Any] = Field(description="material parameters, merged over the object's")
-
-
-class TrackModel(_Strict):
-    """A ``[[track]]`` table: keys moving the camera, a light or an object
-    (:mod:`deferred.scene.tracks`)."""
-
-    target: str = Field(description="what moves: 'camera', 'object:NAME', 'light:INDEX' (0 is "
-                                    "the first [[light]]) or 'light:NAME'")
-    interpolation: Literal[INTERPOLATIONS] = Field(
-        "linear", description="between keys: step (hold), linear, or smooth (cubic Hermite, "
-                              "Catmull-Rom tangents, zero at the first and last keys)")
-    keys: list[dict[str, Any]] = Field(
-        min_length=1, description="{ time = seconds, and the properties set then }, in rising "
-                                  "time")
-
-
-class TypedModel(BaseModel):
-    """A ``[[light]]`` or ``[[effect]]`` table: its type, then that type's parameters."""
-
-    model_config = ConfigDict(extra="allow")
-    type: str
-
-
-class ShadowsModel(_Strict):
-    """The ``[shadows]`` table: the shadow atlas and its budget (:class:`ShadowBudget`)."""
-
-    atlas_size: int = Field(4096, description="texels on a side of the shadow atlas (a power "
-                                              "of two, 256..16384)")
-    max_shadowed_lights: int = Field(16, ge=1, le=64, description="lights given shadow maps, "
-                                     "in scene order; the rest are unshadowed")
-    opacity_scale: float = Field(0.25, description="texels on a side of the fur's deep "
-                                 "opacity maps per shadow-map texel (1, 0.5, .. 1/16)")
-
-    @field_validator("opacity_scale")
-    @classmethod
-    def _fraction(cls, value: float) -> float:
-        if value not in OPACITY_SCALES:
-            raise ValueError("must be 1, 0.5, 0.25, 0.125 or 0.0625")
-        return value
-
-    @field_validator("atlas_size")
-    @classmethod
-    def _power_of_two(cls, value: int) -> int:
-        if not 256 <= value <= 16384 or value & (value - 1):
-            raise ValueError("must be a power of two in 256..16384")
-        return value
-
-
-class SceneModel(_Strict):
-    size: tuple[int, int] = (1280, 720)
-    background: Radiance = Field((0.02, 0.02, 0.025),
-                                 description="linear RGB behind everything, each >= 0")
-    exposure: float = Field(1.0, gt=0.0)
-    tonemap: Literal["reinhard", "aces", "none"] = "aces"
-    light_path: LightPath | None = Field(
-        None, description="how lights reach the pixels (deferred.lighting.paths); default the "
-                          "fastest the context allows")
-    camera: CameraModel = Field(default_factory=CameraModel)
-    shadows: ShadowsModel = Field(default_factory=ShadowsModel)
-    ssao: dict[str, Any] | None = Field(
-        None, description="screen-space ambient occlusion (the same as [[effect]] type 'ssao')")
-    object: list[ObjectModel] = Field(default_factory=list)
-    light: list[TypedModel] = Field(default_factory=list)
-    effect: list[TypedModel] = Field(default_factory=list)
-    event: list[EventModel] = Field(default_factory=list)
-    track: list[TrackModel] = Field(default_factory=list)
 
 
 def builtin_scenes() -> list[str]:
@@ -219,194 +98,283 @@ def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
     """The scene ``data`` describes (a scene file's tables). Every problem is found before one
     is raised: an :class:`InputError` for one, :class:`InputErrors` naming each (in the file's
     order) for several; unknown keys and names say the closest known one."""
-    problems: list[InputError] = []
-    try:
-        model = SceneModel(**data)
-        objects, lights, effects_, events, tracks = (
-            [(item, set()) for item in items] for items in (
-                model.object, model.light, model.effect, model.event, model.track))
-    except ValidationError as exc:
-        problems += validation_problems(exc, name, SceneModel)
-        # the parts valid alone are checked further: all problems are said at once
-        bad = {error["loc"][0] for error in exc.errors() if error["loc"]}
-        model = _valid_alone(SceneModel, {k: v for k, v in data.items()
-                                          if k not in bad and k not in _LISTS})[0]
-        objects, lights, effects_, events, tracks = (
-            _each(cls, data.get(key)) for key, cls in (
-                ("object", ObjectModel), ("light", TypedModel), ("effect", TypedModel),
-                ("event", EventModel), ("track", TrackModel)))
-    _collect(problems, check_size, model.size, f"{name}: size")
-    c = model.camera
-    scene = Scene(camera=Camera(c.position, c.target, c.up, c.fov, c.near, c.far),
-                  size=model.size, background=model.background, exposure=model.exposure,
-                  tonemap=model.tonemap, light_path=model.light_path, source=name,
-                  shadow_budget=ShadowBudget(model.shadows.atlas_size,
-                                             model.shadows.max_shadowed_lights,
-                                             model.shadows.opacity_scale))
-    meshes: dict[str, MeshData | None] = {}
-    # label -> (the object, or None where it is not made; its material class, where known)
-    labels: dict[str, tuple[SceneObject | None, type[Material] | None]] = {}
-    taken: set[str] = set()  # the labels, for unique_label
-    unlabelled = False  # an object whose label is not known (its name is refused)
-    next_index: dict[str, int] = {}  # unique_label's, for every unnamed object
-    for index, (obj, bad) in enumerate(objects):
-        where = f"{name}: object[{index}]"
-        if obj is None:
-            continue
-        material = material_cls = None
-        if "material" not in bad:
-            material_cls = _collect(problems, registry.materials.get, obj.material,
-                                    f"{where}.material")
-            if material_cls is not None and "params" not in bad:
-                material = _collect(problems, material_cls.from_dict, obj.params, base_dir,
-                                    f"{where}.params")
-        mesh = None
-        if "mesh" not in bad:
-            if obj.mesh not in meshes:
-                meshes[obj.mesh] = _collect(problems, load_mesh, obj.mesh, base_dir,
-                                            f"{where}.mesh")
-            mesh = meshes[obj.mesh]
-        if "name" in bad or (obj.name is None and "mesh" in bad):
-            unlabelled = True
-            continue
-        # a mesh that failed to load is named as it would be, for the events naming it
-        label = obj.name or unique_label(taken, mesh.name if mesh is not None else
-                                         _mesh_name(obj.mesh), next_index)
-        if label in labels:
-            problems.append(InputError(f"duplicate object name '{label}'", f"{where}.name"))
-            continue
-        made = None
-        if not bad and material is not None and mesh is not None:
-            made = SceneObject(label, mesh, material,
-                               model_matrix(obj.position, obj.rotation, obj.scale), where=where,
-                               transform=Transform.model_construct(
-                                   position=obj.position, rotation=obj.rotation,
-                                   scale=obj.scale))
-            scene.objects.append(made)
-        labels[label] = (made, material_cls)
-        taken.add(label)
-    # each [[light]] by its index in the file (None where refused), and its name
-    file_lights: list = []
-    light_names: set[str] = set()
-    for index, (light, bad) in enumerate(lights):
-        where = f"{name}: light[{index}]"
-        file_lights.append(None)
-        values = dict(light.model_extra or {}) if light is not None else {}
-        light_name = values.pop("name", None)
-        if light_name is not None:
-            try:
-                check_light_name(light_name, light_names, f"{where}.name")
-                light_names.add(light_name)
-            except InputError as exc:
-                problems.append(exc)
-                light_name = None
-        if light is None or "type" in bad:
-            continue
-        light_cls = _collect(problems, registry.lights.get, light.type, f"{where}.type")
-        if light_cls is not None:
-            made = _collect(problems, light_cls.from_dict, values, where)
-            if made is not None:
-                scene.lights.append(made)
-                file_lights[index] = made
-                if light_name is not None:
-                    scene.light_names[light_name] = made
-    effects = [(f"{name}: effect[{index}]", e.type, e.model_extra or {})
-               for index, (e, bad) in enumerate(effects_) if e is not None and "type" not in bad]
-    if model.ssao is not None:  # the [ssao] table of earlier scene files
-        if any(kind == "ssao" for _, kind, _ in effects):
-            problems.append(InputError("ssao is given both as [ssao] and as an [[effect]]; "
-                                       "keep one", f"{name}: ssao"))
-        else:
-            effects.insert(0, (f"{name}: ssao", "ssao", model.ssao))
-    seen: set[str] = set()
-    for where, kind, values in effects:
-        if kind in seen:
-            problems.append(InputError(f"effect '{kind}' is given twice (one of each type)",
-                                       f"{where}.type"))
-            continue
-        seen.add(kind)
-        effect_cls = _collect(problems, registry.effects.get, kind, f"{where}.type")
-        if effect_cls is not None:
-            made = _collect(problems, effect_cls.from_dict, values, where)
-            if made is not None:
-                scene.effects.append(made)
-    # each object's events added at once (in the file's order: it breaks ties of time)
-    grouped: dict[str, list[tuple[float, dict[str, Any], str]]] = {}
-    for index, (event, bad) in enumerate(events):
-        where = f"{name}: event[{index}]"
-        if event is None or "object" in bad:
-            continue
-        if event.object not in labels:
-            if not unlabelled:
-                problems.append(InputError(_no_object(event.object, list(labels)),
-                                           f"{where}.object"))
-            continue
-        target, material_cls = labels[event.object]
-        if target is not None and not bad:
-            grouped.setdefault(event.object, []).append((event.time, event.params, where))
-        elif material_cls is not None and "params" not in bad:
-            # the object is refused: the event's own keys and values are still checked
-            problems += _params_problems(material_cls.Params, event.params, f"{where}.params")
-    for label, timeline in grouped.items():
-        target = labels[label][0]
-        try:
-            target.add_events(timeline)
-        except InputError as exc:
-            # the timeline stops at its first problem: every event's keys and values are
-            # checked too, so each of their problems is said
-            found = [problem for _, params, where in timeline
-                     for problem in _params_problems(
-                         type(target.base_params),
-                         {**target.base_params.model_dump(), **params}, f"{where}.params")]
-            wheres = {problem.where for problem in found}
-            problems += [p for p in exc.problems if p.where not in wheres] + found
-    _load_tracks(scene, name, tracks, labels, unlabelled, file_lights, light_names, problems)
-    if problems:
+    builder = SceneBuilder(data, name, base_dir)
+    builder.build()
+    if builder.problems:
         order = {key: position for position, key in enumerate(data)}
-        each = [one for problem in problems for one in problem.problems]
+        each = [one for problem in builder.problems for one in problem.problems]
         raise input_error(sorted(each, key=lambda p: _file_order(p.where, name, order)))
-    return scene
+    return builder.scene
 
 
-def _load_tracks(scene: Scene, name: str, tracks: list, labels: dict, unlabelled: bool,
-                 file_lights: list, light_names: set[str], problems: list[InputError]) -> None:
-    """Each ``[[track]]`` checked and added to what it moves (its keys checked alone where that
-    object or light was refused)."""
-    for index, (track, bad) in enumerate(tracks):
-        where = f"{name}: track[{index}]"
-        if track is None or bad & {"target", "interpolation", "keys", ""}:
-            continue
-        target_where = f"{where}.target"
-        kind, target = _collect(problems, parse_target, track.target, target_where) or \
-            (None, None)
-        subject: Any = "camera" if kind == "camera" else None
-        if kind == "object":
-            if target in labels:
-                subject = labels[target][0]
-            elif not unlabelled:
-                problems.append(InputError(_no_object(target, list(labels)), target_where))
-        elif kind == "light":
-            if target in light_names:  # None where that light was refused
-                subject = scene.light_names.get(target)
-            elif target.isdigit() and int(target) < len(file_lights):
-                subject = file_lights[int(target)]
+class SceneBuilder:
+    """Makes a scene from a scene file's tables, collecting every problem (:meth:`build`)."""
+
+    def __init__(self, data: dict[str, Any], name: str, base_dir: Path | None):
+        self.name = name
+        self.base_dir = base_dir
+        self.problems: list[InputError] = []
+        try:
+            model = SceneModel(**data)
+            self.tables = {key: [(item, set()) for item in getattr(model, key)]
+                           for key in LISTS}
+        except ValidationError as exc:
+            self.problems += validation_problems(exc, name, SceneModel)
+            # the parts valid alone are checked further: all problems are said at once
+            bad = {error["loc"][0] for error in exc.errors() if error["loc"]}
+            model = _valid_alone(SceneModel, {k: v for k, v in data.items()
+                                              if k not in bad and k not in LISTS})[0]
+            kinds = {"object": ObjectModel, "group": GroupModel, "light": TypedModel,
+                     "effect": TypedModel, "event": EventModel, "track": TrackModel}
+            self.tables = {key: _each(kinds[key], data.get(key)) for key in LISTS}
+        self.model = model
+        # label -> (the node, or None where it is not made; its material class, where known)
+        self.labels: dict[str, tuple[SceneNode | None, type[Material] | None]] = {}
+        self.unlabelled = False  # a node whose label is not known (its name is refused)
+        self.file_lights: list = []  # each [[light]] by its index in the file (None: refused)
+        self.light_names: set[str] = set()
+        self.group_labels: set[str] = set()
+        # what names a parent, with where it said so: checked once every node is made
+        self.children: list[tuple[Any, str]] = []
+
+    def collect(self, function: Callable[..., T], *args: Any) -> T | None:
+        return _collect(self.problems, function, *args)
+
+    def build(self) -> None:
+        model, name = self.model, self.name
+        self.collect(check_size, model.size, f"{name}: size")
+        c = model.camera
+        self.scene = Scene(
+            camera=Camera(c.position, c.target, c.up, c.fov, c.near, c.far, parent=c.parent),
+            size=model.size, background=model.background, exposure=model.exposure,
+            tonemap=model.tonemap, light_path=model.light_path, source=name,
+            shadow_budget=ShadowBudget(model.shadows.atlas_size,
+                                       model.shadows.max_shadowed_lights,
+                                       model.shadows.opacity_scale))
+        if c.parent is not None:
+            self.children.append((self.scene.camera, f"{name}: camera.parent"))
+        self.objects()
+        self.groups()
+        self.lights()
+        self.effects()
+        self.events()
+        self.tracks()
+        self.parents()
+
+    def _label(self, table: Any, bad: set[str], where: str, mesh_name: str | None,
+               taken: set[str], next_index: dict[str, int]) -> str | None:
+        """The node's label (its name, or one made from its mesh's), or None where it has
+        none or another node has it (said)."""
+        if "name" in bad or (table.name is None and mesh_name is None):
+            self.unlabelled = True
+            return None
+        label = table.name or unique_label(taken, mesh_name, next_index)
+        if label in self.labels:
+            self.problems.append(InputError(f"duplicate object name '{label}'",
+                                            f"{where}.name"))
+            return None
+        taken.add(label)
+        return label
+
+    def objects(self) -> None:
+        meshes: dict[str, MeshData | None] = {}
+        taken: set[str] = set()  # the labels, for unique_label
+        next_index: dict[str, int] = {}  # unique_label's, for every unnamed object
+        self._taken, self._next_index = taken, next_index
+        for index, (obj, bad) in enumerate(self.tables["object"]):
+            where = f"{self.name}: object[{index}]"
+            if obj is None:
+                continue
+            material = material_cls = None
+            if "material" not in bad:
+                material_cls = self.collect(registry.materials.get, obj.material,
+                                            f"{where}.material")
+                if material_cls is not None and "params" not in bad:
+                    material = self.collect(material_cls.from_dict, obj.params, self.base_dir,
+                                            f"{where}.params")
+            mesh = None
+            if "mesh" not in bad:
+                if obj.mesh not in meshes:
+                    meshes[obj.mesh] = self.collect(load_mesh, obj.mesh, self.base_dir,
+                                                    f"{where}.mesh")
+                mesh = meshes[obj.mesh]
+            # a mesh that failed to load is named as it would be, for the events naming it
+            mesh_name = None if "mesh" in bad else \
+                mesh.name if mesh is not None else _mesh_name(obj.mesh)
+            label = self._label(obj, bad, where, mesh_name, taken, next_index)
+            if label is None:
+                continue
+            made = None
+            if not bad and material is not None and mesh is not None:
+                made = SceneObject(label, mesh, material, where=where,
+                                   transform=obj.transform(), parent=obj.parent)
+                self.scene.objects.append(made)
+                if obj.parent is not None:
+                    self.children.append((made, f"{where}.parent"))
+            self.labels[label] = (made, material_cls)
+
+    def groups(self) -> None:
+        for index, (group, bad) in enumerate(self.tables["group"]):
+            where = f"{self.name}: group[{index}]"
+            if group is None:
+                continue
+            label = self._label(group, bad, where, None, self._taken, self._next_index)
+            if label is None:
+                continue
+            self.group_labels.add(label)
+            made = None
+            if not bad:
+                made = SceneNode(label, group.transform(), parent=group.parent, where=where)
+                self.scene.groups.append(made)
+                if group.parent is not None:
+                    self.children.append((made, f"{where}.parent"))
+            self.labels[label] = (made, None)
+
+    def lights(self) -> None:
+        for index, (light, bad) in enumerate(self.tables["light"]):
+            where = f"{self.name}: light[{index}]"
+            self.file_lights.append(None)
+            values = dict(light.model_extra or {}) if light is not None else {}
+            light_name = values.pop("name", None)
+            parent = values.pop("parent", None)
+            if light_name is not None:
+                try:
+                    check_light_name(light_name, self.light_names, f"{where}.name")
+                    self.light_names.add(light_name)
+                except InputError as exc:
+                    self.problems.append(exc)
+                    light_name = None
+            if light is None or "type" in bad:
+                continue
+            light_cls = self.collect(registry.lights.get, light.type, f"{where}.type")
+            made = None if light_cls is None else self.collect(light_cls.from_dict, values,
+                                                               where)
+            if made is None:
+                continue
+            self.scene.lights.append(made)
+            self.file_lights[index] = made
+            if light_name is not None:
+                self.scene.light_names[light_name] = made
+            if parent is not None:
+                made.parent = parent
+                self.children.append((made, f"{where}.parent"))
+
+    def effects(self) -> None:
+        name = self.name
+        effects = [(f"{name}: effect[{index}]", e.type, e.model_extra or {})
+                   for index, (e, bad) in enumerate(self.tables["effect"])
+                   if e is not None and "type" not in bad]
+        if self.model.ssao is not None:  # the [ssao] table of earlier scene files
+            if any(kind == "ssao" for _, kind, _ in effects):
+                self.problems.append(InputError("ssao is given both as [ssao] and as an "
+                                                "[[effect]]; keep one", f"{name}: ssao"))
             else:
-                have = f"light:0 to light:{len(file_lights) - 1}" if file_lights else "none"
-                named = f", or by name: {', '.join(sorted(light_names)[:10])}" \
-                    if light_names else ""
-                problems.append(InputError(f"no light {target[:80]!r} (lights: {have}{named})",
-                                           target_where))
-        if subject is None:  # nothing to move: the keys are still checked
-            if kind is not None:
-                _collect(problems, make_track, track.target, track.keys, track.interpolation,
-                         where)
-            continue
-        _collect(problems, scene.add_track, track.target if subject == "camera" else subject,
-                 track.keys, track.interpolation, where)
+                effects.insert(0, (f"{name}: ssao", "ssao", self.model.ssao))
+        seen: set[str] = set()
+        for where, kind, values in effects:
+            if kind in seen:
+                self.problems.append(InputError(f"effect '{kind}' is given twice (one of each "
+                                                "type)", f"{where}.type"))
+                continue
+            seen.add(kind)
+            effect_cls = self.collect(registry.effects.get, kind, f"{where}.type")
+            if effect_cls is not None:
+                made = self.collect(effect_cls.from_dict, values, where)
+                if made is not None:
+                    self.scene.effects.append(made)
 
+    def events(self) -> None:
+        """Each object's events added at once (in the file's order: it breaks ties of time)."""
+        grouped: dict[str, list[tuple[float, dict[str, Any], str]]] = {}
+        for index, (event, bad) in enumerate(self.tables["event"]):
+            where = f"{self.name}: event[{index}]"
+            if event is None or "object" in bad:
+                continue
+            target, material_cls = self.labels.get(event.object, (None, None))
+            if event.object not in self.labels or event.object in self.group_labels:
+                if not self.unlabelled:
+                    self.problems.append(InputError(_no_object(event.object, self._objects()),
+                                                    f"{where}.object"))
+                continue
+            if target is not None and not bad:
+                grouped.setdefault(event.object, []).append((event.time, event.params, where))
+            elif material_cls is not None and "params" not in bad:
+                # the object is refused: the event's own keys and values are still checked
+                self.problems += _params_problems(material_cls.Params, event.params,
+                                                  f"{where}.params")
+        for label, timeline in grouped.items():
+            target = self.labels[label][0]
+            try:
+                target.add_events(timeline)
+            except InputError as exc:
+                # the timeline stops at its first problem: every event's keys and values are
+                # checked too, so each of their problems is said
+                found = [problem for _, params, where in timeline
+                         for problem in _params_problems(
+                             type(target.base_params),
+                             {**target.base_params.model_dump(), **params}, f"{where}.params")]
+                wheres = {problem.where for problem in found}
+                self.problems += [p for p in exc.problems if p.where not in wheres] + found
 
-_LISTS = ("object", "light", "effect", "event", "track")  # lists of tables, checked item by item
+    def _objects(self) -> list[str]:
+        """The labels of the file's objects (made or not), not its groups'."""
+        return [label for label in self.labels if label not in self.group_labels]
 
+    def tracks(self) -> None:
+        """Each ``[[track]]`` checked and added to what it moves (its keys checked alone where
+        that node or light was refused)."""
+        for index, (track, bad) in enumerate(self.tables["track"]):
+            where = f"{self.name}: track[{index}]"
+            if track is None or bad & {"target", "interpolation", "keys", ""}:
+                continue
+            kind, target = self.collect(parse_target, track.target, f"{where}.target") or \
+                (None, None)
+            subject = self._track_subject(kind, target, f"{where}.target")
+            if subject is None:  # nothing to move: the keys are still checked
+                if kind is not None:
+                    self.collect(make_track, track.target, track.keys, track.interpolation,
+                                 where)
+                continue
+            self.collect(self.scene.add_track,
+                         track.target if subject == "camera" else subject, track.keys,
+                         track.interpolation, where)
+
+    def _track_subject(self, kind: str | None, target: str | None, where: str) -> Any:
+        """What a track's target names: "camera", a node, a light; None where it names
+        nothing made (said, unless it was refused itself)."""
+        if kind == "camera":
+            return "camera"
+        if kind == "object":
+            if target in self.labels:
+                return self.labels[target][0]
+            if not self.unlabelled:
+                self.problems.append(InputError(_no_object(target, list(self.labels)), where))
+        elif kind == "light":
+            lights, names = self.file_lights, self.light_names
+            if target in names:  # None where that light was refused
+                return self.scene.light_names.get(target)
+            if target.isdigit() and int(target) < len(lights):
+                return lights[int(target)]
+            have = f"light:0 to light:{len(lights) - 1}" if lights else "none"
+            named = f", or by name: {', '.join(sorted(names)[:10])}" if names else ""
+            self.problems.append(InputError(f"no light {target[:80]!r} (lights: "
+                                            f"{have}{named})", where))
+        return None
+
+    def parents(self) -> None:
+        """Every parent named exists and none is its own ancestor (checked once all the
+        scene's nodes are made; not where a node was refused, which is said already)."""
+        if not self.children or self.unlabelled or \
+                any(node is None for node, _ in self.labels.values()):
+            return
+        try:
+            hierarchy = Hierarchy(self.scene.nodes(), self.name)
+        except InputError as exc:
+            self.problems.append(exc)
+            return
+        for child, where in self.children:
+            if not isinstance(child, SceneNode):  # the camera, a light
+                self.collect(hierarchy.resolve, child.parent, where)
 
 def _collect(problems: list[InputError], function: Callable[..., T], *args: Any) -> T | None:
     """``function(*args)``, or ``None`` with its ``InputError`` added to ``problems``."""

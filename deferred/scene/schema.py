@@ -23,7 +23,7 @@ from pydantic import BaseModel
 from pydantic.json_schema import GenerateJsonSchema, models_json_schema
 
 from deferred.interfaces import registry
-from deferred.scene.loader import ObjectModel, SceneModel
+from deferred.scene.tables import ObjectModel, SceneModel
 from deferred.scene.tracks import KEY_MODELS
 
 DRAFT = "http://json-schema.org/draft-07/schema#"
@@ -88,6 +88,10 @@ def scene_schema() -> dict[str, Any]:
                 params["properties"]["name"] = {
                     "type": "string", "minLength": 1, "pattern": "^.*[^0-9].*$",
                     "description": "a name for tracks (target = 'light:NAME'); not a number"}
+                params["properties"]["parent"] = {
+                    "type": "string", "minLength": 1,
+                    "description": "the name of an object or group its position and "
+                                   "direction are in"}
             params["required"] = ["type", *params.get("required", [])]
             params["additionalProperties"] = False
             definitions[f"{kind}.{name}"] = params

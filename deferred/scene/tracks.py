@@ -34,6 +34,7 @@ import numpy as np
 from pydantic import ConfigDict, Field, ValidationError, field_validator
 
 from deferred.errors import InputError, input_error
+from deferred.scene.transform import MIN_SCALE, scale_too_small
 from deferred.validation import (
     NonNegativeFloat,
     NonZeroVec3,
@@ -45,13 +46,8 @@ from deferred.validation import (
 
 Vec3 = tuple[float, float, float]
 INTERPOLATIONS = ("step", "linear", "smooth")
-MIN_SCALE = 1e-6  # an object smaller is a mistake of units; 1/scale must fit float32
 
 
-def scale_too_small(scale: float | Sequence[float]) -> bool:
-    """Whether a scale (one number or one per axis) is under ``MIN_SCALE`` in size on an axis:
-    the one rule for a scene file's, a track key's and Python's placements."""
-    return bool(np.any(np.abs(np.asarray(scale, dtype=float)) < MIN_SCALE))
 KINDS = ("camera", "light", "object")
 MAX_KEYS = 100_000
 
@@ -368,26 +364,3 @@ class Turntable:
         c, s = math.cos(angle), math.sin(angle)
         return (float(target[0] + c * dx + s * dz), float(position[1]),
                 float(target[2] - s * dx + c * dz))
-
-
-def decompose(model: np.ndarray) -> tuple[Vec3, Vec3, Vec3]:
-    """(position, rotation in degrees X then Y then Z, scale) of a model matrix made as
-    :func:`~deferred.scene.camera.model_matrix` makes them (a shear is lost)."""
-    model = np.asarray(model, dtype=np.float64)
-    linear = model[:3, :3]
-    scale = np.linalg.norm(linear, axis=0)
-    scale = np.where(scale > 0.0, scale, 1.0)
-    if np.linalg.det(linear) < 0.0:
-        scale[0] = -scale[0]
-    rot = linear / scale  # Rz @ Ry @ Rx
-    sin_y = -float(np.clip(rot[2, 0], -1.0, 1.0))
-    if abs(sin_y) < 1.0 - 1e-9:
-        x = math.atan2(rot[2, 1], rot[2, 2])
-        z = math.atan2(rot[1, 0], rot[0, 0])
-    else:  # gimbal lock: X and Z turn about one axis; all of it is X's
-        x = math.atan2(-rot[1, 2], rot[1, 1])
-        z = 0.0
-    y = math.asin(sin_y)
-    return (tuple(float(v) for v in model[:3, 3]),
-            tuple(math.degrees(v) for v in (x, y, z)),
-            tuple(float(v) for v in scale))

@@ -11,7 +11,7 @@ from deferred.debug.capture import capture_frame
 from deferred.debug.preview import to_uint8
 from deferred.debug.views import View, resolve_view, view, view_catalogue, with_material_view
 from deferred.render.renderer import Renderer
-from deferred.scene.model import Scene
+from deferred.scene.scene import Scene
 
 ALL_CHANNELS = -1
 

@@ -10,7 +10,7 @@ from pathlib import Path
 
 from deferred.gl.shaderlib import FrameworkShaders
 from deferred.io.safety import scene_inputs
-from deferred.scene.model import Scene
+from deferred.scene.scene import Scene
 
 POLL_SECONDS = 0.25
 GLSL_SUFFIXES = (".glsl", ".vert", ".frag", ".geom", ".comp")

@@ -12,7 +12,7 @@ import moderngl
 
 from deferred.gl.context import GLContext, detect_features
 from deferred.render.renderer import Renderer
-from deferred.scene.model import Scene
+from deferred.scene.scene import Scene
 
 Key = tuple[str, str | None, tuple[int, int], int]
 

@@ -18,7 +18,8 @@ from deferred.errors import DeferredError, InputError, one_line
 from deferred.interfaces.catalogue import describe_fields
 from deferred.params import validate_params
 from deferred.scene.loader import load_scene
-from deferred.scene.model import Scene, SceneObject
+from deferred.scene.objects import SceneObject
+from deferred.scene.scene import Scene
 from deferred.viewer.camera import CameraController
 
 OBJECT_WHERE = re.compile(r": object\[(\d+)\]$")

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 
-from deferred.scene.model import Scene
+from deferred.scene.scene import Scene
 
 DEFAULT_DURATION = 10.0  # seconds, for a scene whose timeline says nothing longer
 

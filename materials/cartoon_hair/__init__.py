@@ -219,8 +219,8 @@ class HairState:
                 getattr(self.obj, "events", ()))
 
     def model_at(self, time: float) -> np.ndarray:
-        """The object's model matrix at ``time``: its tracks' (SceneObject.model_at), else
-        its model."""
+        """The object's world matrix at ``time``: its tracks' and its parents'
+        (ObjectState.model_at), else its model."""
         model_at = getattr(self.obj, "model_at", None)
         return model_at(time) if model_at is not None else self.obj.model
 
@@ -301,7 +301,7 @@ def strand_base(scene, obj: SceneObject) -> float:
     """The first strand id of ``obj``'s hair: each cartoon_hair object of the scene has its own
     range of ``STRAND_IDS`` ids, so strands of two heads are told apart too."""
     hairs = [other for other in scene.objects if isinstance(other.material, CartoonHairMaterial)]
-    index = next((k for k, other in enumerate(hairs) if other is obj), 0)
+    index = next((k for k, other in enumerate(hairs) if other.node is obj.node), 0)
     if index >= MAX_HAIR_OBJECTS:
         raise InputError(f"a scene holds at most {MAX_HAIR_OBJECTS} cartoon_hair objects (their "
                          "strand ids share one float channel)", obj.label)
@@ -310,7 +310,10 @@ def strand_base(scene, obj: SceneObject) -> float:
 
 def hair_state(frame: Frame, obj: SceneObject) -> HairState:
     """``obj``'s hair in the frame's renderer, made the first time it is asked for."""
-    return frame.resources.cached(("cartoon_hair_state", obj), lambda ctx: HairState(ctx, obj))
+    state = frame.resources.cached(("cartoon_hair_state", obj.node),
+                                   lambda ctx: HairState(ctx, obj))
+    state.obj = obj  # the object as this frame has it (the tracks moving it now)
+    return state
 
 
 class PreparedHair:
@@ -318,12 +321,11 @@ class PreparedHair:
     is prepared before any draws, so all of them see the same hair) and :meth:`state` gives it
     to the pass's hooks."""
 
-    obj: SceneObject
     name: str
     _prepared: tuple[weakref.ref, HairState] | None = None
 
     def prepare(self, frame: Frame) -> None:
-        state = hair_state(frame, self.obj)
+        state = hair_state(frame, self.object(frame))
         state.advance(frame.time, frame)
         self._prepared = (weakref.ref(frame), state)
 
@@ -337,9 +339,9 @@ class HairInputs(PreparedHair):
     """The hair's surface passes: they draw the tubes instead of the object's mesh."""
 
     def uniforms(self, frame: Frame) -> dict[str, Any]:
-        return {**super().uniforms(frame), "u_hair": True,
-                "u_color": self.obj.material.params.color,
-                "u_strand_base": strand_base(frame.scene, self.obj)}
+        obj = self.object(frame)
+        return {**super().uniforms(frame), "u_hair": True, "u_color": obj.params.color,
+                "u_strand_base": strand_base(frame.scene, obj)}
 
     def draw(self, frame: Frame, program: moderngl.Program) -> None:
         self.state(frame).gpu.render(program)
@@ -359,7 +361,7 @@ class HairHatchingPass(HairInputs, ObjectPass):
     order = Order.OPAQUE  # the material's own pixels, before its strokes
 
     def uniforms(self, frame: Frame) -> dict[str, Any]:
-        params = self.obj.material.params
+        params = self.object(frame).params
         tam = hatching_map()
         return {**super().uniforms(frame), "u_tam_tones": tam.tones,
                 "u_tam_gutter": tam.gutter, "u_hatching_strength": params.hatching_strength,
@@ -396,11 +398,11 @@ class HairSilhouettePass(PreparedHair, SilhouettePass):
     def uniforms(self, frame: Frame) -> dict[str, Any]:
         uniforms = super().uniforms(frame)
         if self.id_buffer:  # the stroke's own strand's id in the G-buffer
-            uniforms["u_strand_base"] = strand_base(frame.scene, self.obj)
+            uniforms["u_strand_base"] = strand_base(frame.scene, self.object(frame))
         return uniforms
 
-    def stroke_settings(self) -> dict[str, Any]:
-        p = self.obj.material.params
+    def stroke_settings(self, frame: Frame) -> dict[str, Any]:
+        p = self.object(frame).params
         # a tube's own front surface lies up to its radius nearer than its silhouette
         return {"width": p.stroke_width, "color": p.stroke_color, "fade": p.stroke_fade,
                 "tolerance": float(tube_radii(p.hair_samples, p.radius, p.taper).max())}

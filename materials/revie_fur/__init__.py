@@ -92,10 +92,8 @@ class CombFieldInputs:
     (``techniques/comb_field.py``) from its mesh's vertex colours or its ``comb``, made when
     either changes."""
 
-    obj: SceneObject
-
     def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
-        return {**super().textures(frame), **comb_field_inputs(frame, self.obj)}
+        return {**super().textures(frame), **comb_field_inputs(frame, self.object(frame))}
 
 
 def comb_field_inputs(frame: Frame, obj: SceneObject) -> dict[str, moderngl.Texture]:
@@ -103,7 +101,7 @@ def comb_field_inputs(frame: Frame, obj: SceneObject) -> dict[str, moderngl.Text
     mesh, params = obj.mesh, obj.material.params
     comb = None if mesh.has_comb else tuple(params.comb)
     texture = frame.resources.current(
-        ("revie_fur_comb_field", obj), (id(mesh), comb),
+        ("revie_fur_comb_field", obj.node), (id(mesh), comb),
         lambda ctx: comb_field_texture(ctx, comb_field(mesh, comb)))
     return {"u_comb_field": texture}
 

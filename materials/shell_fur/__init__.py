@@ -429,8 +429,10 @@ def object_state(frame: Frame, obj: SceneObject) -> ShellFurState:
     """``obj``'s state in the frame's renderer, made the first time it is asked for; keyed by
     the object itself, so objects sharing a material instance each have their own, and
     released with the renderer's resources."""
-    return frame.resources.cached(("shell_fur_state", obj),
-                                  lambda ctx: ShellFurState(ctx, obj))
+    state = frame.resources.cached(("shell_fur_state", obj.node),
+                                   lambda ctx: ShellFurState(ctx, obj))
+    state.obj = obj  # the object as this frame has it (the tracks moving it now)
+    return state
 
 
 class ObjectStateInputs:
@@ -439,14 +441,13 @@ class ObjectStateInputs:
     same state); the pass binds the state's textures, and those that clump (``clumps``) learn
     whether the mesh's UVs wrap."""
 
-    obj: SceneObject
     name: str
     clumps = False
     # the frame prepared for (weakly: a pass keeps no frame alive) and the state
     _prepared: tuple[weakref.ref, ShellFurState] | None = None
 
     def prepare(self, frame: Frame) -> None:
-        state = object_state(frame, self.obj)
+        state = object_state(frame, self.object(frame))
         state.advance(frame.time)  # a no-op for the object's other passes: already there
         self._prepared = (weakref.ref(frame), state)
 
@@ -468,7 +469,7 @@ class ObjectStateInputs:
             state = self.state(frame)
             uniforms["u_mask_wrap"] = tuple(float(w) for w in state.wrap)
             # the world density over the UVs: tiles per world unit x world units per UV unit
-            uniforms["u_fur_uv_tiles"] = tiles_per_unit(self.obj.material.params) * \
+            uniforms["u_fur_uv_tiles"] = tiles_per_unit(self.object(frame).params) * \
                 state.world_per_uv
         return uniforms
 
@@ -513,7 +514,7 @@ class ShellFurFinPass(FurLightReader, ObjectStateInputs, FinPass):
     clumps = True
 
     def draws(self, frame: Frame) -> int:
-        return 0 if self.obj.material.params.debug == "wetness" else super().draws(frame)
+        return 0 if self.object(frame).params.debug == "wetness" else super().draws(frame)
 
     def defines(self, frame: Frame) -> dict[str, str]:
         return {**super().defines(frame), "FIN_STRAND_TANGENT": "1", "STRAND_CHORD": "1"}

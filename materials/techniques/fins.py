@@ -76,17 +76,17 @@ class FinPass(ObjectPass):
         return {**super().defines(frame), "FUR_FINS": "1"}
 
     def uniforms(self, frame) -> dict[str, Any]:
-        params = self.obj.material.params
+        params = self.object(frame).params
         return {"u_fin_band": params.fin_band, "u_shell_fade": 1.0, "u_shell_depth": 0.0,
                 "u_root_shell": False, "u_shell_weight": 1.0, "u_shell_count": 1.0}
 
     def draws(self, frame) -> int:
         # debug views of the skin or one shell show no fins
-        return 0 if self.obj.material.params.debug in ("comb", "shell_count",
-                                                       "single_shell") else 1
+        return 0 if self.object(frame).params.debug in ("comb", "shell_count",
+                                                        "single_shell") else 1
 
     def draw(self, frame, program: moderngl.Program) -> None:
-        mesh = self.obj.mesh
+        mesh = self.mesh
         geometry = frame.resources.cached(
             ("fins", id(mesh)),
             lambda ctx: fin_geometry(ctx, frame.resources.gpu_mesh(mesh), edge_adjacency(mesh)))

@@ -159,9 +159,9 @@ class SilhouettePass(ObjectPass):
         """The tubes with their neighbours this frame."""
         raise NotImplementedError
 
-    def stroke_settings(self) -> dict[str, Any]:
+    def stroke_settings(self, frame) -> dict[str, Any]:
         """``width`` (pixels), ``color`` (linear RGB), ``fade`` (a, b, c) and ``tolerance``
-        (object units)."""
+        (object units) of the object as ``frame`` has it."""
         raise NotImplementedError
 
     def defines(self, frame) -> dict[str, str]:
@@ -169,9 +169,10 @@ class SilhouettePass(ObjectPass):
         return {**defines, "STROKE_ID_BUFFER": "1"} if self.id_buffer else defines
 
     def uniforms(self, frame) -> dict[str, Any]:
-        settings = self.stroke_settings()
+        settings = self.stroke_settings(frame)
         # the tolerance in view units: the object's largest scale
-        scale = float(np.max(np.linalg.norm(np.asarray(self.obj.model)[:3, :3], axis=0)))
+        scale = float(np.max(np.linalg.norm(np.asarray(self.object(frame).model)[:3, :3],
+                                            axis=0)))
         return {"u_stroke_width": float(settings["width"]),
                 "u_stroke_color": tuple(float(c) for c in settings["color"]),
                 "u_stroke_fade": tuple(float(c) for c in settings["fade"]),

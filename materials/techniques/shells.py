@@ -38,7 +38,7 @@ class DitheredShells:
         # Not while a temporal history follows a moving camera or object: it keeps only a small
         # share of each frame there, too little to average the dither out, which then
         # shimmers (benchmarks/crawl.py measures it).
-        moving = frame.moved_since_last_frame(self.obj)
+        moving = frame.moved_since_last_frame(self.object(frame))
         self._dither = 0.0 if moving else \
             shell_dither(frame.sample_index) / max(self.slabs(self._count), 1.0)
         return count
@@ -72,8 +72,9 @@ class ShellPass(ObjectPass):
         return count - 1.0
 
     def draws(self, frame) -> int:
-        params = self.obj.material.params
-        self._count = shell_count(frame, self.obj, params)
+        obj = self.object(frame)
+        params = obj.params
+        self._count = shell_count(frame, obj, params)
         self._layout = self.layout(self._count, params)
         return len(self._layout)
 
@@ -82,7 +83,7 @@ class ShellPass(ObjectPass):
         if shell is None:
             return None
         depth, fade = shell
-        params = self.obj.material.params
+        params = self.object(frame).params
         self._root = index == 0
         return {"u_shell_depth": depth, "u_shell_fade": fade, "u_root_shell": self._root,
                 "u_shell_weight": VOLUME_LAYERS / max(self.slabs(self._count), 1e-6),

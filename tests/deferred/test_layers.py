@@ -95,7 +95,7 @@ def test_an_upward_import_breaks_the_contract(graph):
     """The check can fail: the GL layer importing the renderer is caught, and so is the core
     naming a scene class in a type hint (an edge grimp records like any other)."""
     for importer, imported in (("deferred.gl.context", "deferred.render.renderer"),
-                               ("deferred.core.passes", "deferred.scene.model")):
+                               ("deferred.core.passes", "deferred.scene.scene")):
         graph.add_import(importer=importer, imported=imported)
         try:
             upward = f"{importer.rsplit('.', 1)[0]} -> {imported.rsplit('.', 1)[0]}"

@@ -185,8 +185,8 @@ def test_inserted_passes_survive_a_rebuild(renderer):
 
 
 def test_an_object_with_a_timeline_keeps_parameters_assigned_to_it(renderer):
-    """Assigning material.params on an object with events makes them its base (the timeline's
-    events apply over them), instead of the timeline overwriting them at the next frame."""
+    """Assigning material.params on an object with events makes them its base: the timeline's
+    events apply over them in each frame's state, and never overwrite them."""
     scene = small_scene()
     ball = scene.objects[0]
     scene.add_event(ball, 1.0, {"specular_intensity": 0.1})
@@ -196,8 +196,10 @@ def test_an_object_with_a_timeline_keeps_parameters_assigned_to_it(renderer):
     r.render(time=0.0)
     assert ball.params.color == (0.1, 0.1, 0.9)
     r.render(time=2.0)
-    assert ball.params.color == (0.1, 0.1, 0.9) and ball.params.specular_intensity == 0.1
-    assert ball.base_params.color == (0.1, 0.1, 0.9)
+    at_two = r.state.object_state(ball).params  # the frame's: the event over the new base
+    assert at_two.color == (0.1, 0.1, 0.9) and at_two.specular_intensity == 0.1
+    assert ball.params is ball.base_params and ball.base_params.color == (0.1, 0.1, 0.9)
+    assert ball.params.specular_intensity == 0.5  # the scene's own, not the timeline's
 
 
 # -- results --------------------------------------------------------------------------------------

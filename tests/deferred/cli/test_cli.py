@@ -106,7 +106,7 @@ def test_console_script_exit_code(tmp_path):
 def test_python_argument_names_read_as_the_options_that_set_them(tmp_path, capsys, monkeypatch):
     """The Python API names its arguments (light_path, size, time, pipeline); through the
     command line the same problems name the options."""
-    import deferred.render.renderer as renderer_module
+    import deferred.render.setup as renderer_module
     from deferred.errors import InputError
 
     def refuse(*args, **kwargs):

@@ -158,7 +158,7 @@ def test_a_texture_set_in_python_counts_against_the_memory_budget(gl, tmp_path, 
     from deferred.errors import InputError
     from deferred.gl.resources import image_texture_bytes
     from deferred.render.renderer import Renderer
-    from deferred.scene.model import Scene
+    from deferred.scene.scene import Scene
 
     write_image(tmp_path / "small.png", np.zeros((8, 8, 3), np.uint8))
     write_image(tmp_path / "large.png", np.zeros((512, 1024, 3), np.uint8))

@@ -352,13 +352,13 @@ def test_an_object_moved_between_frames_is_drawn_where_it_is_now(gl, pipeline):
     kept = scene()
     with Renderer(kept, pipeline, gl=gl) as renderer:
         first = renderer.render().hdr
-        kept.objects[1].model[0, 3] += 0.4  # in place
+        kept.objects[1].position = (-0.2, 0.5, 0.0)  # one part of the placement
         in_place = renderer.render().hdr
         kept.objects[2].model = kept.objects[2].model @ np.diag([1.0, 1.6, 1.0, 1.0])
         replaced = renderer.render().hdr
     assert not np.array_equal(first, in_place) and not np.array_equal(in_place, replaced)
     expected = scene()
-    expected.objects[1].model[0, 3] += 0.4
+    expected.objects[1].position = (-0.2, 0.5, 0.0)
     np.testing.assert_array_equal(in_place, fresh(expected))
     expected.objects[2].model = expected.objects[2].model @ np.diag([1.0, 1.6, 1.0, 1.0])
     np.testing.assert_array_equal(replaced, fresh(expected))

@@ -9,6 +9,7 @@ from deferred.io.images import read_image
 from deferred.io.paths import expand_pattern, output_kind
 from deferred.io.video import frame_times, gif_durations
 from deferred.scene.loader import scene_from_toml
+from deferred.scene.timeline import SceneEvaluator
 
 SCENE = """
 size = [64, 48]
@@ -81,13 +82,14 @@ def test_params_at_before_at_and_after_events():
     assert later.color == (0.1, 0.1, 0.8) and later.specular_exponent == 8.0
     assert ball.params_at(0.15) is at  # validated once per set of applied events
     assert ball.params_at(1e6) is later
-    scene.apply_timeline(0.15)
-    assert ball.material.params is at
+    evaluator = SceneEvaluator(scene)  # what a renderer evaluates each frame
+    assert evaluator.evaluate(0.15).object_state(ball).params is at
     cube_params = cube.material.params
-    scene.apply_timeline(0.3)
-    assert ball.material.params is later and cube.material.params is cube_params
-    scene.apply_timeline(0.0)
-    assert ball.material.params.color == (0.8, 0.1, 0.1)
+    state = evaluator.evaluate(0.3)
+    assert state.object_state(ball).params is later
+    assert state.object_state(cube).material is cube.material  # no event: the object's own
+    assert evaluator.evaluate(0.0).object_state(ball).params.color == (0.8, 0.1, 0.1)
+    assert ball.material.params is ball.base_params and cube.material.params is cube_params
 
 
 def test_events_at_the_same_time_apply_in_file_order():

@@ -7,7 +7,7 @@ import time
 
 import pytest
 
-import deferred.scene.model as scene_model
+import deferred.scene.objects as scene_model
 from deferred.scene.loader import scene_from_toml
 
 

@@ -17,7 +17,7 @@ from deferred.io.images import read_image
 from deferred.render.renderer import Renderer
 from deferred.scene.camera import model_matrix
 from deferred.scene.loader import scene_from_toml
-from deferred.scene.model import SceneObject
+from deferred.scene.objects import SceneObject
 from deferred.scene.schema import scene_schema
 
 BASE = """
@@ -131,9 +131,9 @@ def test_between_keys_the_camera_a_light_and_an_object_follow_the_formula(
     ball = scene.objects[0]
     expected = model_matrix(reference(OBJECT, time), reference(ROTATION, time),
                             reference(SCALE, time))
-    assert np.allclose(ball.model_at(time), expected, atol=1e-12)
+    assert np.allclose(ball.local_at(time), expected, atol=1e-12)
     # the object between keys is neither key (the test would pass a track that holds)
-    assert not np.allclose(ball.model_at(time), ball.model_at(TIMES[segment(time)[0]]))
+    assert not np.allclose(ball.local_at(time), ball.local_at(TIMES[segment(time)[0]]))
 
 
 def test_smooth_differs_from_linear_and_eases_at_the_ends():
@@ -151,7 +151,7 @@ def test_step_holds_and_times_out_of_range_clamp():
     for time, index in [(0.0, 0), (0.99, 0), (1.0, 1), (2.99, 1), (3.0, 2), (50.0, 2)]:
         assert scene.camera_at(time).position == CAMERA[index]
         assert scene.light_params_at(key, time).intensity == INTENSITY[index]
-        assert np.allclose(ball.model_at(time),
+        assert np.allclose(ball.local_at(time),
                            model_matrix(OBJECT[index], ROTATION[index], SCALE[index]))
     for interpolation in ("linear", "smooth"):
         scene = scene_with(interpolation)
@@ -176,40 +176,54 @@ def test_a_seek_gives_the_frame_of_a_sequence_bit_for_bit(gl):
             assert np.array_equal(renderer.render(time=times[index]).image, sequence[index])
 
 
-def test_a_scene_without_tracks_is_left_as_it_is():
-    scene = scene_from_toml(BASE, "s.toml")
+def test_rendering_leaves_the_scene_as_it_was_given(gl):
+    """The timeline is evaluated, never written back: after frames at several times, every
+    object's placement and parameters, every light's and the camera are the very values the
+    scene was made with (the same objects, not copies)."""
+    scene = scene_with("smooth")
     models = [obj.model for obj in scene.objects]
-    params = [light.params for light in scene.lights]
+    transforms = [obj.transform for obj in scene.objects]
+    materials = [(obj.material, obj.material.params) for obj in scene.objects]
+    lights = [light.params for light in scene.lights]
     camera = scene.camera
-    scene.apply_timeline(2.0)
-    assert [obj.model for obj in scene.objects] == models  # the same arrays, not copies
-    assert all(a is b for a, b in zip([o.model for o in scene.objects], models, strict=True))
-    assert all(light.params is p for light, p in zip(scene.lights, params, strict=True))
+    revisions = [obj.revision for obj in scene.objects] + [scene.revision]
+    with Renderer(scene, gl=gl, size=(32, 24)) as renderer:
+        for time in (2.0, 0.5, 2.9):
+            renderer.render(time=time)
+            assert renderer.state.time == time
+    assert all(obj.model is model for obj, model in zip(scene.objects, models, strict=True))
+    assert all(obj.transform is t for obj, t in zip(scene.objects, transforms, strict=True))
+    assert all(obj.material is m and obj.material.params is p
+               for obj, (m, p) in zip(scene.objects, materials, strict=True))
+    assert all(light.params is p for light, p in zip(scene.lights, lights, strict=True))
     assert scene.camera is camera
+    assert [obj.revision for obj in scene.objects] + [scene.revision] == revisions
 
 
-def test_what_is_set_by_hand_becomes_the_base_of_the_tracks():
+def test_what_is_set_by_hand_is_the_base_of_the_tracks():
     scene = scene_with("linear")
-    scene.apply_timeline(0.5)
     scene.camera = dataclasses.replace(scene.camera, target=(0.0, 0.3, 0.0), near=0.1)
-    scene.apply_timeline(0.5)
-    assert scene.camera.near == 0.1 and scene.camera.target == (0.0, 0.3, 0.0)
-    assert np.allclose(scene.camera.position, linear_reference(CAMERA, 0.5))
+    moved = scene.camera_at(0.5)
+    assert moved.near == 0.1 and moved.target == (0.0, 0.3, 0.0)
+    assert np.allclose(moved.position, linear_reference(CAMERA, 0.5))
     box = scene.objects[1]  # no placement known: the matrix's is found
     bare = SceneObject("bare", box.mesh, box.material, model_matrix((1, 2, 3), (30, 60, 10), 2))
     scene.objects.append(bare)
     scene.add_track(bare, [{"time": 0.0, "position": [0.0, 0.0, 0.0]},
                            {"time": 1.0, "position": [2.0, 0.0, 0.0]}])
-    assert np.allclose(bare.model_at(0.5), model_matrix((1, 0, 0), (30, 60, 10), 2))
+    assert np.allclose(bare.local_at(0.5), model_matrix((1, 0, 0), (30, 60, 10), 2))
+    assert np.allclose(scene.world_at(bare, 0.5), bare.local_at(0.5))  # no parent
 
 
-def test_the_model_at_a_time_does_not_depend_on_the_frames_before():
+def test_the_model_at_a_time_does_not_depend_on_the_frames_before(gl):
     scene = scene_with("smooth")
     ball = scene.objects[0]
-    direct = ball.model_at(1.7)
-    for time in (0.0, 2.9, 0.3, 1.7):
-        scene.apply_timeline(time)
-    assert np.array_equal(ball.model, direct) and np.array_equal(ball.model_at(1.7), direct)
+    direct = ball.local_at(1.7)
+    with Renderer(scene, gl=gl, size=(32, 24)) as renderer:
+        for time in (0.0, 2.9, 0.3, 1.7):
+            renderer.render(time=time)
+        assert np.array_equal(renderer.state.object_state(ball).model, direct)
+    assert np.array_equal(ball.local_at(1.7), direct)
 
 
 # -- the turntable -------------------------------------------------------------------------------
@@ -403,29 +417,28 @@ def test_the_camera_returns_to_its_base_when_what_moved_it_goes():
     scene = Scene(camera=Camera(position=(0.0, 1.0, 4.0), target=(0.0, 0.0, 0.0)))
     base = scene.camera
     scene.set_turntable(8)
-    scene.apply_timeline(0.25)
-    assert scene.camera is not base
+    assert scene.camera_at(0.25) != base and scene.camera is base
     scene.set_turntable(None)
-    scene.apply_timeline(0.0)
-    assert scene.camera is base
+    assert scene.camera_at(0.25) is base
     stranger = Scene().add_object("builtin:sphere", label="elsewhere")
     with pytest.raises(InputError, match="^target: the object 'elsewhere' is not in the scene"):
         scene.add_track(stranger, [{"time": 0.0, "position": [0.0, 0.0, 0.0]}])
 
 
-def test_a_model_edited_in_place_becomes_the_base_the_tracks_animate():
-    """Writing into obj.model (ObjectTransforms notices in-place writes too) moves the base a
-    rotation track animates, whether the array is the scene's own or the one the tracks set."""
+def test_a_placement_set_by_hand_is_the_base_the_tracks_animate():
+    """A new position (or a matrix) set on an object moves the base a rotation track
+    animates; a model matrix is a value: writing into it in place is refused, not missed."""
     from deferred import Scene
 
     scene = Scene()
     ball = scene.add_object("builtin:sphere", label="ball")
     scene.add_track(ball, [{"time": 0.0, "rotation": [0.0, 0.0, 0.0]},
                            {"time": 1.0, "rotation": [0.0, 90.0, 0.0]}])
-    scene.apply_timeline(0.5)
-    ball.model[:3, 3] = (1.0, 2.0, 3.0)  # the array the tracks set
-    scene.apply_timeline(1.0)
-    np.testing.assert_allclose(ball.model[:3, 3], (1.0, 2.0, 3.0), atol=1e-12)
-    ball.model[:3, 3] = (-1.0, 0.0, 0.5)
-    scene.apply_timeline(0.25)
-    np.testing.assert_allclose(ball.model[:3, 3], (-1.0, 0.0, 0.5), atol=1e-12)
+    with pytest.raises(ValueError, match="read-only"):
+        ball.model[:3, 3] = (1.0, 2.0, 3.0)
+    ball.position = (1.0, 2.0, 3.0)
+    np.testing.assert_allclose(ball.local_at(1.0)[:3, 3], (1.0, 2.0, 3.0), atol=1e-12)
+    moved = ball.model.copy()
+    moved[:3, 3] = (-1.0, 0.0, 0.5)
+    ball.model = moved
+    np.testing.assert_allclose(ball.local_at(0.25)[:3, 3], (-1.0, 0.0, 0.5), atol=1e-12)

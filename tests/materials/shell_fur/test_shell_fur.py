@@ -31,6 +31,7 @@ from deferred.materials.techniques.wetness import (
 )
 from deferred.scene.builtin_meshes import builtin_plane, builtin_sphere
 from deferred.scene.loader import scene_from_dict
+from deferred.scene.timeline import SceneEvaluator
 
 HARNESS = FIXTURES / "shell_fur_harness"
 
@@ -604,13 +605,17 @@ def test_forward_and_deferred_agree_on_straight_fur(render):
     assert covered.mean() > 0.3
 
 
+def evaluated(scene, time: float = 0.0):
+    """The scene's first object as a frame at ``time`` has it (its state: what a material
+    reads of it)."""
+    return SceneEvaluator(scene).evaluate(time).objects[0]
+
+
 def state_at(gl, scene_dict, times):
     scene = scene_from_dict(scene_dict, "anim")
-    obj = scene.objects[0]
-    state = ShellFurState(gl.ctx, obj)
+    state = ShellFurState(gl.ctx, evaluated(scene))
     out = []
     for t in times:
-        scene.apply_timeline(t)
         state.advance(t)
         out.append((state.mask.copy(), state.strands.deflections().copy()))
     state.release()
@@ -682,7 +687,7 @@ def test_deflections_come_back_to_object_space(gl):
                          "params": {"fur_length": 0.2, "damping": 0.5}}]}
     loaded = scene_from_dict(scene, "s")
     obj = loaded.objects[0]
-    state = ShellFurState(gl.ctx, obj)
+    state = ShellFurState(gl.ctx, evaluated(loaded))
     state.advance(0.0)  # settled under gravity
     deflection = state.vertex_deflections()
     linear = obj.model[:3, :3]
@@ -1150,7 +1155,7 @@ def test_a_moving_object_carries_its_strands_along(gl):
         renderer.render(time=2.0, readback=False)
         state = renderer.resources.cached(("shell_fur_state", obj), lambda ctx: None)
         assert isinstance(state, ShellFurState)
-        model = obj.model_at(2.0)
+        model = scene.world_at(obj, 2.0)
         assert np.allclose(state.model, model)
         world = state.vertex_deflections() @ model[:3, :3].T
         assert world[:, 1].mean() < -1e-3  # hanging down the world, not the object

@@ -1,0 +1,48 @@
+"""What a renderer will hold, counted against the memory budget before anything is made: the
+pass graph's render targets, the materials' textures and state, the shadow atlas and deep
+opacity maps, the effects' histories."""
+
+from __future__ import annotations
+
+from deferred.core.graph import PassGraph
+from deferred.gl.target_spec import targets_bytes
+from deferred.io.images import amount
+from deferred.io.memory import check_memory
+from deferred.lighting.shadows import atlas_memory, opacity_size, scene_casts_shadows
+from deferred.scene.state import FrameState
+
+
+def check_target_memory(graph: PassGraph, size: tuple[int, int], where: str = "size",
+                        held: dict[str, int] | None = None, held_where: str = "scene") -> None:
+    """Refuse a frame size whose render targets need more than the memory budget (naming
+    ``where``), then a scene whose materials will hold more (``held``:
+    :meth:`~deferred.interfaces.material.Material.held_memory`) than what the targets leave
+    (naming ``held_where`` and the largest of what they hold)."""
+    targets = targets_bytes(graph.targets.values(), *size)
+    check_memory(targets, f"{size[0]}x{size[1]} needs {{}} of render targets "
+                          f"({len(graph.targets)} targets)", where)
+    if held:
+        largest = max(held, key=held.__getitem__)
+        check_memory(targets + sum(held.values()),
+                     f"the materials' textures and state ({len(held)}, the largest "
+                     f"{largest}: {amount(held[largest])}) and the render targets at "
+                     f"{size[0]}x{size[1]} need {{}}", held_where)
+
+
+def held_memory(scene: FrameState) -> dict[str, int]:
+    """What every object's material will hold, by what it is (a shared texture once)."""
+    held: dict[str, int] = {}
+    for obj in scene.objects:
+        held.update(obj.material.held_memory(obj))
+    return held
+
+
+def renderer_holdings(scene: FrameState, pipeline: str, size: tuple[int, int]) -> dict[str, int]:
+    """What a renderer of ``scene`` holds besides its pass graph's targets: the materials'
+    textures and state, the shadow atlas and opacity maps, the effects' histories."""
+    held = held_memory(scene)
+    if scene_casts_shadows(scene.lights):
+        held.update(atlas_memory(scene.shadow_budget, opacity_size(scene, pipeline)))
+    for effect in scene.effects:
+        held.update(effect.held_memory(size))
+    return held

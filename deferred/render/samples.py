@@ -1,0 +1,60 @@
+"""A frame averaged over sub-pixel samples (``deferred render --samples N``): each sample moved
+by an offset of the Halton (2, 3) sequence, the images averaged in linear light."""
+
+from __future__ import annotations
+
+import numbers
+from typing import Any, Protocol
+
+import numpy as np
+
+from deferred.errors import InputError
+from deferred.interfaces.effect import halton
+from deferred.io.images import srgb_decode, srgb_encode
+from deferred.render.result import RenderResult
+
+
+class SampledRenderer(Protocol):
+    """What :func:`render_samples` asks of a renderer (:class:`deferred.render.renderer.
+    Renderer`)."""
+
+    temporal: Any
+
+    def render(self, **options: Any) -> RenderResult: ...
+
+MAX_SAMPLES = 1024  # sub-pixel samples a frame
+
+__all__ = ["MAX_SAMPLES", "halton", "halton_offsets", "render_samples"]
+
+
+def halton_offsets(count: int) -> list[tuple[float, float]]:
+    """``count`` sub-pixel offsets in [-0.5, 0.5)^2: Halton (2, 3) from index 1, centred."""
+    return [(halton(k, 2) - 0.5, halton(k, 3) - 0.5) for k in range(1, count + 1)]
+
+
+def render_samples(renderer: SampledRenderer, samples: int, time: float = 0.0) -> RenderResult:
+    """:meth:`Renderer.render_samples`: the frame at ``time`` averaged over ``samples``
+    renders; the image averaged in linear light (its sRGB decoded, then encoded again) and the
+    float composite averaged, converging to a supersampled frame (a box filter over the
+    pixel). One sample is a plain render."""
+    if isinstance(samples, bool) or not isinstance(samples, numbers.Integral) or \
+            not 1 <= samples <= MAX_SAMPLES:
+        raise InputError(f"must be a whole number 1..{MAX_SAMPLES}, got {samples!r}",
+                         "samples")
+    if samples == 1:
+        return renderer.render(time=time, hdr=True)
+    light = composite = None
+    for index, jitter in enumerate(halton_offsets(samples)):
+        # each sample its own parity of the stipple pattern (sample_index), which the
+        # average integrates (Revie's 1-in-4 pattern covers every pixel over four)
+        # each sample alone: a temporal effect's history would average the samples twice
+        renderer.temporal.reset()
+        result = renderer.render(time=time, hdr=True, jitter=jitter, sample_index=index)
+        decoded = srgb_decode(result.image.astype(np.float64) / 255.0)
+        light = decoded if light is None else light + decoded
+        composite = result.hdr.astype(np.float64) if composite is None \
+            else composite + result.hdr
+    image = np.clip(np.rint(srgb_encode(light / samples) * 255.0), 0, 255).astype(np.uint8)
+    return RenderResult(image, result.draw_calls * samples,
+                        {name: count * samples for name, count in result.draws_by_pass.items()},
+                        _hdr=(composite / samples).astype(np.float32))
