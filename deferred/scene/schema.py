@@ -38,6 +38,29 @@ class _Generator(GenerateJsonSchema):
         return {}
 
 
+class _Definitions:
+    """Pydantic's JSON Schema of the scene model and of every registered type's parameters:
+    the definitions by name, and each model's reference among them."""
+
+    def __init__(self, models: list[type[BaseModel]]):
+        with warnings.catch_warnings():  # a default with no JSON form is left out, said here
+            warnings.simplefilter("ignore")
+            self.refs, top = models_json_schema([(model, "validation") for model in models],
+                                                ref_template="#/definitions/{model}",
+                                                schema_generator=_Generator)
+        self.by_name: dict[str, Any] = top.get("$defs", {})
+
+    def ref(self, model: type[BaseModel]) -> str:
+        return self.refs[(model, "validation")]["$ref"]
+
+    def of(self, model: type[BaseModel]) -> dict[str, Any]:
+        return self.by_name[self.ref(model).rsplit("/", 1)[1]]
+
+    def of_items(self, table: dict[str, Any]) -> dict[str, Any]:
+        """The definition of an array of tables' items (``[[object]]``, ``[[track]]``)."""
+        return self.by_name[table["items"]["$ref"].rsplit("/", 1)[1]]
+
+
 def scene_schema() -> dict[str, Any]:
     """The JSON Schema (draft-07) of a scene file, for every registered material, light and
     effect."""
@@ -48,24 +71,35 @@ def scene_schema() -> dict[str, Any]:
         for _, cls in types:
             if cls.Params not in models:
                 models.append(cls.Params)
-    with warnings.catch_warnings():  # a default with no JSON form is left out, said here
-        warnings.simplefilter("ignore")
-        refs, top = models_json_schema([(model, "validation") for model in models],
-                                       ref_template="#/definitions/{model}",
-                                       schema_generator=_Generator)
-    definitions: dict[str, Any] = top.get("$defs", {})
-
-    def ref(model: type[BaseModel]) -> str:
-        return refs[(model, "validation")]["$ref"]
-
-    def definition(model: type[BaseModel]) -> dict[str, Any]:
-        return definitions[ref(model).rsplit("/", 1)[1]]
-
-    root = definitions.pop(ref(SceneModel).rsplit("/", 1)[1])
+    definitions = _Definitions(models)
+    root = definitions.by_name.pop(definitions.ref(SceneModel).rsplit("/", 1)[1])
     properties = root["properties"]
-    # [[object]]: the material names, and each material's params
-    objects = definitions[properties["object"]["items"]["$ref"].rsplit("/", 1)[1]]
-    names = [name for name, _ in kinds["material"]]
+    _object_materials(definitions, properties, kinds["material"])
+    typed = properties["light"]["items"]["$ref"].rsplit("/", 1)[1]
+    for kind in ("light", "effect"):
+        _typed_tables(definitions, properties, kind, kinds[kind])
+    definitions.by_name.pop(typed, None)
+    ssao = dict(kinds["effect"]).get("ssao")
+    if ssao is not None:  # the [ssao] table: the ssao effect's parameters
+        properties["ssao"] = {"$ref": definitions.ref(ssao.Params),
+                              "description": properties["ssao"].get("description", "")}
+    events = definitions.of_items(properties["event"])
+    events["properties"]["params"] = {
+        "type": "object",
+        "description": "parameters of the object's material, merged over the object's"}
+    _track_keys(definitions, properties)
+    schema = {"$schema": DRAFT, "title": "deferred scene file",
+              "description": "A scene for deferred (TOML); written by `deferred schema` for the "
+                             "materials, lights and effects registered where it ran.",
+              **root, "definitions": definitions.by_name}
+    return _draft_07(schema)
+
+
+def _object_materials(definitions: _Definitions, properties: dict[str, Any],
+                      materials: list[tuple[str, Any]]) -> None:
+    """[[object]]: the material names, and each material's params."""
+    objects = definitions.of_items(properties["object"])
+    names = [name for name, _ in materials]
     objects["properties"]["material"] = {
         "enum": names, "default": DEFAULT_MATERIAL,
         "description": "the material (deferred params material lists them)"}
@@ -74,60 +108,51 @@ def scene_schema() -> dict[str, Any]:
     objects["allOf"] = [
         {"if": {"properties": {"material": {"const": name}},
                 **({} if name == DEFAULT_MATERIAL else {"required": ["material"]})},
-         "then": {"properties": {"params": {"$ref": ref(cls.Params)}}}}
-        for name, cls in kinds["material"]]
-    # [[light]] and [[effect]]: the type names, and each type's parameters beside it
-    typed = properties["light"]["items"]["$ref"].rsplit("/", 1)[1]
-    for kind, key in (("light", "light"), ("effect", "effect")):
-        names = [name for name, _ in kinds[kind]]
-        branches = []
-        for name, cls in kinds[kind]:
-            params = copy.deepcopy(definition(cls.Params))
-            params["properties"] = {"type": {"const": name}, **params.get("properties", {})}
-            if kind == "light":  # what tracks may call it (light:NAME)
-                params["properties"]["name"] = {
-                    "type": "string", "minLength": 1, "pattern": "^.*[^0-9].*$",
-                    "description": "a name for tracks (target = 'light:NAME'); not a number"}
-                params["properties"]["parent"] = {
-                    "type": "string", "minLength": 1,
-                    "description": "the name of an object or group its position and "
-                                   "direction are in"}
-            params["required"] = ["type", *params.get("required", [])]
-            params["additionalProperties"] = False
-            definitions[f"{kind}.{name}"] = params
-            branches.append({"if": {"properties": {"type": {"const": name}},
-                                    "required": ["type"]},
-                             "then": {"$ref": f"#/definitions/{kind}.{name}"}})
-        definitions[kind] = {
-            "type": "object", "required": ["type"],
-            "properties": {"type": {"enum": names,
-                                    "description": f"the {kind} type (deferred params "
-                                                   f"{kind} lists them)"}},
-            "allOf": branches}
-        properties[key]["items"] = {"$ref": f"#/definitions/{kind}"}
-    definitions.pop(typed, None)
-    ssao = dict(kinds["effect"]).get("ssao")
-    if ssao is not None:  # the [ssao] table: the ssao effect's parameters
-        properties["ssao"] = {"$ref": ref(ssao.Params),
-                              "description": properties["ssao"].get("description", "")}
-    events = definitions[properties["event"]["items"]["$ref"].rsplit("/", 1)[1]]
-    events["properties"]["params"] = {
-        "type": "object",
-        "description": "parameters of the object's material, merged over the object's"}
-    # [[track]]: the target's form, and its kind's key properties
-    tracks = definitions[properties["track"]["items"]["$ref"].rsplit("/", 1)[1]]
+         "then": {"properties": {"params": {"$ref": definitions.ref(cls.Params)}}}}
+        for name, cls in materials]
+
+
+def _typed_tables(definitions: _Definitions, properties: dict[str, Any], kind: str,
+                  types: list[tuple[str, Any]]) -> None:
+    """[[light]] or [[effect]]: the type names, and each type's parameters beside it."""
+    names = [name for name, _ in types]
+    branches = []
+    for name, cls in types:
+        params = copy.deepcopy(definitions.of(cls.Params))
+        params["properties"] = {"type": {"const": name}, **params.get("properties", {})}
+        if kind == "light":  # what tracks may call it (light:NAME)
+            params["properties"]["name"] = {
+                "type": "string", "minLength": 1, "pattern": "^.*[^0-9].*$",
+                "description": "a name for tracks (target = 'light:NAME'); not a number"}
+            params["properties"]["parent"] = {
+                "type": "string", "minLength": 1,
+                "description": "the name of an object or group its position and "
+                               "direction are in"}
+        params["required"] = ["type", *params.get("required", [])]
+        params["additionalProperties"] = False
+        definitions.by_name[f"{kind}.{name}"] = params
+        branches.append({"if": {"properties": {"type": {"const": name}},
+                                "required": ["type"]},
+                         "then": {"$ref": f"#/definitions/{kind}.{name}"}})
+    definitions.by_name[kind] = {
+        "type": "object", "required": ["type"],
+        "properties": {"type": {"enum": names,
+                                "description": f"the {kind} type (deferred params "
+                                               f"{kind} lists them)"}},
+        "allOf": branches}
+    properties[kind]["items"] = {"$ref": f"#/definitions/{kind}"}
+
+
+def _track_keys(definitions: _Definitions, properties: dict[str, Any]) -> None:
+    """[[track]]: the target's form, and its kind's key properties."""
+    tracks = definitions.of_items(properties["track"])
     tracks["properties"]["target"]["pattern"] = "^(camera|object:.+|light:.+)$"
     tracks["properties"]["keys"]["items"] = {"type": "object", "required": ["time"]}
     tracks["allOf"] = [
         {"if": {"properties": {"target": {"pattern": pattern}}, "required": ["target"]},
-         "then": {"properties": {"keys": {"items": {"$ref": ref(KEY_MODELS[kind])}}}}}
+         "then": {"properties": {"keys": {"items": {"$ref": definitions.ref(KEY_MODELS[kind])}}}}}
         for kind, pattern in (("camera", "^camera$"), ("object", "^object:"),
                               ("light", "^light:"))]
-    schema = {"$schema": DRAFT, "title": "deferred scene file",
-              "description": "A scene for deferred (TOML); written by `deferred schema` for the "
-                             "materials, lights and effects registered where it ran.",
-              **root, "definitions": definitions}
-    return _draft_07(schema)
 
 
 def _draft_07(node: Any) -> Any:
