@@ -8,7 +8,9 @@ from deferred.core.graph import PassGraph
 from deferred.gl.target_spec import targets_bytes
 from deferred.io.images import amount
 from deferred.io.memory import check_memory
-from deferred.lighting.shadows import atlas_memory, opacity_size, scene_casts_shadows
+from deferred.lighting.shadows.atlas import atlas_memory
+from deferred.lighting.shadows.opacity import opacity_size
+from deferred.lighting.shadows.plan import scene_casts_shadows
 from deferred.scene.state import FrameState
 
 

@@ -50,7 +50,8 @@ from deferred.gl.targets import (
 from deferred.interfaces.effect import AMBIENT_OCCLUSION
 from deferred.interfaces.material import ForwardLitPass
 from deferred.lighting.culling import LightCullPass, list_shading_pass
-from deferred.lighting.shadows import ShadowPass, scene_casts_shadows
+from deferred.lighting.shadows.caster_pass import ShadowPass
+from deferred.lighting.shadows.plan import scene_casts_shadows
 from deferred.lighting.volumes import LightTypePass, surface_pass
 from deferred.memo import overrides
 from deferred.scene.state import FrameState, ObjectState

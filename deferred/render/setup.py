@@ -26,16 +26,14 @@ from deferred.lighting.lists import (
     check_light_radii,
 )
 from deferred.lighting.paths import resolve_light_path
-from deferred.lighting.shadows import (
+from deferred.lighting.shadows.atlas import SHADOW_ATLAS, SHADOWS_DEFINE, ShadowAtlas
+from deferred.lighting.shadows.opacity import (
     OPACITY_SHADOWS_DEFINE,
-    SHADOW_ATLAS,
-    SHADOWS_DEFINE,
-    ShadowAtlas,
     opacity_extent,
     opacity_size,
-    scene_casts_shadows,
     scene_has_opacity,
 )
+from deferred.lighting.shadows.plan import scene_casts_shadows
 from deferred.names import LightVolume
 from deferred.render.budget import check_target_memory, renderer_holdings
 from deferred.render.generated import generated_glsl

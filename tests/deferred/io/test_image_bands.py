@@ -180,7 +180,7 @@ def test_a_texture_set_in_python_counts_against_the_memory_budget(gl, tmp_path, 
 def test_what_a_renderer_holds_counts_shadow_maps_and_histories_after_an_edit(gl):
     """memory_bytes counts the shadow atlas and TAA's history besides the targets and the
     materials' holdings, when built and after a parameter edit alike."""
-    from deferred.lighting.shadows import atlas_memory
+    from deferred.lighting.shadows.atlas import atlas_memory
     from deferred.render.renderer import Renderer, renderer_holdings
     from deferred.scene.loader import scene_from_dict
 

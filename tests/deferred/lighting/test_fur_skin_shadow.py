@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from deferred.lighting.shadows import OPACITY_LAYERS
+from deferred.lighting.shadows.opacity import OPACITY_LAYERS
 from deferred.materials.techniques.fur import (
     OPACITY_SHELLS,
     FurParams,

@@ -14,7 +14,7 @@ import pytest
 from locations import ROOT
 
 from deferred.interfaces import registry
-from deferred.lighting.shadows import OPACITY_LAYERS
+from deferred.lighting.shadows.opacity import OPACITY_LAYERS
 from deferred.render.renderer import Renderer
 from deferred.scene.loader import scene_from_dict
 

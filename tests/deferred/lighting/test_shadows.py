@@ -15,7 +15,8 @@ import numpy as np
 import pytest
 
 from deferred.errors import InputError
-from deferred.lighting.shadows import SHADOW_ATLAS, practical_splits
+from deferred.lighting.shadows.atlas import SHADOW_ATLAS
+from deferred.lighting.shadows.frusta import practical_splits
 from deferred.render.renderer import Renderer
 from deferred.scene.loader import scene_from_dict
 
@@ -335,7 +336,7 @@ def test_a_light_whose_maps_do_not_fit_leaves_its_squares_to_the_others(point_fi
     """A 256^2 atlas holds four 128^2 squares: a point light's six do not fit, a spot light's
     one does, listed before or after it (the point light's first four squares were kept,
     and the spot light was refused as not fitting)."""
-    from deferred.lighting.shadows import plan_atlas
+    from deferred.lighting.shadows.plan import plan_atlas
 
     the_scene = scene_from_dict({"light": [
         {"type": "point", "position": [0.0, 2.0, 0.0], "shadows": True,

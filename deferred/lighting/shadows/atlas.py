@@ -1,0 +1,272 @@
+"""The shadow atlas: one depth texture holding every shadowed light's maps, the records texture
+of each slot's matrices (``lighting/shadows.glsl`` documents its layout) and, where the scene
+draws them, the deep opacity maps; this frame's tiles. A binding source of the frame."""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import moderngl
+import numpy as np
+
+from deferred.interfaces.light import Light
+from deferred.interfaces.material import ShadowView
+from deferred.lighting.buffer import visible_spheres
+from deferred.lighting.shadows.bounds import world_bounds
+from deferred.lighting.shadows.frusta import (
+    cascade_frusta,
+    cube_frusta,
+    near_far,
+    spot_frustum,
+    unit,
+)
+from deferred.lighting.shadows.opacity import OPACITY_FAR, OPACITY_LAYERS
+from deferred.lighting.shadows.plan import plan_atlas
+from deferred.names import ShadowProjection
+
+if TYPE_CHECKING:
+    from deferred.gl.uniforms import ProgramUniforms
+from deferred.scene.scene import Scene
+
+SHADOW_ATLAS = "shadow_atlas"  # its name on a frame's blackboard
+SHADOWS_DEFINE = "SHADOWS"
+RECORD_TEXELS = 40  # texels a slot's row: 4 + 6 tiles x 6 (lighting/shadows.glsl)
+CASCADE_BLEND = 0.1  # the fraction of a cascade blended into the next at its far end
+PROJECTION_IDS = {ShadowProjection.CASCADES: 1, ShadowProjection.PERSPECTIVE: 2,
+                  ShadowProjection.CUBE: 3}
+
+
+def atlas_memory(budget: Any, opacity_size: int = 0) -> dict[str, int]:
+    """What the shadow atlas of a scene's budget holds, for the memory budget: its depths
+    (4 bytes a texel) and its records; with an ``opacity_size``
+    (:func:`~deferred.lighting.shadows.opacity.opacity_size`), the opacity maps (the front and
+    back depths as drawn 8 + grown 8 + four half-float layers 8 bytes a texel)."""
+    size = budget.atlas_size
+    held = {f"shadow atlas {size}^2": size * size * 4 +
+            RECORD_TEXELS * 16 * budget.max_shadowed_lights}
+    if opacity_size:
+        held[f"opacity shadow maps {opacity_size}^2"] = opacity_size * opacity_size * 24
+    return held
+
+
+def tile_matrix(x: int, y: int, size: int, atlas: int) -> np.ndarray:
+    """NDC of a map -> (u, v, depth) of its tile in the atlas."""
+    half = size / (2.0 * atlas)
+    return np.array([[half, 0.0, 0.0, x / atlas + half], [0.0, half, 0.0, y / atlas + half],
+                     [0.0, 0.0, 0.5, 0.5], [0.0, 0.0, 0.0, 1.0]])
+
+
+@dataclass
+class ShadowTile:
+    """One map of a light: its square of the atlas and the light's view and projection."""
+
+    light: Light
+    slot: int
+    x: int
+    y: int
+    size: int
+    view_projection: np.ndarray  # world -> clip (the caster pass)
+    view: ShadowView
+    # the light's reach (centre, radius) for culling casters; None: every object
+    reach: tuple[np.ndarray, float] | None = None
+
+
+class ShadowAtlas:
+    """The shadow atlas, its records texture and this frame's tiles (a binding source)."""
+
+    def __init__(self, ctx: moderngl.Context, atlas_size: int, max_lights: int,
+                 opacity_size: int = 0, opacity_extent: int = 0):
+        """``opacity_size``: texels on a side of the deep opacity maps (0: none), covering the
+        atlas's square of ``opacity_extent`` texels from its corner."""
+        self.ctx = ctx
+        self.size = atlas_size
+        self.max_lights = max_lights
+        self.texture = ctx.depth_texture((atlas_size, atlas_size))
+        self.texture.compare_func = "<="
+        self.texture.filter = (moderngl.LINEAR, moderngl.LINEAR)
+        self.texture.repeat_x = self.texture.repeat_y = False
+        self.framebuffer = ctx.framebuffer(depth_attachment=self.texture)
+        self.framebuffer.clear(depth=1.0)  # tiles no light holds read as lit, and show so
+        self.records = ctx.texture((RECORD_TEXELS, max_lights), 4, dtype="f4")
+        self.records.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        self.tiles: list[ShadowTile] = []
+        self.slots: dict[int, int] = {}  # id(light) -> slot (1-based)
+        self.splits: dict[int, np.ndarray] = {}  # id(light) -> its cascades' far depths
+        self._plan_key: tuple | None = None
+        self._plan: dict = {}
+        self._uniforms: dict[str, Any] = {}
+        self.opacity = None
+        self.opacity_layer = 0.0  # world units: the thickest opacity volume's layer
+        self.opacity_extent = opacity_extent
+        # opacity-map texels per atlas texel (the tiles' rectangles there: theirs times this)
+        self.opacity_scale = opacity_size / opacity_extent if opacity_size else 0.0
+        if opacity_size:
+            side = opacity_size
+            # the fronts (R) and minus the backs (G) as drawn, kept by min blending, and grown
+            # by a texel into opacity_first (what is read)
+            self.opacity_drawn = ctx.texture((side, side), 2, dtype="f4")
+            self.opacity_first = ctx.texture((side, side), 2, dtype="f4")
+            self.opacity = ctx.texture((side, side), 4, dtype="f2")
+            self.opacity.filter = (moderngl.LINEAR, moderngl.LINEAR)
+            for texture in (self.opacity_drawn, self.opacity_first, self.opacity):
+                texture.repeat_x = texture.repeat_y = False
+            for texture in (self.opacity_drawn, self.opacity_first):
+                texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            self.first_framebuffer = ctx.framebuffer([self.opacity_drawn])
+            self.front_framebuffer = ctx.framebuffer([self.opacity_first])
+            self.opacity_framebuffer = ctx.framebuffer([self.opacity])
+            self.first_framebuffer.clear(OPACITY_FAR, OPACITY_FAR, 0.0, 0.0)
+            self.front_framebuffer.clear(OPACITY_FAR, OPACITY_FAR, 0.0, 0.0)
+            self.opacity_framebuffer.clear(0.0, 0.0, 0.0, 0.0)
+
+
+    # -- per frame ---------------------------------------------------------------------------
+    def update(self, scene: Scene, view: np.ndarray, aspect: float,
+               projection: np.ndarray | None = None) -> dict[int, int]:
+        """This frame's tiles and records for the scene's lights seen through ``view`` (the
+        camera's world -> view); the slots by ``id(light)``. A spot or point light whose
+        sphere lies outside the frustum of ``projection`` lights nothing in view (the light
+        buffer drops it too): its maps are not drawn this frame."""
+        self._plan_lights(scene)
+        view = np.asarray(view, np.float64)
+        inverse_view = np.linalg.inv(view)
+        records = np.zeros((self.max_lights, RECORD_TEXELS, 4), np.float32)
+        self.tiles, self.slots, self.splits = [], {}, {}
+        bounds = None
+        for light in scene.lights:
+            planned = self._plan.get(id(light))
+            if planned is None:
+                continue
+            slot, squares = planned
+            params = light.params
+            kind = light.shadow_projection
+            if kind != ShadowProjection.CASCADES and projection is not None:
+                centre = view @ np.append(np.asarray(params.position, np.float64), 1.0)
+                sphere = np.zeros((1, 4, 4), np.float32)
+                sphere[0, 1] = (*centre[:3], params.radius)
+                if not visible_spheres(sphere, projection)[0]:
+                    continue
+            row = records[slot - 1]
+            row[0] = (PROJECTION_IDS[kind], len(squares),
+                      0.0 if params.shadow_filter == "pcf" else 1.0, params.shadow_softness)
+            row[1] = (params.shadow_bias, params.normal_bias, CASCADE_BLEND, 0.0)
+            if kind == ShadowProjection.CASCADES:
+                if bounds is None:
+                    bounds = world_bounds(scene)
+                frusta = cascade_frusta(light, scene, inverse_view, aspect, bounds,
+                                        squares[0][2])
+                splits = np.array([far for far, *_ in frusta])
+                row[2, :len(splits)] = splits
+                self.splits[id(light)] = splits
+            elif kind == ShadowProjection.PERSPECTIVE:
+                frusta = [spot_frustum(light, squares[0][2])]
+            else:
+                frusta = cube_frusta(light, squares[0][2])
+            self._add_tiles(light, slot, squares, frusta, row, inverse_view)
+            self.slots[id(light)] = slot
+        self.records.write(records.tobytes())
+        self._set_uniforms(scene, inverse_view)
+        return self.slots
+
+    def _plan_lights(self, scene: Scene) -> None:
+        """The slots and squares of the scene's lights, planned again when what the plan
+        depends on changed (an animated light's params change every frame)."""
+        key = tuple((id(light), light.casts_shadows,
+                     getattr(light.params, "shadow_resolution", None),
+                     getattr(light.params, "cascades", None)) for light in scene.lights)
+        if key != self._plan_key:
+            self._plan, left_out = plan_atlas(scene.lights, self.size, self.max_lights)
+            self._plan_key = key
+            if left_out:  # stacklevel: update's caller
+                warnings.warn(f"{scene.source}: unshadowed, over the shadow budget: "
+                              f"{'; '.join(left_out)}", stacklevel=3)
+
+    def _add_tiles(self, light: Light, slot: int, squares: list[tuple[int, int, int]],
+                   frusta: list[tuple], row: np.ndarray, inverse_view: np.ndarray) -> None:
+        """A light's tiles, and their matrices and rectangles in its records ``row``."""
+        position = None if light.shadow_projection == ShadowProjection.CASCADES else \
+            np.asarray(light.params.position, np.float64)
+        for index, ((x, y, size), (_, light_view, light_projection, texel,
+                                   perspective_texel, reach)) in enumerate(
+                zip(squares, frusta, strict=True)):
+            view_projection = light_projection @ light_view
+            to_atlas = tile_matrix(x, y, size, self.size) @ view_projection @ inverse_view
+            base = 4 + 6 * index
+            row[base:base + 4] = to_atlas.T  # columns
+            row[base + 4] = (x / self.size, y / self.size, (x + size) / self.size,
+                             (y + size) / self.size)
+            row[base + 5] = (texel, 1.0 if perspective_texel else 0.0,
+                             *near_far(light_projection))
+            direction = unit(-light_view[2, :3])
+            self.tiles.append(ShadowTile(light, slot, x, y, size, view_projection,
+                                         ShadowView(light_view, light_projection, position,
+                                                    direction, self.opacity is not None),
+                                         reach))
+
+    def _set_uniforms(self, scene: Scene, inverse_view: np.ndarray) -> None:
+        self._uniforms = {"u_shadow_world_from_view": inverse_view[:3, :3].copy(),
+                          "u_shadow_atlas_texel": 1.0 / self.size}
+        if self.opacity is not None:
+            self.opacity_layer = max((float(obj.material.opacity_layer(obj))
+                                      for obj in scene.objects if obj.material.opacity_shadows),
+                                     default=0.0)
+            self._uniforms["u_opacity_layers"] = tuple(b * self.opacity_layer
+                                                       for b in OPACITY_LAYERS)
+            self._uniforms["u_opacity_from_atlas"] = self.size / self.opacity_extent
+
+    # -- binding source ----------------------------------------------------------------------
+    def bind(self, uniforms: ProgramUniforms, texture_unit: int) -> int:
+        """The atlas and records where a program reads them (lighting/shadows.glsl), and the
+        opacity maps where it reads those (the opacity stage reads the first depth only)."""
+        if "u_shadow_records" in uniforms.members:
+            uniforms.set_shared("shadows", self._uniforms)
+            self.texture.use(location=texture_unit)
+            uniforms.set_one("u_shadow_atlas", texture_unit)
+            self.records.use(location=texture_unit + 1)
+            uniforms.set_one("u_shadow_records", texture_unit + 1)
+            texture_unit += 2
+        if self.opacity is None:
+            return texture_unit
+        for name, texture in (("u_opacity_first", self.opacity_first),
+                              ("u_opacity", self.opacity)):
+            if name in uniforms.members:
+                texture.use(location=texture_unit)
+                uniforms.set_one(name, texture_unit)
+                texture_unit += 1
+        for name in ("u_opacity_layers", "u_opacity_from_atlas"):
+            if name in uniforms.members:
+                uniforms.set_one(name, self._uniforms[name])
+        return texture_unit
+
+    def read_depth(self) -> np.ndarray:
+        """The atlas's depths, (size, size) float32, rows bottom-up (GL's)."""
+        data = np.frombuffer(self.texture.read(alignment=1), dtype=np.float32)
+        return data.reshape(self.size, self.size)
+
+    def read_opacity(self) -> tuple[np.ndarray, np.ndarray]:
+        """The opacity maps: the first light-view depth (side, side) and the four layers'
+        optical depths (side, side, 4), float32, rows bottom-up; a tile's texels there are its
+        atlas rectangle times ``opacity_scale``."""
+        side = self.opacity.size[0]
+        first = np.frombuffer(self.opacity_first.read(alignment=1), dtype=np.float32)
+        layers = np.frombuffer(self.opacity.read(alignment=1), dtype=np.float16)
+        return first.reshape(side, side, 2)[..., 0], \
+            layers.reshape(side, side, 4).astype(np.float32)
+
+    def read_opacity_back(self) -> np.ndarray:
+        """The light-view depth of the volumes' back (side, side), float32, rows bottom-up
+        (-OPACITY_FAR: no volume along the texel)."""
+        side = self.opacity.size[0]
+        first = np.frombuffer(self.opacity_first.read(alignment=1), dtype=np.float32)
+        return -first.reshape(side, side, 2)[..., 1]
+
+    def release(self) -> None:
+        parts = [self.framebuffer, self.texture, self.records]
+        if self.opacity is not None:
+            parts += [self.first_framebuffer, self.front_framebuffer, self.opacity_framebuffer,
+                      self.opacity_drawn, self.opacity_first, self.opacity]
+        for part in parts:
+            part.release()
+

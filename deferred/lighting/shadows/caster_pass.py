@@ -1,0 +1,100 @@
+"""The shadow pass: each shadowed light's tiles of the atlas cleared and the casters it reaches
+drawn into them by their materials; then, where the scene has them, the volumes' deep opacity
+maps."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from deferred.core.passes import Order, Phase, RenderPass
+from deferred.lighting.shadows.atlas import SHADOW_ATLAS, ShadowAtlas, ShadowTile
+from deferred.lighting.shadows.bounds import object_sphere
+from deferred.lighting.shadows.opacity import OPACITY_FAR, OPACITY_FRONT_FRAGMENT
+
+if TYPE_CHECKING:
+    from deferred.core.frame import Frame
+
+# the caster pass's slope-scaled depth offset (glPolygonOffset factor, units): with the
+# lookup's normal offset and depth bias (texels), no acne down to grazing light
+CASTER_DEPTH_OFFSET = (1.5, 2.0)
+
+
+class ShadowPass(RenderPass):
+    """Every shadowed light's maps: each tile of the atlas cleared and each object's depth
+    drawn into it by its material (:meth:`~deferred.interfaces.material.Material.draw_shadow`).
+    The atlas is not a frame target; the pass writes none (dumps read the atlas apart)."""
+
+    order = Order.FIRST
+
+    def __init__(self, phase: Phase):
+        self.name = "shadows"
+        self.phase = phase
+
+    def execute(self, frame: Frame) -> None:
+        atlas: ShadowAtlas = frame.blackboard[SHADOW_ATLAS]
+        if not atlas.tiles:
+            return
+        fbo = atlas.framebuffer
+        frame.gl_call(fbo.use)
+        fbo.depth_mask = True
+        frame.set_state(depth_test=True, depth_func="less", cull=None,
+                        depth_offset=CASTER_DEPTH_OFFSET)
+        objects = frame.scene.objects
+        spheres = [object_sphere(obj) for obj in objects]
+
+        def reached(tile: ShadowTile) -> list:
+            return [obj for obj, (centre, radius) in zip(objects, spheres, strict=True)
+                    if tile.reach is None or
+                    np.linalg.norm(centre - tile.reach[0]) <= radius + tile.reach[1]]
+
+        try:
+            for tile in atlas.tiles:
+                rect = (tile.x, tile.y, tile.size, tile.size)
+                fbo.viewport = rect
+                frame.gl_call(lambda rect=rect: fbo.clear(depth=1.0, viewport=rect))
+                for obj in reached(tile):  # beyond the light's reach: casts nothing it lights
+                    obj.material.draw_shadow(frame, obj, tile.view)
+        finally:
+            fbo.viewport = (0, 0, atlas.size, atlas.size)
+        if atlas.opacity is not None:
+            self._opacity(frame, atlas, reached)
+
+    @staticmethod
+    def _opacity(frame: Frame, atlas: ShadowAtlas, reached) -> None:
+        """The deep opacity maps of each tile: the volume's first and last depths (min blending
+        of the depth and its negative), grown by a texel (``shadows/opacity_front.frag``), then
+        its optical depth added into the layers behind the first (Yuksel and Keyser 2008,
+        3.1-3.2)."""
+        scale = atlas.opacity_scale
+        tiles = [(tile, tuple(round(v * scale) for v in (tile.x, tile.y, tile.size, tile.size)),
+                  [obj for obj in reached(tile) if obj.material.opacity_shadows])
+                 for tile in atlas.tiles]
+        stages = ((atlas.first_framebuffer, "first", dict(depth_test=False, blend="min")),
+                  (atlas.front_framebuffer, "front", {}),
+                  (atlas.opacity_framebuffer, "density", dict(depth_test=False, blend="add")))
+        front = frame.shaders.program("post/fullscreen.vert", OPACITY_FRONT_FRAGMENT)
+        for fbo, stage, state in stages:
+            frame.gl_call(fbo.use)
+            frame.set_state(cull=None, **state)
+            try:
+                for tile, rect, volumes in tiles:
+                    fbo.viewport = rect
+                    if stage == "front" and volumes:
+                        x, y, size, _ = rect
+                        frame.bind(front, {"u_tile": (x, y, x + size - 1, y + size - 1)},
+                                   {"u_opacity_drawn": atlas.opacity_drawn})
+                        frame.draw_fullscreen(front)
+                        continue
+                    if stage == "density":
+                        frame.gl_call(lambda f=fbo, r=rect: f.clear(0.0, 0.0, 0.0, 0.0,
+                                                                    viewport=r))
+                    else:
+                        frame.gl_call(lambda f=fbo, r=rect: f.clear(OPACITY_FAR, OPACITY_FAR,
+                                                                    0.0, 0.0, viewport=r))
+                    if stage != "front":
+                        for obj in volumes:
+                            obj.material.draw_opacity(frame, obj, tile.view, stage)
+            finally:
+                fbo.viewport = (0, 0, *atlas.opacity.size)

@@ -1,0 +1,91 @@
+"""Where each shadowed light's maps go in the atlas: its slot (the row of the records
+texture) and its squares, packed as a quadtree of power-of-two squares, largest maps first; the
+lights over the budget, named for the warning."""
+
+from __future__ import annotations
+
+from deferred.interfaces.light import Light
+from deferred.names import ShadowProjection
+
+MAX_TILES = 6  # maps a light at most: a point light's cube faces
+
+
+def scene_casts_shadows(lights: list[Light]) -> bool:
+    return any(light.casts_shadows for light in lights)
+
+
+class QuadtreeAllocator:
+    """Power-of-two squares in a power-of-two atlas: each request takes the smallest free
+    square that holds it, split down to its size (largest requests first)."""
+
+    def __init__(self, size: int):
+        self.free: list[tuple[int, int, int]] = [(0, 0, size)]
+
+    def take(self, size: int) -> tuple[int, int] | None:
+        fitting = [square for square in self.free if square[2] >= size]
+        if not fitting:
+            return None
+        square = min(fitting, key=lambda sq: (sq[2], sq[1], sq[0]))
+        self.free.remove(square)
+        x, y, s = square
+        while s > size:
+            s //= 2
+            self.free += [(x + s, y, s), (x, y + s, s), (x + s, y + s, s)]
+        return x, y
+
+
+def tile_counts(light: Light) -> int:
+    kind = light.shadow_projection
+    if kind == ShadowProjection.CASCADES:
+        return int(light.params.cascades)
+    return MAX_TILES if kind == ShadowProjection.CUBE else 1
+
+
+def _place_tiles(lights: list[Light], atlas_size: int
+                 ) -> tuple[dict[int, list[tuple[int, int, int]]], list[int]]:
+    """The squares of each of ``lights`` whose maps all fit, largest maps first, and the
+    lights whose maps did not (``id``), the first to run out of room first."""
+    requests = sorted(((light.params.shadow_resolution, order, light)
+                       for order, light in enumerate(lights) for _ in range(tile_counts(light))),
+                      key=lambda item: (-item[0], item[1]))
+    allocator = QuadtreeAllocator(atlas_size)
+    tiles: dict[int, list[tuple[int, int, int]]] = {}
+    failed: list[int] = []
+    for size, _, light in requests:
+        if id(light) in failed:
+            continue
+        place = allocator.take(size) if size <= atlas_size else None
+        if place is None:
+            failed.append(id(light))
+            continue
+        tiles.setdefault(id(light), []).append((*place, size))
+    return {key: squares for key, squares in tiles.items() if key not in failed}, failed
+
+
+def plan_atlas(lights: list[Light], atlas_size: int, max_lights: int
+               ) -> tuple[dict[int, tuple[int, list[tuple[int, int, int]]]], list[str]]:
+    """Slots and tiles for the shadowed ``lights`` (scene order): ``{id(light): (slot,
+    [(x, y, size), ...])}``, and why each light left out is (for the warning)."""
+    wanted = [light for light in lights if light.casts_shadows]
+    left_out = [f"light {lights.index(light)} (max_shadowed_lights = {max_lights})"
+                for light in wanted[max_lights:]]
+    wanted = wanted[:max_lights]
+    # Largest maps first packs best; the first light to run out of room is left out and the
+    # rest planned again, so the squares it took are not lost to the lights after it.
+    failed: set[int] = set()
+    while True:
+        tiles, missing = _place_tiles([light for light in wanted if id(light) not in failed],
+                                      atlas_size)
+        if not missing:
+            break
+        failed.add(missing[0])
+    plan: dict[int, tuple[int, list[tuple[int, int, int]]]] = {}
+    for light in wanted:
+        if id(light) in failed:
+            left_out.append(f"light {lights.index(light)} (its {tile_counts(light)} map(s) of "
+                            f"{light.params.shadow_resolution}^2 do not fit the "
+                            f"{atlas_size}^2 atlas)")
+        else:
+            plan[id(light)] = (len(plan) + 1, tiles[id(light)])
+    return plan, left_out
+
