@@ -15,25 +15,26 @@ import statistics
 import time
 
 from deferred.scene.size import parse_size
-from deferred.viewer.app import Viewer, ViewerOptions, make_window, window_size
+from deferred.viewer.app import Viewer, ViewerOptions
 from deferred.viewer.session import Session
+from deferred.viewer.window import make_window, window_size
 
 
 def window_frames(viewer: Viewer, frames: int, orbit: bool) -> list[float]:
     times = []
     x, y = viewer.viewport_rect().x + 100, 100
     if orbit:
-        viewer.mouse_press(x, y, 1)
+        viewer.input.mouse_press(x, y, 1)
     for index in range(frames):
         start = time.perf_counter()
         if orbit:
-            viewer.mouse_drag(x + index, y, 4, 0)  # keeps the input recent: reduced frames
+            viewer.input.mouse_drag(x + index, y, 4, 0)  # keeps the input recent: reduced frames
         viewer.tick()
         viewer.draw()
         viewer.ctx.finish()
         times.append(time.perf_counter() - start)
     if orbit:
-        viewer.mouse_release(x, y, 1)
+        viewer.input.mouse_release(x, y, 1)
     return times
 
 

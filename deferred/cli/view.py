@@ -43,8 +43,9 @@ def view_command(scene: str | None, pipeline: str, light_path: str | None, size:
     parameters, buffer views, split deferred / forward, pixel inspector, timeline, hot reload
     of GLSL and scene files, screenshots and recordings (README.md, "The viewer")."""
     try:
-        from deferred.viewer.app import ViewerOptions, run_headless, run_window
+        from deferred.viewer.app import ViewerOptions
         from deferred.viewer.session import Session
+        from deferred.viewer.window import run_headless, run_window
     except ImportError as exc:
         raise InputError(f"needs the viewer extra (pip install 'deferred[viewer]'): {exc}",
                          "view") from None

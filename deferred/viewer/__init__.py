@@ -1,8 +1,9 @@
 """``deferred view``: the interactive viewer (moderngl-window, imgui-bundle).
 
-One module a responsibility: :mod:`~deferred.viewer.app` the window, its loop and its frames;
-:mod:`~deferred.viewer.camera` the orbit / pan / zoom / fly controller;
-:mod:`~deferred.viewer.session` the scene, its validated edits and saving them;
+One module a responsibility: :mod:`~deferred.viewer.app` the viewer's state, its frames and
+actions; :mod:`~deferred.viewer.window` the window and its loop; :mod:`~deferred.viewer.input`
+the mouse and the keys; :mod:`~deferred.viewer.camera` the orbit / pan / zoom / fly
+controller; :mod:`~deferred.viewer.session` the scene, its validated edits and saving them;
 :mod:`~deferred.viewer.panels` the imgui panels (drawn by :mod:`~deferred.viewer.imgui_gl`);
 :mod:`~deferred.viewer.display` the viewport (single, split, difference);
 :mod:`~deferred.viewer.compare` the split's PSNR; :mod:`~deferred.viewer.buffers` the buffer

@@ -1,6 +1,7 @@
-"""The viewer: a moderngl-window window (or its headless one) showing the scene as the
-framework's renderers draw it, with the camera controller, the panels, the split and buffer
-views, the timeline, hot reload and recording.
+"""The viewer's state and its frames: the scene as the framework's renderers draw it, with the
+camera controller, the panels, the split and buffer views, the timeline, hot reload and
+recording, put on its window (:mod:`~deferred.viewer.window` opens the window and runs the
+loop; :mod:`~deferred.viewer.input` turns the window's events into the viewer's actions).
 
 The viewport sits right of the panels, never under them, at the render size: each pixel of it
 is the pixel ``deferred render`` writes for the same camera and time. While the camera moves
@@ -11,12 +12,11 @@ stops, the full frame is drawn again (with each pass timed for the bar chart).
 from __future__ import annotations
 
 import math
-import os
 import time as clock
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import moderngl
 import numpy as np
@@ -38,18 +38,15 @@ from deferred.viewer.buffers import (
 from deferred.viewer.compare import psnr
 from deferred.viewer.display import FrameSlot, Rect, Viewport
 from deferred.viewer.imgui_gl import ImguiRenderer
+from deferred.viewer.input import ViewerInput
 from deferred.viewer.inspector import inspect_pixel
+from deferred.viewer.panels import PANEL_WIDTH
 from deferred.viewer.record import Recording, save_screenshot
 from deferred.viewer.reload import Watcher
 from deferred.viewer.renderers import RendererPool, timed_render
 from deferred.viewer.session import Session
 from deferred.viewer.timeline import Timeline, scene_duration
 
-if TYPE_CHECKING:
-    from moderngl_window.context.base import BaseWindow
-
-PANEL_WIDTH = 400
-MIN_HEIGHT = 640  # the panels' room when the frame is smaller
 INTERACTION_SECONDS = 0.25  # input this recent draws reduced frames
 # Reduced frames (adaptive): the divisors tried, and the time a reduced render may take so
 # that, with the window's own drawing, interaction stays near 15 frames a second
@@ -58,7 +55,6 @@ INTERACTIVE_BUDGET_MS = 45.0
 # At most this many frames of an unchanged state are drawn (a temporal history converging)
 STILL_FRAMES = 256
 BACKGROUND = (0.11, 0.11, 0.12)
-MODES = ("single", "split", "difference")
 
 
 @dataclass
@@ -71,34 +67,6 @@ class ViewerOptions:
     split: str | None = None  # the other side's pipeline: split view from the start
     reduce: int | None = None  # the reduced frames' divisor; None: adapts (REDUCTIONS)
     panels: bool = True
-
-
-def window_size(frame: tuple[int, int], with_panels: bool = True) -> tuple[int, int]:
-    width, height = frame
-    return (width + (PANEL_WIDTH if with_panels else 0),
-            max(height, MIN_HEIGHT if with_panels else height))
-
-
-def make_window(size: tuple[int, int], headless: bool,
-                title: str = "deferred view") -> BaseWindow:
-    """A moderngl-window window: the headless one (EGL, an offscreen framebuffer) or a real
-    one (glfw by default; ``DEFERRED_VIEW_WINDOW`` names another moderngl-window backend, e.g.
-    pyglet). GL 4.3 where the driver has it (compute shaders: the tiled and clustered light
-    paths), else 3.3."""
-    import moderngl_window
-
-    name = "headless" if headless else os.environ.get("DEFERRED_VIEW_WINDOW", "glfw")
-    cls = moderngl_window.get_local_window_cls(name)
-    extra: dict[str, Any] = {"backend": os.environ.get("DEFERRED_GL_BACKEND", "egl")} \
-        if headless else {}
-    failure: Exception | None = None
-    for version in ((4, 3), (3, 3)):
-        try:
-            return cls(title=title, size=size, gl_version=version, vsync=False,
-                       resizable=not headless, aspect_ratio=None, **extra)
-        except Exception as exc:  # noqa: BLE001 - window backends raise their own types
-            failure = exc
-    raise RuntimeError(f"cannot open a {name} window: {failure}")
 
 
 class Viewer:
@@ -162,9 +130,6 @@ class Viewer:
         # the clock input, interaction and playback read (tests set their own)
         self.now: Callable[[], float] = clock.perf_counter
         self.last_input = -math.inf
-        self.dragging: int | None = None
-        self.mouse = (-1.0, -1.0)  # the pointer's last window position
-        self.keys_down: set[int] = set()
         self.shown_key: tuple | None = None
         self.shown_reduced = False
         self.shaders_generation = 0
@@ -172,8 +137,7 @@ class Viewer:
         self._last_tick = self.now()
         self.still_frames = 0  # frames drawn again for an unchanged state (a history converging)
         self._frame_times: list[float] = []
-        self.keys = key_codes(window)
-        self._attach_events()
+        self.input = ViewerInput(self, window)  # attaches the window's events
 
     # -- layout ----------------------------------------------------------------------------------
     def viewport_rect(self) -> Rect:
@@ -198,7 +162,7 @@ class Viewer:
             self.timeline.advance(1.0 / self.timeline.fps)  # every recorded frame, in turn
         else:
             self.timeline.advance(seconds)
-        self._fly(seconds)
+        self.input.fly(seconds)
         self.poll_files()
         self.update()
 
@@ -422,68 +386,6 @@ class Viewer:
             imgui.render()
             self.imgui.render(imgui.get_draw_data(), fbo)
 
-    # -- input -----------------------------------------------------------------------------------
-    def _attach_events(self) -> None:
-        wnd = self.wnd
-        wnd.mouse_press_event_func = lambda x, y, b: self.mouse_press(
-            x, y, b, ctrl=bool(getattr(wnd.modifiers, "ctrl", False)))
-        wnd.mouse_release_event_func = self.mouse_release
-        wnd.mouse_drag_event_func = self.mouse_drag
-        wnd.mouse_position_event_func = self.mouse_move
-        wnd.mouse_scroll_event_func = self.mouse_scroll
-        wnd.key_event_func = self.key_event
-        wnd.unicode_char_entered_func = self.char_entered
-        wnd.resize_func = self.resize
-
-    def _in_panels(self, x: float) -> bool:
-        return self.show_panels and x < PANEL_WIDTH
-
-    def _pointer(self, x: float, y: float) -> None:
-        self.mouse = (float(x), float(y))
-        self.io.add_mouse_pos_event(float(x), float(y))
-
-    def mouse_move(self, x: float, y: float, dx: float = 0, dy: float = 0) -> None:
-        self._pointer(x, y)
-
-    def mouse_press(self, x: float, y: float, button: int, ctrl: bool = False) -> None:
-        self._pointer(x, y)
-        if self._in_panels(x):
-            self.io.add_mouse_button_event(_imgui_button(button), True)
-            return
-        pixel = self.frame_pixel(x, y)
-        if pixel is None:
-            return
-        if ctrl and button == 1:
-            self.inspect(*pixel)
-            return
-        self.dragging = button
-
-    def mouse_release(self, x: float, y: float, button: int) -> None:
-        self._pointer(x, y)
-        self.io.add_mouse_button_event(_imgui_button(button), False)
-        self.dragging = None
-
-    def mouse_drag(self, x: float, y: float, dx: float, dy: float) -> None:
-        self._pointer(x, y)
-        controller = self.session.controller
-        if self.dragging == 1:
-            controller.orbit(dx, dy)
-        elif self.dragging in (2, 3):
-            controller.pan(dx, dy, self.size[1])
-        else:
-            return
-        self.touch()
-
-    def mouse_scroll(self, x_offset: float, y_offset: float) -> None:
-        if self._in_panels(self.mouse[0]):
-            self.io.add_mouse_wheel_event(float(x_offset), float(y_offset))
-            return
-        self.session.controller.zoom(y_offset)
-        self.touch()
-
-    def char_entered(self, char: str) -> None:
-        self.io.add_input_character(ord(char))
-
     def resize(self, width: int, height: int) -> None:
         """A real window's viewport follows the window (the panels keep their width)."""
         size = (max(16, width - (PANEL_WIDTH if self.show_panels else 0)), max(16, height))
@@ -492,80 +394,7 @@ class Viewer:
             self._material_scene = None
             self.size = size
 
-    def key_event(self, key: Any, action: Any, modifiers: Any) -> None:
-        keys = self.keys
-        pressed = action == keys.ACTION_PRESS
-        imgui_key = _imgui_key(keys, key)
-        if imgui_key is not None:
-            self.io.add_key_event(imgui_key, pressed)
-        ctrl = bool(getattr(modifiers, "ctrl", False))
-        self.io.add_key_event(imgui.Key.mod_ctrl, ctrl)
-        if not pressed:
-            self.keys_down.discard(key)
-            return
-        self.keys_down.add(key)
-        if self.io.want_text_input:
-            return
-        self.shortcut(key, ctrl)
-
-    def shortcut(self, key: Any, ctrl: bool = False) -> None:
-        """The keys (README.md, "The viewer")."""
-        keys = self.keys
-        if ctrl and key == keys.S:
-            self.save()
-        elif key == keys.R:
-            self.reset_camera()
-        elif key == keys.F:
-            self.session.controller.fly = not self.session.controller.fly
-        elif key == keys.SPACE:
-            self.timeline.toggle()
-        elif key == keys.RIGHT:
-            self.timeline.step(1)
-        elif key == keys.LEFT:
-            self.timeline.step(-1)
-        elif key == keys.HOME:
-            self.timeline.scrub(0.0)
-        elif key == keys.TAB:
-            self.mode = MODES[(MODES.index(self.mode) + 1) % len(MODES)]
-        elif key == keys.P:
-            self.pipeline, self.other_pipeline = self.other_pipeline, self.pipeline
-        elif key == keys.B:
-            self.view_name = None
-        elif key == keys.C and not ctrl:
-            self.save(camera=True)
-        elif key == keys.F12:
-            self.screenshot(window=False)
-        elif key == keys.H:
-            self.show_panels = not self.show_panels
-        elif key == keys.ESCAPE:
-            self.wnd.close()
-
-    def _fly(self, seconds: float) -> None:
-        controller = self.session.controller
-        if not controller.fly or not self.keys_down:
-            return
-        keys = self.keys
-        down = self.keys_down
-        forward = (keys.W in down) - (keys.S in down)
-        right = (keys.D in down) - (keys.A in down)
-        up = (keys.E in down) - (keys.Q in down)
-        if forward or right or up:
-            controller.fly_move(forward, right, up, min(seconds, 0.1))
-            self.touch()
-
     # -- life ------------------------------------------------------------------------------------
-    def run(self) -> None:
-        """The window's loop until it closes."""
-        wnd = self.wnd
-        self.running = True
-        while not wnd.is_closing:
-            self.tick()
-            self.draw()
-            wnd.swap_buffers()
-            if not self.timeline.playing and not self.interacting() and \
-                    self.shown_key == self.state_key() and not self.shown_reduced:
-                clock.sleep(1 / 60)  # idle: the panels only
-
     def close(self) -> None:
         if self.recording is not None:
             self.toggle_recording()
@@ -577,65 +406,9 @@ class Viewer:
         imgui.destroy_context(self._imgui_context)
 
 
-def key_codes(window) -> Any:
-    """The window's key codes; glfw's for the headless window, whose keys are all one
-    placeholder (it has no keyboard: the tests send glfw's codes)."""
-    keys = window.keys
-    if getattr(keys, "R", None) == getattr(keys, "SPACE", None):
-        from moderngl_window.context.glfw.keys import Keys
-
-        return Keys
-    return keys
-
-
 def _framework_error(exc: Exception) -> bool:
     from deferred.errors import DeferredError
 
     return isinstance(exc, DeferredError)
 
 
-def _imgui_button(button: int) -> int:
-    """moderngl-window's buttons (1 left, 2 right, 3 middle) as imgui's (0, 1, 2)."""
-    return {1: 0, 2: 1, 3: 2}.get(button, 0)
-
-
-def _imgui_key(keys: Any, key: Any) -> Any:
-    names = {"BACKSPACE": imgui.Key.backspace, "ENTER": imgui.Key.enter,
-             "TAB": imgui.Key.tab, "LEFT": imgui.Key.left_arrow,
-             "RIGHT": imgui.Key.right_arrow, "UP": imgui.Key.up_arrow,
-             "DOWN": imgui.Key.down_arrow, "DELETE": imgui.Key.delete,
-             "HOME": imgui.Key.home, "END": imgui.Key.end, "ESCAPE": imgui.Key.escape}
-    for name, imgui_key in names.items():
-        if getattr(keys, name, object()) == key:
-            return imgui_key
-    return None
-
-
-def run_headless(session: Session, options: ViewerOptions, screenshot: str | Path,
-                 gui_frames: int = 2) -> Path:
-    """Open the viewer's window offscreen, draw the frame (panels included) once, write it
-    to ``screenshot`` (.png) and close."""
-    size = options.size or session.scene.size
-    window = make_window(window_size(size, options.panels), headless=True)
-    viewer = Viewer(session, window, options)
-    try:
-        viewer.update(force_full=True)
-        for _ in range(gui_frames):  # imgui lays its windows out in the first frame
-            viewer.draw()
-        if viewer.render_exception is not None:
-            raise viewer.render_exception
-        return save_screenshot(screenshot, viewer.window_image())
-    finally:
-        viewer.close()
-        window.destroy()
-
-
-def run_window(session: Session, options: ViewerOptions) -> None:
-    size = options.size or session.scene.size
-    window = make_window(window_size(size, options.panels), headless=False)
-    viewer = Viewer(session, window, options)
-    try:
-        viewer.run()
-    finally:
-        viewer.close()
-        window.destroy()

@@ -27,6 +27,8 @@ else:  # pragma: no cover
 # Viewer in the text, Any to the checker (no import circle).
 Viewer = Any
 
+PANEL_WIDTH = 400  # the panels' column, left of the viewport
+MIN_HEIGHT = 640  # the panels' room when the frame is smaller
 RED = imgui.ImVec4(1.0, 0.42, 0.38, 1.0)
 GREY = imgui.ImVec4(0.65, 0.65, 0.65, 1.0)
 COLOR_WORDS = ("color", "albedo", "ground", "tint", "sky")

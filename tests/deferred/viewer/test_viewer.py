@@ -70,8 +70,9 @@ def scene_file(tmp_path: Path) -> Path:
 
 @pytest.fixture
 def make_viewer(gl):
-    from deferred.viewer.app import Viewer, ViewerOptions, make_window, window_size
+    from deferred.viewer.app import Viewer, ViewerOptions
     from deferred.viewer.session import Session
+    from deferred.viewer.window import make_window, window_size
 
     made = []
 
@@ -103,14 +104,14 @@ def test_orbit_changes_the_view_and_reset_restores_it(scene_file, make_viewer):
     viewer = make_viewer(scene_file)
     before = shown(viewer)
     x, y = 400 + 80, 60  # the middle of the viewport (right of the panels)
-    viewer.mouse_press(x, y, 1)
-    viewer.mouse_drag(x + 40, y + 10, 40, 10)
-    viewer.mouse_release(x + 40, y + 10, 1)
+    viewer.input.mouse_press(x, y, 1)
+    viewer.input.mouse_drag(x + 40, y + 10, 40, 10)
+    viewer.input.mouse_release(x + 40, y + 10, 1)
     orbited = shown(viewer)
     assert np.abs(orbited.astype(int) - before).mean() > 2.0
-    viewer.mouse_scroll(0, 2)  # zoom in
+    viewer.input.mouse_scroll(0, 2)  # zoom in
     assert np.abs(shown(viewer).astype(int) - orbited).mean() > 2.0
-    viewer.shortcut(viewer.keys.R)
+    viewer.input.shortcut(viewer.input.keys.R)
     np.testing.assert_array_equal(shown(viewer), before)
 
 
@@ -118,13 +119,13 @@ def test_keys(scene_file, make_viewer, tmp_path):
     from moderngl_window.context.base import KeyModifiers
 
     viewer = make_viewer(scene_file)
-    keys, plain, ctrl = viewer.keys, KeyModifiers(), KeyModifiers()
+    keys, plain, ctrl = viewer.input.keys, KeyModifiers(), KeyModifiers()
     ctrl.ctrl = True
     home = shown(viewer)
 
     def press(key, modifiers=plain):
-        viewer.key_event(key, keys.ACTION_PRESS, modifiers)
-        viewer.key_event(key, keys.ACTION_RELEASE, modifiers)
+        viewer.input.key_event(key, keys.ACTION_PRESS, modifiers)
+        viewer.input.key_event(key, keys.ACTION_RELEASE, modifiers)
 
     press(keys.SPACE)
     assert viewer.timeline.playing
@@ -139,9 +140,9 @@ def test_keys(scene_file, make_viewer, tmp_path):
     press(keys.TAB)
     assert viewer.mode == "single"
     press(keys.F)  # fly: W moves the eye and the target forward
-    viewer.key_event(keys.W, keys.ACTION_PRESS, plain)
-    viewer._fly(0.1)
-    viewer.key_event(keys.W, keys.ACTION_RELEASE, plain)
+    viewer.input.key_event(keys.W, keys.ACTION_PRESS, plain)
+    viewer.input.fly(0.1)
+    viewer.input.key_event(keys.W, keys.ACTION_RELEASE, plain)
     assert np.abs(shown(viewer).astype(int) - home).mean() > 1.0
     press(keys.R)
     np.testing.assert_array_equal(shown(viewer), home)
@@ -154,12 +155,12 @@ def test_keys(scene_file, make_viewer, tmp_path):
 def test_the_viewport_is_the_frame_render_draws_for_the_same_camera(scene_file, make_viewer,
                                                                      tmp_path, gl):
     viewer = make_viewer(scene_file)
-    viewer.mouse_press(480, 60, 1)
-    viewer.mouse_drag(455, 50, -25, -10)
-    viewer.mouse_release(455, 50, 1)
-    viewer.mouse_press(480, 60, 2)  # pan
-    viewer.mouse_drag(485, 58, 5, -2)
-    viewer.mouse_release(485, 58, 2)
+    viewer.input.mouse_press(480, 60, 1)
+    viewer.input.mouse_drag(455, 50, -25, -10)
+    viewer.input.mouse_release(455, 50, 1)
+    viewer.input.mouse_press(480, 60, 2)  # pan
+    viewer.input.mouse_drag(485, 58, 5, -2)
+    viewer.input.mouse_release(485, 58, 2)
     image = shown(viewer)
     moved = tmp_path / "moved.toml"
     viewer.session.save(moved, camera=True)
@@ -304,8 +305,8 @@ def test_interaction_draws_reduced_frames_and_refines_when_idle(scene_file, make
     now = [100.0]
     viewer.now = lambda: now[0]  # the viewer's clock, not the wall's
     shown(viewer)
-    viewer.mouse_press(480, 60, 1)
-    viewer.mouse_drag(490, 60, 10, 0)
+    viewer.input.mouse_press(480, 60, 1)
+    viewer.input.mouse_drag(490, 60, 10, 0)
     assert viewer.last_input == 100.0
     assert viewer.update()
     assert viewer.shown_reduced and viewer.main.texture.size == (80, 60)
@@ -369,7 +370,7 @@ def test_a_still_camera_with_taa_draws_until_its_samples_are_in_then_stops(scene
 def test_pixel_inspector_lists_the_passes_of_a_clicked_pixel(scene_file, make_viewer):
     viewer = make_viewer(scene_file)
     shown(viewer)
-    viewer.mouse_press(400 + 80, 60, 1, ctrl=True)  # the ball
+    viewer.input.mouse_press(400 + 80, 60, 1, ctrl=True)  # the ball
     assert viewer.inspector[0].startswith("pixel 80,60 (top-down) of 160x120")
     assert any("ball.gbuffer" in line for line in viewer.inspector)
 
@@ -460,7 +461,8 @@ def test_screenshot_and_recording(scene_file, make_viewer, tmp_path):
 
 REAL_WINDOW = """
 import sys
-from deferred.viewer.app import Viewer, ViewerOptions, make_window, window_size
+from deferred.viewer.app import Viewer, ViewerOptions
+from deferred.viewer.window import make_window, window_size
 from deferred.viewer.session import Session
 size = (160, 120)
 try:
@@ -474,9 +476,9 @@ viewer.draw()
 image = viewer.window_image()
 assert image[:120, 400:].std() > 5, "an empty frame"
 window.swap_buffers()
-viewer.mouse_press(480, 60, 1)
-viewer.mouse_drag(500, 60, 20, 0)  # a reduced frame: another renderer after a draw
-viewer.mouse_release(500, 60, 1)
+viewer.input.mouse_press(480, 60, 1)
+viewer.input.mouse_drag(500, 60, 20, 0)  # a reduced frame: another renderer after a draw
+viewer.input.mouse_release(500, 60, 1)
 assert viewer.update() and viewer.shown_reduced
 assert viewer.render_error is None, viewer.render_error
 viewer.draw()
