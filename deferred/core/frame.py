@@ -226,7 +226,7 @@ class Frame:
             return False
         if not np.array_equal(self.previous_view_projection, self.view_projection):
             return True
-        previous = (getattr(self.inputs, "previous_models", None) or {}).get(id(obj.node))
+        previous = (getattr(self.inputs, "previous_models", None) or {}).get(obj.node)
         return previous is not None and not np.array_equal(previous, obj.model)
 
     def camera_uniforms(self) -> dict[str, Any]:

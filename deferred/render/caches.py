@@ -40,26 +40,25 @@ class KeptMaterialInputs:
     made 400 uniform dicts a frame otherwise."""
 
     def __init__(self) -> None:
-        self._kept: dict[int, MaterialInputs] = {}
+        self._kept: dict[Material, MaterialInputs] = {}  # materials hash by identity
 
     def start_frame(self, scene: FrameState) -> None:
         """Drop the materials no object of ``scene`` has (replaced on their objects), once
         they outnumber the objects: a scene that keeps its materials pays one comparison."""
         if len(self._kept) > len(scene.objects):
-            present = {id(obj.material) for obj in scene.objects}
+            present = {obj.material for obj in scene.objects}
             self._kept = {key: inputs for key, inputs in self._kept.items() if key in present}
 
     def of(self, material: Material, frame: Frame) -> MaterialInputs:
-        key = id(material)
-        kept = self._kept.get(key)
-        if kept is not None and kept.material is material and kept.params is material.params:
+        kept = self._kept.get(material)
+        if kept is not None and kept.params is material.params:
             return kept
         keep = material.keeps_inputs()
         uniforms = material.uniforms(frame)
         inputs = MaterialInputs(material, StableValues(uniforms) if keep else uniforms,
                                 material.textures(frame), params=material.params, kept=keep)
         if keep:
-            self._kept[key] = inputs
+            self._kept[material] = inputs
         return inputs
 
     def release(self) -> None:  # the textures are Resources', released there
@@ -77,19 +76,19 @@ class ObjectTransforms:
 
     def __init__(self) -> None:
         self._key: tuple | None = None
-        self._values: dict[int, dict[str, Any]] = {}
+        self._values: dict[Any, dict[str, Any]] = {}
 
     def of(self, objects: tuple[ObjectState, ...],
-           previous: dict[int, np.ndarray] | None = None) -> dict[int, dict[str, Any]]:
-        """id(object's node) -> its uniforms; ``previous`` the world matrices of the last
-        frame by node id (``u_previous_model``; an object missing there, or with none given,
+           previous: dict[Any, np.ndarray] | None = None) -> dict[Any, dict[str, Any]]:
+        """The object's node -> its uniforms; ``previous`` the world matrices of the last
+        frame by node (``u_previous_model``; an object missing there, or with none given,
         its own model). Matrices are read-only values: the same array is the same matrix."""
         if not objects:
             return {}
         # the last frame's models where they differ (none without a temporal history)
         befores = None
         if previous:
-            befores = [previous.get(id(obj.node), obj.model) for obj in objects]
+            befores = [previous.get(obj.node, obj.model) for obj in objects]
         key = ([obj.version for obj in objects],
                None if befores is None else [id(before) for before in befores])
         if key != self._key:
@@ -103,7 +102,7 @@ class ObjectTransforms:
 
     @staticmethod
     def _make(objects: tuple[ObjectState, ...], models: np.ndarray,
-              surface_ids: list[float], befores: np.ndarray) -> dict[int, dict[str, Any]]:
+              surface_ids: list[float], befores: np.ndarray) -> dict[Any, dict[str, Any]]:
         normals = np.transpose(np.linalg.inv(models[:, :3, :3]), (0, 2, 1))
 
         def column_major(matrices: np.ndarray) -> bytes:  # GLSL's order, all at once
@@ -114,7 +113,7 @@ class ObjectTransforms:
         before_bytes = column_major(befores)
         values = {}
         for index, (obj, surface_id) in enumerate(zip(objects, surface_ids, strict=True)):
-            values[id(obj.node)] = StableValues(  # replaced whole when they change
+            values[obj.node] = StableValues(  # replaced whole when they change
                 u_model=model_bytes[64 * index:64 * index + 64],
                 u_model_normal_matrix=normal_bytes[36 * index:36 * index + 36],
                 u_previous_model=before_bytes[64 * index:64 * index + 64],
@@ -127,33 +126,33 @@ class FrameInputs:
     frame, or kept from the last), for the frame's passes."""
 
     def __init__(self, scene: FrameState, transforms: ObjectTransforms, kept: KeptMaterialInputs,
-                 strict: bool = False, previous_models: dict[int, np.ndarray] | None = None):
+                 strict: bool = False, previous_models: dict[Any, np.ndarray] | None = None):
         self.scene = scene
         self.previous_models = previous_models
         self.strict = strict
         self.frame: Frame | None = None  # set by the frame it serves (Frame.__init__)
         self._transforms = transforms
         self._kept = kept
-        self._objects: dict[int, dict[str, Any]] | None = None
-        self._materials: dict[int, MaterialInputs] = {}
+        self._objects: dict[Any, dict[str, Any]] | None = None  # by node
+        self._materials: dict[Material, MaterialInputs] = {}
 
     def object_uniforms(self, obj: ObjectState) -> dict[str, Any]:
         """The object's transforms and id (for every object at once, kept across frames while
         the objects' states hold: :class:`ObjectTransforms`)."""
         if self._objects is None:
             self._objects = self._transforms.of(self.scene.objects, self.previous_models)
-        return self._objects[id(obj.node)]
+        return self._objects[obj.node]
 
     def material_inputs(self, material: Material) -> MaterialInputs:
         """``material``'s uniforms and textures, computed once per frame (or kept from the
         last: :class:`KeptMaterialInputs`)."""
-        inputs = self._materials.get(id(material))
+        inputs = self._materials.get(material)
         if inputs is None:
             inputs = self._kept.of(material, self.frame)
             if self.strict:  # what this frame's programs declare is the frame's own
                 inputs = MaterialInputs(material, inputs.uniforms, inputs.textures,
                                         params=inputs.params, kept=inputs.kept)
-            self._materials[id(material)] = inputs
+            self._materials[material] = inputs
         return inputs
 
     def check_material_uniforms(self) -> None:

@@ -123,7 +123,7 @@ def sort_blended(passes: list[RenderPass], scene: FrameState) -> list[RenderPass
     one phase and rank put far to near for the camera and transforms of this frame (the
     order the passes were built in holds the first frame's): the same list where it already
     is so."""
-    index_of = {id(obj.node): k for k, obj in enumerate(scene.objects)}
+    index_of = {obj.node: k for k, obj in enumerate(scene.objects)}
     out = passes
     start = 0
     while start < len(passes):
@@ -135,10 +135,10 @@ def sort_blended(passes: list[RenderPass], scene: FrameState) -> list[RenderPass
                 end += 1
             if end - start > 1:
                 run = passes[start:end]
-                distances = {id(p.node): camera_distance(scene, scene.object_state(p.node))
+                distances = {p.node: camera_distance(scene, scene.object_state(p.node))
                              for p in run}
-                ordered = sorted(run, key=lambda p: (-distances[id(p.node)],
-                                                     index_of.get(id(p.node), 0)))
+                ordered = sorted(run, key=lambda p: (-distances[p.node],
+                                                     index_of.get(p.node, 0)))
                 if ordered != run:
                     if out is passes:
                         out = list(passes)

@@ -191,8 +191,8 @@ class Renderer:
         """Keep what the passes were built from."""
         self._structure = structure_key(state, self.pipeline_name, self._light_path_arg,
                                         self._size_arg)
-        self._params_seen = {id(obj.node): obj.params for obj in state.objects}
-        self._passes_seen = {id(obj.node): object_pass_names(obj) for obj in state.objects}
+        self._params_seen = {obj.node: obj.params for obj in state.objects}
+        self._passes_seen = {obj.node: object_pass_names(obj) for obj in state.objects}
 
     def _follow(self, state: FrameState) -> None:
         """Rebuild before a frame where the scene changed in what the passes are built from;
@@ -204,14 +204,14 @@ class Renderer:
         edited = {}
         for obj in state.objects:
             params = obj.params
-            seen = self._params_seen.get(id(obj.node))
+            seen = self._params_seen.get(obj.node)
             if params is seen:
                 continue
-            if object_pass_names(obj) != self._passes_seen.get(id(obj.node)) or \
+            if object_pass_names(obj) != self._passes_seen.get(obj.node) or \
                     (seen is not None and _restarts(type(obj.material), seen, params)):
                 self._rebuild(state)
                 return
-            edited[id(obj.node)] = params
+            edited[obj.node] = params
         if edited:
             self._count_held_memory(state)  # an edited texture or mask size may not fit
             self._params_seen.update(edited)  # seen once they are known to fit
@@ -407,7 +407,7 @@ class Renderer:
         checking = {cls for cls in {type(obj.material) for obj in objects}
                     if overrides(cls, Material, "check_time", "check_time_for")}
         checked = [obj for obj in objects if type(obj.material) in checking]
-        revisions = tuple((id(obj), obj.revision, obj.material.revision) for obj in checked)
+        revisions = tuple((obj, obj.revision, obj.material.revision) for obj in checked)
         if self._times_checked is not None and self._times_checked[1] == revisions and \
                 latest <= self._times_checked[0]:
             return

@@ -51,7 +51,7 @@ def structure_key(state: FrameState, pipeline: str, light_path_arg: str | None,
     lights' shadow resolutions) and the shadow budget (the shadow pass, the atlas and the
     SHADOWS and OPACITY_SHADOWS defines), the clear colour, the tone mapping operator, the
     light path and the size asked for. Membership is by identity: which objects are there."""
-    return (tuple((id(obj.node), id(obj.mesh), type(obj.material), obj.label)
+    return (tuple((obj.node, id(obj.mesh), type(obj.material), obj.label)
                   for obj in state.objects),
             tuple(map(type, state.lights)), scene_casts_shadows(state.lights),
             opacity_size(state, pipeline), state.shadow_budget,

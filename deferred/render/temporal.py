@@ -11,7 +11,7 @@ where the scene has no temporal effect or the effect says the frame does not fol
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -31,7 +31,7 @@ class FrameHistory:
     index: int
     moment: FrameMoment
     previous_view_projection: np.ndarray
-    previous_models: dict[int, np.ndarray] = field(default_factory=dict)
+    previous_models: dict[Any, np.ndarray] = field(default_factory=dict)  # by node
 
 
 def temporal_effect(scene: FrameState) -> Effect | None:
@@ -45,7 +45,7 @@ class TemporalState:
     def __init__(self) -> None:
         self.moment: FrameMoment | None = None
         self.index = 0
-        self.models: dict[int, np.ndarray] = {}
+        self.models: dict[Any, np.ndarray] = {}  # world matrices by node
 
     def reset(self) -> None:
         """Forget the last frame: the next starts a history (each of render_samples'
@@ -71,4 +71,4 @@ class TemporalState:
         kept, not copied)."""
         self.moment = history.moment
         self.index = history.index
-        self.models = {id(obj.node): obj.model for obj in scene.objects}
+        self.models = {obj.node: obj.model for obj in scene.objects}

@@ -32,12 +32,12 @@ class Hierarchy:
         self.by_label: dict[str, SceneNode] = {}
         for node in self.nodes:
             self.by_label.setdefault(node.label, node)
-        self._members = {id(node) for node in self.nodes}
-        self.parents: dict[int, SceneNode] = {}
+        self._members = set(self.nodes)  # nodes hash by identity
+        self.parents: dict[SceneNode, SceneNode] = {}
         for node in self.nodes:
             parent = self.resolve(node.parent, self._where(node, where))
             if parent is not None:
-                self.parents[id(node)] = parent
+                self.parents[node] = parent
         for node in self.nodes:
             self._check_acyclic(node, where)
 
@@ -60,7 +60,7 @@ class Hierarchy:
                 raise InputError(f"no object or group named {parent[:80]!r} to be the parent "
                                  f"({hint}nodes: {names})", where)
             return found
-        if id(parent) in self._members:
+        if parent in self._members:
             return parent
         label = getattr(parent, "label", None)
         if isinstance(label, str) and label in self.by_label:
@@ -69,7 +69,7 @@ class Hierarchy:
 
     def _check_acyclic(self, node: SceneNode, where: str) -> None:
         seen = [node]
-        parent = self.parents.get(id(node))
+        parent = self.parents.get(node)
         while parent is not None:
             if parent is node:
                 chain = " -> ".join(n.label[:40] for n in [*seen, node])
@@ -78,34 +78,34 @@ class Hierarchy:
             seen.append(parent)
             if len(seen) > len(self.nodes) + 1:
                 return  # a cycle above this node: reported for its own members
-            parent = self.parents.get(id(parent))
+            parent = self.parents.get(parent)
 
     def parent_of(self, node: SceneNode) -> SceneNode | None:
-        return self.parents.get(id(node))
+        return self.parents.get(node)
 
     def ancestors(self, node: SceneNode) -> list[SceneNode]:
         """The node's parent, its parent's, ... up to the root."""
         chain = []
-        parent = self.parents.get(id(node))
+        parent = self.parents.get(node)
         while parent is not None:
             chain.append(parent)
-            parent = self.parents.get(id(parent))
+            parent = self.parents.get(parent)
         return chain
 
 
 def world_matrix(node: SceneNode, hierarchy: Hierarchy, local: LocalMatrix,
-                 worlds: dict[int, np.ndarray] | None = None) -> np.ndarray:
+                 worlds: dict[SceneNode, np.ndarray] | None = None) -> np.ndarray:
     """``node``'s world matrix: its ancestors' local matrices (``local``) times its own, root
     first. ``worlds`` keeps each node's as it is made (a scene's worlds made in one pass)."""
     if worlds is not None:
-        known = worlds.get(id(node))
+        known = worlds.get(node)
         if known is not None:
             return known
     parent = hierarchy.parent_of(node)
     own = local(node)
     world = own if parent is None else world_matrix(parent, hierarchy, local, worlds) @ own
     if worlds is not None:
-        worlds[id(node)] = world
+        worlds[node] = world
     return world
 
 

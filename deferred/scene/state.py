@@ -101,17 +101,19 @@ class FrameState:
     source: str
     scene: Any = field(repr=False)  # the user's Scene (deferred.scene.scene)
     revision: int = 0
-    _by_node: dict[int, ObjectState] = field(default_factory=dict, init=False, repr=False)
+    # by the user's object (nodes hash by identity: which object, not what it holds)
+    _by_node: dict[SceneObject, ObjectState] = field(default_factory=dict, init=False,
+                                                     repr=False)
 
     def __post_init__(self) -> None:
-        self._by_node.update((id(state.node), state) for state in self.objects)
+        self._by_node.update((state.node, state) for state in self.objects)
 
     def object_state(self, node: Any) -> ObjectState:
         """The state of the object ``node`` (a :class:`SceneObject`, or a state of it)."""
-        return self._by_node[id(getattr(node, "node", node))]
+        return self._by_node[getattr(node, "node", node)]
 
     def has_object(self, node: Any) -> bool:
-        return id(getattr(node, "node", node)) in self._by_node
+        return getattr(node, "node", node) in self._by_node
 
     def gbuffer_layout(self) -> GBufferLayout:
         """The G-buffer of this scene: the core plus the data its materials declare."""

@@ -143,14 +143,14 @@ def check_tracks(scene: Scene, times: list[float] | tuple[float, ...]) -> None:
     zero): ``InputError`` naming the track and the time."""
     moving_camera = scene.turntable is not None or scene.camera.parent is not None or \
         any(t.kind == "camera" for t in scene.tracks)
-    lights = {id(t.subject): t.subject for t in scene.tracks if t.kind == "light"}
+    lights = list(dict.fromkeys(t.subject for t in scene.tracks if t.kind == "light"))
     if not (moving_camera or lights):
         return
     hierarchy = hierarchy_of(scene)
     for time in times:
         if moving_camera:
             camera_at(scene, time, hierarchy)
-        for light in lights.values():
+        for light in lights:
             light_params_at(scene, light, time)
 
 
@@ -162,16 +162,19 @@ class SceneEvaluator:
 
     def __init__(self, scene: Scene):
         self.scene = scene
-        self._objects: dict[int, ObjectState] = {}  # the last state of each object
-        self._keys: dict[int, tuple[int, int]] = {}  # the revisions each was evaluated at
-        self._lights: dict[int, tuple[Light, int, Light]] = {}
-        self._materials: dict[int, tuple[Material, int, Any, Material]] = {}
+        # by the user's object or light (hashed by identity): the last state of each object,
+        # the revisions it was evaluated at, the last evaluated copy of each light and of each
+        # object's material
+        self._objects: dict[SceneObject, ObjectState] = {}
+        self._keys: dict[SceneObject, tuple[int, int]] = {}
+        self._lights: dict[Light, tuple[int, Light]] = {}
+        self._materials: dict[SceneObject, tuple[Material, int, Any, Material]] = {}
         self._hierarchy: tuple[tuple, Hierarchy] | None = None
 
     def hierarchy(self) -> Hierarchy:
         """The scene graph's parents, resolved again when a node or a parent changed."""
         scene = self.scene
-        key = tuple((id(node), node.revision) for node in scene.nodes())
+        key = tuple((node, node.revision) for node in scene.nodes())
         if self._hierarchy is None or self._hierarchy[0] != key:
             self._hierarchy = (key, hierarchy_of(scene))
         return self._hierarchy[1]
@@ -180,10 +183,10 @@ class SceneEvaluator:
         """The scene at ``time``."""
         scene = self.scene
         hierarchy = self.hierarchy()
-        worlds: dict[int, np.ndarray] = {}
+        worlds: dict[SceneNode, np.ndarray] = {}
         objects = tuple(self._object(obj, time, hierarchy, worlds) for obj in scene.objects)
         if len(self._objects) > 2 * len(objects) + 16:  # objects removed from the scene
-            present = {id(obj) for obj in scene.objects}
+            present = set(scene.objects)
             self._objects = {k: v for k, v in self._objects.items() if k in present}
             self._materials = {k: v for k, v in self._materials.items() if k in present}
             self._keys = {k: v for k, v in self._keys.items() if k in present}
@@ -196,14 +199,12 @@ class SceneEvaluator:
             revision=scene.revision)
 
     def _object(self, obj: SceneObject, time: float, hierarchy: Hierarchy,
-                worlds: dict[int, np.ndarray]) -> ObjectState:
-        previous = self._objects.get(id(obj))
-        if previous is not None and previous.node is not obj:
-            previous = None  # another object had that id
+                worlds: dict[SceneNode, np.ndarray]) -> ObjectState:
+        previous = self._objects.get(obj)
         key = (obj.revision, obj.material.revision)
         parent = hierarchy.parent_of(obj)
         static = not obj.tracks and not obj.events and parent is None
-        if static and previous is not None and self._keys.get(id(obj)) == key:
+        if static and previous is not None and self._keys.get(obj) == key:
             return previous  # nothing to evaluate: the object as the user left it
         model = world_matrix(obj, hierarchy, lambda n: local_matrix_at(n, time), worlds)
         if previous is not None and model is not previous.model and \
@@ -212,7 +213,7 @@ class SceneEvaluator:
         elif model is not obj.model:
             model = read_only(model)
         material = self._material_at(obj, time)
-        self._keys[id(obj)] = key
+        self._keys[obj] = key
         if previous is not None and previous.model is model and \
                 previous.material is material and previous.mesh is obj.mesh and \
                 previous.label == obj.label:
@@ -222,7 +223,7 @@ class SceneEvaluator:
         state = ObjectState(node=obj, label=obj.label, mesh=obj.mesh, material=material,
                             model=model, version=next_revision(), world_at=self._world_at(obj),
                             tracks=tuple(tracks))
-        self._objects[id(obj)] = state
+        self._objects[obj] = state
         return state
 
     def _light(self, light: Light, time: float, hierarchy: Hierarchy) -> Light:
@@ -231,11 +232,11 @@ class SceneEvaluator:
         if light.parent is None and not self._light_tracks(light):
             return light
         evaluated = light_at(self.scene, light, time, hierarchy)
-        kept = self._lights.get(id(light))
-        if kept is not None and kept[0] is light and kept[1] == light.revision and \
-                evaluated is not light and kept[2].params == evaluated.params:
-            return kept[2]
-        self._lights[id(light)] = (light, light.revision, evaluated)
+        kept = self._lights.get(light)
+        if kept is not None and kept[0] == light.revision and evaluated is not light and \
+                kept[1].params == evaluated.params:
+            return kept[1]
+        self._lights[light] = (light.revision, evaluated)
         return evaluated
 
     def _light_tracks(self, light: Light) -> bool:
@@ -256,11 +257,11 @@ class SceneEvaluator:
         params = obj.params_at(time)
         if params is material.params:
             return material
-        kept = self._materials.get(id(obj))
+        kept = self._materials.get(obj)
         if kept is not None and kept[0] is material and kept[1] == material.revision and \
                 kept[2] is params:
             return kept[3]
         evaluated = copy.copy(material)
         evaluated.params = params
-        self._materials[id(obj)] = (material, material.revision, params, evaluated)
+        self._materials[obj] = (material, material.revision, params, evaluated)
         return evaluated
