@@ -177,10 +177,15 @@ def test_a_seek_gives_the_frame_of_a_sequence_bit_for_bit(gl):
 
 
 def test_rendering_leaves_the_scene_as_it_was_given(gl):
-    """The timeline is evaluated, never written back: after frames at several times, every
-    object's placement and parameters, every light's and the camera are the very values the
-    scene was made with (the same objects, not copies)."""
-    scene = scene_with("smooth")
+    """The timeline (tracks and events) is evaluated, never written back: after frames at
+    several times, every object's placement and parameters, every light's and the camera are
+    the very values the scene was made with (the same objects, not copies)."""
+    scene = scene_from_toml(BASE + tracks("smooth") + """
+[[event]]
+time = 1.5
+object = "box"
+params = { color = [0.1, 0.9, 0.1], specular_intensity = 0.9 }
+""", "s.toml")
     models = [obj.model for obj in scene.objects]
     transforms = [obj.transform for obj in scene.objects]
     materials = [(obj.material, obj.material.params) for obj in scene.objects]
@@ -198,6 +203,8 @@ def test_rendering_leaves_the_scene_as_it_was_given(gl):
     assert all(light.params is p for light, p in zip(scene.lights, lights, strict=True))
     assert scene.camera is camera
     assert [obj.revision for obj in scene.objects] + [scene.revision] == revisions
+    box = scene.objects[1]  # the event holds in the frames' states, not in the object
+    assert box.params_at(2.9).color == (0.1, 0.9, 0.1) and box.params.color != (0.1, 0.9, 0.1)
 
 
 def test_what_is_set_by_hand_is_the_base_of_the_tracks():
