@@ -4,14 +4,18 @@ A plugin (the built-in materials, lights and effects, and the example package in
 ``examples/plugins``) imports from here and nowhere else in ``deferred``;
 ``docs/writing-a-material.md`` walks through it. The names, by what they are for:
 
-- **interfaces**: :class:`Material` (with :class:`MaterialParams`, :class:`BlinnPhongParams`,
-  the passes it gets by default, :class:`GBufferPass` and :class:`ForwardLitPass`),
-  :class:`ShadingModel`, :class:`GBufferData`, :class:`Light` (:class:`LightParams`),
-  :class:`Effect` (:class:`EffectParams`), and the registries to register them with:
-  ``materials``, ``lights``, ``shading_models``, ``effects``.
-- **passes**: :class:`RenderPass`, :class:`ObjectPass`, :class:`FullscreenPass`,
-  :class:`ClearPass`, :func:`copy_pass`, :class:`Phase` and :class:`Order`; the
-  :class:`Frame` a pass runs against; :class:`TargetSpec` for the targets a pass creates.
+- **interfaces**: :class:`Material` (with :class:`MaterialParams`, :class:`BlinnPhongParams`)
+  and the parts it is composed of: its passes, :class:`Technique` (:class:`SurfacePasses`, the
+  :class:`GBufferPass` and :class:`ForwardLitPass` every material has by default;
+  :class:`PhasePasses`), its shadows, :class:`ShadowCaster` (:class:`NoShadow`,
+  :class:`ShadowView`, ``SHADOW_CASTER_DEFINES``), :class:`Motion` (:class:`ReachMotion`) and
+  :class:`Simulation`; :class:`ShadingModel`, :class:`GBufferData`, :class:`Light`
+  (:class:`LightParams`), :class:`Effect` (:class:`EffectParams`), and the registries to
+  register them with: ``materials``, ``lights``, ``shading_models``, ``effects``.
+- **passes**: :class:`RenderPass`, :class:`ObjectPass` (with the :class:`PassInput` and
+  :class:`Shape` it composes), :class:`FullscreenPass`, :class:`ClearPass`, :func:`copy_pass`,
+  :class:`Phase` and :class:`Order`; the :class:`Frame` a pass runs against;
+  :class:`TargetSpec` for the targets a pass creates.
 - **targets by name**: the G-buffer's (``ALBEDO_SPECULAR``, ``NORMAL_EXPONENT_ID``,
   ``LINEAR_DEPTH``, ``DEPTH``, ``GBUFFER_COLOR_TARGETS``) and the frame's
   (``LIGHT_ACCUMULATION``, ``COMPOSITE``, ``FINAL`` and their specs).
@@ -39,8 +43,10 @@ from deferred.core.passes import (
     FullscreenPass,
     ObjectPass,
     Order,
+    PassInput,
     Phase,
     RenderPass,
+    Shape,
     copy_pass,
 )
 from deferred.errors import InputError, RenderError
@@ -83,17 +89,23 @@ from deferred.interfaces.light import (
     view_point,
     view_points,
 )
-from deferred.interfaces.material import (
-    SHADOW_CASTER_DEFINES,
-    BlinnPhongParams,
-    ForwardLitPass,
-    GBufferPass,
-    Material,
-    MaterialParams,
-    ShadowView,
-)
+from deferred.interfaces.material import BlinnPhongParams, Material, MaterialParams
 from deferred.interfaces.registry import effects, lights, materials, shading_models
 from deferred.interfaces.shading import ShadingModel
+from deferred.interfaces.shadow_casting import (
+    SHADOW_CASTER_DEFINES,
+    NoShadow,
+    ShadowCaster,
+    ShadowView,
+)
+from deferred.interfaces.simulation import Motion, ReachMotion, Simulation
+from deferred.interfaces.techniques import (
+    ForwardLitPass,
+    GBufferPass,
+    PhasePasses,
+    SurfacePasses,
+    Technique,
+)
 from deferred.io.images import check_image, read_channels, read_image, srgb_decode
 from deferred.names import LightPath, LightVolume, Pipeline, ShadowProjection
 from deferred.params import Params, UniformOverrides
@@ -151,10 +163,12 @@ __all__ = [
     "BlinnPhongParams", "ClearPass", "Effect", "EffectParams", "ForwardLitPass", "Frame",
     "FullscreenPass", "GBufferData", "GBufferPass", "GpuMesh", "InputError", "Light",
     "LightParams", "LightPath", "LightVolume", "Material", "MaterialParams", "MeshData",
-    "MeshPrimitives", "SHADOW_CASTER_DEFINES", "ShadowParams", "ShadowProjection",
-    "ShadowView",
-    "NonZeroVec3", "ObjectPass", "Order", "Params", "Phase", "Pipeline", "Radiance",
-    "RenderError", "RenderPass", "Scene", "SceneObject", "ShadingModel", "TargetSpec",
+    "MeshPrimitives", "Motion", "NoShadow", "SHADOW_CASTER_DEFINES", "ShadowCaster",
+    "ShadowParams", "ShadowProjection", "ShadowView",
+    "NonZeroVec3", "ObjectPass", "Order", "Params", "PassInput", "Phase", "PhasePasses",
+    "Pipeline", "Radiance", "ReachMotion",
+    "RenderError", "RenderPass", "Scene", "SceneObject", "ShadingModel", "Shape",
+    "Simulation", "SurfacePasses", "TargetSpec", "Technique",
     "UniformOverrides", "builtin_head_spheres", "check_image", "copy_pass", "effects", "halton",
     "image_texture_bytes", "lights", "materials",
     "radiances", "read_channels", "read_image", "register_shader_root", "require_regular_file",

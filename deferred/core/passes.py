@@ -13,7 +13,7 @@ from abc import ABC, abstractmethod
 from collections.abc import Callable, Mapping
 from enum import Enum
 from types import MappingProxyType
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar, Protocol
 
 import moderngl
 
@@ -169,6 +169,31 @@ def copy_pass(name: str, phase: Phase, source: str, target: str, spec: TargetSpe
                           creates={target: spec}, order=order)
 
 
+class PassInput:
+    """Something an object pass reads besides the material's inputs, given to the pass as one
+    of its ``inputs`` (composed, not mixed in: a pass type takes any of them). It may sample
+    targets (``reads``: the pass graph orders the pass after their makers; the input binds them
+    under its own sampler names with ``frame.target``), and gives uniforms and textures for the
+    object as the frame has it (``obj``: its state at the frame's time). The same input serves
+    every pass and object it is given to: it keeps nothing of one (what lasts is in
+    ``frame.resources``, keyed by ``obj.node``)."""
+
+    reads: tuple[str, ...] = ()
+
+    def uniforms(self, frame: Frame, obj: SceneObjectLike) -> dict[str, Any]:
+        return {}
+
+    def textures(self, frame: Frame, obj: SceneObjectLike) -> dict[str, moderngl.Texture]:
+        return {}
+
+
+class Shape(Protocol):
+    """What an object pass draws instead of its object's mesh (its ``shape``: the hair's tubes,
+    say): one or more draw calls of ``program``, which the pass has bound."""
+
+    def draw(self, frame: Frame, obj: SceneObjectLike, program: moderngl.Program) -> None: ...
+
+
 class ObjectPass(RenderPass):
     """Draw one scene object's mesh with a program; materials build their passes on this.
 
@@ -178,9 +203,12 @@ class ObjectPass(RenderPass):
     read the object through it, never a state kept from another frame.
 
     Subclasses (or callers) give the shader files (a geometry shader too, if any), defines, the
-    targets and state, and a ``uniforms`` hook. ``draws`` > 1 renders the mesh that many times,
-    each draw with its own ``draw_uniforms`` (e.g. one shell per draw; ``None`` skips the draw).
-    ``draw`` issues one draw call (override it to draw other primitives of the mesh).
+    targets and state, and a ``uniforms`` hook. ``inputs`` (:class:`PassInput`) add what the
+    pass reads besides the material's inputs (a comb field, a simulation's textures), each its
+    uniforms and textures; ``shape`` (:class:`Shape`) draws something else than the mesh.
+    ``draws`` > 1 renders the mesh that many times, each draw with its own ``draw_uniforms``
+    (e.g. one shell per draw; ``None`` skips the draw). ``draw`` issues one draw call (override
+    it to draw other primitives of the mesh).
 
     What a subclass overrides of those hooks is found when the class is made (a pass keeping
     them all draws without asking them), so change a hook by subclassing, not by patching the
@@ -201,6 +229,8 @@ class ObjectPass(RenderPass):
     extra_reads: tuple[str, ...] = ()
     constants: dict[str, Any] | None = None  # uniforms fixed at construction
     extra_defines: dict[str, str] | None = None
+    inputs: tuple[PassInput, ...] = ()  # what the pass reads besides the material's inputs
+    shape: Shape | None = None  # what the pass draws; None: the object's mesh
     # the last program lookup: (shaders, generation, material, params, mesh, defines, program)
     _program_memo: tuple | None = None
     # whether uniforms, textures, draws and draw_uniforms are ObjectPass's own, and whether
@@ -224,7 +254,11 @@ class ObjectPass(RenderPass):
                     not hasattr(type(self), key):
                 raise TypeError(f"{type(self).__name__} has no option '{key}'")
             setattr(self, key, value)
-        self.samples = tuple(self.extra_reads)
+        self.inputs = tuple(self.inputs)
+        self.samples = tuple(dict.fromkeys(
+            [*self.extra_reads, *(target for given in self.inputs for target in given.reads)]))
+        # one draw of the material's inputs alone: the pass's hooks are not asked (execute)
+        self._plain = self._hooks_unchanged and not self.extra_reads and not self.inputs
         self.reads, self.writes = drawn_targets(self.samples, self.colors, self.blend,
                                                 self.depth, self.depth_test, self.depth_write)
 
@@ -253,7 +287,27 @@ class ObjectPass(RenderPass):
         return {}
 
     def draw(self, frame: Frame, program: moderngl.Program) -> None:
-        frame.draw_mesh(self.mesh, program)
+        if self.shape is None:
+            frame.draw_mesh(self.mesh, program)
+        else:
+            self.shape.draw(frame, self.object(frame), program)
+
+    def gather_uniforms(self, frame: Frame, obj: SceneObjectLike) -> dict[str, Any]:
+        """The pass's uniforms (:meth:`uniforms`) and its inputs', an input's over the pass's
+        of one name."""
+        return self._with_inputs(self.uniforms(frame), "uniforms", frame, obj)
+
+    def gather_textures(self, frame: Frame, obj: SceneObjectLike) -> dict[str, moderngl.Texture]:
+        """The pass's samplers (:meth:`textures`) and its inputs'."""
+        return self._with_inputs(self.textures(frame), "textures", frame, obj)
+
+    def _with_inputs(self, own: dict[str, Any], hook: str, frame: Frame,
+                     obj: SceneObjectLike) -> dict[str, Any]:
+        for given in self.inputs:
+            extra = getattr(given, hook)(frame, obj)
+            if extra:
+                own = {**own, **extra}
+        return own
 
     def program(self, frame: Frame, obj: SceneObjectLike | None = None) -> moderngl.Program:
         shaders = frame.shaders
@@ -281,7 +335,7 @@ class ObjectPass(RenderPass):
         frame.set_state(depth_test=self.depth_test, depth_func=self.depth_func, cull=self.cull,
                         blend=self.blend, depth_offset=self.depth_offset)
         material = frame.material_inputs(obj.material)
-        if self._hooks_unchanged and not self.extra_reads:
+        if self._plain:
             # one draw and nothing of the pass's own but its constants (most objects'
             # G-buffer and forward passes): the hooks' empty answers are not asked for
             # (benchmarks/README.md has what asking cost)
@@ -289,10 +343,10 @@ class ObjectPass(RenderPass):
                        material=material)
             self.draw(frame, program)
             return
-        uniforms = self.uniforms(frame)
+        uniforms = self.gather_uniforms(frame, obj)
         if self.constants:
             uniforms = {**self.constants, **uniforms}
-        textures = self.textures(frame)
+        textures = self.gather_textures(frame, obj)
         offered = frame.object_uniforms(obj)
         count = self.draws(frame)
         bound = False

@@ -99,8 +99,8 @@ def with_material_view(scene: Scene, name: str) -> Scene | None:
 def check_material_view(scene: Scene, name: str, pipeline: str) -> None:
     """Refuse a material view the scene or pipeline cannot show: ``<fur>.opacity_shadow``
     needs a shadowed light and a pipeline whose shells read the deep opacity maps (forward;
-    deferred where the material's ``deferred_opacity`` says so, as both built-in furs' does:
-    a plugin's fur whose deferred passes do not read them is refused there)."""
+    deferred where the material's caster's ``deferred_opacity`` says so, as both built-in
+    furs' does: a plugin's fur whose deferred passes do not read them is refused there)."""
     if not name.endswith(".opacity_shadow"):
         return
     if not any(light.casts_shadows for light in scene.lights):
@@ -108,7 +108,7 @@ def check_material_view(scene: Scene, name: str, pipeline: str) -> None:
                          "scene casts shadows (shadows = true)", "--view")
     material = name.partition(".")[0]
     if pipeline != "forward" and not any(obj.material.name == material and
-                                         obj.material.deferred_opacity
+                                         obj.material.shadow.deferred_opacity
                                          for obj in scene.objects):
         raise InputError(f"view '{name}' shows the deep opacity maps, which {material}'s "
                          "deferred passes do not read: use --pipeline forward", "--view")

@@ -1,42 +1,47 @@
-"""The material interface: plain parameter data, GLSL files, and the passes a material contributes.
+"""The material interface: what the frame asks of every material, and the parts it composes.
 
 A material is a class with a unique ``name``, a pydantic ``Params`` model (defaults, ranges, a
-one-line description per field) and a ``surface_shader``: a GLSL file defining
-``Surface material_surface(SurfaceInput i)`` (``common/surface.glsl``). With only that, the base
-class gives it a G-buffer pass (geometry phase) and a forward lit pass (forward pipeline). Materials
-that need more (stipple, shells, composition) override the ``*_passes`` hooks, and may add passes
-once per scene (``scene_passes``); they never edit the pipeline. Register with
-``@deferred.api.materials.register`` or the entry-point group ``deferred.materials``.
+one-line description per field), a ``surface_shader`` (a GLSL file defining ``Surface
+material_surface(SurfaceInput i)``, ``common/surface.glsl``) lit by a ``shading_model``, and the
+G-buffer data it writes. What it does beyond that is composed of parts, each optional, each a
+plain object given as a class attribute rather than a hook overridden:
 
-Parameters become uniforms by name (:mod:`deferred.params`): field ``fur_length`` is
-``u_fur_length``; ``uniform_overrides`` maps a field to ``None`` (not a uniform: a pass count, a
-file, a define) or to a function giving the uniforms it becomes.
+- ``techniques`` (:mod:`deferred.interfaces.techniques`): the passes it contributes, per object
+  and phase and once per scene; by default its surface's G-buffer pass and forward lit pass;
+- ``shadow`` (:mod:`deferred.interfaces.shadow_casting`): how its objects cast shadows (the
+  mesh by default) and draw into deep opacity maps;
+- ``motion`` and ``simulation`` (:mod:`deferred.interfaces.simulation`): how far it draws beyond
+  the mesh, and a state per object over time.
+
+Register with ``@deferred.api.materials.register`` or the entry-point group
+``deferred.materials``. Parameters become uniforms by name (:mod:`deferred.params`): field
+``fur_length`` is ``u_fur_length``; ``uniform_overrides`` maps a field to ``None`` (not a
+uniform: a pass count, a file, a define) or to a function giving the uniforms it becomes.
 """
 
 from __future__ import annotations
 
 import sys
-from collections.abc import Iterable
-from dataclasses import dataclass
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
 
 import moderngl
-import numpy as np
 from pydantic import Field
 
-from deferred.core.passes import ObjectPass, Phase, RenderPass
+from deferred.core.passes import Phase, RenderPass
 from deferred.errors import InputError
 from deferred.gbuffer.layout import (
-    DEPTH,
     GBUFFER_COLOR_TARGETS,
     GBufferData,
     GBufferLayout,
     data_write_file,
 )
 from deferred.gbuffer.surface_id import surface_id
-from deferred.gl.targets import COMPOSITE
 from deferred.interfaces import registry
+from deferred.interfaces.shadow_casting import ShadowCaster
+from deferred.interfaces.simulation import Motion, Simulation
+from deferred.interfaces.techniques import SurfacePasses, Technique
 from deferred.memo import kept_while
 from deferred.params import Params, UniformOverrides, params_uniforms, validate_params
 from deferred.revision import Revisioned
@@ -64,75 +69,42 @@ class BlinnPhongParams(MaterialParams):
     specular_exponent: float = Field(32.0, ge=1.0, le=2048.0, description="Blinn-Phong exponent")
 
 
-class GBufferPass(ObjectPass):
-    """Geometry phase: the material's surface written into the G-buffer: the core targets and
-    the G-buffer data the material declares (``Material.gbuffer_targets``)."""
-
-    fragment = "gbuffer/geometry.frag"
-    depth = DEPTH
-
-    def __init__(self, name: str, phase: Phase, obj: SceneObjectLike, **options: Any):
-        options.setdefault("colors", obj.material.gbuffer_targets())
-        super().__init__(name, phase, obj, **options)
-
-
-class ForwardLitPass(ObjectPass):
-    """Forward pipeline: the material's surface lit by every light in one pass (``lequal``:
-    Forward+ lays the same depth down in its pre-pass first)."""
-
-    fragment = "forward/lit.frag"
-    colors = (COMPOSITE,)
-    depth = DEPTH
-    depth_func = "lequal"
-
-
-SHADOW_CASTER_VERTEX = "shadows/caster.vert"
-SHADOW_CASTER_FRAGMENT = "shadows/caster.frag"
-
-
-# A vertex shader of the camera (``u_view``, ``u_projection``) compiled with these defines
-# draws from the light instead, reading :attr:`ShadowView.camera_uniforms`: how a material's
-# own vertex stage (fur shells, displaced strands) becomes its shadow caster's.
-SHADOW_CASTER_DEFINES = {"u_view": "u_shadow_view", "u_projection": "u_shadow_projection",
-                         "SHADOW_CASTER": "1"}
-
-
-@dataclass(frozen=True)
-class ShadowView:
-    """One shadow map being drawn (:meth:`Material.draw_shadow`): the light's world -> view
-    and view -> clip matrices, where the light is (a world position, or ``None`` for a
-    directional light) and the direction it shines (world, unit), for casters that shape
-    themselves to it. ``opacity_maps``: the light has deep opacity maps this frame, which
-    every material with ``opacity_shadows`` draws itself into (:meth:`Material.draw_opacity`)
-    and through which the other surfaces take its shadow (``lighting/shadows.glsl``): such a
-    volume may leave its translucent part out of the depth map."""
-
-    view: np.ndarray
-    projection: np.ndarray
-    position: np.ndarray | None
-    direction: np.ndarray
-    opacity_maps: bool = False
-
-    @property
-    def uniforms(self) -> dict[str, Any]:
-        """``u_shadow_view_projection``: what ``shadows/caster.vert`` reads."""
-        return {"u_shadow_view_projection": self.projection @ self.view}
-
-    @property
-    def camera_uniforms(self) -> dict[str, Any]:
-        """The light as the camera of a vertex shader compiled with
-        :data:`SHADOW_CASTER_DEFINES`."""
-        return {"u_shadow_view": self.view, "u_shadow_projection": self.projection}
+# Hooks of the material base class that became composed parts: a class defining one is refused
+# when it is made (at its registration or before), saying what to write instead.
+MOVED_HOOKS: dict[str, str] = {
+    **{f"{phase}_passes": (
+        f"a material's passes come from its techniques: add "
+        f"`techniques = (*Material.techniques, PhasePasses(Phase.{phase.upper()}, build))`, "
+        "`build(material, obj)` returning the passes (or a Technique of your own)"
+        + ("; to change the surface's own pass, give SurfacePasses(vertex=..., inputs=...) "
+           "in place of Material.techniques' " if phase in ("geometry", "forward") else ""))
+       for phase in ("geometry", "screen", "stipple", "material", "forward")},
+    **{name: (f"shadow casting is the material's `shadow`: write `shadow = MyCaster()`, a "
+              f"ShadowCaster subclass defining {new}")
+       for name, new in (("draw_shadow", "draw(frame, obj, view)"),
+                         ("opacity_shadows", "opacity_shadows(obj)"),
+                         ("deferred_opacity", "deferred_opacity"),
+                         ("opacity_layer", "opacity_layer(obj)"),
+                         ("draw_opacity", "draw_opacity(frame, obj, view, stage)"))},
+    "motion_extent": "write `motion = ReachMotion(\"<parameter>\")`, or a Motion subclass "
+                     "defining extent(obj)",
+    **{name: "a time the material cannot reach is its simulation's to refuse: write "
+             "`simulation = MySimulation()`, a Simulation subclass defining "
+             "check_time(obj, time, where)" for name in ("check_time", "check_time_for")},
+}
 
 
 class Material(Revisioned):
     """A material: a unique ``name``, a validated ``Params`` model and a GLSL surface function
-    (``surface_shader``, ``Surface material_surface(SurfaceInput i)``) lit by ``shading_model``.
+    (``surface_shader``, ``Surface material_surface(SurfaceInput i)``) lit by ``shading_model``,
+    writing the core G-buffer and its ``gbuffer_data``.
 
-    The base class gives each object a G-buffer pass and a forward lit pass; the per-object
-    hooks (:meth:`geometry_passes`, :meth:`stipple_passes`, :meth:`material_passes`,
-    :meth:`forward_passes`, ...) and :meth:`scene_passes` add more. Every parameter becomes a
-    ``u_<field>`` uniform unless ``uniform_overrides`` says otherwise.
+    What the frame asks of every material is here: its passes (:meth:`passes`,
+    :meth:`scene_passes`), its programs' defines (:meth:`defines`), its uniforms and textures,
+    its G-buffer data and id, what it holds (:meth:`held_memory`), and its composed parts:
+    ``techniques`` (the passes), ``shadow`` (how its objects cast shadows), ``motion`` (how far
+    it draws beyond the mesh) and ``simulation`` (a state per object over time, or none).
+    Every parameter becomes a ``u_<field>`` uniform unless ``uniform_overrides`` says otherwise.
     """
 
     name: ClassVar[str]
@@ -144,6 +116,11 @@ class Material(Revisioned):
     gbuffer_data: tuple[GBufferData, ...] = ()  # extra per-pixel data (deferred.interfaces.shading)
     # field -> None (not a uniform) or value -> {uniform: value} (see the module documentation)
     uniform_overrides: ClassVar[UniformOverrides] = {}
+    # the composed parts: the passes, shadow casting, motion beyond the mesh, a simulation
+    techniques: ClassVar[tuple[Technique, ...]] = (SurfacePasses(),)
+    shadow: ClassVar[ShadowCaster] = ShadowCaster()
+    motion: ClassVar[Motion] = Motion()
+    simulation: ClassVar[Simulation | None] = None
     # parameters the material reads once, at t = 0 (a simulation's set-up): a scene timeline
     # may not change them
     timeline_fixed: ClassVar[tuple[str, ...]] = ()
@@ -159,6 +136,14 @@ class Material(Revisioned):
     # debug views (``deferred render --view <material>.<name>``): name -> (what it shows, the
     # parameters that make the material draw it)
     debug_views: ClassVar[dict[str, tuple[str, dict[str, Any]]]] = {}
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        for hook, instead in MOVED_HOOKS.items():
+            if hook in cls.__dict__:
+                raise TypeError(f"material class {cls.__module__}.{cls.__qualname__} defines "
+                                f"{hook}, which the framework no longer asks: {instead} "
+                                "(docs/writing-a-material.md)")
 
     def __init__(self, params: MaterialParams | None = None, base_dir: Path | None = None):
         self.params = params if params is not None else self.Params()
@@ -192,13 +177,6 @@ class Material(Revisioned):
         path = self.resolve_path(value)
         require_regular_file(path, what, key)
         return path
-
-    def motion_extent(self, obj: SceneObjectLike) -> float:
-        """How far, in object units along the mesh's normals, what the material draws for
-        ``obj`` reaches beyond the mesh (fur shells and fins, hair): motion vectors are drawn
-        over the mesh pushed out that far (deferred.effects.taa), so the pixels of those
-        layers move with the object."""
-        return 0.0
 
     # -- shader inputs -----------------------------------------------------------------------
     @classmethod
@@ -269,80 +247,25 @@ class Material(Revisioned):
         return False  # not a Material subclass's MRO (a mixin listed after it)
 
     def held_memory(self, obj: SceneObjectLike) -> dict[str, int]:
-        """Bytes this material will hold for ``obj`` (textures, simulation state) by what they
-        are, counted with the render targets against the memory budget before the first frame:
-        a key names the thing (``texture /path/fur.png``), so a texture objects share counts
-        once. Files are sized by their headers. By default nothing."""
+        """Bytes this material will hold for ``obj`` (textures it loads) by what they are,
+        counted with the render targets and its simulation's state against the memory budget
+        before the first frame: a key names the thing (``texture /path/fur.png``), so a texture
+        objects share counts once. Files are sized by their headers. By default nothing."""
         return {}
 
-    def check_time(self, time: float, where: str) -> None:
-        """Refuse (``InputError`` naming ``where``) a frame time this material cannot reach in
-        bounded work, before any frame is rendered: a simulation stepping from 0 to it."""
-
-    def check_time_for(self, obj: SceneObjectLike, time: float, where: str) -> None:
-        """:meth:`check_time` for this material on ``obj``, whose mesh may set the work (a
-        simulation of a strand a triangle); by default :meth:`check_time`."""
-        self.check_time(time, where)
-
-    # -- passes per phase --------------------------------------------------------------------
-    def geometry_passes(self, obj: SceneObjectLike) -> list[RenderPass]:
-        return [GBufferPass(f"{obj.label}.gbuffer", Phase.GEOMETRY, obj)]
-
-    def screen_passes(self, obj: SceneObjectLike) -> list[RenderPass]:
-        return []
-
-    def stipple_passes(self, obj: SceneObjectLike) -> list[RenderPass]:
-        return []
-
-    def material_passes(self, obj: SceneObjectLike) -> list[RenderPass]:
-        return []
-
-    def forward_passes(self, obj: SceneObjectLike) -> list[RenderPass]:
-        return [ForwardLitPass(f"{obj.label}.forward", Phase.FORWARD, obj)]
+    # -- passes ------------------------------------------------------------------------------
+    def passes(self, phase: Phase, obj: SceneObjectLike) -> list[RenderPass]:
+        """The passes of ``obj`` in ``phase``: its techniques', in their order."""
+        return [render_pass for technique in self.techniques
+                for render_pass in technique.passes(self, phase, obj)]
 
     @classmethod
-    def scene_passes(cls, objects: list[SceneObjectLike], phase: Phase) -> list[RenderPass]:
-        """Passes this material adds once per scene, not per object, in ``phase`` (scene-wide
-        setup, screen or post effects of its own); ``objects`` are the scene's objects of this
-        material. Passes of one name from several materials (a shared technique's) run once."""
-        return []
-
-    def draw_shadow(self, frame: Frame, obj: SceneObjectLike, view: ShadowView) -> None:
-        """Draw ``obj``'s depth into the shadow map ``view`` (the framework has bound that
-        tile of the shadow atlas, cleared it and set depth-only state: depth test, no culling,
-        a slope-scaled depth offset). By default the mesh through ``shadows/caster.vert``; a
-        material whose look is not its mesh (fur shells, displaced strands) draws that, with
-        ``view.uniforms`` and a vertex stage of its own; one that casts no shadow draws
-        nothing."""
-        program = frame.shaders.program(SHADOW_CASTER_VERTEX, SHADOW_CASTER_FRAGMENT)
-        frame.bind(program, view.uniforms, offered=frame.object_uniforms(obj))
-        frame.draw_mesh(obj.mesh, program)
-
-    # A volume that shadows itself through deep opacity maps (fur; deferred.lighting.shadows):
-    # it draws them (draw_opacity) and its receivers compile with OPACITY_RECEIVER.
-    opacity_shadows: bool = False
-    # ... and its deferred passes read them too (the forward passes of such a material do)
-    deferred_opacity: ClassVar[bool] = False
-
-    def opacity_layer(self, obj: SceneObjectLike) -> float:
-        """World thickness of ``obj``'s volume (the opacity layers span a few of the thickest)."""
-        return 0.0
-
-    def draw_opacity(self, frame: Frame, obj: SceneObjectLike, view: ShadowView,
-                     stage: str) -> None:
-        """Draw ``obj``'s volume into the deep opacity maps of ``view`` (materials with
-        ``opacity_shadows``): ``stage`` "first", the light-view depth of its outer surface
-        (which every point it draws lies inside) as (depth, -depth, 0, 0) into an RG32F target
-        with min blending, no depth test: its front and its back along each texel; "density",
-        its optical depth times the volume's density factor (what lies behind it keeps
-        exp(-the layers' sum) of the light), added into the four layers behind that front
-        (``u_opacity_first``, ``u_opacity_layers``), blended additively."""
-
-    def passes(self, phase: Phase, obj: SceneObjectLike) -> list[RenderPass]:
-        hooks = {Phase.GEOMETRY: self.geometry_passes, Phase.SCREEN: self.screen_passes,
-                 Phase.STIPPLE: self.stipple_passes, Phase.MATERIAL: self.material_passes,
-                 Phase.FORWARD: self.forward_passes}
-        return hooks[phase](obj) if phase in hooks else []
+    def scene_passes(cls, objects: Sequence[SceneObjectLike],
+                     phase: Phase) -> list[RenderPass]:
+        """Passes this material adds once per scene in ``phase``: its techniques'; ``objects``
+        are the scene's objects of this material."""
+        return [render_pass for technique in cls.techniques
+                for render_pass in technique.scene_passes(objects, phase)]
 
 
 def compose_layout(materials: Iterable[Material]) -> GBufferLayout:

@@ -32,10 +32,13 @@ def check_target_memory(graph: PassGraph, size: tuple[int, int], where: str = "s
 
 
 def held_memory(scene: FrameState) -> dict[str, int]:
-    """What every object's material will hold, by what it is (a shared texture once)."""
+    """What every object's material will hold, by what it is (a shared texture once): the
+    textures it loads and its simulation's state."""
     held: dict[str, int] = {}
     for obj in scene.objects:
         held.update(obj.material.held_memory(obj))
+        if obj.material.simulation is not None:
+            held.update(obj.material.simulation.held_memory(obj))
     return held
 
 

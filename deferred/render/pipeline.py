@@ -48,7 +48,7 @@ from deferred.gl.targets import (
     LIGHT_ACCUMULATION_SPEC,
 )
 from deferred.interfaces.effect import AMBIENT_OCCLUSION
-from deferred.interfaces.material import ForwardLitPass
+from deferred.interfaces.techniques import ForwardLitPass
 from deferred.lighting.culling import LightCullPass, list_shading_pass
 from deferred.lighting.shadows.caster_pass import ShadowPass
 from deferred.lighting.shadows.plan import scene_casts_shadows
@@ -280,11 +280,14 @@ class DepthPrepass(ObjectPass):
         self.lit.prepare(frame)  # a twin of the graph's lit pass: what its hooks read
 
     def uniforms(self, frame) -> dict:
-        return OfferedUniforms(self.lit.uniforms(frame))  # those of its stages
+        # those of its stages: the lit pass's and its inputs'
+        return OfferedUniforms(self.lit.gather_uniforms(frame, self.object(frame)))
 
     def textures(self, frame) -> dict:
         # the lit pass's target reads are not the pre-pass's (it runs before their makers)
-        return {} if self.lit.extra_reads else OfferedUniforms(self.lit.textures(frame))
+        if self.lit.samples:
+            return {}
+        return OfferedUniforms(self.lit.gather_textures(frame, self.object(frame)))
 
     def draw(self, frame, program) -> None:
         self.lit.draw(frame, program)  # what the lit pass draws (a material's own geometry)
@@ -298,7 +301,8 @@ def depth_prepass(lit: ForwardLitPass) -> RenderPass:
     stem = lit.name.removesuffix(".forward") if lit.name == f"{lit.node.label}.forward" \
         else lit.name
     name = f"{stem}.depth_prepass"
-    if lit._hooks_unchanged and not overrides(type(lit), RenderPass, "prepare") and \
+    if lit._hooks_unchanged and not lit.inputs and lit.shape is None and \
+            not overrides(type(lit), RenderPass, "prepare") and \
             not overrides(type(lit), ObjectPass, "draw"):
         return ObjectPass(name, Phase.FORWARD, lit, vertex=lit.vertex,
                           fragment=DepthPrepass.fragment, colors=DepthPrepass.colors,

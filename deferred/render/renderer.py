@@ -28,8 +28,8 @@ from deferred.gl.context import GLContext, acquire_context, give_back_context
 from deferred.gl.target_spec import targets_bytes
 from deferred.gl.targets import COMPOSITE, FINAL
 from deferred.interfaces.material import Material
+from deferred.interfaces.simulation import advance_simulations
 from deferred.io.safety import raise_if_stop_requested
-from deferred.memo import overrides
 from deferred.names import Pipeline
 from deferred.params import validate_params
 from deferred.render.budget import check_target_memory, held_memory, renderer_holdings
@@ -310,6 +310,7 @@ class Renderer:
         if stale != "GL_NO_ERROR":
             warnings.warn(f"GL error {stale} left by code outside the renderer", stacklevel=2)
         frame, history = self._begin_frame(state, time, jitter, sample_index, time_gl_calls)
+        advance_simulations(frame)
         prepare_passes(frame, self.passes)
         self.gl.park()  # whatever framebuffer was bound may have been released since
         run_passes(frame, sort_blended(self.passes, state), before_pass, on_pass)
@@ -394,8 +395,9 @@ class Renderer:
         return read
 
     def check_times(self, times: list[float], where: str = "--time") -> None:
-        """Every material's :meth:`~deferred.interfaces.material.Material.check_time` for the
-        latest of ``times``: an animation is refused before its first frame, not part way.
+        """Every simulated object's :meth:`~deferred.interfaces.simulation.Simulation.check_time`
+        for the latest of ``times``: an animation is refused before its first frame, not part
+        way.
         The work a check weighs grows with the time (steps from 0, droplets fallen by then),
         so a time passed covers every earlier one while the checked objects' revisions are
         the same: a frame at such a time checks nothing again."""
@@ -404,18 +406,16 @@ class Renderer:
         self.scene.check_tracks(times)  # every frame's camera and lights, not just the last
         latest = max(times)
         objects = self.scene.objects
-        checking = {cls for cls in {type(obj.material) for obj in objects}
-                    if overrides(cls, Material, "check_time", "check_time_for")}
-        checked = [obj for obj in objects if type(obj.material) in checking]
+        checked = [obj for obj in objects if obj.material.simulation is not None]
         revisions = tuple((obj, obj.revision, obj.material.revision) for obj in checked)
         if self._times_checked is not None and self._times_checked[1] == revisions and \
                 latest <= self._times_checked[0]:
             return
         if checked:
             state = self.evaluator.evaluate(latest)
-            for obj in checked:  # most materials have no check
+            for obj in checked:  # most materials have no simulation
                 evaluated = state.object_state(obj)
-                evaluated.node.material.check_time_for(evaluated, latest, where)
+                evaluated.material.simulation.check_time(evaluated, latest, where)
         self._times_checked = (latest, revisions)
 
     def _check_gl(self, stage: str) -> None:

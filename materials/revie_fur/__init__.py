@@ -28,11 +28,12 @@ from deferred.api import (
     NORMAL_EXPONENT_ID,
     Albedo,
     BlinnPhongParams,
-    ForwardLitPass,
-    GBufferPass,
     NonZeroVec3,
+    PassInput,
     Phase,
     RenderPass,
+    SurfacePasses,
+    Technique,
     materials,
 )
 
@@ -44,19 +45,16 @@ from ..techniques.fur import (
     FurMaterial,
     FurParams,
     debug_defines,
+    vertex_constants,
 )
-from ..techniques.shells import DitheredShells, ShellPass
-from ..techniques.stipple import (
-    StippleObliterationPass,
-    StipplePass,
-    pattern_defines,
-    stipple_scene_passes,
-)
+from ..techniques.fur_shadow import FurShadow
+from ..techniques.shells import ShellPass
+from ..techniques.stipple import Stipple, pattern_defines
 
 if TYPE_CHECKING:
     import moderngl
 
-    from deferred.api import Frame, SceneObject
+    from deferred.api import Frame, Material, SceneObject
 
 FUR_VERTEX = "materials/revie_fur/fur.vert"
 SHELL_FRAGMENT = "materials/revie_fur/shell.frag"
@@ -87,47 +85,21 @@ class RevieFurParams(FurParams, BlinnPhongParams):
                              description="marschner: longitudinal roughness beta, radians")
 
 
-class CombFieldInputs:
-    """Passes of a revie_fur object: ``u_comb_field``, the object's comb field
-    (``techniques/comb_field.py``) from its mesh's vertex colours or its ``comb``, made when
-    either changes."""
+class CombField(PassInput):
+    """``u_comb_field``, a revie_fur object's comb field (``techniques/comb_field.py``) from its
+    mesh's vertex colours or its ``comb``, made when either changes: an input of every pass of
+    the object and of its shadow caster."""
 
-    def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
-        return {**super().textures(frame), **comb_field_inputs(frame, self.object(frame))}
-
-
-def comb_field_inputs(frame: Frame, obj: SceneObject) -> dict[str, moderngl.Texture]:
-    """``u_comb_field`` of a revie_fur object (:class:`CombFieldInputs`)."""
-    mesh, params = obj.mesh, obj.material.params
-    comb = None if mesh.has_comb else tuple(params.comb)
-    texture = frame.resources.current(
-        ("revie_fur_comb_field", obj.node), (id(mesh), comb),
-        lambda ctx: comb_field_texture(ctx, comb_field(mesh, comb)))
-    return {"u_comb_field": texture}
+    def textures(self, frame: Frame, obj: SceneObject) -> dict[str, moderngl.Texture]:
+        mesh, params = obj.mesh, obj.material.params
+        comb = None if mesh.has_comb else tuple(params.comb)
+        texture = frame.resources.current(
+            ("revie_fur_comb_field", obj.node), (id(mesh), comb),
+            lambda ctx: comb_field_texture(ctx, comb_field(mesh, comb)))
+        return {"u_comb_field": texture}
 
 
-class CombedGBufferPass(CombFieldInputs, GBufferPass):
-    pass
-
-
-class CombedStipplePass(CombFieldInputs, StipplePass):
-    pass
-
-
-class CombedObliterationPass(CombFieldInputs, StippleObliterationPass):
-    pass
-
-
-class CombedFinPass(CombFieldInputs, FinPass):
-    pass
-
-
-class CombedShellPass(CombFieldInputs, DitheredShells, ShellPass):
-    pass
-
-
-class CombedForwardPass(CombFieldInputs, ForwardLitPass):
-    pass
+COMB_FIELD = CombField()
 
 
 # Options of the shell and fin passes: in the material phase both take their light from the
@@ -139,6 +111,27 @@ FORWARD_LAYERS: dict[str, Any] = {
     "vertex": FUR_VERTEX, "fragment": FORWARD_SHELL_FRAGMENT, "colors": (COMPOSITE,)}
 
 
+class FurLayers(Technique):
+    """The fins and shells over the stipple obliteration: in the material phase lit from the
+    light accumulation, in the forward pipeline by themselves; fins first, the shells
+    composite over them, which fill the gaps between shell rims at grazing angles."""
+
+    def passes(self, material: Material, phase: Phase, obj: SceneObject) -> list[RenderPass]:
+        params = material.params
+        if phase not in (Phase.MATERIAL, Phase.FORWARD) or params.shells == 0:
+            return []
+        layers, prefix = (MATERIAL_LAYERS, "") if phase == Phase.MATERIAL else \
+            (FORWARD_LAYERS, "forward_")
+        constants = vertex_constants(obj)
+        passes: list[RenderPass] = []
+        if params.fins:
+            passes.append(FinPass(f"{obj.label}.{prefix}fins", phase, obj, inputs=(COMB_FIELD,),
+                                  constants=constants, **layers))
+        passes.append(ShellPass(f"{obj.label}.{prefix}shells", phase, obj, dither=True,
+                                inputs=(COMB_FIELD,), constants=constants, **layers))
+        return passes
+
+
 @materials.register
 class RevieFurMaterial(FurMaterial):
     name = "revie_fur"
@@ -148,19 +141,23 @@ class RevieFurMaterial(FurMaterial):
     # pass counts and switches compiled as defines are not uniforms; density becomes tiles
     uniform_overrides = {**FUR_UNIFORM_OVERRIDES, "stipple": None, "occlusion_test": None,
                          "shading": None,
-                         "comb": None}  # the comb field's texture instead (CombFieldInputs)
+                         "comb": None}  # the comb field's texture instead (CombField)
     timeline_fixed = ("shading",)  # the shading model, and so the G-buffer layout
+    debug_views = FUR_DEBUG_VIEWS
+    # the base mesh (grain normals) and its forward twin, the stippled outer shell and its
+    # obliteration (rim-bent normals), then the fins and shells; every pass reads the comb
+    techniques = (
+        SurfacePasses(vertex=FUR_VERTEX, inputs=(COMB_FIELD,),
+                      constants=lambda obj: vertex_constants(obj, 0.0)),
+        Stipple("materials/revie_fur/stipple.frag", vertex=FUR_VERTEX, inputs=(COMB_FIELD,),
+                constants=lambda obj: vertex_constants(obj, 1.0),
+                when=lambda material: material.params.stipple),
+        FurLayers())
+    shadow = FurShadow(FUR_VERTEX, inputs=(COMB_FIELD,))
 
     def __init__(self, params: RevieFurParams | None = None, base_dir: Path | None = None):
         super().__init__(params, base_dir)
         self.shading_model = "marschner" if self.params.shading == "marschner" else "blinn_phong"
-
-    debug_views = FUR_DEBUG_VIEWS
-    fur_vertex = FUR_VERTEX
-    deferred_opacity = True  # its shells correct their samples' light light by light (shell.frag)
-
-    def shadow_textures(self, frame: Frame, obj: SceneObject) -> dict[str, moderngl.Texture]:
-        return comb_field_inputs(frame, obj)
 
     def defines(self, obj: SceneObject) -> dict[str, str]:
         defines = {**super().defines(obj), **pattern_defines(4, STIPPLE_PARITY)}
@@ -171,48 +168,3 @@ class RevieFurMaterial(FurMaterial):
         if self.params.shading == "marschner":
             defines["FUR_MARSCHNER"] = "1"
         return {**defines, **debug_defines(self.params)}
-
-    # -- passes ------------------------------------------------------------------------------
-    @classmethod
-    def scene_passes(cls, objects: list[SceneObject], phase: Phase) -> list[RenderPass]:
-        stippled = any(obj.material.params.stipple for obj in objects)
-        return stipple_scene_passes(phase) if stippled else []
-
-    def geometry_passes(self, obj: SceneObject) -> list[RenderPass]:
-        return [CombedGBufferPass(f"{obj.label}.gbuffer", Phase.GEOMETRY, obj, vertex=FUR_VERTEX,
-                            constants=self.vertex_constants(obj, 0.0))]
-
-    def stipple_passes(self, obj: SceneObject) -> list[RenderPass]:
-        if not self.params.stipple:
-            return []
-        return [CombedStipplePass(f"{obj.label}.stipple", Phase.STIPPLE, obj, vertex=FUR_VERTEX,
-                            fragment="materials/revie_fur/stipple.frag",
-                            constants=self.vertex_constants(obj, 1.0))]
-
-    def material_passes(self, obj: SceneObject) -> list[RenderPass]:
-        passes: list[RenderPass] = []
-        if self.params.stipple:
-            passes.append(CombedObliterationPass(f"{obj.label}.stipple_obliteration",
-                                                  Phase.MATERIAL, obj, vertex=FUR_VERTEX,
-                                                  constants=self.vertex_constants(obj, 1.0)))
-        if self.params.shells > 0:
-            # fins first: the shells composite over them, which fill the gaps between shell
-            # rims at grazing angles
-            if self.params.fins:
-                passes.append(CombedFinPass(f"{obj.label}.fins", Phase.MATERIAL, obj,
-                                      constants=self.vertex_constants(obj), **MATERIAL_LAYERS))
-            passes.append(CombedShellPass(f"{obj.label}.shells", Phase.MATERIAL, obj,
-                                    constants=self.vertex_constants(obj), **MATERIAL_LAYERS))
-        return passes
-
-    def forward_passes(self, obj: SceneObject) -> list[RenderPass]:
-        passes: list[RenderPass] = [CombedForwardPass(f"{obj.label}.forward", Phase.FORWARD, obj,
-                                                   vertex=FUR_VERTEX,
-                                                   constants=self.vertex_constants(obj, 0.0))]
-        if self.params.shells > 0:
-            if self.params.fins:
-                passes.append(CombedFinPass(f"{obj.label}.forward_fins", Phase.FORWARD, obj,
-                                      constants=self.vertex_constants(obj), **FORWARD_LAYERS))
-            passes.append(CombedShellPass(f"{obj.label}.forward_shells", Phase.FORWARD, obj,
-                                    constants=self.vertex_constants(obj), **FORWARD_LAYERS))
-        return passes

@@ -25,16 +25,12 @@ from deferred.api import (
     ObjectPass,
     Order,
     Phase,
+    PhasePasses,
     RenderPass,
     materials,
 )
 
-from ..techniques.stipple import (
-    StippleObliterationPass,
-    StipplePass,
-    pattern_defines,
-    stipple_scene_passes,
-)
+from ..techniques.stipple import Stipple, pattern_defines
 
 if TYPE_CHECKING:
     from deferred.api import SceneObject
@@ -60,35 +56,30 @@ class DeinterlacePass(ObjectPass):
     extra_reads = (LIGHT_ACCUMULATION, NORMAL_EXPONENT_ID, LINEAR_DEPTH)
 
 
+def deinterlace_pass(material: Material, obj: SceneObject) -> list[RenderPass]:
+    return [DeinterlacePass(f"{obj.label}.deinterlace", Phase.MATERIAL, obj)]
+
+
+def forward_pass(material: Material, obj: SceneObject) -> list[RenderPass]:
+    """The forward technique: an alpha-blended lit pass."""
+    return [ObjectPass(f"{obj.label}.forward", Phase.FORWARD, obj,
+                       fragment="materials/stipple_glass/forward.frag", colors=(COMPOSITE,),
+                       depth_write=False, blend="alpha", order=Order.TRANSPARENT)]
+
+
 @materials.register
 class StippleGlassMaterial(Material):
     name = "stipple_glass"
     Params = StippleGlassParams
     surface_shader = "materials/stipple_glass/surface.glsl"
     uniform_overrides = {"pattern": None}  # a define (STIPPLE_PATTERN)
+    # transparent: nothing in the opaque G-buffer phase; stippled instead, its samples
+    # obliterated with the opaque scene and blended back over it with the transparent passes
+    techniques = (Stipple("materials/stipple_glass/stipple.frag"),
+                  PhasePasses(Phase.MATERIAL, deinterlace_pass),
+                  PhasePasses(Phase.FORWARD, forward_pass))
 
     def defines(self, obj: SceneObject) -> dict[str, str]:
         # the other parity classes than fur's (0, 0), so glass and fur samples coexist
         parity = (1, 1) if self.params.pattern == 4 else (1, 0)
         return {**super().defines(obj), **pattern_defines(self.params.pattern, parity)}
-
-    @classmethod
-    def scene_passes(cls, objects: list[SceneObject], phase: Phase) -> list[RenderPass]:
-        return stipple_scene_passes(phase)
-
-    def geometry_passes(self, obj: SceneObject) -> list[RenderPass]:
-        return []  # transparent: nothing in the opaque G-buffer phase
-
-    def stipple_passes(self, obj: SceneObject) -> list[RenderPass]:
-        return [StipplePass(f"{obj.label}.stipple", Phase.STIPPLE, obj,
-                            fragment="materials/stipple_glass/stipple.frag")]
-
-    def material_passes(self, obj: SceneObject) -> list[RenderPass]:
-        return [StippleObliterationPass(f"{obj.label}.stipple_obliteration", Phase.MATERIAL,
-                                        obj),
-                DeinterlacePass(f"{obj.label}.deinterlace", Phase.MATERIAL, obj)]
-
-    def forward_passes(self, obj: SceneObject) -> list[RenderPass]:
-        return [ObjectPass(f"{obj.label}.forward", Phase.FORWARD, obj,
-                           fragment="materials/stipple_glass/forward.frag", colors=(COMPOSITE,),
-                           depth_write=False, blend="alpha", order=Order.TRANSPARENT)]

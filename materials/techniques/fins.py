@@ -15,6 +15,8 @@ from deferred.api import DEPTH, GpuMesh, MeshData, MeshPrimitives, ObjectPass, O
 
 from .topology import weld
 
+NO_FINS = ("comb", "shell_count", "single_shell", "wetness")  # debug views showing no fins
+
 
 def edge_adjacency(mesh: MeshData, tolerance: float = 1e-6) -> np.ndarray:
     """(E, 4) uint32 ``[c1, a, b, c2]`` per interior edge: its endpoints as triangle 1 winds
@@ -81,9 +83,8 @@ class FinPass(ObjectPass):
                 "u_root_shell": False, "u_shell_weight": 1.0, "u_shell_count": 1.0}
 
     def draws(self, frame) -> int:
-        # debug views of the skin or one shell show no fins
-        return 0 if self.object(frame).params.debug in ("comb", "shell_count",
-                                                        "single_shell") else 1
+        # debug views of the skin, its wetness or one shell show no fins
+        return 0 if self.object(frame).params.debug in NO_FINS else 1
 
     def draw(self, frame, program: moderngl.Program) -> None:
         mesh = self.mesh

@@ -12,7 +12,7 @@ units, level of detail and self-shadowing. ``revie_fur`` and ``shell_fur`` build
   ``gamma(h) = (K - 1 + h) / K`` (``self_shadow`` = K) darkens every shell toward the roots.
 - **Self-shadowing**: under a shadowed light, every shell, the root shell (the skin) too,
   takes the light through the fur in front of it instead, from deep opacity maps
-  (``self_shadow_density``; :meth:`FurMaterial.draw_opacity`, ``lighting/shadows.glsl``).
+  (``self_shadow_density``; ``fur_shadow.FurShadow``, ``lighting/shadows.glsl``).
 - **Level of detail**: the shell count follows the fur layer's projected thickness,
   ``n = clamp(pixels / lod_error, min_shells, shells)``, continuous; the depths move with it and
   the outermost fades by the fraction, so a dolly never pops (:func:`shell_count`).
@@ -28,15 +28,9 @@ import moderngl
 import numpy as np
 from pydantic import Field, model_validator
 
-from deferred.api import (
-    SHADOW_CASTER_DEFINES,
-    Material,
-    MaterialParams,
-    ShadowView,
-    check_image,
-)
+from deferred.api import Material, MaterialParams, ReachMotion, check_image
 
-from .fur_volume import VOLUME_LAYERS, FurPattern, pattern, strand_volume, volume_texture
+from .fur_volume import FurPattern, pattern, strand_volume, volume_texture
 from .heightfield import (
     HEIGHTFIELD_BYTES_PER_TEXEL,
     HEIGHTFIELD_GPU_BYTES_PER_TEXEL,
@@ -49,11 +43,6 @@ if TYPE_CHECKING:
 
 # A heightfield image tile counts as this many strands when density converts to tiles per unit.
 IMAGE_TILE_STRANDS = 1024
-SHADOW_CASTER_FRAGMENT = "materials/techniques/fur_caster.frag"
-SHADOW_SHELLS = 8  # most shells a fur object casts its shadow with (with its root shell)
-OPACITY_FRAGMENT = "materials/techniques/fur_opacity.frag"
-OPACITY_SHELLS = 12  # most shells the fur draws into the deep opacity maps (without the skin)
-OPACITY_ENVELOPE = 1.0  # the shell depth of the fur's front in the opacity maps: the tips
 
 
 class FurParams(MaterialParams):
@@ -182,12 +171,29 @@ def fur_scale(obj: SceneObject) -> tuple[float, float, float]:
     return tuple(float(s) for s in object_scale(obj))
 
 
+def self_shadowing(params: FurParams) -> bool:
+    """Whether the fur shadows itself through deep opacity maps; with ``self_shadow_density``
+    0 it does not draw them and gamma(h) darkens it for every light."""
+    return params.self_shadow_density > 0.0
+
+
+def vertex_constants(obj: SceneObject, shell_depth: float | None = None) -> dict[str, Any]:
+    """Uniforms of the fur vertex shader fixed for the object (and the shell depth)."""
+    constants = {"u_fur_scale": fur_scale(obj)}
+    if shell_depth is not None:
+        constants["u_shell_depth"] = shell_depth
+    return constants
+
+
 class FurMaterial(Material):
     """What every fur material has (its ``params`` are a :class:`FurParams`): the heightfield
-    image checked and resolved, the fur volume and its tiling as inputs, and the constants of
-    the fur vertex shader for an object."""
+    image checked and resolved, the fur volume and its tiling as inputs, its programs receiving
+    the deep opacity maps, and shells and fins reaching ``fur_length`` beyond the mesh (along
+    the comb-bent normal: materials/techniques/shells.glsl). Its shadow caster is the fur's
+    (``fur_shadow.FurShadow``), given by each fur material with its own vertex stage."""
 
     params: FurParams
+    motion = ReachMotion("fur_length")
 
     def check_files(self, where: str | None) -> None:
         """Bad input for a heightfield image that is missing, not a file or unreadable
@@ -197,11 +203,6 @@ class FurMaterial(Material):
         key = f"{where}.heightfield" if where else "heightfield"
         load_heightfield(self.file_parameter(self.params.heightfield, "heightfield image",
                                              key), key)
-
-    def motion_extent(self, obj: SceneObject) -> float:
-        """The shells and fins reach fur_length beyond the mesh (along the comb-bent normal:
-        materials/techniques/shells.glsl)."""
-        return float(self.params.fur_length)
 
     def held_memory(self, obj: SceneObject) -> dict[str, int]:
         path = self.heightfield_path()
@@ -226,115 +227,9 @@ class FurMaterial(Material):
         ``self_shadow_density`` is 0: where the scene draws them, a shadowed light reaches a
         forward shell through the fur in front."""
         defines = super().defines(obj)
-        if self.opacity_shadows:
+        if self_shadowing(self.params):
             defines["OPACITY_RECEIVER"] = "1"
         return defines
-
-    # -- shadows -------------------------------------------------------------------------------
-    @property
-    def opacity_shadows(self) -> bool:  # type: ignore[override]
-        """The fur shadows itself through deep opacity maps; with ``self_shadow_density`` 0
-        it does not draw them and gamma(h) darkens it for every light."""
-        return self.params.self_shadow_density > 0.0
-    fur_vertex: str = ""  # the material's fur vertex shader (its shells' and its caster's)
-
-    def shadow_textures(self, frame: Frame, obj: SceneObject) -> dict[str, moderngl.Texture]:
-        """The per-object textures the fur vertex shader reads (a comb field, a simulation's
-        state), for the shadow caster."""
-        return {}
-
-    def draw_shadow(self, frame: Frame, obj: SceneObject, view: ShadowView) -> None:
-        """The fur's depth from a light, through the material's own fur vertex shader seen from
-        it (:data:`SHADOW_CASTER_DEFINES`), which pushes it a strand's length away from the
-        light (so its own skin, lit through the fur in front, does not shadow itself at the
-        roots).
-
-        Where the light has deep opacity maps (``view.opacity_maps``) and the fur is in them
-        (``self_shadow_density`` above 0), only the root shell (the skin, opaque) casts depth:
-        the body shadows its own far side and what lies behind it, and the fur's translucent
-        shadow, on other surfaces as on itself, is the maps' alone (``lighting/shadows.glsl``:
-        a surface beyond the fur's back keeps exp(-k x the fur's optical depth) there, the
-        fur's own shells and skin the transmittance at their depth). Dithered shells in the
-        depth map too would shadow the fur twice: toward the terminator a shell at height h
-        reaches a flat skin under it where the light meets the skin at more than arccos(h)
-        from its normal, however far it is pushed, and the deferred shells read their light
-        from the skin's pixels.
-
-        Otherwise (``self_shadow_density`` 0, or a pipeline that draws no maps) the root shell
-        and up to ``SHADOW_SHELLS`` shells above it cast, each kept by a dither under its
-        opacity (``materials/techniques/fur_caster.frag``), so the floor darkens with the fur's
-        density; gamma(h) is the fur's own self-shadowing then."""
-        params = self.params
-        if params.shells == 0 or not self.fur_vertex:
-            super().draw_shadow(frame, obj, view)
-            return
-        program = frame.shaders.program(self.fur_vertex, SHADOW_CASTER_FRAGMENT,
-                                        defines={**self.defines(obj), **SHADOW_CASTER_DEFINES})
-        count = min(params.shells, SHADOW_SHELLS) + 1.0  # the root shell and the slabs above
-        drawn = 1 if view.opacity_maps and self.opacity_shadows else int(count)
-        # the light's matrices offered, not set: the shader declares them under the camera's
-        # names (renamed by the defines), which is what strict mode reads
-        frame.bind(program, {**self.vertex_constants(obj), "u_shell_depth": 0.0,
-                             "u_root_shell": True,
-                             "u_shell_weight": VOLUME_LAYERS / (count - 1.0)},
-                   self.shadow_textures(frame, obj),
-                   offered={**frame.object_uniforms(obj), **view.camera_uniforms},
-                   material=frame.material_inputs(self))
-        for k in range(drawn):
-            if k:
-                frame.set_uniforms(program, {"u_shell_depth": shell_depth(k, count),
-                                             "u_root_shell": False})
-            frame.draw_mesh(obj.mesh, program)
-
-    def opacity_layer(self, obj: SceneObject) -> float:
-        """The fur's world thickness: a strand's length."""
-        return float(self.params.fur_length * object_scale(obj).max())
-
-    def opacity_shells(self, frame: Frame, obj: SceneObject) -> int:
-        """How many outer shells the fur draws into the deep opacity maps this frame: as many
-        as it draws in view (:func:`shell_count`, rounded up; the root shell is the skin's,
-        the depth atlas's), at most ``OPACITY_SHELLS``. Far away the fur's self-shadowing
-        takes few pixels and few shells; each shell then stands for more of the volume, so the
-        optical depth summed through the fur stays the same."""
-        params = self.params
-        wanted = math.ceil(shell_count(frame, obj, params) - 1e-9)
-        return max(1, min(wanted, params.shells, OPACITY_SHELLS))
-
-    def draw_opacity(self, frame: Frame, obj: SceneObject, view: ShadowView,
-                     stage: str) -> None:
-        """The fur in the deep opacity maps, where it is (not pushed away as the depth casters
-        are). Stage "first": the fur's envelope, the shell through its strands' tips, which every
-        shell drawn in view lies inside, so the front is where the fur begins along each texel
-        (an inner shell would leave the tips beyond it out of the maps, with no fur in front).
-        Stage "density": :meth:`opacity_shells` outer shells, each adding the optical depth of
-        the opacity it draws (``materials/techniques/fur_opacity.frag``)."""
-        params = self.params
-        if params.shells == 0 or not self.fur_vertex:
-            return
-        defines = {**self.defines(obj), **SHADOW_CASTER_DEFINES, "OPACITY_CASTER": "1"}
-        if stage == "first":
-            defines["OPACITY_FIRST"] = "1"
-        program = frame.shaders.program(self.fur_vertex, OPACITY_FRAGMENT, defines=defines)
-        count = self.opacity_shells(frame, obj) + 1.0  # as the shells: a root and slabs
-        depths = [OPACITY_ENVELOPE] if stage == "first" else \
-            [shell_depth(k, count) for k in range(1, int(count))]
-        frame.bind(program, {**self.vertex_constants(obj, depths[0]),
-                             "u_shell_weight": VOLUME_LAYERS / (count - 1.0)},
-                   self.shadow_textures(frame, obj),
-                   offered={**frame.object_uniforms(obj), **view.camera_uniforms},
-                   material=frame.material_inputs(self))
-        for k, depth in enumerate(depths):
-            if k:
-                frame.set_uniforms(program, {"u_shell_depth": depth})
-            frame.draw_mesh(obj.mesh, program)
-
-    @staticmethod
-    def vertex_constants(obj: SceneObject, shell_depth: float | None = None) -> dict[str, Any]:
-        """Uniforms of the fur vertex shader fixed for the object (and the shell depth)."""
-        constants = {"u_fur_scale": fur_scale(obj)}
-        if shell_depth is not None:
-            constants["u_shell_depth"] = shell_depth
-        return constants
 
 
 def projected_fur_pixels(frame: Frame, obj: SceneObject, fur_length: float) -> float:

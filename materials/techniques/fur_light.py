@@ -36,12 +36,13 @@ from deferred.api import (
     NORMAL_EXPONENT_ID,
     FullscreenPass,
     Order,
+    PassInput,
     Phase,
     TargetSpec,
 )
 
 if TYPE_CHECKING:
-    from deferred.api import Frame
+    from deferred.api import Frame, SceneObject
 
 FUR_LIGHT_FRAGMENT = "materials/techniques/fur_light.frag"
 
@@ -51,26 +52,19 @@ def fur_light_targets(target: str) -> tuple[str, str]:
     return target, f"{target}_depths"
 
 
-class FurLightReader:
-    """Mixin for an ``ObjectPass`` whose shader reads a fur_light gather through
-    ``materials/techniques/fur_light.glsl``: give its name as ``fur_light`` and its targets
-    (:func:`fur_light_targets`) among ``extra_reads`` (the pass graph orders the passes by
-    them); they are bound as ``u_fur_light`` and ``u_fur_light_depths``."""
+class FurLight(PassInput):
+    """What an ``ObjectPass`` whose shader reads a fur_light gather through
+    ``materials/techniques/fur_light.glsl`` takes as one of its ``inputs``: the gather's
+    targets (:func:`fur_light_targets` of ``target``; the pass graph orders the pass after the
+    gather) as ``u_fur_light`` and ``u_fur_light_depths``."""
 
-    fur_light: str | None = None
+    def __init__(self, target: str):
+        self.target = target
+        self.reads = fur_light_targets(target)
 
-    def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
-        textures = super().textures(frame)  # type: ignore[misc]
-        if self.fur_light is None:
-            return textures
-        light, depths = fur_light_targets(self.fur_light)
-        if f"u_{light}" not in textures or f"u_{depths}" not in textures:
-            raise TypeError(f"{self.name}: fur_light {self.fur_light!r} needs "  # type: ignore[attr-defined]
-                            f"extra_reads {light!r} and {depths!r}")
-        textures = dict(textures)
-        textures["u_fur_light"] = textures.pop(f"u_{light}")
-        textures["u_fur_light_depths"] = textures.pop(f"u_{depths}")
-        return textures
+    def textures(self, frame: Frame, obj: SceneObject) -> dict[str, moderngl.Texture]:
+        light, depths = self.reads
+        return {"u_fur_light": frame.target(light), "u_fur_light_depths": frame.target(depths)}
 
 
 def fur_light_pass(name: str, target: str, surface_id: int, material: str) -> FullscreenPass:

@@ -26,33 +26,15 @@ def shell_dither(sample_index: int) -> float:
     return (halton(sample_index, 5) + 0.5) % 1.0 - 0.5
 
 
-class DitheredShells:
-    """A shell pass whose vertex stage offsets each shell but the root by ``u_shell_dither``
-    (of the layer's depth) beyond its ``u_shell_depth``, which its shading keeps: the geometry
-    moves within the slab from sample to sample, not the strands' colour or coverage: where the
-    level of detail leaves few shells, moving those too would change the fur's brightness from
-    sample to sample instead of only where its rim lies."""
-
-    def draws(self, frame) -> int:
-        count = super().draws(frame)
-        # Not while a temporal history follows a moving camera or object: it keeps only a small
-        # share of each frame there, too little to average the dither out, which then
-        # shimmers (benchmarks/crawl.py measures it).
-        moving = frame.moved_since_last_frame(self.object(frame))
-        self._dither = 0.0 if moving else \
-            shell_dither(frame.sample_index) / max(self.slabs(self._count), 1.0)
-        return count
-
-    def draw_uniforms(self, frame, index: int, count: int) -> dict[str, Any] | None:
-        uniforms = super().draw_uniforms(frame, index, count)
-        if uniforms is not None:
-            uniforms["u_shell_dither"] = 0.0 if self._root else self._dither
-        return uniforms
-
-
 class ShellPass(ObjectPass):
     """Draw the object's shells, innermost first, alpha-blended over the target. The object's
-    material parameters are a ``FurParams``."""
+    material parameters are a ``FurParams``.
+
+    With ``dither`` the vertex stage offsets each shell but the root by ``u_shell_dither`` (of
+    the layer's depth) beyond its ``u_shell_depth``, which its shading keeps: the geometry
+    moves within the slab from sample to sample (:func:`shell_dither`), not the strands' colour
+    or coverage: where the level of detail leaves few shells, moving those too would change the
+    fur's brightness from sample to sample instead of only where its rim lies."""
 
     depth = DEPTH
     depth_test = True
@@ -60,6 +42,7 @@ class ShellPass(ObjectPass):
     depth_write = False
     blend = "alpha"
     order = Order.VOLUME
+    dither = False
 
     def layout(self, count: float, params: FurParams) -> list[tuple[float, float] | None]:
         """(depth, fade) of each draw for a continuous shell count, the root shell first (None:
@@ -76,6 +59,13 @@ class ShellPass(ObjectPass):
         params = obj.params
         self._count = shell_count(frame, obj, params)
         self._layout = self.layout(self._count, params)
+        if self.dither:
+            # Not while a temporal history follows a moving camera or object: it keeps only a
+            # small share of each frame there, too little to average the dither out, which
+            # then shimmers (benchmarks/crawl.py measures it).
+            moving = frame.moved_since_last_frame(obj)
+            self._dither = 0.0 if moving else \
+                shell_dither(frame.sample_index) / max(self.slabs(self._count), 1.0)
         return len(self._layout)
 
     def draw_uniforms(self, frame, index: int, count: int) -> dict[str, Any] | None:
@@ -85,9 +75,12 @@ class ShellPass(ObjectPass):
         depth, fade = shell
         params = self.object(frame).params
         self._root = index == 0
-        return {"u_shell_depth": depth, "u_shell_fade": fade, "u_root_shell": self._root,
-                "u_shell_weight": VOLUME_LAYERS / max(self.slabs(self._count), 1e-6),
-                "u_shell_count": self._count / max(params.shells, 1)}
+        uniforms = {"u_shell_depth": depth, "u_shell_fade": fade, "u_root_shell": self._root,
+                    "u_shell_weight": VOLUME_LAYERS / max(self.slabs(self._count), 1e-6),
+                    "u_shell_count": self._count / max(params.shells, 1)}
+        if self.dither:
+            uniforms["u_shell_dither"] = 0.0 if self._root else self._dither
+        return uniforms
 
     def draw(self, frame, program) -> None:
         # The root shell lies on the base mesh: pulled toward the eye it wins the depth test

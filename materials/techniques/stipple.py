@@ -14,6 +14,9 @@ under another's stipple samples.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING, Any
+
 from deferred.api import (
     COMPOSITE,
     COMPOSITE_SPEC,
@@ -23,10 +26,15 @@ from deferred.api import (
     GBufferPass,
     ObjectPass,
     Order,
+    PassInput,
     Phase,
     RenderPass,
+    Technique,
     copy_pass,
 )
+
+if TYPE_CHECKING:
+    from deferred.api import Material, SceneObject
 
 PATTERNS = (2, 4)
 COMPOSITE_SNAPSHOT = "composite_snapshot"
@@ -72,3 +80,40 @@ class StippleObliterationPass(ObjectPass):
     depth_func = "always"  # the pass writes depth (gl_FragDepth) wherever it keeps a fragment
     order = Order.RESTORE
     extra_reads = (COMPOSITE_SNAPSHOT, LINEAR_DEPTH, NORMAL_EXPONENT_ID)
+
+
+class Stipple(Technique):
+    """A material's stippled surface: in the stipple phase ``<label>.stipple``, a
+    :class:`StipplePass` through ``fragment`` (a stipple pattern writer); in the material phase
+    ``<label>.stipple_obliteration``, its samples erased; once per scene the composition's
+    snapshot obliteration copies from (:func:`stipple_scene_passes`). Both passes draw through
+    ``vertex`` with ``inputs``; ``constants(obj)`` gives uniforms fixed when they are made;
+    ``when(material)`` whether the material stipples (always, by default)."""
+
+    def __init__(self, fragment: str, *, vertex: str | None = None,
+                 inputs: Sequence[PassInput] = (),
+                 constants: Callable[[SceneObject], dict[str, Any]] | None = None,
+                 when: Callable[[Material], bool] | None = None):
+        self.fragment = fragment
+        self.options: dict[str, Any] = {"inputs": tuple(inputs)}
+        if vertex is not None:
+            self.options["vertex"] = vertex
+        self.constants = constants
+        self.when = when
+
+    def passes(self, material: Material, phase: Phase, obj: SceneObject) -> list[RenderPass]:
+        if phase not in (Phase.STIPPLE, Phase.MATERIAL) or \
+                (self.when is not None and not self.when(material)):
+            return []
+        options = dict(self.options)
+        if self.constants is not None:
+            options["constants"] = self.constants(obj)
+        if phase == Phase.STIPPLE:
+            return [StipplePass(f"{obj.label}.stipple", phase, obj, fragment=self.fragment,
+                                **options)]
+        return [StippleObliterationPass(f"{obj.label}.stipple_obliteration", phase, obj,
+                                        **options)]
+
+    def scene_passes(self, objects: Sequence[SceneObject], phase: Phase) -> list[RenderPass]:
+        stippled = self.when is None or any(self.when(obj.material) for obj in objects)
+        return stipple_scene_passes(phase) if stippled else []

@@ -30,6 +30,19 @@ def site(tmp_path_factory):
     info.mkdir()
     (info / "METADATA").write_text("Metadata-Version: 2.1\nName: broken-plugin\nVersion: 0.1\n")
     (info / "entry_points.txt").write_text("[deferred.lights]\nbroken = no_such_module:Light\n")
+    # a material written against the hooks the base class had: refused when it loads
+    (target / "old_velvet.py").write_text(
+        "from deferred.api import Material\n\n\n"
+        "class OldVelvet(Material):\n"
+        "    name = 'old_velvet'\n"
+        "    surface_shader = 'materials/standard/surface.glsl'\n\n"
+        "    def material_passes(self, obj):\n"
+        "        return []\n")
+    info = target / "old_plugin-0.1.dist-info"
+    info.mkdir()
+    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: old-plugin\nVersion: 0.1\n")
+    (info / "entry_points.txt").write_text(
+        "[deferred.materials]\nold_velvet = old_velvet:OldVelvet\n")
     return target
 
 
@@ -91,3 +104,18 @@ def test_a_broken_plugin_fails_only_the_scenes_that_use_it(site, tmp_path):
     assert "cannot load light plugin 'broken'" in result.stderr
     assert "rim" in next(line for line in result.stdout.splitlines()
                          if line.strip().startswith("lights:"))
+
+
+@pytest.mark.slow
+def test_a_plugin_overriding_a_hook_that_became_a_part_is_told_what_to_write(site, tmp_path):
+    scene = tmp_path / "old.toml"
+    scene.write_text('[[object]]\nmesh = "builtin:sphere"\nmaterial = "old_velvet"\n')
+    result = deferred(site, "render", scene, "-o", tmp_path / "old.png", cwd=tmp_path)
+    assert result.returncode == 2
+    line = result.stderr.strip().splitlines()[-1]
+    assert line.startswith("error: old.toml: object[0].material: cannot load material plugin "
+                           "'old_velvet' (old-plugin): TypeError: material class "
+                           "old_velvet.OldVelvet defines material_passes, which the framework "
+                           "no longer asks: "), line
+    assert "PhasePasses(Phase.MATERIAL, build)" in line
+    assert not (tmp_path / "old.png").exists()

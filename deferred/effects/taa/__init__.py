@@ -8,10 +8,10 @@ Passes:
 - ``motion.camera`` / ``motion.objects`` (after the opaque geometry: the screen phase, or the
   end of the forward phase): the :data:`~deferred.api.MOTION` target, what the camera alone
   moves (from the depth; the background as directions), then every object over it, its mesh
-  pushed out by what its material draws beyond it
-  (:meth:`~deferred.api.Material.motion_extent`: fur shells and fins, hair) with this frame's
-  and the last frame's model and view-projection (``common/motion.glsl``). Materials change
-  nothing: the framework sets ``u_previous_model`` and ``u_previous_view_projection``.
+  pushed out by what its material draws beyond it (:meth:`~deferred.api.Motion.extent` of
+  its material's ``motion``: fur shells and fins, hair) with this frame's and the last
+  frame's model and view-projection (``common/motion.glsl``). Materials change nothing: the
+  framework sets ``u_previous_model`` and ``u_previous_view_projection``.
 - ``post.taa`` (before tone mapping, on the linear composite): the history reprojected,
   clipped to the current 3x3 neighbourhood in YCoCg and blended (``effects/taa/taa_resolve.frag``);
 - ``post.taa_sharpen``: the result into the composite, optionally sharpened.
@@ -121,7 +121,7 @@ class MotionObjectsPass(RenderPass):
         frame.set_state(depth_test=True, depth_func="lequal", cull="back", blend=None,
                         depth_offset=(-1.0, -4.0))
         for obj in frame.scene.objects:
-            extent = obj.material.motion_extent(obj)
+            extent = obj.material.motion.extent(obj)
             frame.bind(program, {"u_motion_extent": float(extent)},
                        offered=frame.object_uniforms(obj))
             frame.draw_mesh(obj.mesh, program)

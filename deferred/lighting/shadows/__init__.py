@@ -24,7 +24,7 @@ that reads it; programs only read it where the scene has a shadowed light (the d
 ``SHADOWS``), so a scene without shadows pays nothing.
 
 **Deep opacity maps** (Yuksel and Keyser 2008), where an object's material draws a volume
-(``Material.opacity_shadows``: fur; in the deferred pipeline ``deferred_opacity`` too): beside
+(``ShadowCaster.opacity_shadows``: fur; in the deferred pipeline ``deferred_opacity`` too): beside
 the atlas, two textures over the square of the atlas the lights' maps take (from its corner,
 :func:`~deferred.lighting.shadows.opacity.opacity_extent`), at ``opacity_scale`` (a
 ``[shadows]`` key) of its resolution:
@@ -33,9 +33,9 @@ texel sees (the volume's own front and back, not the depth atlas's casters; min 
 (depth, -depth); grown by a texel where a texel's centre missed the volume,
 ``shadows/opacity_front.frag``), and ``opacity``, four layers (RGBA) of the volume's optical
 depth (times its density factor) accumulated from that front up to ``OPACITY_LAYERS`` x the
-thickest volume's layer (``Material.opacity_layer``). Each material draws both stages
-(:meth:`~deferred.interfaces.material.Material.draw_opacity`) and leaves its translucent part
-out of the depth atlas (``ShadowView.opacity_maps``): a receiver compiled with
+thickest volume's layer (``ShadowCaster.opacity_layer``). Each material's caster draws both
+stages (:meth:`~deferred.interfaces.shadow_casting.ShadowCaster.draw_opacity`) and leaves its
+translucent part out of the depth atlas (``ShadowView.opacity_maps``): a receiver compiled with
 ``OPACITY_RECEIVER`` (the volume's own) multiplies a shadowed light by the transmittance at
 its depth (``lighting/shadows.glsl``, ``opacity_transmittance``), any other surface by the
 transmittance through the whole volume where it lies beyond the volume's back

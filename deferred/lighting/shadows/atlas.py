@@ -12,7 +12,7 @@ import moderngl
 import numpy as np
 
 from deferred.interfaces.light import Light
-from deferred.interfaces.material import ShadowView
+from deferred.interfaces.shadow_casting import ShadowView
 from deferred.lighting.buffer import visible_spheres
 from deferred.lighting.shadows.bounds import world_bounds
 from deferred.lighting.shadows.frusta import (
@@ -209,8 +209,8 @@ class ShadowAtlas:
         self._uniforms = {"u_shadow_world_from_view": inverse_view[:3, :3].copy(),
                           "u_shadow_atlas_texel": 1.0 / self.size}
         if self.opacity is not None:
-            self.opacity_layer = max((float(obj.material.opacity_layer(obj))
-                                      for obj in scene.objects if obj.material.opacity_shadows),
+            self.opacity_layer = max((float(obj.material.shadow.opacity_layer(obj)) for obj
+                                      in scene.objects if obj.material.shadow.opacity_shadows(obj)),
                                      default=0.0)
             self._uniforms["u_opacity_layers"] = tuple(b * self.opacity_layer
                                                        for b in OPACITY_LAYERS)

@@ -14,9 +14,9 @@ from deferred.scene.scene import Scene
 
 def object_box(obj: SceneObject) -> tuple[np.ndarray, np.ndarray]:
     """The object-space box of what the object draws: its mesh's, grown by how far its
-    material draws beyond the mesh (fur shells, hair: ``Material.motion_extent``)."""
+    material draws beyond the mesh (fur shells, hair: ``Material.motion``)."""
     low, high = obj.mesh.bounds()
-    extent = float(obj.material.motion_extent(obj))
+    extent = float(obj.material.motion.extent(obj))
     return low - extent, high + extent
 
 

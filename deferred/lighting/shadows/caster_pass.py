@@ -23,7 +23,8 @@ CASTER_DEPTH_OFFSET = (1.5, 2.0)
 
 class ShadowPass(RenderPass):
     """Every shadowed light's maps: each tile of the atlas cleared and each object's depth
-    drawn into it by its material (:meth:`~deferred.interfaces.material.Material.draw_shadow`).
+    drawn into it by its material's caster
+    (:meth:`~deferred.interfaces.shadow_casting.ShadowCaster.draw`).
     The atlas is not a frame target; the pass writes none (dumps read the atlas apart)."""
 
     order = Order.FIRST
@@ -55,7 +56,7 @@ class ShadowPass(RenderPass):
                 fbo.viewport = rect
                 frame.gl_call(lambda rect=rect: fbo.clear(depth=1.0, viewport=rect))
                 for obj in reached(tile):  # beyond the light's reach: casts nothing it lights
-                    obj.material.draw_shadow(frame, obj, tile.view)
+                    obj.material.shadow.draw(frame, obj, tile.view)
         finally:
             fbo.viewport = (0, 0, atlas.size, atlas.size)
         if atlas.opacity is not None:
@@ -69,7 +70,7 @@ class ShadowPass(RenderPass):
         3.1-3.2)."""
         scale = atlas.opacity_scale
         tiles = [(tile, tuple(round(v * scale) for v in (tile.x, tile.y, tile.size, tile.size)),
-                  [obj for obj in reached(tile) if obj.material.opacity_shadows])
+                  [obj for obj in reached(tile) if obj.material.shadow.opacity_shadows(obj)])
                  for tile in atlas.tiles]
         stages = ((atlas.first_framebuffer, "first", dict(depth_test=False, blend="min")),
                   (atlas.front_framebuffer, "front", {}),
@@ -95,6 +96,6 @@ class ShadowPass(RenderPass):
                                                                     0.0, 0.0, viewport=r))
                     if stage != "front":
                         for obj in volumes:
-                            obj.material.draw_opacity(frame, obj, tile.view, stage)
+                            obj.material.shadow.draw_opacity(frame, obj, tile.view, stage)
             finally:
                 fbo.viewport = (0, 0, *atlas.opacity.size)

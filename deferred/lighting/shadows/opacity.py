@@ -22,8 +22,8 @@ def scene_has_opacity(scene: Scene, pipeline: str) -> bool:
     pipeline; in the deferred one only where ``deferred_opacity`` says its deferred passes
     do)."""
     return scene_casts_shadows(scene.lights) and any(
-        obj.material.opacity_shadows and (pipeline == Pipeline.FORWARD
-                                          or obj.material.deferred_opacity)
+        obj.material.shadow.opacity_shadows(obj) and (
+            pipeline == Pipeline.FORWARD or obj.material.shadow.deferred_opacity)
         for obj in scene.objects)
 
 

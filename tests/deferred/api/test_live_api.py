@@ -339,14 +339,14 @@ def test_scene_values_set_in_python_are_checked_at_the_next_frame(renderer):
 def test_a_frame_at_a_time_already_checked_checks_nothing_again(renderer, monkeypatch):
     """check_times passes for the latest time cover every earlier one while the parameters
     stay (the droplet count was weighed again each frame: 30-50 ms at 10,000 droplets)."""
-    import deferred.materials.shell_fur as shell_fur
+    from deferred.materials.shell_fur.state import ShellFurSimulation
 
     scene = small_scene()
     fur = scene.add_object("builtin:sphere", "shell_fur", label="fur", position=(1.2, 0, 0),
                            params={"shells": 2, "droplets": 5})
     calls = []
-    real = shell_fur.ShellFurMaterial.check_time_for
-    monkeypatch.setattr(shell_fur.ShellFurMaterial, "check_time_for",
+    real = ShellFurSimulation.check_time
+    monkeypatch.setattr(ShellFurSimulation, "check_time",
                         lambda self, *a: calls.append(a[1]) or real(self, *a))
     r = renderer(scene)
     r.check_times([0.5])

@@ -11,6 +11,7 @@ from deferred.gbuffer.layout import LINEAR_DEPTH
 from deferred.gl.target_spec import TargetSpec
 from deferred.gl.targets import COMPOSITE, FINAL
 from deferred.interfaces.material import Material
+from deferred.interfaces.techniques import PhasePasses
 from deferred.render.renderer import Renderer
 from deferred.scene.loader import scene_from_dict
 
@@ -71,11 +72,9 @@ class ReadsUnknown(Material):
 
     name = "test_reads_unknown"
     surface_shader = "materials/standard/surface.glsl"
-
-    def material_passes(self, obj):
-        return [ObjectPass(f"{obj.label}.broken", Phase.MATERIAL, obj,
-                           fragment="post/copy.frag", colors=(COMPOSITE,),
-                           extra_reads=("velocity",))]
+    techniques = (*Material.techniques, PhasePasses(Phase.MATERIAL, lambda material, obj: [
+        ObjectPass(f"{obj.label}.broken", Phase.MATERIAL, obj, fragment="post/copy.frag",
+                   colors=(COMPOSITE,), extra_reads=("velocity",))]))
 
 
 class ReadsTooEarly(Material):
@@ -83,11 +82,9 @@ class ReadsTooEarly(Material):
 
     name = "test_reads_early"
     surface_shader = "materials/standard/surface.glsl"
-
-    def geometry_passes(self, obj):
-        return [*super().geometry_passes(obj),
-                ObjectPass(f"{obj.label}.early", Phase.GEOMETRY, obj, fragment="post/copy.frag",
-                           colors=(COMPOSITE,), extra_reads=("light_accumulation",))]
+    techniques = (*Material.techniques, PhasePasses(Phase.GEOMETRY, lambda material, obj: [
+        ObjectPass(f"{obj.label}.early", Phase.GEOMETRY, obj, fragment="post/copy.frag",
+                   colors=(COMPOSITE,), extra_reads=("light_accumulation",))]))
 
 
 @pytest.mark.parametrize("material, message", [
@@ -264,7 +261,7 @@ def test_a_parameter_may_not_shadow_a_framework_uniform(render):
 def test_a_gbuffer_pass_writing_surfaces_without_depth_is_refused(render):
     """The lighting runs where the G-buffer's depth is nearer than the far plane: a pass that
     wrote surfaces without depth would leave them unlit, so it is refused before it runs."""
-    from deferred.interfaces.material import GBufferPass
+    from deferred.interfaces.techniques import GBufferPass
 
     scene = scene_from_dict(SCENE)
     _, renderer = render(scene)

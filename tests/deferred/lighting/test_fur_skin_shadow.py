@@ -1,7 +1,7 @@
 """Fur shadows its own skin (#27): the root shell, the skin between the strands' roots, is a
 receiver of the deep opacity maps like every shell, so a shadowed light reaches it through the
 whole fur in front. With the maps, only the fur's skin casts in the depth map (pushed a strand's
-length away from the light; FurMaterial.draw_shadow), so the skin is not shadowed twice, once by
+length away from the light; FurShadow.draw), so the skin is not shadowed twice, once by
 the dithered depth casters and once by the maps. Measured on the skin alone (shell_range (0, 0),
 no fins), lit from the camera: at the middle of the ball the light crosses the fur along the
 normal."""
@@ -12,12 +12,8 @@ import numpy as np
 import pytest
 
 from deferred.lighting.shadows.opacity import OPACITY_LAYERS
-from deferred.materials.techniques.fur import (
-    OPACITY_SHELLS,
-    FurParams,
-    fur_pattern,
-    shell_depth,
-)
+from deferred.materials.techniques.fur import FurParams, fur_pattern, shell_depth
+from deferred.materials.techniques.fur_shadow import OPACITY_SHELLS
 from deferred.materials.techniques.fur_volume import VOLUME_LAYERS, strand_volume
 from deferred.render.renderer import Renderer
 from deferred.scene.loader import scene_from_dict
@@ -138,7 +134,7 @@ def test_skin_transmittance_has_no_steps_at_coarse_maps(gl, material):
     (lighting/shadows.glsl, interpolated_front). Read nearest, the front stepped at every texel's
     edge and so did the depth behind it: 4-5% of neighbouring pixels differed by more than 0.04,
     contour bands across the ball. Now under 2.5% against the skin with no shadow map (the fur's
-    dithered shells cast in the depth map without self-shadowing, FurMaterial.draw_shadow; with
+    dithered shells cast in the depth map without self-shadowing, FurShadow.draw; with
     it only its skin does): what is left are the maps' own streaks along the light."""
     scene = {"direction": (1.0, -0.3, -0.5), "size": (192, 144), "opacity_scale": 0.25}
     with_ = skin_luminance(gl, material, 0.5, "forward", **scene)

@@ -147,7 +147,7 @@ def test_lit_and_far_sides_differ_more(gl, material):
     (forward; the deferred fur follows it, as the next test shows). revie_fur's grain normal
     lights little of the near side of a light square to the view. Without self-shadowing the
     fur's dithered shells shadow its far side from the depth map; with it they do not
-    (FurMaterial.draw_shadow) and the maps alone do: the far side keeps 0.80 (revie_fur) and
+    (FurShadow.draw) and the maps alone do: the far side keeps 0.80 (revie_fur) and
     0.70 (shell_fur) of its light, the ratio grows 1.25x and 1.08x (0.64 and 0.47, 1.6x and
     2.2x, when the shells cast in the depth map on top of the maps)."""
     with_ = side_means(*luminance(gl, fur_scene(material, 0.5)))
@@ -159,9 +159,9 @@ def test_lit_and_far_sides_differ_more(gl, material):
 
 def skin_casts_alone(monkeypatch):
     """The fur's depth casters cut to the first mesh each draws (the root shell: the skin)."""
-    from deferred.materials.techniques.fur import FurMaterial
+    from deferred.materials.techniques.fur_shadow import FurShadow
 
-    draw_shadow = FurMaterial.draw_shadow
+    draw_shadow = FurShadow.draw
 
     def root_shell_only(self, frame, obj, view):
         draw_mesh = frame.draw_mesh
@@ -178,7 +178,7 @@ def skin_casts_alone(monkeypatch):
         finally:
             frame.draw_mesh = draw_mesh
 
-    monkeypatch.setattr(FurMaterial, "draw_shadow", root_shell_only)
+    monkeypatch.setattr(FurShadow, "draw", root_shell_only)
 
 
 @pytest.mark.slow
@@ -369,16 +369,16 @@ def test_far_fur_draws_fewer_opacity_shells(gl, monkeypatch):
     """The opacity maps take as many shells as the fur draws in view (its level of detail),
     at most OPACITY_SHELLS: close up 12 of shell_fur's 16, far away its 2 (min_shells); the
     shadow pass draws that many fewer."""
-    from deferred.materials.techniques.fur import OPACITY_SHELLS, FurMaterial
+    from deferred.materials.techniques.fur_shadow import OPACITY_SHELLS, FurShadow
 
     counts = []
-    original = FurMaterial.opacity_shells
+    original = FurShadow.opacity_shells
 
     def counted(self, frame, obj):
         counts.append(original(self, frame, obj))
         return counts[-1]
 
-    monkeypatch.setattr(FurMaterial, "opacity_shells", counted)
+    monkeypatch.setattr(FurShadow, "opacity_shells", counted)
     draws = {}
     for distance in (2.0, 40.0):
         counts.clear()

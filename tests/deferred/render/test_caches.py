@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from deferred.core.passes import Phase
-from deferred.interfaces.material import GBufferPass
+from deferred.interfaces.techniques import GBufferPass
 from deferred.io.images import write_image
 from deferred.materials.standard import StandardMaterial
 from deferred.render.renderer import Renderer

@@ -13,12 +13,9 @@ from locations import FIXTURES, ROOT
 
 from deferred.gl.shaderlib import ShaderLibrary
 from deferred.io.images import write_image
-from deferred.materials.shell_fur import (
-    ShellFurMaterial,
-    ShellFurState,
-    layer_layout,
-    object_state,
-)
+from deferred.materials.shell_fur import ShellFurMaterial
+from deferred.materials.shell_fur.passes import layer_layout
+from deferred.materials.shell_fur.state import ShellFurState, fur_state
 from deferred.materials.techniques.strands import StrandForces, StrandSimulation, triangle_strands
 from deferred.materials.techniques.wetness import (
     DRY_CENTRE,
@@ -749,7 +746,7 @@ def test_an_event_on_one_object_leaves_another_sharing_its_material_alone(render
     np.testing.assert_array_equal(before.hdr[:, 48:], after.hdr[:, 48:])
 
     def states(renderer, a, b):
-        return (object_state(renderer.last_frame, a), object_state(renderer.last_frame, b))
+        return (fur_state(renderer.last_frame, a), fur_state(renderer.last_frame, b))
 
     (plain_a, plain_b), (windy_a, windy_b) = states(plain_renderer, plain_a, plain_b), \
         states(windy_renderer, windy_a, windy_b)
@@ -778,11 +775,11 @@ def test_the_strands_step_before_any_pass_draws_and_go_with_the_renderer(render)
 
     def before_pass(render_pass, frame):
         if not steps:  # the first pass of the frame: every pass is prepared by now
-            steps.extend(object_state(frame, obj).step for obj in (a, b))
+            steps.extend(fur_state(frame, obj).step for obj in (a, b))
 
     _, renderer = render(scene, time=0.5, before_pass=before_pass)
     assert steps == [120, 120]  # 0.5 s of 1/240 s steps
-    states = [object_state(renderer.last_frame, obj) for obj in (a, b)]
+    states = [fur_state(renderer.last_frame, obj) for obj in (a, b)]
     textures = [t for state in states for t in (state.mask_texture, state.tips_texture)]
     renderer.release()
     assert all(type(t.mglo).__name__ == "InvalidObject" for t in textures)
@@ -1037,9 +1034,9 @@ params = { droplets = 15 }
 def test_the_simulation_budget_grows_with_the_strands(render, monkeypatch):
     """Refused before a frame: the steps to reach a time times the object's strands (one a
     triangle) past MAX_STRAND_STEPS; the same time on a coarser mesh renders."""
-    import deferred.materials.shell_fur as shell_fur
+    import deferred.materials.shell_fur.state as shell_fur_state
 
-    monkeypatch.setattr(shell_fur, "MAX_STRAND_STEPS", 20_000)
+    monkeypatch.setattr(shell_fur_state, "MAX_STRAND_STEPS", 20_000)
 
     def scene(divisions: int):
         return scene_from_dict({"size": [32, 24], "object": [
@@ -1100,9 +1097,9 @@ def test_droplet_work_past_the_budget_is_refused_before_a_frame(tmp_path, capsys
     """radius^2 x droplets past MAX_DROPLET_TEXELS is refused naming the params or the event
     that asked for the droplets (10,000 droplets of radius 1 on a 4096^2 mask would take hours);
     fewer droplets render, and nothing is written for the refused ones."""
-    import deferred.materials.shell_fur as shell_fur
+    import deferred.materials.shell_fur.state as shell_fur_state
 
-    monkeypatch.setattr(shell_fur, "MAX_DROPLET_TEXELS", 20_000)
+    monkeypatch.setattr(shell_fur_state, "MAX_DROPLET_TEXELS", 20_000)
     out = tmp_path / "out.png"
     scene = write_scene(tmp_path / "s.toml", "droplets = 40\ndroplet_radius = 1.0\nmask_size = 64")
     code, text = cli(capsys, "render", str(scene), "-o", str(out))
@@ -1137,7 +1134,6 @@ def test_a_moving_object_carries_its_strands_along(gl):
     """Issue #25: the strands follow the object's transform at each step (model_at), so a
     sphere turned upside down by its track still has its fur hanging down the world's -y,
     and its roots sit on the turned mesh (they stayed at the first transform)."""
-    from deferred.materials.shell_fur import ShellFurState
     from deferred.render.renderer import Renderer
     from deferred.scene.loader import scene_from_dict
 

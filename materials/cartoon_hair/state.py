@@ -1,0 +1,198 @@
+"""cartoon_hair's state over time, one per object and renderer: the guide strands simulated as
+mass-spring chains (``techniques/hair_dynamics.py``) and swept into the tube mesh every frame
+(``techniques/hair_tubes.py``), and the simulation (:class:`HairSimulation`) that brings it to
+each frame's time and refuses a time it cannot reach in bounded work."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import moderngl
+import numpy as np
+
+from deferred.api import GpuMesh, InputError, MeshData, MeshPrimitives, Simulation
+
+from ..techniques.hair_dynamics import HairPhysics, HairSimulation
+from ..techniques.hair_silhouettes import silhouette_geometry, tube_adjacency
+from ..techniques.hair_strands import load_strands
+from ..techniques.hair_tubes import GpuTubes, build_tubes
+from .params import MAX_HAIR_STEPS, MAX_HAIR_STRAND_STEPS, CartoonHairParams, settle_steps
+
+if TYPE_CHECKING:
+    from deferred.api import Frame, SceneObject
+
+
+def hair_physics(params: CartoonHairParams) -> HairPhysics:
+    """The simulation's parameters of a material state."""
+    return HairPhysics(
+        edge_stiffness=params.edge_stiffness, bend_stiffness=params.bend_stiffness,
+        torsion_stiffness=params.torsion_stiffness, anchor_stiffness=params.anchor_stiffness,
+        anchor_curve=params.anchor_curve, gravity=params.gravity, wind=params.wind,
+        drag=params.drag, time_step=params.time_step)
+
+
+def params_at(obj: SceneObject, time: float) -> CartoonHairParams:
+    """``obj``'s parameters at ``time`` on its timeline (its material's, without one)."""
+    at = getattr(obj, "params_at", None)
+    return at(time) if at is not None else obj.material.params
+
+
+class HairState:
+    """One object's hair in one renderer: the simulation and the tube mesh's GPU buffers,
+    brought to a frame's time by :meth:`advance`.
+
+    The tubes' positions and normals live in a buffer of their own (a moving
+    :class:`GpuMesh`); with compute shaders they are built there (:class:`GpuTubes`) and
+    ``mesh.positions`` keep the tubes of t = 0, else numpy builds them and they are uploaded.
+    """
+
+    def __init__(self, ctx: moderngl.Context, obj: SceneObject):
+        self.obj = obj
+        material = obj.material  # a CartoonHairMaterial
+        params = params_at(obj, 0.0)  # what builds the hair: timeline_fixed
+        self.params = params
+        rest = material.rest_strands(obj)
+        keyframes = material.keyframe_strands(rest.shape) if params.keyframes else None
+        self._physics: dict[int, tuple[CartoonHairParams, HairPhysics]] = {}
+        self.simulation = HairSimulation(rest, self.physics_at(0.0), material.spheres(obj),
+                                         keyframes, params.key_times or None,
+                                         self.model_at(0.0), settle_steps(params))
+        self.inverse_model = np.linalg.inv(self.model_at(0.0))
+        tubes = self._tubes(params)
+        self.mesh = MeshData("cartoon_hair tubes", tubes[0], tubes[1],
+                             *self._constant_attributes(tubes[2]), tubes[3])
+        self.gpu = GpuMesh(ctx, self.mesh, moving=True)
+        self.ctx = ctx
+        self._gpu_tubes: GpuTubes | None = None
+        self._silhouettes: MeshPrimitives | None = None
+        self.time: float | None = None
+        self._placed = self._placement()
+
+    def physics_at(self, time: float) -> HairPhysics:
+        """The simulation's parameters at ``time`` (made once for each state of the
+        timeline)."""
+        params = params_at(self.obj, time)
+        known = self._physics.get(id(params))
+        if known is None or known[0] is not params:
+            known = self._physics[id(params)] = (params, hair_physics(params))
+        return known[1]
+
+    def _placement(self) -> tuple:
+        """What the hair's history is made of: the object's tracks, its placement at t = 0
+        and its timeline (the base parameters and events)."""
+        material = self.obj.material
+        return (tuple(map(id, getattr(self.obj, "tracks", ()))),
+                self.model_at(0.0).tobytes(),
+                getattr(self.obj, "base_params", material.params),
+                getattr(self.obj, "events", ()))
+
+    def model_at(self, time: float) -> np.ndarray:
+        """The object's world matrix at ``time``: its tracks' and its parents'
+        (ObjectState.model_at), else its model."""
+        model_at = getattr(self.obj, "model_at", None)
+        return model_at(time) if model_at is not None else self.obj.model
+
+    @property
+    def silhouettes(self) -> MeshPrimitives:
+        """The tubes with each triangle's neighbours (made the first time it is asked for)."""
+        if self._silhouettes is None:
+            p = self.params
+            topology = (self.simulation.strands.shape[0], p.hair_samples, p.sides)
+            self._silhouettes = silhouette_geometry(self.ctx, self.gpu,
+                                                    tube_adjacency(*topology))
+        return self._silhouettes
+
+    def _tubes(self, params: CartoonHairParams):
+        """The tubes by numpy (:func:`build_tubes`), in object space."""
+        p = self.params
+        tubes = build_tubes(self.simulation.strands, p.hair_samples, p.sides, params.radius,
+                            params.taper, reference=self.simulation.root_references())
+        # the simulation is in world space; the object's passes draw in object space
+        linear, offset = self.inverse_model[:3, :3], self.inverse_model[:3, 3]
+        positions = tubes.positions @ linear.T + offset
+        normals = tubes.normals @ np.linalg.inv(linear)  # the inverse transpose, applied
+        normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-12)
+        return positions.astype(np.float32), normals.astype(np.float32), tubes, tubes.indices
+
+    @staticmethod
+    def _constant_attributes(tubes) -> tuple[np.ndarray, ...]:
+        count = len(tubes.positions)
+        uvs = np.stack([tubes.along, tubes.around], axis=1).astype(np.float32)
+        zeros = np.zeros((count, 3), np.float32)
+        comb = np.zeros((count, 4), np.float32)
+        comb[:, 0] = tubes.strand_ids
+        comb[:, 1] = tubes.along
+        return uvs, zeros, zeros.copy(), comb
+
+    def advance(self, time: float, frame: Frame | None = None) -> None:
+        """The hair at ``time`` (seconds): stepped from where it is (or from the start, for an
+        earlier time), the tubes rebuilt: by compute shaders where ``frame``'s context has
+        them, else by numpy and uploaded."""
+        placement = self._placement()
+        if placement != self._placed:  # new tracks, model or timeline: the history starts over
+            self.simulation.reset(self.model_at(0.0))
+            self._physics.clear()
+            self._placed, self.time = placement, None
+        if self.time == time:
+            return
+        # the roots follow the object's transform at each step (its tracks move it); the
+        # tubes go back to object space through the transform at the simulated step
+        self.simulation.advance(time, self.model_at, self.physics_at)
+        simulated = max(self.simulation.time, 0.0)
+        self.inverse_model = np.linalg.inv(self.model_at(simulated))
+        params = params_at(self.obj, simulated)  # the tube's radius and taper
+        if frame is not None and frame.gl.features.compute_shaders:
+            if self._gpu_tubes is None:
+                p = self.params
+                self._gpu_tubes = GpuTubes(self.ctx, self.simulation.strand_count,
+                                           self.simulation.point_count, p.hair_samples,
+                                           p.sides)
+            self._gpu_tubes.upload(self.simulation.component_points,
+                                   self.simulation.component_references())
+            self._gpu_tubes.build(frame.shaders, self.gpu.surface_vbo, params.radius,
+                                  params.taper, self.inverse_model)
+        else:
+            positions, normals, _, _ = self._tubes(params)
+            self.mesh.positions, self.mesh.normals = positions, normals
+            self.gpu.write_surface()
+        self.time = time
+
+    def release(self) -> None:
+        if self._silhouettes is not None:
+            self._silhouettes.release()
+        if self._gpu_tubes is not None:
+            self._gpu_tubes.release()
+        self.gpu.release()
+
+
+class HairDynamics(Simulation):
+    """The hair of each cartoon_hair object (:class:`HairState`), stepped from t = 0 at
+    ``time_step`` after ``settle``: the steps, and the steps times the strands, are bounded
+    (``MAX_HAIR_STEPS``, ``MAX_HAIR_STRAND_STEPS``), so a late frame is refused before any
+    frame instead of running for hours."""
+
+    key = "cartoon_hair_state"
+
+    def start(self, ctx: moderngl.Context, obj: SceneObject) -> HairState:
+        return HairState(ctx, obj)
+
+    def advance(self, state: HairState, frame: Frame, obj: SceneObject) -> None:
+        state.obj = obj  # the object as this frame has it (the tracks moving it now)
+        state.advance(frame.time, frame)
+
+    def check_time(self, obj: SceneObject, time: float, where: str) -> None:
+        material = obj.material
+        params = material.params
+        steps = round(time / params.time_step) + settle_steps(params)
+        strands = params.strands if params.strands_file is None else \
+            len(load_strands(material.resolve_path(params.strands_file), "strands_file"))
+        if steps > MAX_HAIR_STEPS or steps * strands > MAX_HAIR_STRAND_STEPS:
+            settling = " (with settle)" if params.settle > 0.0 else ""
+            raise InputError(f"t = {time:g} s needs {steps:,} simulation steps of "
+                             f"{params.time_step:g} s{settling} for {strands:,} strands "
+                             f"({obj.label}); the most is {MAX_HAIR_STEPS:,} steps and "
+                             f"{MAX_HAIR_STRAND_STEPS:,} strand steps: render an earlier time, "
+                             "raise time_step or grow fewer strands", where)
+
+
+DYNAMICS = HairDynamics()
