@@ -38,8 +38,9 @@ class Hierarchy:
             parent = self.resolve(node.parent, self._where(node, where))
             if parent is not None:
                 self.parents[node] = parent
+        rooted: set[SceneNode] = set()  # nodes whose ancestors are known to end at the world
         for node in self.nodes:
-            self._check_acyclic(node, where)
+            self._check_acyclic(node, where, rooted)
 
     @staticmethod
     def _where(item: Any, where: str) -> str:
@@ -67,18 +68,24 @@ class Hierarchy:
             return self.by_label[label]  # a copy of the node (a debug view's scene)
         raise InputError(f"the parent {label or parent!r:.80} is not in the scene", where)
 
-    def _check_acyclic(self, node: SceneNode, where: str) -> None:
+    def _check_acyclic(self, node: SceneNode, where: str, rooted: set[SceneNode]) -> None:
+        """``InputError`` where ``node`` is its own ancestor; a chain that reaches a node of
+        ``rooted`` (or the world) is added to it, so each link is walked about once."""
         seen = [node]
         parent = self.parents.get(node)
-        while parent is not None:
+        while parent is not None and parent not in rooted:
             if parent is node:
-                chain = " -> ".join(n.label[:40] for n in [*seen, node])
+                labels = [n.label[:40] for n in [*seen, node]]
+                if len(labels) > 8:  # one readable line, however long the cycle
+                    labels = [*labels[:4], f"... ({len(seen)} nodes) ...", *labels[-3:]]
+                chain = " -> ".join(labels)
                 raise InputError(f"the parents form a cycle ({chain}): a node cannot be its "
                                  "own ancestor", self._where(node, where))
             seen.append(parent)
             if len(seen) > len(self.nodes) + 1:
                 return  # a cycle above this node: reported for its own members
             parent = self.parents.get(parent)
+        rooted.update(seen)
 
     def parent_of(self, node: SceneNode) -> SceneNode | None:
         return self.parents.get(node)
@@ -96,17 +103,20 @@ class Hierarchy:
 def world_matrix(node: SceneNode, hierarchy: Hierarchy, local: LocalMatrix,
                  worlds: dict[SceneNode, np.ndarray] | None = None) -> np.ndarray:
     """``node``'s world matrix: its ancestors' local matrices (``local``) times its own, root
-    first. ``worlds`` keeps each node's as it is made (a scene's worlds made in one pass)."""
-    if worlds is not None:
-        known = worlds.get(node)
-        if known is not None:
-            return known
-    parent = hierarchy.parent_of(node)
-    own = local(node)
-    world = own if parent is None else world_matrix(parent, hierarchy, local, worlds) @ own
-    if worlds is not None:
-        worlds[node] = world
-    return world
+    first. ``worlds`` keeps each node's as it is made (a scene's worlds made in one pass).
+    Made walking up, then down: a hierarchy of any depth takes no recursion."""
+    worlds = {} if worlds is None else worlds
+    chain = []  # the node and its ancestors whose worlds are not known yet, nearest first
+    current: SceneNode | None = node
+    while current is not None and current not in worlds:
+        chain.append(current)
+        current = hierarchy.parent_of(current)
+    world = None if current is None else worlds[current]
+    for each in reversed(chain):
+        own = local(each)
+        world = own if world is None else world @ own
+        worlds[each] = world
+    return worlds[node]
 
 
 def place_point(matrix: np.ndarray | None, point: Any) -> tuple[float, float, float]:

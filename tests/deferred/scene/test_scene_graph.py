@@ -285,3 +285,20 @@ def test_placement_keys_are_checked():
     ball.quaternion = (0.0, 0.0, 0.0, 2.0)
     assert ball.rotation == (0.0, 0.0, 0.0)
     np.testing.assert_allclose(ball.model, np.identity(4), atol=1e-12)
+
+
+def test_a_deep_hierarchy_and_a_long_cycle():
+    """Two thousand nested groups place their child (no recursion limit); a cycle through
+    thirty nodes is said in one short line."""
+    scene = Scene()
+    groups = [scene.add_group(f"g{index}", position=(0.001, 0.0, 0.0)) for index in range(2000)]
+    for child, parent in zip(groups[1:], groups, strict=False):
+        child.parent = parent
+    ball = scene.add_object("builtin:sphere", label="ball", parent=groups[-1])
+    assert scene.world_at(ball, 0.0)[0, 3] == pytest.approx(2.0)
+    groups[0].parent = groups[29]
+    with pytest.raises(InputError) as caught:
+        scene.world_at(ball, 0.0)
+    message = str(caught.value)
+    assert "the parents form a cycle" in message and "(30 nodes)" in message
+    assert len(message) < 300 and "\n" not in message
