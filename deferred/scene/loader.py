@@ -176,6 +176,14 @@ class SceneBuilder:
         taken.add(label)
         return label
 
+    def _made(self, label: str, node: SceneNode | None, material_cls: type[Material] | None,
+              where: str) -> None:
+        """A node of the file, made (or None where refused): named, and its parent checked
+        once every node is made."""
+        self.labels[label] = (node, material_cls)
+        if node is not None and node.parent is not None:
+            self.children.append((node, f"{where}.parent"))
+
     def objects(self) -> None:
         meshes: dict[str, MeshData | None] = {}
         taken: set[str] = set()  # the labels, for unique_label
@@ -209,9 +217,7 @@ class SceneBuilder:
                 made = SceneObject(label, mesh, material, where=where,
                                    transform=obj.transform(), parent=obj.parent)
                 self.scene.objects.append(made)
-                if obj.parent is not None:
-                    self.children.append((made, f"{where}.parent"))
-            self.labels[label] = (made, material_cls)
+            self._made(label, made, material_cls, where)
 
     def groups(self) -> None:
         for index, (group, bad) in enumerate(self.tables["group"]):
@@ -226,9 +232,7 @@ class SceneBuilder:
             if not bad:
                 made = SceneNode(label, group.transform(), parent=group.parent, where=where)
                 self.scene.groups.append(made)
-                if group.parent is not None:
-                    self.children.append((made, f"{where}.parent"))
-            self.labels[label] = (made, None)
+            self._made(label, made, None, where)
 
     def lights(self) -> None:
         for index, (light, bad) in enumerate(self.tables["light"]):

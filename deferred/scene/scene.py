@@ -18,13 +18,11 @@ from typing import Any
 import numpy as np
 
 from deferred.errors import InputError
-from deferred.gbuffer.layout import GBufferLayout
 from deferred.gl.meshes import MeshData
 from deferred.interfaces import registry
 from deferred.interfaces.effect import Effect
 from deferred.interfaces.light import Light
-from deferred.interfaces.material import Material, compose_layout
-from deferred.interfaces.shading import ShadingModel
+from deferred.interfaces.material import Material
 from deferred.params import validate_params
 from deferred.revision import Revisioned
 from deferred.scene import timeline
@@ -34,13 +32,14 @@ from deferred.scene.meshes import load_mesh
 from deferred.scene.nodes import SceneNode
 from deferred.scene.objects import SceneObject, TimelineEvent
 from deferred.scene.shadow_budget import ShadowBudget
+from deferred.scene.state import SceneContents
 from deferred.scene.tracks import Track, Turntable, make_track
 from deferred.scene.transform import Transform
 from deferred.validation import join_where
 
 
 @dataclass(eq=False)
-class Scene(Revisioned):
+class Scene(SceneContents, Revisioned):
     """A scene ready to render (meshes loaded, materials and lights validated).
 
     ``groups`` are nodes without a mesh that objects, lights and the camera may hang from
@@ -97,20 +96,6 @@ class Scene(Revisioned):
     def nodes(self) -> list[SceneNode]:
         """Every node of the scene graph: the objects, then the groups."""
         return [*self.objects, *self.groups]
-
-    def gbuffer_layout(self) -> GBufferLayout:
-        """The G-buffer of this scene: the core plus the data its materials declare."""
-        return compose_layout(obj.material for obj in self.objects)
-
-    def shading_models(self) -> list[type[ShadingModel]]:
-        """The shading models the scene's materials use, by id (only these are compiled)."""
-        found = {registry.shading_models.get(obj.material.shading_model)
-                 for obj in self.objects}
-        return sorted(found, key=lambda cls: cls.type_id)
-
-    def light_types(self) -> list[type[Light]]:
-        """The light types of the scene, by id (only these are compiled)."""
-        return sorted({type(light) for light in self.lights}, key=lambda cls: cls.type_id)
 
     # -- the timeline --------------------------------------------------------------------------
     def add_event(self, obj: SceneObject | str, time: float, params: Mapping[str, Any],

@@ -37,6 +37,28 @@ if TYPE_CHECKING:
     from deferred.scene.shadow_budget import ShadowBudget
 
 
+class SceneContents:
+    """What a scene's objects and lights need compiled, asked alike of the user's scene and of
+    a frame's state (both have ``objects``, each with a ``material``, and ``lights``)."""
+
+    objects: Any
+    lights: Any
+
+    def gbuffer_layout(self) -> GBufferLayout:
+        """The G-buffer of this scene: the core plus the data its materials declare."""
+        return compose_layout(obj.material for obj in self.objects)
+
+    def shading_models(self) -> list[type[ShadingModel]]:
+        """The shading models the scene's materials use, by id (only these are compiled)."""
+        found = {registry.shading_models.get(obj.material.shading_model)
+                 for obj in self.objects}
+        return sorted(found, key=lambda cls: cls.type_id)
+
+    def light_types(self) -> list[type[Light]]:
+        """The light types of the scene, by id (only these are compiled)."""
+        return sorted({type(light) for light in self.lights}, key=lambda cls: cls.type_id)
+
+
 @dataclass(frozen=True, eq=False)
 class ObjectState:
     """One object at the frame's time (see the module documentation)."""
@@ -83,7 +105,7 @@ class ObjectState:
 
 
 @dataclass(frozen=True, eq=False)
-class FrameState:
+class FrameState(SceneContents):
     """The scene at ``time`` (see the module documentation). ``scene`` is the user's scene it
     was evaluated from, ``revision`` the scene's revision then."""
 
@@ -114,17 +136,3 @@ class FrameState:
 
     def has_object(self, node: Any) -> bool:
         return getattr(node, "node", node) in self._by_node
-
-    def gbuffer_layout(self) -> GBufferLayout:
-        """The G-buffer of this scene: the core plus the data its materials declare."""
-        return compose_layout(obj.material for obj in self.objects)
-
-    def shading_models(self) -> list[type[ShadingModel]]:
-        """The shading models the scene's materials use, by id (only these are compiled)."""
-        found = {registry.shading_models.get(obj.material.shading_model)
-                 for obj in self.objects}
-        return sorted(found, key=lambda cls: cls.type_id)
-
-    def light_types(self) -> list[type[Light]]:
-        """The light types of the scene, by id (only these are compiled)."""
-        return sorted({type(light) for light in self.lights}, key=lambda cls: cls.type_id)

@@ -18,6 +18,8 @@ from deferred.scene.transform import (
     Quaternion,
     RotationOrder,
     Transform,
+    nonzero_quaternion,
+    one_rotation,
     scale_too_small,
 )
 from deferred.validation import Radiance, StrictValues
@@ -47,10 +49,7 @@ class PlacementModel(_Strict):
     @field_validator("quaternion")
     @classmethod
     def _unit(cls, quaternion: Quaternion | None) -> Quaternion | None:
-        if quaternion is not None and float(np.linalg.norm(quaternion)) < 1e-9:
-            raise ValueError("is zero: a rotation needs a quaternion of length > 0 "
-                             "([0, 0, 0, 1] is none)")
-        return quaternion
+        return nonzero_quaternion(quaternion)
 
     @model_validator(mode="after")
     def _check_scale(self) -> PlacementModel:
@@ -63,8 +62,7 @@ class PlacementModel(_Strict):
 
     @model_validator(mode="after")
     def _one_rotation(self) -> PlacementModel:
-        if self.quaternion is not None and any(self.rotation):
-            raise ValueError("give rotation (Euler degrees) or quaternion, not both")
+        one_rotation(self.rotation, self.quaternion)
         return self
 
     def transform(self) -> Transform:

@@ -116,6 +116,20 @@ def read_only(matrix: np.ndarray) -> np.ndarray:
     return matrix
 
 
+def nonzero_quaternion(quaternion: Quaternion | None) -> Quaternion | None:
+    """``quaternion`` if it can be a rotation (of length > 0): the placements' one rule."""
+    if quaternion is not None and float(np.linalg.norm(quaternion)) < 1e-9:
+        raise ValueError("is zero: a rotation needs a quaternion of length > 0 "
+                         "([0, 0, 0, 1] is none)")
+    return quaternion
+
+
+def one_rotation(rotation: Vec3, quaternion: Quaternion | None) -> None:
+    """A placement turns by Euler angles or by a quaternion, not both."""
+    if quaternion is not None and any(rotation):
+        raise ValueError("give rotation (Euler degrees) or quaternion, not both")
+
+
 class Transform(StrictValues):
     """A node's local placement as a scene file gives it: finite numbers, a scale of at least
     ``MIN_SCALE`` on each axis (its normal matrix would overflow float32), a rotation as Euler
@@ -139,15 +153,11 @@ class Transform(StrictValues):
     @field_validator("quaternion")
     @classmethod
     def _check_quaternion(cls, quaternion: Quaternion | None) -> Quaternion | None:
-        if quaternion is not None and float(np.linalg.norm(quaternion)) < 1e-9:
-            raise ValueError("is zero: a rotation needs a quaternion of length > 0 "
-                             "([0, 0, 0, 1] is none)")
-        return quaternion
+        return nonzero_quaternion(quaternion)
 
     @model_validator(mode="after")
     def _one_rotation(self) -> Transform:
-        if self.quaternion is not None and any(self.rotation):
-            raise ValueError("give rotation (Euler degrees) or quaternion, not both")
+        one_rotation(self.rotation, self.quaternion)
         return self
 
     def matrix(self) -> np.ndarray:
