@@ -30,8 +30,8 @@ import numpy as np  # noqa: E402
 
 from deferred.debug.views import with_material_view  # noqa: E402
 from deferred.io.images import read_image, write_image  # noqa: E402
+from deferred.materials.techniques.uv_seams import UVSeams  # noqa: E402
 from deferred.materials.techniques.wetness import (  # noqa: E402
-    UVSeams,
     dry_mask,
     random_droplets,
     uv_wrap,

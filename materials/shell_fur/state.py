@@ -25,8 +25,8 @@ from ..techniques.strands import (
     gust_wind,
     triangle_strands,
 )
+from ..techniques.uv_seams import UVSeams
 from ..techniques.wetness import (
-    UVSeams,
     dry_mask,
     dry_out,
     footprint_texels,

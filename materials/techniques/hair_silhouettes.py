@@ -21,7 +21,7 @@ and Northrup et al.).
   where the normal leans along the edge. The stroke image runs along
   the whole strand (its ``u`` is the parameter along the strand, 0 root to 1 tip) and across
   the quad, so strokes are coherent from frame to frame without chaining; it is the hatching
-  generator's soft-ended stroke (:func:`.hatching.default_stroke`).
+  generator's soft-ended stroke (:func:`.tam.default_stroke`).
 - **Fade** (Fig. 4.19): the stroke's alpha times ``clamp(a x^2 + b x + c, 0, 1)`` of the
   parameter ``x`` along the strand, so self-overlaps near the roots (Fig. 4.18) fade out.
 - **Visibility** (4.3.7, Northrup's ID buffer): deferred, depth test off, a fragment is drawn
@@ -54,7 +54,7 @@ from deferred.api import (
 )
 
 from .hair_tubes import tube_indices
-from .hatching import default_stroke
+from .tam import default_stroke
 
 SILHOUETTE_VERTEX = "materials/cartoon_hair/silhouette.vert"
 SILHOUETTE_GEOMETRY = "materials/cartoon_hair/silhouette.geom"

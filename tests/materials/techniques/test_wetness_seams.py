@@ -1,4 +1,4 @@
-"""The wetness mask across UV-chart seams (techniques/wetness.py, UVSeams): the seam map checked
+"""The wetness mask across UV-chart seams (techniques/uv_seams.py, UVSeams): the seam map checked
 against the charts' own UVs of the same surface points, a droplet on a seam wetting both
 charts alike (where a plain blend is cut at the chart's edge), and droplets kept to their own
 chart."""
@@ -12,9 +12,9 @@ import pytest
 from locations import ROOT
 
 from deferred.materials.techniques.topology import weld
+from deferred.materials.techniques.uv_seams import UVSeams
 from deferred.materials.techniques.wetness import (
     Droplet,
-    UVSeams,
     blend_droplet,
     dry_mask,
     footprint_texels,
@@ -266,12 +266,10 @@ def test_rendered_clumps_continue_across_the_seam(render, tmp_path, monkeypatch)
     """Rendered (the wetness view, what the shaders read), wet and dry agree across the seam
     about as often as across a line inside a chart; with the seams ignored (the droplets
     blended in their own chart's UVs alone, as before) the wet areas are cut at the seam."""
-    from deferred.materials.techniques import wetness
-
     write_square_obj(tmp_path / "square.obj", mirrored=True)
     across, inside = seam_mismatch(render, tmp_path)
     assert across <= inside + 0.1, (across, inside)
-    monkeypatch.setattr(wetness.UVSeams, "laid_out", property(lambda self: False))
+    monkeypatch.setattr(UVSeams, "laid_out", property(lambda self: False))
     cut, _ = seam_mismatch(render, tmp_path)
     assert cut > across + 0.2, (cut, across)
 
