@@ -76,8 +76,9 @@ MOVED_HOOKS: dict[str, str] = {
         f"a material's passes come from its techniques: add "
         f"`techniques = (*Material.techniques, PhasePasses(Phase.{phase.upper()}, build))`, "
         "`build(material, obj)` returning the passes (or a Technique of your own)"
-        + ("; to change the surface's own pass, give SurfacePasses(vertex=..., inputs=...) "
-           "in place of Material.techniques' " if phase in ("geometry", "forward") else ""))
+        + ("; to change the surface's own passes, give SurfacePasses(vertex=..., inputs=..., "
+           f"{phase.replace('geometry', 'gbuffer')}=MyPass) in place of the default "
+           "SurfacePasses()" if phase in ("geometry", "forward") else ""))
        for phase in ("geometry", "screen", "stipple", "material", "forward")},
     **{name: (f"shadow casting is the material's `shadow`: write `shadow = MyCaster()`, a "
               f"ShadowCaster subclass defining {new}")

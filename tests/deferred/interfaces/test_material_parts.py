@@ -169,7 +169,8 @@ def test_a_material_without_parts_has_the_defaults():
 @pytest.mark.parametrize("hook, instead", [
     ("material_passes", "techniques = (*Material.techniques, PhasePasses(Phase.MATERIAL, "
                         "build))"),
-    ("geometry_passes", "SurfacePasses(vertex=..., inputs=...)"),
+    ("geometry_passes", "give SurfacePasses(vertex=..., inputs=..., gbuffer=MyPass) in place "
+                        "of the default SurfacePasses() (docs/"),
     ("stipple_passes", "PhasePasses(Phase.STIPPLE, build)"),
     ("draw_shadow", "shadow = MyCaster()`, a ShadowCaster subclass defining draw(frame, obj, "
                     "view)"),
