@@ -10,7 +10,7 @@ import numpy as np
 
 from deferred.viewer.shaders import viewer_program
 
-MODES = {"single": 0, "split": 1, "difference": 2}
+MODES = {"single": 0, "split": 1, "difference": 2}  # the views, in order: their shader ids
 
 
 @dataclass

@@ -8,13 +8,13 @@ from typing import Any
 
 from imgui_bundle import imgui
 
+from deferred.viewer.display import MODES
 from deferred.viewer.panels import PANEL_WIDTH
 
 # The input drives a deferred.viewer.app.Viewer, which imports this module: typed as Viewer in
 # the text, Any to the checker (no import circle), as in deferred.viewer.panels.
 Viewer = Any
 
-MODES = ("single", "split", "difference")
 
 
 class ViewerInput:
@@ -125,7 +125,7 @@ class ViewerInput:
         elif key == keys.HOME:
             viewer.timeline.scrub(0.0)
         elif key == keys.TAB:
-            viewer.mode = MODES[(MODES.index(viewer.mode) + 1) % len(MODES)]
+            viewer.mode = list(MODES)[(list(MODES).index(viewer.mode) + 1) % len(MODES)]
         elif key == keys.P:
             viewer.pipeline, viewer.other_pipeline = viewer.other_pipeline, viewer.pipeline
         elif key == keys.B:

@@ -17,6 +17,7 @@ from imgui_bundle import imgui
 from deferred.names import LightPath, Pipeline
 from deferred.viewer.buffers import ALL_CHANNELS
 from deferred.viewer.compare import describe
+from deferred.viewer.display import MODES
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -34,7 +35,6 @@ GREY = imgui.ImVec4(0.65, 0.65, 0.65, 1.0)
 COLOR_WORDS = ("color", "albedo", "ground", "tint", "sky")
 PIPELINES = [p.value for p in Pipeline]
 LIGHT_PATHS = ["(scene's)", *(p.value for p in LightPath)]
-MODES = ("single", "split", "difference")
 OPEN = imgui.TreeNodeFlags_.default_open
 LABEL_WIDTH = 140  # pixels right of each widget for its label
 
