@@ -17,12 +17,18 @@ catalogue, whatever is loaded first; a plugin's comes after the built-ins', in t
 register. Loading a name loads that class only, so a broken plugin fails only the scenes that
 use it. Listing everything (``deferred params``) loads every class and skips a broken plugin
 with a warning naming it.
+
+A plugin is checked as it loads: its module imports, the entry point gives a class deriving
+from the registry's interface (``Material``, ``Light``, ...) with what a scene needs of it
+(``name``, ``Params``, ``from_dict``), and no other distribution declares the same name.
+Each failure is one line naming the entry point, its distribution and what is wrong.
 """
 
 from __future__ import annotations
 
 import importlib
 import threading
+import types
 import warnings
 from collections.abc import Iterator
 from importlib.metadata import EntryPoint, entry_points
@@ -30,6 +36,7 @@ from typing import Generic, TypeVar
 
 from deferred.errors import InputError
 from deferred.gbuffer.surface_id import MAX_MATERIAL_ID, MAX_SHADING_MODEL_ID
+from deferred.params import Params
 from deferred.validation import closest
 
 T = TypeVar("T")
@@ -44,16 +51,25 @@ class PluginWarning(UserWarning):
     """A plugin that could not be loaded was skipped."""
 
 
+MAX_PLUGIN_ERROR = 300  # characters of a plugin's own exception message said
+
+
 class Registry(Generic[T]):
     """One kind's classes by name. ``catalogue``: ``"package"`` or ``"package:ATTRIBUTE"``,
     the module and attribute (``BUILTINS`` unless named) holding the built-ins' catalogue, a
-    dict of name to ``"module:Class"`` in the order of their type ids (none: no built-ins)."""
+    dict of name to ``"module:Class"`` in the order of their type ids (none: no built-ins).
+    ``interface``: ``"module:Class"``, the base every plugin's class derives from, and
+    ``requires`` the class attributes a plugin's class must have (none: anything with a
+    ``name`` registers)."""
 
-    def __init__(self, what: str, group: str, catalogue: str, max_id: int | None = None):
+    def __init__(self, what: str, group: str, catalogue: str, max_id: int | None = None,
+                 interface: str | None = None, requires: tuple[str, ...] = ()):
         self.what = what
         self.group = group
         self.catalogue = catalogue
         self.max_id = max_id  # ids are stored in the G-buffer for some registries
+        self.interface = interface
+        self.requires = requires
         self._classes: dict[str, type[T]] = {}
         self._ids: dict[str, int] = {}  # name -> the type id its class was given here
         self._builtin_entries: dict[str, EntryPoint] | None = None  # read on first use
@@ -127,19 +143,72 @@ class Registry(Generic[T]):
         if entry.name in self._tried:
             return self._tried[entry.name]
         error = None
-        dist = f" ({entry.dist.name})" if entry.dist is not None else ""
+        named = f"{self.what} plugin '{entry.name}'{distribution(entry)}"
         try:
-            cls = self.register(entry.load())
-        except Exception as exc:  # noqa: BLE001 - plugins fail in many ways; say which
-            error = f"cannot load {self.what} plugin '{entry.name}'{dist}: " \
-                    f"{type(exc).__name__}: {exc}"
+            loaded = entry.load()
+        except (Exception, SystemExit) as exc:  # noqa: BLE001 - plugins fail in many ways
+            error = f"cannot load {named}: {type(exc).__name__}: {shortened(exc)}"
         else:
-            if cls.name != entry.name:
-                self._misnamed[entry.name] = (
-                    cls.name, f"{self.what} plugin entry point '{entry.name}'{dist} loads "
-                              f"{entry.value}, whose name is '{cls.name}'")
+            problem = self.interface_problem(loaded)
+            if problem is not None:
+                error = f"{named} loads {entry.value}, which {problem}"
+            else:
+                try:
+                    cls = self.register(loaded)
+                except (TypeError, ValueError) as exc:
+                    error = f"cannot load {named}: {exc}"
+                else:
+                    if cls.name != entry.name:
+                        self._misnamed[entry.name] = (
+                            cls.name, f"{self.what} plugin entry point '{entry.name}'"
+                                      f"{distribution(entry)} loads {entry.value}, whose name "
+                                      f"is '{cls.name}'")
         self._tried[entry.name] = error
         return error
+
+    def interface_problem(self, loaded: object) -> str | None:
+        """What keeps ``loaded`` (what an entry point gave) from being one of this registry's
+        classes, said after "which"; None where nothing does."""
+        if not isinstance(loaded, type):
+            return f"is not a class but {kind_of(loaded)}"
+        if self.interface is not None:
+            base = self.interface_class()
+            if not issubclass(loaded, base):
+                bases = [b.__qualname__ for b in loaded.__mro__[1:-1]]
+                derives = f"derives from {', '.join(bases)}" if bases else "derives from nothing"
+                return f"is not a {base.__qualname__} subclass (it {derives})"
+        missing = [attribute for attribute in ("name", *self.requires)
+                   if getattr(loaded, attribute, None) is None]
+        if missing:
+            return f"lacks {', '.join(missing)}"
+        if not isinstance(loaded.name, str) or not loaded.name:
+            return f"has name {loaded.name!r}, not a non-empty string"
+        if "Params" in self.requires and not (isinstance(loaded.Params, type) and
+                                              issubclass(loaded.Params, Params)):
+            return f"has a Params that is not a deferred.api.Params subclass ({loaded.Params!r})"
+        if "from_dict" in self.requires and not callable(loaded.from_dict):
+            return "has a from_dict that cannot be called"
+        return None
+
+    def interface_class(self) -> type:
+        """The interface's class, imported on first use (it imports this module)."""
+        module, _, attribute = self.interface.partition(":")
+        return getattr(importlib.import_module(module), attribute)
+
+    def _declared_twice(self, entries: list[EntryPoint]) -> str | None:
+        """The error for a name that several distributions declare with different classes."""
+        values = {entry.value for entry in entries}
+        if len(values) < 2:
+            return None
+        said = " and ".join(f"{entry.value}{distribution(entry)}" for entry in entries)
+        return f"{self.what} plugin '{entries[0].name}' is declared twice, by {said}: " \
+               "uninstall one, or rename its entry point and class"
+
+    def _entries_by_name(self) -> dict[str, list[EntryPoint]]:
+        by_name: dict[str, list[EntryPoint]] = {}
+        for entry in self._entry_points():
+            by_name.setdefault(entry.name, []).append(entry)
+        return by_name
 
     def _misnamed_hint(self, entry_name: str) -> str:
         """What to do about an entry point named otherwise than its class."""
@@ -150,26 +219,30 @@ class Registry(Generic[T]):
     def _load_all(self) -> None:
         for name in self._builtins():
             self._load_builtin(name)
-        for entry in self._entry_points():
-            first_time = entry.name not in self._tried
-            error = self._load_entry(entry)
+        for name, entries in self._entries_by_name().items():
+            first_time = name not in self._tried
+            error = self._declared_twice(entries)
+            if error is not None:
+                self._tried[name] = error  # neither is loaded: which one is meant is unknown
+            else:
+                error = self._load_entry(entries[0])
             if error and first_time:
                 warnings.warn(f"{error} (skipped)", PluginWarning, stacklevel=3)
-            elif first_time and entry.name in self._misnamed:
-                warnings.warn(self._misnamed_hint(entry.name), PluginWarning, stacklevel=3)
+            elif first_time and name in self._misnamed:
+                warnings.warn(self._misnamed_hint(name), PluginWarning, stacklevel=3)
 
     # -- lookup ------------------------------------------------------------------------------
     def get(self, name: str, where: str | None = None) -> type[T]:
         cls = self._classes.get(name) or self._load_builtin(name)
         if cls is not None:
             return cls
-        for entry in self._entry_points():
-            if entry.name == name:
-                error = self._load_entry(entry)
-                if error:
-                    raise InputError(error, where or f"entry point {self.group}")
-                if entry.name in self._misnamed:
-                    raise InputError(self._misnamed_hint(entry.name), where)
+        entries = self._entries_by_name().get(name, []) if isinstance(name, str) else []
+        if entries:
+            error = self._declared_twice(entries) or self._load_entry(entries[0])
+            if error:
+                raise InputError(error, where or f"entry point {self.group}")
+            if name in self._misnamed:
+                raise InputError(self._misnamed_hint(name), where)
         cls = self._classes.get(name)
         if cls is None:
             cls = self._from_misnamed_entry(name)
@@ -215,11 +288,40 @@ class Registry(Generic[T]):
         return self._in_id_order()
 
 
+def distribution(entry: EntryPoint) -> str:
+    """`` (its distribution)`` of an entry point, where it has one."""
+    return f" ({entry.dist.name})" if entry.dist is not None else ""
+
+
+def kind_of(value: object) -> str:
+    """What a value is, for a message: ``a function``, ``a module``, ``an instance of Boom``."""
+    kind = "a module" if isinstance(value, types.ModuleType) else \
+        "a function" if callable(value) and hasattr(value, "__code__") else \
+        f"an instance of {type(value).__qualname__}"
+    return kind
+
+
+def shortened(exc: BaseException) -> str:
+    """A plugin's own exception message, cut to :data:`MAX_PLUGIN_ERROR` characters."""
+    text = str(exc)
+    return text if len(text) <= MAX_PLUGIN_ERROR else f"{text[:MAX_PLUGIN_ERROR]}..."
+
+
+# what a scene needs of a material, a light or an effect class (loader.py: Params, from_dict)
+_FROM_A_SCENE = ("Params", "from_dict")
+
 materials: Registry = Registry("material", "deferred.materials", "deferred.materials",
-                               max_id=MAX_MATERIAL_ID)
+                               max_id=MAX_MATERIAL_ID,
+                               interface="deferred.interfaces.material:Material",
+                               requires=_FROM_A_SCENE)
 # a listed light's colour texel holds its type id in w's low 8 bits (lighting/light_lists.glsl)
-lights: Registry = Registry("light", "deferred.lights", "deferred.lights", max_id=255)
+lights: Registry = Registry("light", "deferred.lights", "deferred.lights", max_id=255,
+                            interface="deferred.interfaces.light:Light", requires=_FROM_A_SCENE)
 shading_models: Registry = Registry("shading model", "deferred.shading_models",
                                     "deferred.materials:SHADING_MODELS",
-                                    max_id=MAX_SHADING_MODEL_ID)
-effects: Registry = Registry("effect", "deferred.effects", "deferred.effects")
+                                    max_id=MAX_SHADING_MODEL_ID,
+                                    interface="deferred.interfaces.shading:ShadingModel",
+                                    requires=("glsl_file", "glsl_function"))
+effects: Registry = Registry("effect", "deferred.effects", "deferred.effects",
+                             interface="deferred.interfaces.effect:Effect",
+                             requires=_FROM_A_SCENE)
