@@ -143,7 +143,8 @@ class GpuMesh:
 class MeshPrimitives:
     """A mesh's vertex buffer drawn through another index buffer as other primitives (lines or
     triangles with adjacency for a geometry shader: fins, silhouette strokes); one vertex array
-    per program, released with it. The mesh's buffers stay the mesh's."""
+    per program, released with it. The mesh's buffers stay the mesh's. No indices (a mesh
+    with no interior edge has no fins) draw nothing: GL has no empty buffer."""
 
     def __init__(self, ctx: moderngl.Context, gpu_mesh: GpuMesh, indices: np.ndarray,
                  mode: int):
@@ -151,10 +152,13 @@ class MeshPrimitives:
         self.gpu_mesh = gpu_mesh  # holds its MeshData: a cache key's id() stays unique
         self.mode = mode
         self.count = int(indices.size)
-        self.ibo = ctx.buffer(np.ascontiguousarray(indices, dtype=np.uint32).tobytes())
+        self.ibo = ctx.buffer(np.ascontiguousarray(indices, dtype=np.uint32).tobytes()) \
+            if self.count else None
         self._arrays: dict[int, moderngl.VertexArray] = {}
 
     def render(self, program: moderngl.Program) -> None:
+        if self.ibo is None:
+            return
         vao = self._arrays.get(program.glo)
         if vao is None:
             vao = self.ctx.vertex_array(program, self.gpu_mesh.vertex_buffers(program),
@@ -166,4 +170,5 @@ class MeshPrimitives:
         for vao in self._arrays.values():
             vao.release()
         self._arrays.clear()
-        self.ibo.release()
+        if self.ibo is not None:
+            self.ibo.release()

@@ -91,5 +91,6 @@ class FinPass(ObjectPass):
         geometry = frame.resources.cached(
             ("fins", id(mesh)),
             lambda ctx: fin_geometry(ctx, frame.resources.gpu_mesh(mesh), edge_adjacency(mesh)))
-        frame.gl_call(lambda: geometry.render(program))
-        frame.count_draw()
+        if geometry.count:  # a mesh with no interior edge has no fins
+            frame.gl_call(lambda: geometry.render(program))
+            frame.count_draw()
