@@ -51,6 +51,7 @@ def dump(scene: str | None, output: str | None, pipeline: str, size: str | None,
         return
     if not output:
         raise InputError("a dump needs an output folder", "-o")
+    options.check_light_path_option(pipeline, light_path)
     from deferred.debug.dump_folder import check_dump_folder
 
     out_dir = check_dump_folder(output)  # not a folder of other files: a dump replaces it
@@ -83,6 +84,7 @@ def write_dump(scene: str | None, out_dir: Path, pipeline: str, size: str | None
         progress.status("starting the renderer")
         with Renderer(loaded, pipeline, parse_size_option(size), strict=strict or None,
                       light_path=light_path) as renderer:
+            light_path_ran = renderer.light_path
             chosen = select_passes(renderer.passes, patterns)  # bad input fails before any file
             where = parse_pixel(pixel, renderer.size) if pixel is not None else None
             progress.status("capturing the frame (shaders compile, simulations settle)")
@@ -94,7 +96,8 @@ def write_dump(scene: str | None, out_dir: Path, pipeline: str, size: str | None
         for line in format_history(history, *where, renderer.size):
             click.echo(line)
     width, height = renderer.size
-    stderr.print(f"wrote {out_dir}/ ({width}x{height}, {pipeline}, {len(chosen)} of "
+    stderr.print(f"wrote {out_dir}/ ({width}x{height}, {pipeline}, {light_path_ran} lights, "
+                 f"{len(chosen)} of "
                  f"{len(manifest['passes'])} passes, frame {manifest['frame_ms']:.1f} ms)")
 
 

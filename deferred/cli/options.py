@@ -12,8 +12,9 @@ from typing import TYPE_CHECKING, TypeVar
 import click
 from rich.console import Console
 
+from deferred.errors import InputError
 from deferred.io import safety
-from deferred.names import LightPath, Pipeline
+from deferred.names import LIGHT_PATHS, LightPath, Pipeline
 from deferred.render.pipeline import PIPELINES
 from deferred.scene.size import parse_size
 
@@ -59,6 +60,20 @@ def size_option(text: str = SIZE_HELP) -> Callable[[Command], Command]:
 
 def light_path_option(command: Command) -> Command:
     return click.option("--light-path", type=LIGHT_PATH_CHOICE, help=LIGHT_PATH_HELP)(command)
+
+
+def check_light_path_option(pipeline: str, light_path: str | None) -> None:
+    """--light-path names one of --pipeline's paths. (The Python API and a scene's
+    ``light_path`` run the other pipeline's equivalent instead: the viewer switches pipelines
+    under a chosen path, and a scene is rendered by both.)"""
+    if light_path is None:
+        return
+    own = LIGHT_PATHS[Pipeline(pipeline)]
+    if LightPath(light_path) not in own:
+        other = next(p for p in Pipeline if LightPath(light_path) in LIGHT_PATHS[p])
+        theirs = f"{', '.join(own[:-1])} and {own[-1]}"
+        raise InputError(f"'{light_path}' is a light path of the {other} pipeline; the "
+                         f"{pipeline} pipeline's are {theirs}", "--light-path")
 
 
 def strict_option(command: Command) -> Command:

@@ -117,6 +117,7 @@ def render_job(scene: str | None, output: str, pipeline: str, size: str | None, 
     from deferred.io.paths import output_kind
     from deferred.io.video import check_video_writer, frame_times
 
+    options.check_light_path_option(pipeline, light_path)
     out = check_output_path(output)
     kind = output_kind(out)
     if turntable is not None:

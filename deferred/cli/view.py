@@ -6,7 +6,12 @@ from __future__ import annotations
 import click
 
 from deferred.cli import options
-from deferred.cli.options import check_not_inputs, parse_size_option, stderr
+from deferred.cli.options import (
+    check_light_path_option,
+    check_not_inputs,
+    parse_size_option,
+    stderr,
+)
 from deferred.cli.view_option import (
     LISTING,
     VIEWER_HELP,
@@ -49,6 +54,7 @@ def view_command(scene: str | None, pipeline: str, light_path: str | None, size:
     except ImportError as exc:
         raise InputError(f"needs the viewer extra (pip install 'deferred[viewer]'): {exc}",
                          "view") from None
+    check_light_path_option(pipeline, light_path)
     if view_name == LISTING:
         print_view_names(scene, pipeline, light_path)
         return
