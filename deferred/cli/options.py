@@ -45,8 +45,19 @@ class FiniteFloat(click.FloatRange):
 
 
 def scene_argument(command: Command) -> Command:
-    """SCENE: a TOML file; the built-in demo when omitted."""
+    """SCENE: a TOML file or a glTF file (.gltf, .glb); the built-in demo when omitted."""
     return click.argument("scene", required=False, type=click.Path(dir_okay=False))(command)
+
+
+def gltf_options(command: Command) -> Command:
+    """--camera and --animation: what a glTF SCENE shows."""
+    command = click.option("--animation", metavar="NAME|INDEX",
+                           help="A glTF SCENE's animation to play (default the first; "
+                                "'none': none).")(command)
+    return click.option("--camera", "gltf_camera", metavar="NAME",
+                        help="A glTF SCENE's camera, by its name, its node's or its index "
+                             "(default the first; without one, a camera framing the "
+                             "scene).")(command)
 
 
 def pipeline_option(command: Command) -> Command:

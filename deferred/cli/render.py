@@ -5,7 +5,7 @@ needs the scene."""
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -53,6 +53,8 @@ class RenderJob:
     light_path: str | None
     strict: bool
     view_name: str | None
+    gltf_camera: str | None = None
+    animation: str | None = None
 
     @property
     def frames(self) -> int:
@@ -95,16 +97,19 @@ class Rendered:
 @options.light_path_option
 @options.strict_option
 @view_option(RENDER_HELP)
+@options.gltf_options
 def render(scene: str | None, output: str, pipeline: str, size: str | None, frames: int,
            fps: float, start_time: float, turntable: int | None, samples: int,
-           light_path: str | None, strict: bool, view_name: str | None) -> None:
-    """Render SCENE (a TOML file; the built-in demo when omitted) to an image, a numbered
-    image sequence or a video."""
+           light_path: str | None, strict: bool, view_name: str | None,
+           gltf_camera: str | None, animation: str | None) -> None:
+    """Render SCENE (a TOML file or a glTF file; the built-in demo when omitted) to an image,
+    a numbered image sequence or a video."""
     if view_name == LISTING:
         print_view_names(scene, pipeline, light_path)
         return
     job = render_job(scene, output, pipeline, size, frames, fps, start_time, turntable, samples,
                      light_path, strict, view_name)
+    job = replace(job, gltf_camera=gltf_camera, animation=animation)
     with Progress("render", stderr) as progress:
         rendered = run_render(job, progress)
     stderr.print(summary(job, rendered), markup=False, highlight=False)
@@ -171,7 +176,7 @@ def _load(job: RenderJob) -> tuple[Scene, tuple[int, int] | None]:
     where an output would replace one of its files or a video cannot hold its frames."""
     from deferred.io.video import check_animation_memory, check_video_size
 
-    loaded = load_scene(job.scene)
+    loaded = load_scene(job.scene, job.gltf_camera, job.animation)
     if job.turntable is not None:
         loaded.set_turntable(job.turntable / job.fps, job.start_time)
     check_not_inputs(_outputs(job), loaded, job.scene, "-o")

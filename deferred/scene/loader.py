@@ -25,6 +25,8 @@ from deferred.gl.meshes import MeshData
 from deferred.interfaces import registry
 from deferred.interfaces.material import Material
 from deferred.scene.camera import Camera
+from deferred.scene.gltf import GLTF_SUFFIXES, add_gltf, read_gltf, scene_from_gltf
+from deferred.scene.gltf.building import animate, choose_animation
 from deferred.scene.graph import Hierarchy
 from deferred.scene.meshes import load_mesh
 from deferred.scene.nodes import SceneNode
@@ -60,9 +62,19 @@ def builtin_scenes() -> list[str]:
                   if entry.name.endswith(".toml"))
 
 
-def load_scene(path: str | Path | None = None) -> Scene:
+def load_scene(path: str | Path | None = None, camera: str | None = None,
+               animation: str | None = None) -> Scene:
     """Load a scene file; ``None`` loads the built-in demo scene, ``builtin:<name>`` another
-    scene shipped with the package (``builtin:overdraw``, the bench scene with overdraw)."""
+    scene shipped with the package (``builtin:overdraw``, the bench scene with overdraw). A
+    glTF file (.gltf, .glb) is a scene of its own (:func:`deferred.scene.gltf.scene_from_gltf`):
+    ``camera`` names one of its cameras, ``animation`` one of its animations (or ``none``);
+    either with another file is an error."""
+    if path is not None and Path(path).suffix.lower() in GLTF_SUFFIXES:
+        return scene_from_gltf(Path(path), camera, animation)
+    for value, option in ((camera, "--camera"), (animation, "--animation")):
+        if value is not None:
+            raise InputError(f"{option} chooses among a glTF file's; {path or 'the demo'} is "
+                             "a scene file", option)
     if path is None:
         path = f"builtin:{DEMO_SCENE.removesuffix('.toml')}"
     if isinstance(path, str) and path.startswith("builtin:"):
@@ -200,6 +212,13 @@ class SceneBuilder:
                 if material_cls is not None and "params" not in bad:
                     material = self.collect(material_cls.from_dict, obj.params, self.base_dir,
                                             f"{where}.params")
+            if "mesh" not in bad and Path(obj.mesh).suffix.lower() in GLTF_SUFFIXES:
+                self._gltf_object(obj, bad, where, material, material_cls)
+                continue
+            for key in ("node", "animation"):
+                if getattr(obj, key, None) is not None and key not in bad:
+                    self.problems.append(InputError(f"{key} picks from a glTF mesh (.gltf, "
+                                                    ".glb)", f"{where}.{key}"))
             mesh = None
             if "mesh" not in bad:
                 if obj.mesh not in meshes:
@@ -218,6 +237,40 @@ class SceneBuilder:
                                    transform=obj.transform(), parent=obj.parent)
                 self.scene.objects.append(made)
             self._made(label, made, material_cls, where)
+
+    def _gltf_object(self, obj: Any, bad: set[str], where: str, material: Material | None,
+                     material_cls: type[Material] | None) -> None:
+        """An object whose mesh is a glTF file: a group placed as the object is, holding the
+        file's nodes (or ``node``'s subtree) with their materials, or with the object's
+        ``material`` where it gives one; the file's first animation (or ``animation``)."""
+        path = Path(obj.mesh)
+        if not path.is_absolute() and self.base_dir is not None:
+            path = self.base_dir / path
+        assets = self.__dict__.setdefault("_assets", {})
+        if path not in assets:
+            assets[path] = self.collect(read_gltf, path, f"{where}.mesh")
+        asset = assets[path]
+        label = self._label(obj, bad, where, path.name, self._taken, self._next_index)
+        if label is None:
+            return
+        overrides = bool({"material", "params"} & obj.model_fields_set)
+        made = None
+        if not bad and asset is not None and (material is not None or not overrides):
+            made = SceneNode(label, obj.transform(), parent=obj.parent, where=where)
+            self.scene.groups.append(made)
+            placed = self.collect(add_gltf, self.scene, asset, made,
+                                  material if overrides else None, obj.node, f"{where}.node",
+                                  f"{label}/")
+            if placed is None:
+                made = None
+            else:
+                animate(placed, self.collect(choose_animation, asset, obj.animation,
+                                             f"{where}.animation"))
+                for node in placed.nodes.values():
+                    self._taken.add(node.label)
+                    kind = type(node.material) if isinstance(node, SceneObject) else None
+                    self._made(node.label, node, kind, where)
+        self._made(label, made, material_cls if overrides else None, where)
 
     def groups(self) -> None:
         for index, (group, bad) in enumerate(self.tables["group"]):

@@ -1,6 +1,7 @@
-"""Meshes by name: a file loaded through trimesh (OBJ, PLY, STL, OFF, GLB/glTF; its vertex
-colours carry the fur comb) or a built-in shape (:mod:`deferred.scene.builtin_meshes`), made into
-the framework's vertex format by :mod:`deferred.scene.geometry`. A file is refused before
+"""Meshes by name: a file loaded through trimesh (OBJ, PLY, STL, OFF; its vertex colours carry
+the fur comb), a glTF file's default scene as one mesh (:mod:`deferred.scene.gltf`) or a
+built-in shape (:mod:`deferred.scene.builtin_meshes`), made into the framework's vertex format
+by :mod:`deferred.scene.geometry`. A file is refused before
 trimesh parses it when it is larger than ``MAX_MESH_FILE_BYTES``.
 """
 from __future__ import annotations
@@ -45,6 +46,10 @@ def load_mesh(spec: str, base_dir: Path | None = None, where: str | None = None)
         raise InputError(f"mesh file {path.name} is {size:,} bytes, more than the "
                          f"{MAX_MESH_FILE_BYTES:,} the framework reads; simplify it", where)
     _check_magic(path, where)
+    if path.suffix.lower() in (".gltf", ".glb"):  # read by deferred.scene.gltf, not trimesh
+        from deferred.scene.gltf.building import flat_mesh
+
+        return flat_mesh(path, where)
     import trimesh
 
     resolver = _regular_file_resolver(trimesh, path)

@@ -24,6 +24,7 @@ from deferred.gl.meshes import MeshData
 from deferred.interfaces.material import Material, MaterialParams
 from deferred.params import validate_params
 from deferred.scene.nodes import SceneNode
+from deferred.scene.skin import Skin
 from deferred.scene.transform import Transform
 
 
@@ -54,6 +55,7 @@ class SceneObject(SceneNode):
         self._states_base: MaterialParams | None = None  # the base those were made over
         self._times: tuple[float, ...] = ()
         super().__init__(label, transform, parent, where, tracks, model)
+        self.skin: Skin | None = None  # joints deforming the mesh (deferred.scene.skin)
         self.mesh = mesh
         self.material = material
         self._set_events(events)
@@ -246,4 +248,5 @@ class SceneObject(SceneNode):
                              transform=self.transform, tracks=self.tracks, parent=self.parent)
         if self._matrix is not None:
             copied._matrix = self._matrix
+        copied.skin = self.skin
         return copied

@@ -78,8 +78,15 @@ class ObjectModel(PlacementModel):
     name: str | None = Field(None, max_length=1000,
                              description="label: printable, no control characters")
     mesh: str
-    material: str = "standard"
+    material: str = Field("standard", description="a registered material; on a glTF mesh, "
+                                                  "given: it replaces the file's materials")
     params: dict[str, Any] = Field(default_factory=dict)
+    node: str | None = Field(None, max_length=1000,
+                             description="a glTF mesh's node (by name): it and its children "
+                                         "alone")
+    animation: str | None = Field(None, max_length=1000,
+                                  description="a glTF mesh's animation, by name or index "
+                                              "(default the first; 'none': none)")
 
     @field_validator("name")
     @classmethod

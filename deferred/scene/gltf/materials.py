@@ -1,0 +1,219 @@
+"""glTF materials as the framework's: each glTF material's metallic-roughness values and
+textures as the ``pbr`` material's parameters (:func:`pbr_values`), and the material made from
+them (:func:`make_material`).
+
+The keys are ``pbr``'s: ``base_color`` (RGBA), ``metallic``, ``roughness``, ``emissive``,
+``emissive_strength``, ``alpha_mode``, ``alpha_cutoff``, ``double_sided``, ``normal_scale``,
+``occlusion_strength`` and, for each texture slot (``base_color``, ``metallic_roughness``,
+``normal``, ``occlusion``, ``emissive``), ``<slot>_texture`` (a file), ``<slot>_texcoord``,
+``<slot>_transform`` (``KHR_texture_transform`` as a 2x3 matrix on GL's UVs:
+:func:`gl_texture_transform`),
+``<slot>_wrap`` and ``<slot>_filter`` (the sampler). Only the keys the registered material's
+parameters have are given to it; a value it cannot take is warned about once, by key.
+Where no ``pbr`` material is registered, ``standard`` stands in (base colour and its texture).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from deferred.errors import InputError
+from deferred.interfaces import registry
+from deferred.interfaces.material import Material
+from deferred.scene.gltf.document import GltfDocument
+from deferred.scene.gltf.images import ImageFiles
+
+SLOTS = ("base_color", "metallic_roughness", "normal", "occlusion", "emissive")
+WRAPS = {33071: "clamp", 33648: "mirror", 10497: "repeat"}
+FILTERS = {9728: "nearest", 9729: "linear", 9984: "nearest_mipmap_nearest",
+           9985: "linear_mipmap_nearest", 9986: "nearest_mipmap_linear",
+           9987: "linear_mipmap_linear"}
+ALPHA_MODES = {"OPAQUE": "opaque", "MASK": "mask", "BLEND": "blend"}
+DEFAULT_VALUES: dict[str, Any] = {
+    "base_color": (1.0, 1.0, 1.0, 1.0), "metallic": 1.0, "roughness": 1.0,
+    "emissive": (0.0, 0.0, 0.0), "emissive_strength": 1.0, "alpha_mode": "opaque",
+    "alpha_cutoff": 0.5, "double_sided": False, "normal_scale": 1.0, "occlusion_strength": 1.0}
+
+
+@dataclass
+class GltfMaterial:
+    """A glTF material as ``pbr`` parameter values (``values``), its name and JSON path."""
+
+    name: str
+    where: str
+    values: dict[str, Any] = field(default_factory=dict)
+
+
+def _floats(value: Any, count: int, default: tuple, document: GltfDocument,
+            where: str) -> tuple[float, ...]:
+    if value is None:
+        return default
+    if not isinstance(value, list | tuple) or len(value) != count or \
+            not all(isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
+                    for v in value):
+        raise document.error(f"expected {count} finite numbers", where)
+    return tuple(float(v) for v in value)
+
+
+def _number(value: Any, default: float, document: GltfDocument, where: str,
+            low: float = 0.0, high: float = math.inf) -> float:
+    if value is None:
+        return default
+    if not isinstance(value, int | float) or isinstance(value, bool) or \
+            not (math.isfinite(value) and low <= value <= high):
+        raise document.error(f"expected a number in [{low:g}, {high:g}], got {value!r:.40}",
+                             where)
+    return float(value)
+
+
+def read_material(document: GltfDocument, images: ImageFiles, index: int) -> GltfMaterial:
+    """Material ``index`` of the file as ``pbr`` values (textures made files)."""
+    raw = document.raw["materials"][index]
+    where = f"materials[{index}]"
+    if not isinstance(raw, dict):
+        raise document.error("expected an object", where)
+    pbr = raw.get("pbrMetallicRoughness") or {}
+    extensions = raw.get("extensions") or {}
+    values: dict[str, Any] = {
+        "base_color": _floats(pbr.get("baseColorFactor"), 4, DEFAULT_VALUES["base_color"],
+                              document, f"{where}.pbrMetallicRoughness.baseColorFactor"),
+        "metallic": _number(pbr.get("metallicFactor"), 1.0, document,
+                            f"{where}.pbrMetallicRoughness.metallicFactor", high=1.0),
+        "roughness": _number(pbr.get("roughnessFactor"), 1.0, document,
+                             f"{where}.pbrMetallicRoughness.roughnessFactor", high=1.0),
+        "emissive": _floats(raw.get("emissiveFactor"), 3, (0.0, 0.0, 0.0), document,
+                            f"{where}.emissiveFactor"),
+        "emissive_strength": _number(
+            (extensions.get("KHR_materials_emissive_strength") or {}).get("emissiveStrength"),
+            1.0, document, f"{where}.extensions.KHR_materials_emissive_strength"),
+        "alpha_cutoff": _number(raw.get("alphaCutoff"), 0.5, document,
+                                f"{where}.alphaCutoff"),
+        "double_sided": bool(raw.get("doubleSided", False)),
+    }
+    mode = raw.get("alphaMode", "OPAQUE")
+    if mode not in ALPHA_MODES:
+        raise document.error(f"unknown alphaMode {mode!r:.40} (OPAQUE, MASK or BLEND)",
+                             f"{where}.alphaMode")
+    values["alpha_mode"] = ALPHA_MODES[mode]
+    textures = {"base_color": (pbr.get("baseColorTexture"),
+                               f"{where}.pbrMetallicRoughness.baseColorTexture"),
+                "metallic_roughness": (pbr.get("metallicRoughnessTexture"),
+                                       f"{where}.pbrMetallicRoughness.metallicRoughnessTexture"),
+                "normal": (raw.get("normalTexture"), f"{where}.normalTexture"),
+                "occlusion": (raw.get("occlusionTexture"), f"{where}.occlusionTexture"),
+                "emissive": (raw.get("emissiveTexture"), f"{where}.emissiveTexture")}
+    for slot, (info, at) in textures.items():
+        if info is not None:
+            values.update(_texture(document, images, slot, info, at))
+    if "normalTexture" in raw:
+        values["normal_scale"] = _number(raw["normalTexture"].get("scale"), 1.0, document,
+                                         f"{where}.normalTexture.scale", low=-math.inf)
+    if "occlusionTexture" in raw:
+        values["occlusion_strength"] = _number(raw["occlusionTexture"].get("strength"), 1.0,
+                                               document, f"{where}.occlusionTexture.strength",
+                                               high=1.0)
+    name = raw.get("name") if isinstance(raw.get("name"), str) else f"material{index}"
+    return GltfMaterial(name, where, values)
+
+
+def _texture(document: GltfDocument, images: ImageFiles, slot: str, info: Any,
+             where: str) -> dict[str, Any]:
+    """A texture reference's values: the image file, its UV set, transform and sampler."""
+    if not isinstance(info, dict):
+        raise document.error("expected an object", where)
+    texture = document.entry("textures", info.get("index"), f"{where}.index")
+    texture_at = f"textures[{info['index']}]"
+    source = texture.source
+    if source is None:
+        raise document.error("has no source image (or only an extension's, which the "
+                             "framework does not read)", texture_at)
+    values: dict[str, Any] = {
+        f"{slot}_texture": str(images.path(source, f"{texture_at}.source")),
+        f"{slot}_texcoord": _texcoord(document, info.get("texCoord"), f"{where}.texCoord")}
+    transform = (info.get("extensions") or {}).get("KHR_texture_transform")
+    if transform is not None:
+        at = f"{where}.extensions.KHR_texture_transform"
+        offset = _floats(transform.get("offset"), 2, (0.0, 0.0), document, f"{at}.offset")
+        rotation = _number(transform.get("rotation"), 0.0, document, f"{at}.rotation",
+                           low=-math.inf)
+        scale = _floats(transform.get("scale"), 2, (1.0, 1.0), document, f"{at}.scale")
+        values[f"{slot}_transform"] = gl_texture_transform(offset, rotation, scale)
+        if "texCoord" in transform:
+            values[f"{slot}_texcoord"] = _texcoord(document, transform["texCoord"],
+                                                   f"{at}.texCoord")
+    if texture.sampler is not None:
+        sampler = document.entry("samplers", texture.sampler, f"{texture_at}.sampler")
+        values[f"{slot}_wrap"] = (WRAPS.get(sampler.wrapS, "repeat"),
+                                  WRAPS.get(sampler.wrapT, "repeat"))
+        values[f"{slot}_filter"] = (FILTERS.get(sampler.magFilter, "linear"),
+                                    FILTERS.get(sampler.minFilter, "linear_mipmap_linear"))
+    return values
+
+
+def gl_texture_transform(offset: tuple[float, float], rotation: float,
+                         scale: tuple[float, float]) -> tuple[float, ...]:
+    """A ``KHR_texture_transform`` as the 2x3 affine matrix (rows: ``u' = a u + b v + c``,
+    ``v' = d u + e v + f``) acting on the framework's texture coordinates, whose v the loader
+    flipped (:func:`~deferred.scene.gltf.primitives.gl_uvs`): the flip, the glTF transform
+    (offset, then a rotation of the UVs by ``rotation`` radians as the extension's example
+    turns them, then the scale) and the flip back."""
+    c, s = math.cos(rotation), math.sin(rotation)
+    gltf = np.array([[c * scale[0], s * scale[1], offset[0]],
+                     [-s * scale[0], c * scale[1], offset[1]], [0.0, 0.0, 1.0]])
+    flip = np.array([[1.0, 0.0, 0.0], [0.0, -1.0, 1.0], [0.0, 0.0, 1.0]])
+    matrix = flip @ gltf @ flip
+    return tuple(float(v) for v in matrix[:2].reshape(-1))
+
+
+def _texcoord(document: GltfDocument, value: Any, where: str) -> int:
+    if value is None:
+        return 0
+    if value not in (0, 1) or isinstance(value, bool):
+        raise document.error(f"the framework reads TEXCOORD_0 and TEXCOORD_1, not "
+                             f"{value!r:.40}", where)
+    return int(value)
+
+
+DEFAULT_MATERIAL = GltfMaterial("default", "the default material", dict(DEFAULT_VALUES))
+
+
+def make_material(material: GltfMaterial, document: GltfDocument) -> Material:
+    """The framework's material of ``material``: ``pbr`` with the values its parameters take
+    (the others warned about once, by key), or the ``standard`` stand-in where no ``pbr`` is
+    registered."""
+    try:
+        cls = registry.materials.get("pbr")
+    except InputError:
+        return _standard(material, document)
+    fields = cls.Params.model_fields
+    taken = {key: value for key, value in material.values.items() if key in fields}
+    left = sorted(key for key, value in material.values.items()
+                  if key not in fields and value != DEFAULT_VALUES.get(key))
+    for key in left:
+        _warn_once(document, f"{material.where}: pbr has no parameter {key} (left out)", key)
+    return cls.from_dict(taken, None, f"{document.name}: {material.where}")
+
+
+def _standard(material: GltfMaterial, document: GltfDocument) -> Material:
+    """The ``standard`` material standing in for ``pbr``: the base colour (linear RGB) and
+    its texture, a dull highlight where the surface is rough."""
+    values = material.values
+    color = tuple(min(1.0, max(0.0, c)) for c in values["base_color"][:3])
+    params: dict[str, Any] = {"color": color,
+                              "specular_intensity": 0.5 * (1.0 - values["roughness"]) + 0.05,
+                              "specular_exponent": 8.0 + 120.0 * (1.0 - values["roughness"])}
+    if "base_color_texture" in values:
+        params["texture"] = values["base_color_texture"]
+    return registry.materials.get("standard").from_dict(params, None,
+                                                        f"{document.name}: {material.where}")
+
+
+def _warn_once(document: GltfDocument, message: str, key: str) -> None:
+    said = document.__dict__.setdefault("_said", set())
+    if key not in said:
+        said.add(key)
+        document.warn(message)
