@@ -3,11 +3,15 @@ G-buffer layout."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import click
 from rich.console import Console
 
 from deferred.cli.options import scene_argument
 from deferred.interfaces import registry
+from deferred.scene.gltf import GLTF_SUFFIXES
+from deferred.scene.gltf.summary import describe_file
 from deferred.scene.loader import load_scene
 
 
@@ -15,13 +19,19 @@ from deferred.scene.loader import load_scene
 @scene_argument
 def info(scene: str | None) -> None:
     """GL vendor, renderer, version, the optional features in use, and the G-buffer layout of
-    SCENE (the built-in demo when omitted)."""
+    SCENE (the built-in demo when omitted); of a glTF file, its nodes, meshes, materials,
+    textures, animations, cameras, lights and skins, and what the framework does not draw."""
     from deferred.gl.context import create_context
 
+    gltf = None
+    if scene is not None and Path(scene).suffix.lower() in GLTF_SUFFIXES:
+        gltf = describe_file(Path(scene))  # the file's parts, what is not drawn
     layout = load_scene(scene).gbuffer_layout()  # bad input fails before GL start-up
     gl = create_context()
     try:
         console = Console(soft_wrap=True, markup=False)  # one line per entry; [..] is text
+        for line in gltf or ():
+            console.print(line)
         console.print(f"gbuffer: {layout.bytes_per_pixel} bytes per pixel")
         for name, entry in layout.describe().items():
             channels = f"  [{' '.join(entry['channels'])}]" if "channels" in entry else ""

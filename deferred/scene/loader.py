@@ -25,7 +25,7 @@ from deferred.gl.meshes import MeshData
 from deferred.interfaces import registry
 from deferred.interfaces.material import Material
 from deferred.scene.camera import Camera
-from deferred.scene.gltf import GLTF_SUFFIXES, add_gltf, read_gltf, scene_from_gltf
+from deferred.scene.gltf import GLTF_SUFFIXES, add_gltf, fill_scene, read_gltf
 from deferred.scene.gltf.building import animate, choose_animation
 from deferred.scene.graph import Hierarchy
 from deferred.scene.meshes import load_mesh
@@ -66,11 +66,11 @@ def load_scene(path: str | Path | None = None, camera: str | None = None,
                animation: str | None = None) -> Scene:
     """Load a scene file; ``None`` loads the built-in demo scene, ``builtin:<name>`` another
     scene shipped with the package (``builtin:overdraw``, the bench scene with overdraw). A
-    glTF file (.gltf, .glb) is a scene of its own (:func:`deferred.scene.gltf.scene_from_gltf`):
+    glTF file (.gltf, .glb) is a scene of its own (:func:`deferred.scene.gltf.fill_scene`):
     ``camera`` names one of its cameras, ``animation`` one of its animations (or ``none``);
     either with another file is an error."""
     if path is not None and Path(path).suffix.lower() in GLTF_SUFFIXES:
-        return scene_from_gltf(Path(path), camera, animation)
+        return fill_scene(Scene(source=Path(path).name), Path(path), camera, animation)
     for value, option in ((camera, "--camera"), (animation, "--animation")):
         if value is not None:
             raise InputError(f"{option} chooses among a glTF file's; {path or 'the demo'} is "

@@ -6,10 +6,10 @@ the nodes, cameras, lights and skins, :mod:`~deferred.scene.gltf.materials` the 
 :mod:`~deferred.scene.gltf.building` places them in a scene."""
 
 from deferred.scene.gltf.asset import GltfAsset, read_gltf
-from deferred.scene.gltf.building import add_gltf, scene_from_gltf
+from deferred.scene.gltf.building import add_gltf, fill_scene
 from deferred.scene.gltf.document import GltfWarning
 
 GLTF_SUFFIXES = (".gltf", ".glb")
 
 __all__ = ["GLTF_SUFFIXES", "GltfAsset", "GltfWarning", "add_gltf", "read_gltf",
-           "scene_from_gltf"]
+           "fill_scene"]

@@ -6,7 +6,7 @@ primitives drawn with their materials, its cameras, lights, skins and an animati
   node with one primitive a :class:`~deferred.scene.objects.SceneObject` itself, a node with
   several a group whose objects are labelled ``<node>/<k>``; a material given overrides every
   primitive's.
-- :func:`scene_from_gltf` is ``deferred render model.glb``'s scene: the asset, the file's camera
+- :func:`fill_scene` makes ``deferred render model.glb``'s scene: the asset, the file's camera
   (the first, or the one named) or one framing the scene's bounds, the file's lights or, where
   it has none, the default light, and the first animation (or the one named).
 """
@@ -290,13 +290,11 @@ def default_lights(scene: Any) -> None:
         {"direction": (-0.4, -0.8, -0.6), "intensity": 2.5}, "default light"))
 
 
-def scene_from_gltf(path: Path, camera: str | None = None,
-                    animation: str | int | None = None) -> Any:
-    """``deferred render model.glb``'s scene (see the module documentation)."""
-    from deferred.scene.scene import Scene
-
+def fill_scene(scene: Any, path: Path, camera: str | None = None,
+               animation: str | int | None = None) -> Any:
+    """``deferred render model.glb``'s scene (see the module documentation), made in the
+    empty ``scene`` (a :class:`~deferred.scene.scene.Scene`)."""
     asset = read_gltf(path)
-    scene = Scene(source=path.name)
     placed = add_gltf(scene, asset)
     animate(placed, choose_animation(asset, animation))
     chosen = file_camera(scene, placed, camera)
@@ -311,33 +309,35 @@ def flat_mesh(path: Path, where: str | None = None) -> Any:
     primitive moved by its node's world matrix): a glTF file where one mesh is asked for
     (``Scene.add_object("model.glb")``)."""
     from deferred.gl.meshes import MeshData
-    from deferred.scene.scene import Scene
 
     asset = read_gltf(path, where)
-    scene = Scene(source=path.name)
-    add_gltf(scene, asset)
-    if not scene.objects:
-        raise InputError(f"{asset.name} has no triangles in its default scene",
-                         where or asset.name)
+    worlds: dict[int, np.ndarray] = {}
     parts: dict[str, list[np.ndarray]] = {key: [] for key in
                                           ("positions", "normals", "uvs", "tangents",
                                            "binormals", "comb", "indices")}
     offset = 0
-    for obj in scene.objects:
-        world = scene.world_at(obj, 0.0)
+    for index in asset.subtree():
+        node = asset.nodes[index]
+        local = node.matrix if node.matrix is not None else node.transform.matrix()
+        parent = asset.parents.get(index)
+        world = worlds[index] = local if parent is None else worlds[parent] @ local
         linear = world[:3, :3]
         normal_matrix = np.linalg.inv(linear).T
-        mesh = obj.mesh
-        parts["positions"].append(mesh.positions @ linear.T + world[:3, 3])
-        for key, matrix in (("normals", normal_matrix), ("tangents", linear),
-                            ("binormals", linear)):
-            turned = getattr(mesh, key) @ matrix.T
-            parts[key].append(turned / np.maximum(np.linalg.norm(turned, axis=1,
-                                                                 keepdims=True), 1e-12))
-        parts["uvs"].append(mesh.uvs)
-        parts["comb"].append(mesh.comb)
-        parts["indices"].append(mesh.indices.astype(np.int64) + offset)
-        offset += mesh.vertex_count
+        for primitive in asset.meshes.get(node.mesh, []) if node.mesh is not None else []:
+            mesh = primitive.mesh
+            parts["positions"].append(mesh.positions @ linear.T + world[:3, 3])
+            for key, matrix in (("normals", normal_matrix), ("tangents", linear),
+                                ("binormals", linear)):
+                turned = getattr(mesh, key) @ matrix.T
+                parts[key].append(turned / np.maximum(np.linalg.norm(turned, axis=1,
+                                                                     keepdims=True), 1e-12))
+            parts["uvs"].append(mesh.uvs)
+            parts["comb"].append(mesh.comb)
+            parts["indices"].append(mesh.indices.astype(np.int64) + offset)
+            offset += mesh.vertex_count
+    if not offset:
+        raise InputError(f"{asset.name} has no triangles in its default scene",
+                         where or asset.name)
     joined = {key: np.concatenate(values).astype(np.float32 if key != "indices" else np.uint32)
               for key, values in parts.items()}
     return MeshData(name=path.name, sources=(path, *asset.document.sources), **joined)

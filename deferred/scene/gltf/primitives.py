@@ -56,6 +56,10 @@ def read_primitives(document: GltfDocument, mesh_index: int) -> list[GltfPrimiti
             document.entry("materials", material, f"{where}.material")
         targets = raw.get("targets") or []
         made.append(GltfPrimitive(mesh, material, where, len(targets)))
+    morphed = sum(1 for primitive in made if primitive.targets)
+    if morphed:
+        document.warn(f"meshes[{mesh_index}] ({name}) has morph targets in {morphed} "
+                      "primitive(s): drawn in the base shape (morph targets are not drawn)")
     return made
 
 
