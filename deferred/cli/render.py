@@ -176,7 +176,9 @@ def _load(job: RenderJob) -> tuple[Scene, tuple[int, int] | None]:
     where an output would replace one of its files or a video cannot hold its frames."""
     from deferred.io.video import check_animation_memory, check_video_size
 
-    loaded = load_scene(job.scene, job.gltf_camera, job.animation)
+    chosen = {key: value for key, value in (("camera", job.gltf_camera),
+                                            ("animation", job.animation)) if value is not None}
+    loaded = load_scene(job.scene, **chosen)
     if job.turntable is not None:
         loaded.set_turntable(job.turntable / job.fps, job.start_time)
     check_not_inputs(_outputs(job), loaded, job.scene, "-o")

@@ -62,6 +62,11 @@ class MeshData:
         return self.positions.min(axis=0), self.positions.max(axis=0)
 
 
+SKINNED_SURFACE = (("position", 3), ("normal", 3), ("tangent", 3), ("binormal", 3))
+# a skinned mesh's previous surface, as the motion vectors read it (the rest skipped)
+PREVIOUS_SURFACE = (("previous_position", 3), ("previous_frame", 9))
+
+
 @dataclass
 class GpuMesh:
     """A mesh's vertex and index buffers, with one vertex array per program using it.
@@ -69,18 +74,36 @@ class GpuMesh:
     ``moving=True`` keeps positions and normals in a buffer of their own,
     :attr:`surface_vbo` (6 floats a vertex, rewritten as the mesh moves: by
     :meth:`write_surface` or by a compute shader), and the constant attributes in :attr:`vbo`:
-    a frame's rewrite touches a third of the bytes of the whole vertex format."""
+    a frame's rewrite touches a third of the bytes of the whole vertex format.
+
+    ``skinned=True`` (a mesh with joints and weights) is a moving mesh whose surface holds
+    the tangent frame too, rewritten each frame by the skinning step
+    (``deferred.render.skinning``) from :attr:`rest_vbo` (the rest surface, joints and
+    weights); :attr:`previous_vbo` keeps the surface of the frame before (motion vectors)."""
 
     ctx: moderngl.Context
     data: MeshData
     moving: bool = False
+    skinned: bool = False
     vbo: moderngl.Buffer = field(init=False)
     ibo: moderngl.Buffer = field(init=False)
     surface_vbo: moderngl.Buffer | None = field(init=False, default=None)
+    rest_vbo: moderngl.Buffer | None = field(init=False, default=None)
+    previous_vbo: moderngl.Buffer | None = field(init=False, default=None)
     _arrays: dict[int, moderngl.VertexArray] = field(init=False, default_factory=dict)
 
     def __post_init__(self) -> None:
-        if self.moving:
+        if self.skinned:
+            self.moving = True
+            surface = self._surface(SKINNED_SURFACE)
+            self.surface_vbo = self.ctx.buffer(surface.tobytes())
+            self.previous_vbo = self.ctx.buffer(surface.tobytes())
+            rest = np.hstack([surface, self.data.joints.astype(np.float32),
+                              self.data.weights.astype(np.float32)])
+            self.rest_vbo = self.ctx.buffer(np.ascontiguousarray(rest, np.float32).tobytes())
+            parts = [self.data.uvs, self.data.comb]
+            self.vbo = self.ctx.buffer(np.hstack(parts).astype(np.float32).tobytes())
+        elif self.moving:
             self.surface_vbo = self.ctx.buffer(self._surface().tobytes())
             parts = [self.data.uvs, self.data.tangents, self.data.binormals, self.data.comb]
             self.vbo = self.ctx.buffer(np.hstack(parts).astype(np.float32).tobytes())
@@ -88,9 +111,9 @@ class GpuMesh:
             self.vbo = self.ctx.buffer(self.data.interleaved().tobytes())
         self.ibo = self.ctx.buffer(self.data.indices.astype(np.uint32).tobytes())
 
-    def _surface(self) -> np.ndarray:
-        return np.ascontiguousarray(np.hstack([self.data.positions, self.data.normals]),
-                                    dtype=np.float32)
+    def _surface(self, attributes=VERTEX_ATTRIBUTES[:2]) -> np.ndarray:
+        return np.ascontiguousarray(np.hstack([getattr(self.data, f"{name}s")
+                                               for name, _ in attributes]), dtype=np.float32)
 
     def write_surface(self) -> None:
         """Upload the mesh data's positions and normals again (``moving`` meshes)."""
@@ -110,8 +133,14 @@ class GpuMesh:
         """:meth:`vertex_buffer`, or a moving mesh's two buffers (those ``program`` reads)."""
         if not self.moving:
             return [self.vertex_buffer(program)]
-        buffers = [self._buffer_format(self.surface_vbo, VERTEX_ATTRIBUTES[:2], program),
-                   self._buffer_format(self.vbo, VERTEX_ATTRIBUTES[2:], program)]
+        if self.skinned:
+            buffers = [self._buffer_format(self.surface_vbo, SKINNED_SURFACE, program),
+                       self._buffer_format(self.vbo, (VERTEX_ATTRIBUTES[2],
+                                                      VERTEX_ATTRIBUTES[5]), program),
+                       self._buffer_format(self.previous_vbo, PREVIOUS_SURFACE, program)]
+        else:
+            buffers = [self._buffer_format(self.surface_vbo, VERTEX_ATTRIBUTES[:2], program),
+                       self._buffer_format(self.vbo, VERTEX_ATTRIBUTES[2:], program)]
         return [buffer for buffer in buffers if len(buffer) > 2]
 
     @staticmethod
@@ -143,8 +172,9 @@ class GpuMesh:
         self._arrays.clear()
         self.vbo.release()
         self.ibo.release()
-        if self.surface_vbo is not None:
-            self.surface_vbo.release()
+        for buffer in (self.surface_vbo, self.rest_vbo, self.previous_vbo):
+            if buffer is not None:
+                buffer.release()
 
 
 class MeshPrimitives:

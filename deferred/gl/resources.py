@@ -45,7 +45,7 @@ class Resources:
     def gpu_mesh(self, mesh: MeshData) -> GpuMesh:
         gpu = self._meshes.get(id(mesh))
         if gpu is None:
-            gpu = GpuMesh(self.ctx, mesh)
+            gpu = GpuMesh(self.ctx, mesh, skinned=mesh.joints is not None)
             self._meshes[id(mesh)] = gpu
             self._mesh_refs.append(mesh)
         return gpu

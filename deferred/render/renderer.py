@@ -313,6 +313,7 @@ class Renderer:
         advance_simulations(frame)
         prepare_passes(frame, self.passes)
         self.gl.park()  # whatever framebuffer was bound may have been released since
+        self._setup.skinning.run(state)  # draws (captured): needs a complete framebuffer
         run_passes(frame, sort_blended(self.passes, state), before_pass, on_pass)
         if self.strict:
             frame.inputs.check_material_uniforms()

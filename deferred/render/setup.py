@@ -38,6 +38,7 @@ from deferred.names import LightVolume
 from deferred.render.budget import check_target_memory, renderer_holdings
 from deferred.render.generated import generated_glsl
 from deferred.render.pipeline import PIPELINES, check_passes
+from deferred.render.skinning import Skinning
 from deferred.scene.state import FrameState
 
 FULL_FEATURES = Features(storage_buffers=True, compute_shaders=True)
@@ -129,6 +130,7 @@ class RenderSetup:
         self.targets = FrameTargets(ctx, *plan.size)
         self.declare_targets()
         self.resources = Resources(ctx)
+        self.skinning = Skinning(ctx, self.shaders, self.resources)
         self.light_buffer = LightBuffer(ctx)
         self.light_lists = LightLists(ctx) if features.compute_shaders else None
         budget = state.shadow_budget
@@ -170,8 +172,8 @@ class RenderSetup:
 
     def release(self) -> None:
         """Every GL object made here (a constructor that failed part way made only some)."""
-        for name in ("light_buffer", "light_lists", "shadow_atlas", "resources", "targets",
-                     "shaders"):
+        for name in ("skinning", "light_buffer", "light_lists", "shadow_atlas", "resources",
+                     "targets", "shaders"):
             part = self.__dict__.pop(name, None)
             if part is not None:
                 part.release()

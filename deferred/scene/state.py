@@ -73,6 +73,8 @@ class ObjectState:
     world_at: Callable[[float], np.ndarray] = field(repr=False)
     # the tracks that move the world matrix: the object's own and its ancestors'
     tracks: tuple = ()
+    # a skinned object's joint matrices (J, 4, 4) in its own space (deferred.scene.skin)
+    skin_matrices: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def params(self) -> MaterialParams:

@@ -203,7 +203,7 @@ class SceneEvaluator:
         previous = self._objects.get(obj)
         key = (obj.revision, obj.material.revision)
         parent = hierarchy.parent_of(obj)
-        static = not obj.tracks and not obj.events and parent is None
+        static = not obj.tracks and not obj.events and parent is None and obj.skin is None
         if static and previous is not None and self._keys.get(obj) == key:
             return previous  # nothing to evaluate: the object as the user left it
         model = world_matrix(obj, hierarchy, lambda n: local_matrix_at(n, time), worlds)
@@ -212,19 +212,36 @@ class SceneEvaluator:
             model = previous.model  # the same world: the same array, for the caches
         elif model is not obj.model:
             model = read_only(model)
+        skin = self._skin_at(obj, model, previous, time, hierarchy, worlds)
         material = self._material_at(obj, time)
         self._keys[obj] = key
         if previous is not None and previous.model is model and \
                 previous.material is material and previous.mesh is obj.mesh and \
-                previous.label == obj.label:
+                previous.label == obj.label and previous.skin_matrices is skin:
             return previous
         tracks = obj.tracks if parent is None else \
             (*obj.tracks, *(t for node in hierarchy.ancestors(obj) for t in node.tracks))
         state = ObjectState(node=obj, label=obj.label, mesh=obj.mesh, material=material,
                             model=model, version=next_revision(), world_at=self._world_at(obj),
-                            tracks=tuple(tracks))
+                            tracks=tuple(tracks), skin_matrices=skin)
         self._objects[obj] = state
         return state
+
+    @staticmethod
+    def _skin_at(obj: SceneObject, model: np.ndarray, previous: ObjectState | None,
+                 time: float, hierarchy: Hierarchy,
+                 worlds: dict[SceneNode, np.ndarray]) -> np.ndarray | None:
+        """A skinned object's joint matrices at ``time`` (the previous state's array where
+        they are the same)."""
+        if obj.skin is None:
+            return None
+        joint_worlds = [world_matrix(joint, hierarchy, lambda n: local_matrix_at(n, time),
+                                     worlds) for joint in obj.skin.joints]
+        matrices = obj.skin.matrices(model, joint_worlds)
+        kept = previous.skin_matrices if previous is not None else None
+        if kept is not None and np.array_equal(kept, matrices):
+            return kept
+        return matrices
 
     def _light(self, light: Light, time: float, hierarchy: Hierarchy) -> Light:
         """:func:`light_at`, the same copy while its evaluated parameters are equal (the light

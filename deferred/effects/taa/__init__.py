@@ -115,12 +115,14 @@ class MotionObjectsPass(RenderPass):
         self.writes = (MOTION,)
 
     def execute(self, frame: Frame) -> None:
-        program = frame.shaders.program("effects/taa/motion_objects.vert",
-                                        "effects/taa/motion_objects.frag")
         frame.use_framebuffer((MOTION,), DEPTH, depth_write=False)
         frame.set_state(depth_test=True, depth_func="lequal", cull="back", blend=None,
                         depth_offset=(-1.0, -4.0))
         for obj in frame.scene.objects:
+            # a skinned mesh's motion reads its surface of the frame before too
+            defines = {"SKINNED_MOTION": "1"} if obj.skin_matrices is not None else None
+            program = frame.shaders.program("effects/taa/motion_objects.vert",
+                                            "effects/taa/motion_objects.frag", defines=defines)
             extent = obj.material.motion.extent(obj)
             frame.bind(program, {"u_motion_extent": float(extent)},
                        offered=frame.object_uniforms(obj))
