@@ -37,7 +37,9 @@ def world_bounds(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
         low, high = obj.mesh.bounds()
         box = np.array([[x, y, z, 1.0] for x in (low[0], high[0]) for y in (low[1], high[1])
                         for z in (low[2], high[2])])
-        corners.append((box @ obj.model.T)[:, :3])
+        # the world matrix at t = 0: an object in a group (a glTF file's nodes) is placed by
+        # its parents too
+        corners.append((box @ scene.world_at(obj, 0.0).T)[:, :3])
     points = np.concatenate(corners)
     return points.min(axis=0), points.max(axis=0)
 

@@ -38,13 +38,17 @@ class MeshData:
     # the files it was read from: the mesh file and those it names (a material library, its
     # textures, glTF buffers): inputs an output must not replace
     sources: tuple[Path, ...] = ()
-    # glTF's further attributes, outside the vertex format above: a second UV set
-    # (TEXCOORD_1), vertex colours (COLOR_0, linear RGBA multiplying the base colour) and a
-    # skin's four joints and weights a vertex (JOINTS_0, WEIGHTS_0; deferred.render.skinning)
-    uvs1: np.ndarray | None = None
+    # glTF's further attributes, outside the vertex format above, None where the file has
+    # none: TEXCOORD_1 (N, 2) in the framework's convention as ``uvs`` (v up: 1 - glTF's v),
+    # COLOR_0 (N, 4) linear RGBA, TANGENT (N, 4): xyz along +U, w the handedness
+    # (cross(normal, xyz) * w runs along +V), and a skin's four joints and weights a vertex
+    # (JOINTS_0 (N, 4) uint16, WEIGHTS_0 (N, 4) float32 summing to 1:
+    # deferred.render.skinning)
+    uv1: np.ndarray | None = None
     colors: np.ndarray | None = None
-    joints: np.ndarray | None = None  # (N, 4) uint16
-    weights: np.ndarray | None = None  # (N, 4) float32, summing to 1
+    file_tangents: np.ndarray | None = None
+    joints: np.ndarray | None = None
+    weights: np.ndarray | None = None
 
     @property
     def vertex_count(self) -> int:

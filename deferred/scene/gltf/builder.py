@@ -122,9 +122,13 @@ class GltfBuilder:
         return doc
 
     def save_glb(self, path: Path) -> Path:
+        import warnings
+
         import pygltflib
 
-        gltf = pygltflib.GLTF2.from_dict(self.document())
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # pygltflib's notes on fields it fills in
+            gltf = pygltflib.GLTF2.from_dict(self.document())
         gltf.set_binary_blob(bytes(self.blob))
         gltf.save_binary(str(path))
         return path

@@ -5,10 +5,10 @@ them (:func:`make_material`).
 The keys are ``pbr``'s: ``base_color`` (RGBA), ``metallic``, ``roughness``, ``emissive``,
 ``emissive_strength``, ``alpha_mode``, ``alpha_cutoff``, ``double_sided``, ``normal_scale``,
 ``occlusion_strength`` and, for each texture slot (``base_color``, ``metallic_roughness``,
-``normal``, ``occlusion``, ``emissive``), ``<slot>_texture`` (a file), ``<slot>_texcoord``,
-``<slot>_transform`` (``KHR_texture_transform`` as a 2x3 matrix on GL's UVs:
-:func:`gl_texture_transform`),
-``<slot>_wrap`` and ``<slot>_filter`` (the sampler). Only the keys the registered material's
+``normal``, ``occlusion``, ``emissive``), ``<slot>_texture``: a table of the image file
+(``path``), its UV set (``uv``), its ``KHR_texture_transform`` (``offset``, ``rotation``,
+``scale``, in glTF's texture space) and its sampler (``wrap_s``, ``wrap_t``, ``mag_filter``,
+``min_filter``). Only the keys the registered material's
 parameters have are given to it; a value it cannot take is warned about once, by key.
 Where no ``pbr`` material is registered, ``standard`` stands in (base colour and its texture).
 """
@@ -19,8 +19,6 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
-import numpy as np
-
 from deferred.errors import InputError
 from deferred.interfaces import registry
 from deferred.interfaces.material import Material
@@ -28,7 +26,7 @@ from deferred.scene.gltf.document import GltfDocument
 from deferred.scene.gltf.images import ImageFiles
 
 SLOTS = ("base_color", "metallic_roughness", "normal", "occlusion", "emissive")
-WRAPS = {33071: "clamp", 33648: "mirror", 10497: "repeat"}
+WRAPS = {33071: "clamp_to_edge", 33648: "mirrored_repeat", 10497: "repeat"}
 FILTERS = {9728: "nearest", 9729: "linear", 9984: "nearest_mipmap_nearest",
            9985: "linear_mipmap_nearest", 9986: "nearest_mipmap_linear",
            9987: "linear_mipmap_linear"}
@@ -122,7 +120,9 @@ def read_material(document: GltfDocument, images: ImageFiles, index: int) -> Glt
 
 def _texture(document: GltfDocument, images: ImageFiles, slot: str, info: Any,
              where: str) -> dict[str, Any]:
-    """A texture reference's values: the image file, its UV set, transform and sampler."""
+    """A texture reference as ``pbr``'s texture table: the image file, its UV set, its
+    ``KHR_texture_transform`` (in glTF's texture space, as the extension gives it) and its
+    sampler's wrap and filter modes."""
     if not isinstance(info, dict):
         raise document.error("expected an object", where)
     texture = document.entry("textures", info.get("index"), f"{where}.index")
@@ -131,42 +131,29 @@ def _texture(document: GltfDocument, images: ImageFiles, slot: str, info: Any,
     if source is None:
         raise document.error("has no source image (or only an extension's, which the "
                              "framework does not read)", texture_at)
-    values: dict[str, Any] = {
-        f"{slot}_texture": str(images.path(source, f"{texture_at}.source")),
-        f"{slot}_texcoord": _texcoord(document, info.get("texCoord"), f"{where}.texCoord")}
+    table: dict[str, Any] = {"path": str(images.path(source, f"{texture_at}.source")),
+                             "uv": _texcoord(document, info.get("texCoord"),
+                                             f"{where}.texCoord")}
     transform = (info.get("extensions") or {}).get("KHR_texture_transform")
     if transform is not None:
         at = f"{where}.extensions.KHR_texture_transform"
-        offset = _floats(transform.get("offset"), 2, (0.0, 0.0), document, f"{at}.offset")
-        rotation = _number(transform.get("rotation"), 0.0, document, f"{at}.rotation",
-                           low=-math.inf)
-        scale = _floats(transform.get("scale"), 2, (1.0, 1.0), document, f"{at}.scale")
-        values[f"{slot}_transform"] = gl_texture_transform(offset, rotation, scale)
+        table["offset"] = _floats(transform.get("offset"), 2, (0.0, 0.0), document,
+                                  f"{at}.offset")
+        table["rotation"] = _number(transform.get("rotation"), 0.0, document, f"{at}.rotation",
+                                    low=-math.inf)
+        table["scale"] = _floats(transform.get("scale"), 2, (1.0, 1.0), document, f"{at}.scale")
         if "texCoord" in transform:
-            values[f"{slot}_texcoord"] = _texcoord(document, transform["texCoord"],
-                                                   f"{at}.texCoord")
+            table["uv"] = _texcoord(document, transform["texCoord"], f"{at}.texCoord")
     if texture.sampler is not None:
         sampler = document.entry("samplers", texture.sampler, f"{texture_at}.sampler")
-        values[f"{slot}_wrap"] = (WRAPS.get(sampler.wrapS, "repeat"),
-                                  WRAPS.get(sampler.wrapT, "repeat"))
-        values[f"{slot}_filter"] = (FILTERS.get(sampler.magFilter, "linear"),
-                                    FILTERS.get(sampler.minFilter, "linear_mipmap_linear"))
-    return values
-
-
-def gl_texture_transform(offset: tuple[float, float], rotation: float,
-                         scale: tuple[float, float]) -> tuple[float, ...]:
-    """A ``KHR_texture_transform`` as the 2x3 affine matrix (rows: ``u' = a u + b v + c``,
-    ``v' = d u + e v + f``) acting on the framework's texture coordinates, whose v the loader
-    flipped (:func:`~deferred.scene.gltf.primitives.gl_uvs`): the flip, the glTF transform
-    (offset, then a rotation of the UVs by ``rotation`` radians as the extension's example
-    turns them, then the scale) and the flip back."""
-    c, s = math.cos(rotation), math.sin(rotation)
-    gltf = np.array([[c * scale[0], s * scale[1], offset[0]],
-                     [-s * scale[0], c * scale[1], offset[1]], [0.0, 0.0, 1.0]])
-    flip = np.array([[1.0, 0.0, 0.0], [0.0, -1.0, 1.0], [0.0, 0.0, 1.0]])
-    matrix = flip @ gltf @ flip
-    return tuple(float(v) for v in matrix[:2].reshape(-1))
+        table.update(wrap_s=WRAPS.get(sampler.wrapS, "repeat"),
+                     wrap_t=WRAPS.get(sampler.wrapT, "repeat"),
+                     mag_filter=FILTERS.get(sampler.magFilter, "linear"),
+                     min_filter=FILTERS.get(sampler.minFilter, "linear_mipmap_linear"))
+        if table["mag_filter"] not in ("nearest", "linear"):
+            raise document.error(f"magFilter {sampler.magFilter!r:.20} is a minification "
+                                 "filter", f"samplers[{texture.sampler}].magFilter")
+    return {f"{slot}_texture": table}
 
 
 def _texcoord(document: GltfDocument, value: Any, where: str) -> int:
@@ -207,7 +194,7 @@ def _standard(material: GltfMaterial, document: GltfDocument) -> Material:
                               "specular_intensity": 0.5 * (1.0 - values["roughness"]) + 0.05,
                               "specular_exponent": 8.0 + 120.0 * (1.0 - values["roughness"])}
     if "base_color_texture" in values:
-        params["texture"] = values["base_color_texture"]
+        params["texture"] = values["base_color_texture"]["path"]
     return registry.materials.get("standard").from_dict(params, None,
                                                         f"{document.name}: {material.where}")
 

@@ -135,7 +135,7 @@ def _extra_attributes(document: GltfDocument, mesh: MeshData, read: dict, where:
     if read["TANGENT"] is not None:
         _file_tangents(mesh, read["TANGENT"])
     if read["TEXCOORD_1"] is not None:
-        mesh.uvs1 = gl_uvs(read["TEXCOORD_1"]).astype(np.float32)
+        mesh.uv1 = gl_uvs(read["TEXCOORD_1"]).astype(np.float32)
     if read["COLOR_0"] is not None:
         colors = read["COLOR_0"].astype(np.float32)
         if colors.shape[1] == 3:
@@ -233,6 +233,7 @@ def _file_tangents(mesh: MeshData, tangents: np.ndarray) -> None:
     binormals = np.where(usable[:, None], np.cross(normals, t) * sign, mesh.binormals)
     mesh.tangents = t.astype(np.float32)
     mesh.binormals = binormals.astype(np.float32)
+    mesh.file_tangents = np.hstack([t, np.where(usable[:, None], sign, 1.0)]).astype(np.float32)
 
 
 def _skin_attributes(document: GltfDocument, mesh: MeshData, joints: np.ndarray | None,
