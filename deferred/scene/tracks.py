@@ -182,6 +182,16 @@ def _unit_roots(a: float, b: float, c: float) -> list[float]:
     return [s for s in roots if 0.0 < s < 1.0]
 
 
+def curve_properties(track: Any) -> tuple[str, ...]:
+    """The properties a track (anything with ``curves``) animates."""
+    return tuple(track.curves)
+
+
+def curve_key_times(track: Any) -> tuple[float, ...]:
+    """Every key's time of a track (anything with ``curves`` holding ``times``), sorted."""
+    return tuple(sorted({float(t) for curve in track.curves.values() for t in curve.times}))
+
+
 @dataclass(frozen=True, eq=False)
 class Track:
     """A target's keys: ``kind`` (camera, light, object) and ``name`` (the object's or the
@@ -197,14 +207,8 @@ class Track:
     where: str
     subject: Any = field(default=None, repr=False)
 
-    @property
-    def properties(self) -> tuple[str, ...]:
-        return tuple(self.curves)
-
-    @property
-    def key_times(self) -> tuple[float, ...]:
-        """Every key's time, sorted."""
-        return tuple(sorted({float(t) for curve in self.curves.values() for t in curve.times}))
+    properties = property(lambda self: curve_properties(self))
+    key_times = property(lambda self: curve_key_times(self))
 
     def at(self, time: float) -> dict[str, Any]:
         """The animated properties at ``time``: a float for ``fov`` and ``intensity``, a tuple

@@ -24,6 +24,7 @@ import numpy as np
 
 from deferred.scene.gltf.accessors import read_accessor
 from deferred.scene.gltf.document import GltfDocument
+from deferred.scene.tracks import curve_key_times, curve_properties
 from deferred.scene.transform import MIN_SCALE
 
 INTERPOLATIONS = ("LINEAR", "STEP", "CUBICSPLINE")
@@ -96,13 +97,8 @@ class GltfTrack:
     interpolation: str = "gltf"
     subject: Any = field(default=None, repr=False)
 
-    @property
-    def properties(self) -> tuple[str, ...]:
-        return tuple(self.curves)
-
-    @property
-    def key_times(self) -> tuple[float, ...]:
-        return tuple(sorted({float(t) for curve in self.curves.values() for t in curve.times}))
+    properties = property(lambda self: curve_properties(self))
+    key_times = property(lambda self: curve_key_times(self))
 
     def at(self, time: float) -> dict[str, Any]:
         out: dict[str, Any] = {}

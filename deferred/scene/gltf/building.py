@@ -164,7 +164,10 @@ def _light(scene: Any, asset: GltfAsset, index: int, node: SceneNode) -> Light:
     made.parent = node
     scene.lights.append(made)
     name = light.name
-    if name not in scene.light_names and not name.isdigit():
+    # a track may name it (light:NAME) where the name may be a light's (Scene.add_light's
+    # rule: printable, not a number, not taken); else the light has no name
+    if name.isprintable() and not name.isdigit() and len(name) <= 1000 and \
+            name not in scene.light_names:
         scene.light_names[name] = made
     return made
 
