@@ -24,3 +24,6 @@ deferred render examples/cartoon_hair/moving_head.toml --frames 48 --fps 24 \
     -o docs/figures/cartoon_hair_moving.gif
 deferred render examples/cartoon_hair/anchored_head.toml --frames 48 --fps 24 \
     -o docs/figures/cartoon_hair_anchored.gif
+# glTF files (#35): the sample models of ../shared/assets in both pipelines, the helmet with fur on
+# its crest, a skinned animation, in docs/figures/gltf/
+python examples/gltf/figures.py

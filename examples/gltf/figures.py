@@ -48,14 +48,15 @@ def samples(size=(480, 360)) -> None:
 
 def split_helmet(folder: Path) -> Path:
     """A copy of the DamagedHelmet whose crest (the ridge over the top, from the brow back) is a
-    node of its own, ``crest``, over the whole helmet, node ``helmet``."""
+    node of its own, ``crest``, over the whole helmet, node ``helmet``. The visor's glass
+    reaches the top at the front: the crest starts behind it."""
     source = ASSETS / "DamagedHelmet" / "DamagedHelmet.gltf"
     asset = read_gltf(source)
     mesh = asset.meshes[0][0].mesh
     rotation = asset.nodes[0].transform.matrix()[:3, :3]
     world = mesh.positions @ rotation.T
-    corners = world[mesh.indices.astype(np.int64)]  # (T, 3, 3)
-    crest = np.all((np.abs(corners[..., 0]) < 0.09) & (corners[..., 1] > 0.45), axis=1)
+    centres = world[mesh.indices.astype(np.int64)].mean(axis=1)
+    crest = (np.abs(centres[:, 0]) < 0.14) & (centres[:, 1] > 0.45) & (centres[:, 2] < -0.05)
     gltf = GltfBuilder()
     raw = asset.document.raw
     gltf.doc.update(images=raw["images"], textures=raw["textures"],
@@ -80,9 +81,9 @@ CREST_SCENE = """
 size = [640, 480]
 background = [0.05, 0.05, 0.06]
 [camera]
-position = [1.6, 1.1, 2.6]
-target = [0.0, 0.15, 0.0]
-fov = 40.0
+position = [2.9, 1.6, 1.3]
+target = [0.0, 0.3, -0.3]
+fov = 42.0
 
 [[light]]
 type = "ambient"
@@ -103,7 +104,7 @@ name = "mohawk"
 mesh = "helmet_crest.gltf"
 node = "crest"
 material = "shell_fur"
-params = { fur_length = 0.12, shells = 32, color = [0.75, 0.12, 0.08], density = 40000.0 }
+params = { fur_length = 0.22, shells = 48, color = [0.75, 0.12, 0.08], density = 30000.0 }
 """
 
 
