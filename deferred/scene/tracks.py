@@ -112,6 +112,14 @@ def parse_target(text: Any, where: str) -> tuple[str, str | None]:
                      f"{text!r:.80}{said}", where)
 
 
+def key_before(times: np.ndarray, time: float) -> int | None:
+    """The key ``k`` with ``times[k] <= time < times[k + 1]``; None at or before the first key
+    and at or after the last (where a curve holds an end's value)."""
+    if time <= times[0] or time >= times[-1]:
+        return None
+    return bisect_right(times, time) - 1
+
+
 @dataclass(frozen=True, eq=False)
 class Curve:
     """One property's keys: ``times`` (K,) strictly rising, ``values`` (K, D); ``keys`` the
@@ -125,11 +133,9 @@ class Curve:
     def at(self, time: float) -> np.ndarray:
         """The value at ``time`` (D,), held before the first key and after the last."""
         times, values = self.times, self.values
-        if time <= times[0]:
-            return values[0]
-        if time >= times[-1]:
-            return values[-1]
-        k = bisect_right(times, time) - 1  # times[k] <= time < times[k + 1]
+        k = key_before(times, time)
+        if k is None:  # held before the first key and after the last
+            return values[0] if time <= times[0] else values[-1]
         if self.interpolation == "step":
             return values[k]
         h = times[k + 1] - times[k]

@@ -14,7 +14,6 @@ it evaluates a scene file's track (``SceneNode.local_at``), as ``position``, ``q
 from __future__ import annotations
 
 import math
-from bisect import bisect_right
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
@@ -24,7 +23,7 @@ import numpy as np
 
 from deferred.scene.gltf.accessors import read_accessor
 from deferred.scene.gltf.document import GltfDocument
-from deferred.scene.tracks import curve_key_times, curve_properties
+from deferred.scene.tracks import curve_key_times, curve_properties, key_before
 from deferred.scene.transform import MIN_SCALE
 
 INTERPOLATIONS = ("LINEAR", "STEP", "CUBICSPLINE")
@@ -48,11 +47,9 @@ class ChannelCurve:
     def at(self, time: float) -> np.ndarray:
         """The value at ``time`` (a unit quaternion for a rotation)."""
         times, values = self.times, self.values
-        if time <= times[0]:
-            return values[0]
-        if time >= times[-1]:
-            return values[-1]
-        k = bisect_right(times, time) - 1
+        k = key_before(times, time)
+        if k is None:  # held before the first key and after the last
+            return values[0] if time <= times[0] else values[-1]
         if self.interpolation == "STEP":
             return values[k]
         span = times[k + 1] - times[k]
