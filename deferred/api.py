@@ -21,7 +21,8 @@ A plugin (the built-in materials, lights and effects, and the example package in
   (``LIGHT_ACCUMULATION``, ``COMPOSITE``, ``FINAL`` and their specs).
 - **parameters**: the validated types (:data:`Albedo`, :data:`Radiance`, :data:`NonZeroVec3`),
   :class:`Params` and ``UniformOverrides``; ``require_regular_file`` for file parameters.
-- **data**: :class:`MeshData` and :class:`GpuMesh` (the vertex format), :class:`SceneObject`
+- **data**: :class:`MeshData` and :class:`GpuMesh` (the vertex format), the disk cache
+  (:func:`cache_folder`, :func:`write_cached_arrays`, :func:`file_digest`), :class:`SceneObject`
   and :class:`Scene` (what passes are made for), images (:func:`read_image`,
   :func:`read_channels`, :func:`check_image`), the light helpers (``view_point(s)``,
   ``view_direction(s)``, ``radiances``), the names (:class:`LightVolume`, :class:`Pipeline`,
@@ -106,6 +107,7 @@ from deferred.interfaces.techniques import (
     SurfacePasses,
     Technique,
 )
+from deferred.io.cache import cache_folder, file_digest, write_cached_arrays
 from deferred.io.images import check_image, read_channels, read_image, srgb_decode
 from deferred.names import LightPath, LightVolume, Pipeline, ShadowProjection
 from deferred.params import Params, UniformOverrides
@@ -133,6 +135,10 @@ GLSL_INCLUDES: dict[str, str] = {
                             "through the whole volume beyond its back for any other surface",
     "common/forward_lighting.glsl": "every light of the frame at one surface point (forward "
                                     "passes)",
+    "lighting/environment.glsl": "struct Environment and the image-based light's lookups: "
+                                 "irradiance (9 spherical harmonics) and GGX-prefiltered "
+                                 "radiance by roughness (a shading model's environment "
+                                 "function)",
     "gbuffer/layout.glsl": "the G-buffer's encoding and decoding",
     "gbuffer/write.glsl": "the G-buffer's outputs and gbuffer_write (G-buffer passes)",
     "materials/techniques/stipple.glsl": "stipple patterns (Revie 2.3.4, Listing 2.6)",
@@ -169,10 +175,11 @@ __all__ = [
     "Pipeline", "Radiance", "ReachMotion",
     "RenderError", "RenderPass", "Scene", "SceneObject", "ShadingModel", "Shape",
     "Simulation", "SurfacePasses", "TargetSpec", "Technique",
-    "UniformOverrides", "builtin_head_spheres", "check_image", "copy_pass", "effects", "halton",
+    "UniformOverrides", "builtin_head_spheres", "cache_folder", "check_image", "copy_pass",
+    "effects", "file_digest", "halton",
     "image_texture_bytes", "lights", "materials",
     "radiances", "read_channels", "read_image", "register_shader_root", "require_regular_file",
     "srgb_decode",
     "shading_models",
-    "view_direction", "view_directions", "view_point", "view_points",
+    "view_direction", "view_directions", "view_point", "view_points", "write_cached_arrays",
 ]

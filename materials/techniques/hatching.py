@@ -14,15 +14,14 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
-import sys
-import tempfile
 import zipfile
 from dataclasses import asdict
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
+
+from deferred.api import cache_folder, write_cached_arrays
 
 from .tam import (
     DEFAULT_STROKE_SHAPE,
@@ -52,21 +51,6 @@ FLOAT_SETTINGS = ("stroke_length", "stroke_width", "angle", "angle_jitter", "len
 
 
 # -- the cache ----------------------------------------------------------------------------------
-
-def cache_folder() -> Path:
-    """Where cached TAMs live: ``$DEFERRED_CACHE_DIR``, else the user's cache folder
-    (``$XDG_CACHE_HOME`` or ~/.cache on Linux) under ``deferred``."""
-    folder = os.environ.get("DEFERRED_CACHE_DIR")
-    if folder:
-        return Path(folder)
-    if sys.platform == "win32":
-        local = os.environ.get("LOCALAPPDATA")
-        return (Path(local) if local else Path.home() / "AppData" / "Local") / "deferred" / "Cache"
-    if sys.platform == "darwin":
-        return Path.home() / "Library" / "Caches" / "deferred"
-    xdg = os.environ.get("XDG_CACHE_HOME")
-    return (Path(xdg) if xdg else Path.home() / ".cache") / "deferred"
-
 
 def cache_key(settings: TamSettings, stroke: np.ndarray) -> str:
     """A hash of the generator's version, the settings and the stroke's pixels."""
@@ -105,22 +89,8 @@ def _read_cached(path: Path, settings: TamSettings) -> ToneArtMap | None:
 
 
 def _write_cached(path: Path, tam: ToneArtMap) -> None:
-    """Write ``tam`` to ``path`` atomically (a temporary file in the same folder, renamed); a
-    cache that cannot be written is skipped, not an error."""
-    temporary = None
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with tempfile.NamedTemporaryFile(dir=path.parent, prefix=".tam-", suffix=".tmp",
-                                         delete=False) as handle:
-            temporary = Path(handle.name)
-            np.savez(handle, **{f"level{m}": level for m, level in enumerate(tam.levels)})
-        os.replace(temporary, path)
-        temporary = None
-    except OSError:
-        pass
-    finally:
-        if temporary is not None:
-            temporary.unlink(missing_ok=True)
+    """Write ``tam`` to ``path`` (atomically; a cache that cannot be written is skipped)."""
+    write_cached_arrays(path, {f"level{m}": level for m, level in enumerate(tam.levels)})
 
 
 def tonal_art_map(settings: TamSettings = DEFAULT_SETTINGS,
