@@ -4,6 +4,12 @@
 Every mesh has the same vertex format (``VERTEX_ATTRIBUTES``): position, normal, UV, tangent,
 binormal and the RGBA *comb* colour of Revie section 2.4.1 (RGB: comb direction in tangent space
 packed from [-1, 1] to [0, 1]; A: fur length scale).
+
+A mesh may carry more (``EXTRA_ATTRIBUTES``, glTF's): a second UV set, a vertex colour and
+tangents with their handedness for normal maps. They go into a second vertex buffer that a mesh
+makes only for a program reading one of them (``in_uv1``, ``in_color``, ``in_tangent4``): every
+other program reads the buffer it always has. Where a mesh lacks one, its stand-in is used: the
+first UV set, white, and MikkTSpace's frame (:mod:`deferred.gl.tangents`).
 """
 
 from __future__ import annotations
@@ -14,11 +20,14 @@ from pathlib import Path
 import moderngl
 import numpy as np
 
+from deferred.gl.tangents import mikktspace_tangents
 from deferred.memo import kept_while
 
 # (name, components) in buffer order; the GLSL attribute is ``in_<name>``.
 VERTEX_ATTRIBUTES = (("position", 3), ("normal", 3), ("uv", 2), ("tangent", 3),
                      ("binormal", 3), ("comb", 4))
+# the second buffer's, made only for programs reading one of them (see the module documentation)
+EXTRA_ATTRIBUTES = (("uv1", 2), ("color", 4), ("tangent4", 4))
 
 
 @dataclass
@@ -38,7 +47,7 @@ class MeshData:
     # the files it was read from: the mesh file and those it names (a material library, its
     # textures, glTF buffers): inputs an output must not replace
     sources: tuple[Path, ...] = ()
-    # glTF's further attributes, outside the vertex format above, None where the file has
+    # glTF's further attributes (the first three are EXTRA_ATTRIBUTES'), None where the file has
     # none: TEXCOORD_1 (N, 2) in the framework's convention as ``uvs`` (v up: 1 - glTF's v),
     # COLOR_0 (N, 4) linear RGBA, TANGENT (N, 4): xyz along +U, w the handedness
     # (cross(normal, xyz) * w runs along +V), and a skin's four joints and weights a vertex
@@ -57,6 +66,17 @@ class MeshData:
     def interleaved(self) -> np.ndarray:
         parts = [self.positions, self.normals, self.uvs, self.tangents, self.binormals, self.comb]
         return np.ascontiguousarray(np.hstack(parts).astype(np.float32))
+
+    @kept_while("uvs", "uv1", "colors", "file_tangents", "normals", "indices")
+    def extra_attributes(self) -> np.ndarray:
+        """``EXTRA_ATTRIBUTES`` interleaved, ``(N, 10)`` float32: each the mesh's own or its
+        stand-in (the first UV set, opaque white, MikkTSpace tangents)."""
+        count = self.vertex_count
+        uv1 = self.uvs if self.uv1 is None else self.uv1
+        colors = np.ones((count, 4), np.float32) if self.colors is None else self.colors
+        tangents = self.file_tangents if self.file_tangents is not None else \
+            mikktspace_tangents(self.positions, self.normals, self.uvs, self.indices)
+        return np.ascontiguousarray(np.hstack([uv1, colors, tangents]).astype(np.float32))
 
     @kept_while("positions")
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
@@ -94,6 +114,7 @@ class GpuMesh:
     surface_vbo: moderngl.Buffer | None = field(init=False, default=None)
     rest_vbo: moderngl.Buffer | None = field(init=False, default=None)
     previous_vbo: moderngl.Buffer | None = field(init=False, default=None)
+    extra_vbo: moderngl.Buffer | None = field(init=False, default=None)  # made when first read
     _arrays: dict[int, moderngl.VertexArray] = field(init=False, default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -134,18 +155,25 @@ class GpuMesh:
         return self._buffer_format(self.vbo, VERTEX_ATTRIBUTES, program)
 
     def vertex_buffers(self, program: moderngl.Program) -> list[tuple]:
-        """:meth:`vertex_buffer`, or a moving mesh's two buffers (those ``program`` reads)."""
+        """:meth:`vertex_buffer`, or a moving mesh's two buffers (those ``program`` reads),
+        and the extra attributes' buffer where ``program`` reads one of them."""
         if not self.moving:
-            return [self.vertex_buffer(program)]
-        if self.skinned:
-            buffers = [self._buffer_format(self.surface_vbo, SKINNED_SURFACE, program),
-                       self._buffer_format(self.vbo, (VERTEX_ATTRIBUTES[2],
-                                                      VERTEX_ATTRIBUTES[5]), program),
-                       self._buffer_format(self.previous_vbo, PREVIOUS_SURFACE, program)]
+            buffers = [self.vertex_buffer(program)]
         else:
-            buffers = [self._buffer_format(self.surface_vbo, VERTEX_ATTRIBUTES[:2], program),
-                       self._buffer_format(self.vbo, VERTEX_ATTRIBUTES[2:], program)]
-        return [buffer for buffer in buffers if len(buffer) > 2]
+            if self.skinned:
+                buffers = [self._buffer_format(self.surface_vbo, SKINNED_SURFACE, program),
+                           self._buffer_format(self.vbo, (VERTEX_ATTRIBUTES[2],
+                                                          VERTEX_ATTRIBUTES[5]), program),
+                           self._buffer_format(self.previous_vbo, PREVIOUS_SURFACE, program)]
+            else:
+                buffers = [self._buffer_format(self.surface_vbo, VERTEX_ATTRIBUTES[:2], program),
+                           self._buffer_format(self.vbo, VERTEX_ATTRIBUTES[2:], program)]
+            buffers = [buffer for buffer in buffers if len(buffer) > 2]
+        if any(f"in_{name}" in program for name, _ in EXTRA_ATTRIBUTES):
+            if self.extra_vbo is None:
+                self.extra_vbo = self.ctx.buffer(self.data.extra_attributes().tobytes())
+            buffers.append(self._buffer_format(self.extra_vbo, EXTRA_ATTRIBUTES, program))
+        return buffers
 
     @staticmethod
     def _buffer_format(buffer: moderngl.Buffer, attributes, program: moderngl.Program) -> tuple:
@@ -176,7 +204,7 @@ class GpuMesh:
         self._arrays.clear()
         self.vbo.release()
         self.ibo.release()
-        for buffer in (self.surface_vbo, self.rest_vbo, self.previous_vbo):
+        for buffer in (self.surface_vbo, self.rest_vbo, self.previous_vbo, self.extra_vbo):
             if buffer is not None:
                 buffer.release()
 

@@ -78,10 +78,13 @@ class Resources:
         """A cached texture (see :meth:`cached`)."""
         return self.cached(key, create)
 
-    def image_texture(self, path: Path, srgb: bool = True,
-                      where: str | None = None) -> moderngl.Texture:
+    def image_texture(self, path: Path, srgb: bool = True, where: str | None = None,
+                      sampler: tuple[tuple[int, int], tuple[bool, bool]] | None = None
+                      ) -> moderngl.Texture:
         """The image at ``path`` as a mipmapped texture (cached); ``where`` (the scene key)
-        names it in a read error."""
+        names it in a read error. ``sampler``: its (minification, magnification) filters
+        and whether it repeats along x and y (else clamped to its edge), where not
+        trilinear and repeating; each sampler of one image is a texture of its own."""
         def create(ctx: moderngl.Context) -> moderngl.Texture:
             pixels = read_image(path, srgb_to_linear=srgb, where=where,
                                 max_size=ctx.info["GL_MAX_TEXTURE_SIZE"], dtype=np.float16)
@@ -95,9 +98,12 @@ class Resources:
                               viewport=(0, height - first - len(band), width, len(band)))
             texture.build_mipmaps()
             texture.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+            if sampler is not None:
+                texture.filter, (texture.repeat_x, texture.repeat_y) = sampler
             return texture
 
-        return self.texture(("image", str(path), srgb), create)
+        key = ("image", str(path), srgb)
+        return self.texture(key if sampler is None else (*key, sampler), create)
 
     def fullscreen_vertex_array(self, program: moderngl.Program) -> moderngl.VertexArray:
         # Full-screen triangles are generated from gl_VertexID; a VAO with no buffers draws them.

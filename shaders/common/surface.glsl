@@ -9,6 +9,10 @@ struct SurfaceInput {
     vec3 binormal;   // view space, unit, along +V
     vec2 uv;
     vec4 comb;       // tangent-space comb direction packed to [0, 1], fur length scale (Revie 2.4.1)
+#ifdef MESH_EXTRAS
+    vec2 uv1;        // the second UV set (the first where the mesh has none)
+    vec4 color;      // the vertex colour, linear RGBA (white where the mesh has none)
+#endif
 };
 
 struct Surface {

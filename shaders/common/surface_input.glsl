@@ -8,6 +8,10 @@ in vec3 v_tangent;
 in vec3 v_binormal;
 in vec2 v_uv;
 in vec4 v_comb;
+#ifdef MESH_EXTRAS
+in vec2 v_uv1;
+in vec4 v_color;
+#endif
 
 uniform float u_surface_id;  // this object's G-buffer id: shading model and material
 
@@ -19,6 +23,10 @@ SurfaceInput surface_input() {
     i.binormal = normalize(v_binormal);
     i.uv = v_uv;
     i.comb = v_comb;
+#ifdef MESH_EXTRAS
+    i.uv1 = v_uv1;
+    i.color = v_color;
+#endif
     return i;
 }
 
