@@ -42,6 +42,8 @@ LIGHT_PATHS: dict[Pipeline, tuple[LightPath, ...]] = {
 }
 # the paths that cull lights into lists with compute shaders (GL 4.3)
 LIST_PATHS = (LightPath.TILED, LightPath.CLUSTERED)
+# the scene's `background` that shows its environment light's map instead of a colour
+ENVIRONMENT_BACKGROUND = "environment"
 # a path named for one pipeline, asked of the other: what that one runs instead
 EQUIVALENT_PATHS: dict[Pipeline, dict[LightPath, LightPath]] = {
     Pipeline.DEFERRED: {LightPath.NAIVE: LightPath.VOLUMES},

@@ -26,7 +26,8 @@ def info(scene: str | None) -> None:
     gltf = None
     if scene is not None and Path(scene).suffix.lower() in GLTF_SUFFIXES:
         gltf = describe_file(Path(scene))  # the file's parts, what is not drawn
-    layout = load_scene(scene).gbuffer_layout()  # bad input fails before GL start-up
+    loaded = load_scene(scene)
+    layout = loaded.gbuffer_layout()  # bad input fails before GL start-up
     gl = create_context()
     try:
         console = Console(soft_wrap=True, markup=False)  # one line per entry; [..] is text
@@ -37,6 +38,10 @@ def info(scene: str | None) -> None:
             channels = f"  [{' '.join(entry['channels'])}]" if "channels" in entry else ""
             console.print(f"  {name:<20} {entry['format']:<8} {entry['bytes_per_pixel']:>2} B  "
                           f"{entry['description']}{channels}")
+        for model in loaded.shading_models():
+            if model.gbuffer_budget is not None:
+                console.print(f"  shading model {model.name}: at most {model.gbuffer_budget} "
+                              "bytes per pixel (its budget)")
         for key, value in gl.info.items():
             console.print(f"{key:>16}: {value}")
         for key, value in gl.features.names().items():

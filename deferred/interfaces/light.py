@@ -9,13 +9,17 @@ pass reads it per instance, the forward pass loops over all records per fragment
 ``volume`` says how the deferred pass bounds a light: ``"fullscreen"`` (directional, ambient) or
 ``"sphere"`` (the record's ``position.xyz`` is the centre and ``position.w`` the radius), so that
 cost follows the pixels a light touches.
+
+A type whose GLSL reads textures (an environment's maps) gives them from :meth:`Light.textures`,
+bound wherever lights are evaluated, as a shading model's are; a light naming files checks them
+in :meth:`Light.check_files` (paths relative to the scene file's folder, ``base_dir``).
 """
 
 from __future__ import annotations
 
 import sys
 from pathlib import Path
-from typing import Any, ClassVar, Literal
+from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import Field, field_validator
@@ -29,6 +33,11 @@ if sys.version_info >= (3, 11):
     from importlib.resources.abc import Traversable
 else:  # Python 3.10
     from importlib.abc import Traversable
+
+if TYPE_CHECKING:
+    import moderngl
+
+    from deferred.core.frame import Frame
 
 Vec3 = tuple[float, float, float]
 
@@ -94,12 +103,31 @@ class Light(Revisioned):
     # None: the world (each frame's state holds the light placed in the world)
     parent: Any = None
 
-    def __init__(self, params: LightParams | None = None):
+    def __init__(self, params: LightParams | None = None, base_dir: Path | None = None):
         self.params = params if params is not None else self.Params()
+        self.base_dir = base_dir  # the scene file's folder: relative file parameters' root
 
     @classmethod
-    def from_dict(cls, values: dict[str, Any], where: str | None = None) -> Light:
-        return cls(validate_params(cls.Params, values, where))
+    def from_dict(cls, values: dict[str, Any], where: str | None = None,
+                  base_dir: Path | None = None) -> Light:
+        light = cls(validate_params(cls.Params, values, where), base_dir)
+        light.check_files(where)
+        return light
+
+    def check_files(self, where: str | None) -> None:
+        """Raise ``InputError`` (naming ``where``'s key) for parameters naming files that are
+        not there or not readable images; nothing by default."""
+
+    def resolve_path(self, value: str | Path) -> Path:
+        """A file parameter's path: relative ones from the scene file's folder."""
+        path = Path(value)
+        return path if path.is_absolute() or self.base_dir is None else self.base_dir / path
+
+    @classmethod
+    def textures(cls, frame: Frame) -> dict[str, moderngl.Texture]:
+        """Samplers the type's GLSL reads (made from the frame's lights of this type), bound
+        wherever lights are evaluated; none by default."""
+        return {}
 
     @property
     def casts_shadows(self) -> bool:

@@ -33,6 +33,7 @@ from deferred.core.passes import Phase, RenderPass
 from deferred.errors import InputError
 from deferred.gbuffer.layout import (
     GBUFFER_COLOR_TARGETS,
+    GBUFFER_TARGETS,
     GBufferData,
     GBufferLayout,
     data_write_file,
@@ -208,6 +209,14 @@ class Material(Revisioned):
                 raise InputError(f"material {self.name}: G-buffer data '{data.name}' is "
                                  "declared twice with different formats")
             merged[data.name] = data
+        budget = model.gbuffer_budget
+        if budget is not None:
+            used = sum(spec.bytes_per_pixel for spec in GBUFFER_TARGETS.values()) + \
+                sum(data.spec.bytes_per_pixel for data in merged.values())
+            if used > budget:
+                raise InputError(f"material {self.name}: its G-buffer takes {used} bytes a "
+                                 f"pixel, over its shading model {model.name}'s budget of "
+                                 f"{budget}")
         return tuple(merged.values())
 
     def gbuffer_targets(self) -> tuple[str, ...]:

@@ -7,8 +7,12 @@ A **shading model** is a BRDF in one GLSL file, defining
 Both pipelines call it: the deferred lights through a generated dispatch on the G-buffer's
 shading-model id, the forward pass in its loop over the lights. An optional
 ``vec3 <ambient_function>(Surface s, vec3 irradiance)`` answers the ambient light (default:
-``albedo * irradiance``). Register with ``@deferred.api.shading_models.register`` or the
-entry-point group ``deferred.shading_models``; only the models a scene uses are compiled.
+``albedo * irradiance``), and an optional ``vec3 <environment_function>(Surface s, vec3 V,
+Environment e)`` the image-based light (``lighting/environment.glsl``: its irradiance and its
+prefiltered radiance by roughness; default: the ambient answer to its irradiance at the
+normal, times the surface's occlusion). Register with
+``@deferred.api.shading_models.register`` or the entry-point group ``deferred.shading_models``;
+only the models a scene uses are compiled.
 
 **G-buffer data** is extra per-pixel data (a strand tangent, a toon ramp row) in a render target
 of its own. A material declares it (``Material.gbuffer_data``) and so may a shading model (what it
@@ -44,6 +48,10 @@ class ShadingModel:
     glsl_file: ClassVar[str] = ""
     glsl_function: ClassVar[str] = ""
     ambient_function: ClassVar[str | None] = None
+    environment_function: ClassVar[str | None] = None
+    # the most bytes a pixel the model's surfaces may take in the G-buffer (the core and its
+    # data): `deferred info` states it, and a model's data over it is refused (None: no budget)
+    gbuffer_budget: ClassVar[int | None] = None
     gbuffer_data: ClassVar[tuple[GBufferData, ...]] = ()
     shader_root: ClassVar[Traversable | Path | None] = None
     type_id: ClassVar[int] = 0  # set by the registry; stored in the G-buffer
@@ -54,9 +62,14 @@ class ShadingModel:
         return {}
 
 
+ENVIRONMENT_GLSL = "lighting/environment.glsl"
+
+
 def shading_dispatch_glsl(models: list[type[ShadingModel]]) -> str:
-    """GLSL of ``shade_light`` and ``shade_ambient``: the scene's models, by id."""
-    lines = [f'#include "{cls.glsl_file}"' for cls in models]
+    """GLSL of ``shade_light``, ``shade_ambient`` and ``shade_environment``: the scene's
+    models, by id."""
+    lines = [f'#include "{ENVIRONMENT_GLSL}"']
+    lines += [f'#include "{cls.glsl_file}"' for cls in models]
     lines.append("vec3 shade_light(Surface s, vec3 L, vec3 V, vec3 radiance) {")
     lines += [f"    if (s.shading_model == {cls.type_id}) "
               f"return {cls.glsl_function}(s, L, V, radiance);" for cls in models]
@@ -66,4 +79,10 @@ def shading_dispatch_glsl(models: list[type[ShadingModel]]) -> str:
               f"return {cls.ambient_function}(s, irradiance);"
               for cls in models if cls.ambient_function]
     lines += ["    return s.albedo * irradiance;", "}"]
+    lines.append("vec3 shade_environment(Surface s, vec3 V, Environment e) {")
+    lines += [f"    if (s.shading_model == {cls.type_id}) "
+              f"return {cls.environment_function}(s, V, e);"
+              for cls in models if cls.environment_function]
+    lines += ["    return shade_ambient(s, environment_irradiance(e, s.normal) * s.occlusion);",
+              "}"]
     return "\n".join(lines) + "\n"

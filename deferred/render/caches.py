@@ -28,6 +28,7 @@ if TYPE_CHECKING:
     from deferred.core.frame import Frame
     from deferred.gl.shaderlib import Source
     from deferred.gl.uniforms import ProgramUniforms
+    from deferred.interfaces.light import Light
     from deferred.interfaces.material import Material
     from deferred.interfaces.shading import ShadingModel
     from deferred.scene.state import FrameState, ObjectState
@@ -228,24 +229,27 @@ def unwritten_data(source: Source, names: list[str]) -> list[str]:
 
 
 class ShadingTextures:
-    """The samplers of a scene's shading models (ramps...), offered to every program a frame
-    binds (a binding source of the frame: wherever lights run)."""
+    """The samplers of a scene's shading models (ramps...) and light types (an environment's
+    maps), offered to every program a frame binds (a binding source of the frame: wherever
+    lights run)."""
 
     def __init__(self, textures: dict[str, moderngl.Texture]):
         self.textures = textures
 
     @classmethod
-    def of(cls, models: Iterable[type[ShadingModel]], frame: Frame) -> ShadingTextures | None:
-        """The models' samplers this frame; ``None`` where they have none (most scenes: the
-        frame then has no source to ask at every draw)."""
+    def of(cls, models: Iterable[type[ShadingModel]], frame: Frame,
+           light_types: Iterable[type[Light]] = ()) -> ShadingTextures | None:
+        """The models' and the light types' samplers this frame; ``None`` where they have
+        none (most scenes: the frame then has no source to ask at every draw)."""
         textures: dict[str, moderngl.Texture] = {}
-        for model in models:
+        for kind, owner in [*(("shading model", model) for model in models),
+                            *(("light", light_type) for light_type in light_types)]:
             try:
-                textures.update(model.textures(frame))
+                textures.update(owner.textures(frame))
             except DeferredError:
                 raise
-            except Exception as exc:  # noqa: BLE001 - a plugin's model: say which
-                raise RenderError(f"shading model {model.name}: textures: "
+            except Exception as exc:  # noqa: BLE001 - a plugin's model or light: say which
+                raise RenderError(f"{kind} {owner.name}: textures: "
                                   f"{type(exc).__name__}: {exc}") from exc
         return cls(textures) if textures else None
 

@@ -54,6 +54,7 @@ from deferred.lighting.shadows.caster_pass import ShadowPass
 from deferred.lighting.shadows.plan import scene_casts_shadows
 from deferred.lighting.volumes import LightTypePass, surface_pass
 from deferred.memo import overrides
+from deferred.names import ENVIRONMENT_BACKGROUND
 from deferred.scene.state import FrameState, ObjectState
 
 # what the pass graph checks beyond the core's rules: the G-buffer's
@@ -69,6 +70,24 @@ def check_passes(passes: list[RenderPass]) -> PassGraph:
 TONEMAPS = {"none": 0, "reinhard": 1, "aces": 2}
 
 PIPELINE_PASS, SCENE_PASS, OBJECT_PASS = 0, 1, 2  # groups within one Order rank
+
+
+def clear_colour(scene: FrameState) -> tuple[float, float, float]:
+    """What the frame is cleared to behind the scene: the background colour, or black where
+    a pass draws the environment there (:func:`environment_background_pass`)."""
+    if isinstance(scene.background, str):
+        return (0.0, 0.0, 0.0)
+    return tuple(scene.background)
+
+
+def environment_background_pass(phase: Phase, target: str, order: int) -> RenderPass:
+    """The environment light's map behind the scene (``background = "environment"``): drawn
+    on the far plane where the depth test "lequal" finds nothing nearer, into ``target``
+    (alpha 0, as the background colour)."""
+    return FullscreenPass(f"{phase.value}.environment_background", phase,
+                          "lighting/environment_background.frag", {}, (target,),
+                          defines={"FULLSCREEN_AT_FAR": "1"}, depth=DEPTH, depth_test=True,
+                          depth_func="lequal", order=order)
 
 
 def tonemap_pass(scene: FrameState) -> RenderPass:
@@ -207,13 +226,14 @@ class DeferredPipeline(Pipeline):
         occlusion = AMBIENT_OCCLUSION if any(AMBIENT_OCCLUSION in p.creates for p in passes) \
             else None
         folded = False  # the composition made by the lighting pass (below)
+        environment = scene.background == ENVIRONMENT_BACKGROUND
         if self.light_path == names.LightPath.VOLUMES:
             # the light accumulation starts as 0 on surfaces and the background elsewhere
             # (its clear); each light type's pass adds into it
             background = surface_pass("lighting.background", "lighting/background.frag",
                                       {"u_normal_exponent_id": NORMAL_EXPONENT_ID},
                                       {LIGHT_ACCUMULATION: LIGHT_ACCUMULATION_SPEC},
-                                      scene.background)
+                                      clear_colour(scene))
             lights = [background, *(LightTypePass(cls, occlusion, layout.color_targets)
                                     for cls in scene.light_types())]
         else:
@@ -222,14 +242,18 @@ class DeferredPipeline(Pipeline):
             # pass, the composition is the light accumulation: the same pass writes both, and
             # there is nothing to copy.
             clustered = self.light_path == names.LightPath.CLUSTERED
-            folded = not phase_passes(scene, Phase.MATERIAL, [], wide) and not any(
+            folded = not environment and not phase_passes(scene, Phase.MATERIAL, [], wide) \
+                and not any(
                 LIGHT_ACCUMULATION in p.writes
                 for p in phase_passes(scene, Phase.LIGHTING, [], wide))
             lights = [LightCullPass(f"lighting.cull_{'clusters' if clustered else 'tiles'}",
                                     Phase.LIGHTING, clustered),
                       list_shading_pass(f"lighting.{self.light_path}", clustered,
-                                        layout.color_targets, occlusion, scene.background,
-                                        composite=folded)]
+                                        layout.color_targets, occlusion,
+                                        clear_colour(scene), composite=folded)]
+        if environment:  # behind the lit surfaces, after every light
+            lights.append(environment_background_pass(Phase.LIGHTING, LIGHT_ACCUMULATION,
+                                                      Order.LAST))
         passes += phase_passes(scene, Phase.LIGHTING, lights, wide)
         if not folded:
             composite = copy_pass("material.composite_copy", Phase.MATERIAL,
@@ -246,7 +270,7 @@ class ForwardPipeline(Pipeline):
 
     def build(self, scene: FrameState) -> list[RenderPass]:
         wide = scene_passes(scene, self.name)
-        creates = {COMPOSITE: replace(COMPOSITE_SPEC, clear=(*scene.background, 0.0)),
+        creates = {COMPOSITE: replace(COMPOSITE_SPEC, clear=(*clear_colour(scene), 0.0)),
                    DEPTH: GBUFFER_TARGETS[DEPTH]}
         fixed: list[RenderPass] = []
         if self.light_path == names.LightPath.TILED:  # Forward+: depth pre-pass, tiled culling
@@ -258,6 +282,8 @@ class ForwardPipeline(Pipeline):
                                        from_near=True))
         clear = ClearPass("forward.clear", Phase.FORWARD, creates)
         shadows = [ShadowPass(Phase.FORWARD)] if scene_casts_shadows(scene.lights) else []
+        if scene.background == ENVIRONMENT_BACKGROUND:  # after the opaque surfaces
+            fixed.append(environment_background_pass(Phase.FORWARD, COMPOSITE, Order.OPAQUE + 1))
         passes = phase_passes(scene, Phase.FORWARD, [*shadows, clear, *fixed], wide)
         passes += phase_passes(scene, Phase.POST, [tonemap_pass(scene)], wide)
         return passes

@@ -30,7 +30,7 @@ from deferred.gl.targets import COMPOSITE, FINAL
 from deferred.interfaces.material import Material
 from deferred.interfaces.simulation import advance_simulations
 from deferred.io.safety import raise_if_stop_requested
-from deferred.names import Pipeline
+from deferred.names import ENVIRONMENT_BACKGROUND, Pipeline
 from deferred.params import validate_params
 from deferred.render.budget import check_target_memory, held_memory, renderer_holdings
 from deferred.render.caches import (
@@ -74,10 +74,19 @@ def check_scene_values(scene: Scene) -> None:
     if scene.tonemap not in TONEMAPS:
         raise InputError(f"unknown tone mapping operator {scene.tonemap!r} (choose from "
                          f"{', '.join(TONEMAPS)})", "tonemap")
-    background = np.asarray(scene.background, dtype=np.float64)
-    if background.shape != (3,) or not np.all(np.isfinite(background)) or np.any(background < 0):
-        raise InputError(f"expected three finite numbers >= 0, got {scene.background!r}",
-                         "background")
+    if isinstance(scene.background, str):
+        if scene.background != ENVIRONMENT_BACKGROUND:
+            raise InputError(f"expected three numbers or \"environment\", got "
+                             f"{scene.background!r}", "background")
+        if not any(light.name == ENVIRONMENT_BACKGROUND for light in scene.lights):
+            raise InputError("\"environment\" shows the environment light's map: add a light "
+                             "of type \"environment\"", "background")
+    else:
+        background = np.asarray(scene.background, dtype=np.float64)
+        if background.shape != (3,) or not np.all(np.isfinite(background)) or \
+                np.any(background < 0):
+            raise InputError(f"expected three finite numbers >= 0, got {scene.background!r}",
+                             "background")
     if not (isinstance(scene.exposure, float | int) and math.isfinite(scene.exposure) and
             scene.exposure > 0.0):
         raise InputError(f"expected a finite number > 0, got {scene.exposure!r}", "exposure")
@@ -346,7 +355,8 @@ class Renderer:
                       jitter=(float(jitter[0]), float(jitter[1])), sample_index=sample_index,
                       history_kept=history.kept,
                       previous_view_projection=history.previous_view_projection)
-        shading = ShadingTextures.of(setup.shading_models, frame)  # the models' samplers
+        # the shading models' and the light types' samplers
+        shading = ShadingTextures.of(setup.shading_models, frame, setup.plan.light_types)
         if shading is not None:
             frame.binding_sources.insert(0, shading)
         slots = None

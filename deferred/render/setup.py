@@ -56,7 +56,9 @@ def structure_key(state: FrameState, pipeline: str, light_path_arg: str | None,
                   for obj in state.objects),
             tuple(map(type, state.lights)), scene_casts_shadows(state.lights),
             opacity_size(state, pipeline), state.shadow_budget,
-            tuple(map(id, state.effects)), tuple(state.background), state.tonemap,
+            tuple(map(id, state.effects)),
+            state.background if isinstance(state.background, str) else tuple(state.background),
+            state.tonemap,
             state.light_path if light_path_arg is None else None,
             state.size if size_arg is None else None)
 

@@ -305,7 +305,7 @@ class SceneBuilder:
                 continue
             light_cls = self.collect(registry.lights.get, light.type, f"{where}.type")
             made = None if light_cls is None else self.collect(light_cls.from_dict, values,
-                                                               where)
+                                                               where, self.base_dir)
             if made is None:
                 continue
             self.scene.lights.append(made)

@@ -51,7 +51,7 @@ class Scene(SceneContents, Revisioned):
     objects: list[SceneObject] = field(default_factory=list)
     lights: list[Light] = field(default_factory=list)
     size: tuple[int, int] = (1280, 720)
-    background: tuple[float, float, float] = (0.02, 0.02, 0.025)
+    background: tuple[float, float, float] | str = (0.02, 0.02, 0.025)  # or "environment"
     exposure: float = 1.0
     tonemap: str = "aces"
     light_path: str | None = None

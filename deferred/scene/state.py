@@ -117,7 +117,7 @@ class FrameState(SceneContents):
     lights: tuple[Light, ...]
     effects: tuple[Effect, ...]
     size: tuple[int, int]
-    background: tuple[float, float, float]
+    background: tuple[float, float, float] | str  # a colour, or "environment"
     exposure: float
     tonemap: str
     light_path: str | None

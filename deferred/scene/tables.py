@@ -178,8 +178,9 @@ class ShadowsModel(_Strict):
 
 class SceneModel(_Strict):
     size: tuple[int, int] = (1280, 720)
-    background: Radiance = Field((0.02, 0.02, 0.025),
-                                 description="linear RGB behind everything, each >= 0")
+    background: Radiance | Literal["environment"] = Field(
+        (0.02, 0.02, 0.025), description="linear RGB behind everything, each >= 0, or "
+                                         "\"environment\": the environment light's map")
     exposure: float = Field(1.0, gt=0.0)
     tonemap: Literal["reinhard", "aces", "none"] = "aces"
     light_path: LightPath | None = Field(

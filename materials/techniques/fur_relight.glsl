@@ -11,8 +11,8 @@
 // it (t), and the sample's share of them in the light read is swapped (fur_relit). The volume
 // lights (point, spot) keep the sample's light. Include common/light_buffer.glsl and
 // generated/lights.glsl first: the light types come from the scene (LIGHT_RANGE_ambient,
-// LIGHT_RANGE_directional); another full-screen type, a plugin's, is in neither c nor t and so
-// keeps the sample's light too.
+// LIGHT_RANGE_environment, LIGHT_RANGE_directional); another full-screen type, a plugin's, is
+// in neither c nor t and so keeps the sample's light too.
 //
 // Each type is a loop over its own range, calling its function: llvmpipe runs every branch of a
 // switch on the light type (shadow lookups included) for every light.
@@ -33,6 +33,16 @@ void fur_fullscreen_lights(Surface a, Surface b, vec3 P, vec3 V, out vec3 la, ou
             la += ambient_light(light, a, P, V);
             lb += ambient_light(light, b, P, V);
         } while (++k < LIGHT_RANGE_ambient.x + LIGHT_RANGE_ambient.y);
+    }
+#endif
+#ifdef LIGHT_RANGE_environment
+    if (LIGHT_RANGE_environment.y > 0) {
+        int k = LIGHT_RANGE_environment.x;
+        do {
+            LightRecord light = fullscreen_light(k);
+            la += environment_light(light, a, P, V);
+            lb += environment_light(light, b, P, V);
+        } while (++k < LIGHT_RANGE_environment.x + LIGHT_RANGE_environment.y);
     }
 #endif
 #ifdef LIGHT_RANGE_directional

@@ -1,5 +1,6 @@
 // Light records and the shading-model interface shared by the deferred and forward pipelines.
 #include "common/surface.glsl"
+#include "lighting/environment.glsl"
 
 // One light, four vec4s in view space (deferred.interfaces.light.Light.record):
 //   color     rgb = colour * intensity, w = light type id
@@ -19,6 +20,8 @@ struct LightRecord {
 vec3 shade_light(Surface s, vec3 L, vec3 V, vec3 radiance);
 // ... and ambient irradiance (default: albedo * irradiance).
 vec3 shade_ambient(Surface s, vec3 irradiance);
+// ... and the image-based light (default: shade_ambient of its irradiance at the normal).
+vec3 shade_environment(Surface s, vec3 V, Environment e);
 
 // Inverse-square falloff windowed to reach exactly 0 at the radius:
 //   (clamp(1 - (d/r)^4, 0, 1))^2 / (d^2 + 1)
