@@ -11,4 +11,5 @@ BUILTINS = {
     "directional": "deferred.lights.directional:DirectionalLight",
     "point": "deferred.lights.point:PointLight",
     "spot": "deferred.lights.spot:SpotLight",
+    "environment": "deferred.lights.environment:EnvironmentLight",
 }

@@ -12,6 +12,7 @@ BUILTINS = {
     "shell_fur": "deferred.materials.shell_fur:ShellFurMaterial",
     "standard": "deferred.materials.standard:StandardMaterial",
     "stipple_glass": "deferred.materials.stipple_glass:StippleGlassMaterial",
+    "pbr": "deferred.materials.pbr:PbrMaterial",
 }
 
 # One package for the four: small classes sharing G-buffer data (the strand tangent), loaded
@@ -21,4 +22,5 @@ SHADING_MODELS = {
     "kajiya_kay": "deferred.materials.shading_models:KajiyaKay",
     "toon": "deferred.materials.shading_models:Toon",
     "marschner": "deferred.materials.shading_models:Marschner",
+    "pbr": "deferred.materials.shading_models:Pbr",
 }

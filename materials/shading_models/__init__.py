@@ -10,6 +10,13 @@ registers them.
   longitudinal roughness (radians), ``specular_intensity`` scales R.
 - ``toon``: N.L through a ramp texture (a row per ramp, chosen per pixel by G-buffer data) and
   a hard-edged specular band (X-toon, Costigan's cartoon shading).
+- ``pbr``: glTF 2.0's metallic-roughness as Filament lights it (``pbr.glsl``): GGX, Smith
+  height-correlated visibility, Schlick Fresnel, multiple-scattering energy compensation from
+  its DFG table (``dfg.py``), Lambert diffuse; its ambient and environment answers split the
+  light between the lobes by the same table. The G-buffer carries the base colour as the
+  albedo, metallic as the specular intensity, the perceptual roughness as the specular exponent
+  and the material's ambient occlusion in the datum ``pbr_occlusion``: 21 bytes a pixel,
+  within the model's budget of :data:`PBR_GBUFFER_BUDGET`.
 """
 
 from __future__ import annotations
@@ -22,6 +29,7 @@ import numpy as np
 from deferred.api import GBufferData, ShadingModel, shading_models
 
 from ..techniques.xtoon import RAMP_HEIGHT, RAMP_WIDTH, XToonRamp, ramp_layer, scene_ramps
+from .dfg import dfg_table
 
 if TYPE_CHECKING:
     from deferred.api import Frame
@@ -30,6 +38,10 @@ STRAND_TANGENT = GBufferData(
     "strand_tangent", "RG16F", ("u", "v"),
     "strand tangent, view space, octahedral (kajiya_kay: materials/techniques/strand_tangent.glsl)")
 TOON_RAMP = GBufferData("toon_ramp", "R8", ("row",), "row of the toon ramp texture / 255")
+PBR_OCCLUSION = GBufferData("pbr_occlusion", "R8", ("occlusion",),
+                            "pbr: the material's ambient occlusion (its map, by strength)")
+# bytes a pixel the pbr model's surfaces may take: the 20-byte core and 4 of its own
+PBR_GBUFFER_BUDGET = 24
 
 
 @shading_models.register
@@ -136,3 +148,27 @@ class Marschner(ShadingModel):
     glsl_function = "marschner"
     ambient_function = "marschner_ambient"
     gbuffer_data = (STRAND_TANGENT,)
+
+
+@shading_models.register
+class Pbr(ShadingModel):
+    name = "pbr"
+    glsl_file = "materials/shading_models/pbr.glsl"
+    glsl_function = "pbr"
+    ambient_function = "pbr_ambient"
+    environment_function = "pbr_environment"
+    gbuffer_data = (PBR_OCCLUSION,)
+    gbuffer_budget = PBR_GBUFFER_BUDGET
+
+    @classmethod
+    def textures(cls, frame: Frame) -> dict[str, moderngl.Texture]:
+        def create(ctx: moderngl.Context) -> moderngl.Texture:
+            table = dfg_table()
+            size = table.shape[0]
+            texture = ctx.texture((size, size), 2, np.ascontiguousarray(table).tobytes(),
+                                  dtype="f4")
+            texture.filter = (moderngl.LINEAR, moderngl.LINEAR)
+            texture.repeat_x = texture.repeat_y = False
+            return texture
+
+        return {"u_pbr_dfg": frame.resources.texture("pbr_dfg", create)}
