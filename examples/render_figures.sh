@@ -12,6 +12,7 @@ python examples/comb_figures.py  # the demo before and after the comb field
 python examples/marschner_figures.py  # the demo and Fig. 2.21 with shading = "marschner"
 python examples/taa_figures.py  # taa and --samples 16 on Fig. 2.21 and the demo; the turntable GIF
 python examples/self_shadow_figures.py  # fur without and with self-shadowing (deep opacity maps)
+python examples/pbr_figures.py  # pbr spheres, roughness by metallic, under the sky and a studio HDR
 # Silva et al., curling and clumping fur (the shell_fur material): Figs. 7, 9, 11, 12 (c), Table 1's
 # torus and the wet-in-the-wind GIF (examples/shell_fur/README.md)
 python examples/shell_fur/figures.py

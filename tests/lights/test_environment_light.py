@@ -4,7 +4,7 @@ rotation, the disk cache and its refusals."""
 
 import numpy as np
 import pytest
-from pbr_reference import interior, sphere_hits
+from pbr_reference import interior, render_hdr, sphere_hits
 
 from deferred.errors import InputError
 from deferred.io.images import write_image
@@ -35,14 +35,6 @@ def one_sphere(map_path, material, params, rotation=0.0, size=SIZE, camera=CAMER
         "size": list(size), "tonemap": "none", "background": [0.0, 0.0, 0.0], "camera": camera,
         "object": [{"mesh": SPHERE, "material": material, "params": params}],
         "light": [{"type": "environment", "map": map_path, "rotation": rotation}]})
-
-
-def render_hdr(gl, scene, pipeline="deferred"):
-    renderer = Renderer(scene, pipeline, gl=gl)
-    try:
-        return renderer.render(hdr=True).hdr[..., :3]
-    finally:
-        renderer.release()
 
 
 @pytest.mark.parametrize("pipeline", ["deferred", "forward"])

@@ -4,10 +4,10 @@ whatever the objects' order, and hides behind an opaque one."""
 
 import numpy as np
 import pytest
+from pbr_reference import render_hdr
 from plane_reference import plane_points
 
 from deferred.io.images import write_image
-from deferred.render.renderer import Renderer
 from deferred.scene.loader import scene_from_dict
 
 TOP = {"position": [0.0, 4.0, 0.0], "target": [0.0, 0.0, 0.0], "up": [0.0, 0.0, -1.0],
@@ -24,14 +24,6 @@ def alpha_ramp(path, rising=True):
     return str(path)
 
 
-def render(gl, scene, pipeline):
-    renderer = Renderer(scene, pipeline, gl=gl)
-    try:
-        return renderer.render(hdr=True).hdr[..., :3]
-    finally:
-        renderer.release()
-
-
 @pytest.mark.parametrize("pipeline", ["deferred", "forward"])
 def test_mask_cuts_below_the_cutoff(gl, tmp_path, pipeline):
     cutoff = 0.3
@@ -41,7 +33,7 @@ def test_mask_cuts_below_the_cutoff(gl, tmp_path, pipeline):
                     "params": {"base_color": [0.0, 0.0, 0.0], "emissive": [1.0, 1.0, 1.0],
                                "alpha_mode": "mask", "alpha_cutoff": cutoff,
                                "base_color_texture": alpha_ramp(tmp_path / "ramp.png")}}]})
-    image = render(gl, scene, pipeline)[::-1]  # bottom row first, as plane_points
+    image = render_hdr(gl, scene, pipeline)[::-1]  # bottom row first, as plane_points
     points = plane_points(scene, SIZE)
     u = points[..., 0] / 2.0 + 0.5
     on_plane = (np.abs(points[..., 0]) < 0.97) & (np.abs(points[..., 2]) < 0.97)
@@ -68,7 +60,7 @@ def test_mask_cuts_its_shadow(gl, tmp_path, pipeline):
                         "base_color_texture": alpha_ramp(tmp_path / "ramp.png", False)}}],
         "light": [{"type": "directional", "direction": [1.0, -1.0, 0.0], "shadows": True,
                    "shadow_resolution": 1024}]})
-    image = render(gl, scene, pipeline)[::-1]
+    image = render_hdr(gl, scene, pipeline)[::-1]
     ground = plane_points(scene, SIZE)  # the ground beside the small plane
     row = np.argmin(np.abs(ground[:, SIZE[0] // 2, 2]))
     x = ground[row, :, 0]
@@ -101,9 +93,9 @@ def two_planes(front_first, blend_in_front=True):
 
 @pytest.mark.parametrize("pipeline", ["deferred", "forward"])
 def test_blend_in_front_shows_both_colours_in_proportion(gl, pipeline):
-    image = render(gl, two_planes(True), pipeline)
+    image = render_hdr(gl, two_planes(True), pipeline)
     np.testing.assert_allclose(image[32, 32], [0.25, 0.75, 0.0], atol=2e-3)
     np.testing.assert_allclose(image[32, 4], [0.0, 1.0, 0.0], atol=2e-3)  # the back alone
-    np.testing.assert_array_equal(image, render(gl, two_planes(False), pipeline))
-    hidden = render(gl, two_planes(True, blend_in_front=False), pipeline)
+    np.testing.assert_array_equal(image, render_hdr(gl, two_planes(False), pipeline))
+    hidden = render_hdr(gl, two_planes(True, blend_in_front=False), pipeline)
     np.testing.assert_allclose(hidden[32, 32], [0.0, 1.0, 0.0], atol=2e-3)
