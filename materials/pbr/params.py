@@ -54,7 +54,9 @@ def texture_params(value: TextureField) -> TextureParams | None:
 
 
 class PbrParams(MaterialParams):
-    base_color: tuple[UnitFloat, UnitFloat, UnitFloat, UnitFloat] = Field(
+    # three numbers are taken as opaque (the validator below): the union says so to a schema
+    base_color: tuple[UnitFloat, UnitFloat, UnitFloat, UnitFloat] | \
+        tuple[UnitFloat, UnitFloat, UnitFloat] = Field(
         (1.0, 1.0, 1.0, 1.0), description="linear RGBA (glTF baseColorFactor; three numbers: "
                                           "opaque)")
     metallic: float = Field(1.0, ge=0.0, le=1.0, description="glTF metallicFactor")
