@@ -320,8 +320,9 @@ class DepthPrepass(ObjectPass):
 
 
 def depth_prepass(lit: ForwardLitPass) -> RenderPass:
-    """Forward+'s depth pre-pass twin of ``lit``: a plain object pass of its vertex stage and
-    constants where those are all it sets (most materials: no hooks asked at each draw), else
+    """Forward+'s depth pre-pass twin of ``lit`` (its faces: a double-sided surface's back
+    faces too): a plain object pass of its vertex stage and constants where those are all it
+    sets (most materials: no hooks asked at each draw), else
     a :class:`DepthPrepass`."""
     # an object's lit pass is <label>.forward; a material's other lit passes keep their names
     stem = lit.name.removesuffix(".forward") if lit.name == f"{lit.node.label}.forward" \
@@ -332,9 +333,9 @@ def depth_prepass(lit: ForwardLitPass) -> RenderPass:
             not overrides(type(lit), ObjectPass, "draw"):
         return ObjectPass(name, Phase.FORWARD, lit, vertex=lit.vertex,
                           fragment=DepthPrepass.fragment, colors=DepthPrepass.colors,
-                          constants=lit.constants, order=Order.FIRST)
+                          constants=lit.constants, cull=lit.cull, order=Order.FIRST)
     return DepthPrepass(name, Phase.FORWARD, lit, vertex=lit.vertex,
-                        constants=lit.constants, lit=lit)
+                        constants=lit.constants, cull=lit.cull, lit=lit)
 
 
 PIPELINES: dict[str, type[Pipeline]] = {names.Pipeline.DEFERRED.value: DeferredPipeline,

@@ -99,3 +99,28 @@ def test_blend_in_front_shows_both_colours_in_proportion(gl, pipeline):
     np.testing.assert_array_equal(image, render_hdr(gl, two_planes(False), pipeline))
     hidden = render_hdr(gl, two_planes(True, blend_in_front=False), pipeline)
     np.testing.assert_allclose(hidden[32, 32], [0.0, 1.0, 0.0], atol=2e-3)
+
+
+@pytest.mark.parametrize("double_sided", [False, True])
+def test_double_sided_shows_the_back_lit_as_its_front(gl, double_sided):
+    """A plane seen from behind: culled unless double-sided, then lit with its normal turned
+    toward the viewer (a light behind the camera lights it), the same in both pipelines
+    (Forward+'s pre-pass draws the back faces too)."""
+    def plane(flip):
+        return scene_from_dict({
+            "size": [48, 48], "tonemap": "none", "background": [0.0, 0.0, 1.0],
+            "camera": {"position": [0.0, 3.0, 0.0], "target": [0.0, 0.0, 0.0],
+                       "up": [0.0, 0.0, -1.0], "fov": 40.0},
+            "object": [{"mesh": "builtin:plane", "material": "pbr",
+                        "rotation": [180.0 if flip else 0.0, 0.0, 0.0],
+                        "params": {"base_color": [0.8, 0.2, 0.2], "metallic": 0.0,
+                                   "roughness": 0.6, "double_sided": double_sided}}],
+            "light": [{"type": "directional", "direction": [0.2, -1.0, 0.1]}]})
+
+    front = render_hdr(gl, plane(False))
+    for pipeline in ("deferred", "forward"):
+        back = render_hdr(gl, plane(True), pipeline)
+        if double_sided:
+            np.testing.assert_allclose(back[24, 24], front[24, 24], rtol=1e-3, atol=1e-4)
+        else:
+            np.testing.assert_array_equal(back[24, 24], [0.0, 0.0, 1.0])
