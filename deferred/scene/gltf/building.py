@@ -8,7 +8,8 @@ primitives drawn with their materials, its cameras, lights, skins and an animati
   primitive's.
 - :func:`fill_scene` makes ``deferred render model.glb``'s scene: the asset, the file's camera
   (the first, or the one named) or one framing the scene's bounds, the file's lights or, where
-  it has none, the default light, and the first animation (or the one named).
+  it has none, the built-in sky's ``environment`` light, and the first animation (or the one
+  named).
 """
 
 from __future__ import annotations
@@ -278,19 +279,8 @@ def file_camera(scene: Any, placed: PlacedAsset, choice: str | None) -> Camera |
 
 
 def default_lights(scene: Any) -> None:
-    """The light of a file without lights: an environment where the ``environment`` light is
-    registered, else a sky-and-ground ambient and a sun from over the viewer's shoulder."""
-    try:
-        environment = registry.lights.get("environment")
-    except InputError:
-        environment = None
-    if environment is not None:
-        scene.lights.append(environment.from_dict({}, "default light"))
-        return
-    scene.lights.append(registry.lights.get("ambient").from_dict(
-        {"color": (0.35, 0.37, 0.42), "ground": (0.12, 0.11, 0.10)}, "default light"))
-    scene.lights.append(registry.lights.get("directional").from_dict(
-        {"direction": (-0.4, -0.8, -0.6), "intensity": 2.5}, "default light"))
+    """The light of a file without lights: an ``environment`` light of the built-in sky."""
+    scene.lights.append(registry.lights.get("environment").from_dict({}, "default light"))
 
 
 def fill_scene(scene: Any, path: Path, camera: str | None = None,

@@ -1,5 +1,5 @@
 """glTF materials as the framework's: each glTF material's metallic-roughness values and
-textures as the ``pbr`` material's parameters (:func:`pbr_values`), and the material made from
+textures as the ``pbr`` material's parameters (:func:`read_material`), and the material made from
 them (:func:`make_material`).
 
 The keys are ``pbr``'s: ``base_color`` (RGBA), ``metallic``, ``roughness``, ``emissive``,
@@ -8,9 +8,7 @@ The keys are ``pbr``'s: ``base_color`` (RGBA), ``metallic``, ``roughness``, ``em
 ``normal``, ``occlusion``, ``emissive``), ``<slot>_texture``: a table of the image file
 (``path``), its UV set (``uv``), its ``KHR_texture_transform`` (``offset``, ``rotation``,
 ``scale``, in glTF's texture space) and its sampler (``wrap_s``, ``wrap_t``, ``mag_filter``,
-``min_filter``). Only the keys the registered material's
-parameters have are given to it; a value it cannot take is warned about once, by key.
-Where no ``pbr`` material is registered, ``standard`` stands in (base colour and its texture).
+``min_filter``).
 """
 
 from __future__ import annotations
@@ -19,7 +17,6 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
-from deferred.errors import InputError
 from deferred.interfaces import registry
 from deferred.interfaces.material import Material
 from deferred.scene.gltf.document import GltfDocument
@@ -169,38 +166,7 @@ DEFAULT_MATERIAL = GltfMaterial("default", "the default material", dict(DEFAULT_
 
 
 def make_material(material: GltfMaterial, document: GltfDocument) -> Material:
-    """The framework's material of ``material``: ``pbr`` with the values its parameters take
-    (the others warned about once, by key), or the ``standard`` stand-in where no ``pbr`` is
-    registered."""
-    try:
-        cls = registry.materials.get("pbr")
-    except InputError:
-        return _standard(material, document)
-    fields = cls.Params.model_fields
-    taken = {key: value for key, value in material.values.items() if key in fields}
-    left = sorted(key for key, value in material.values.items()
-                  if key not in fields and value != DEFAULT_VALUES.get(key))
-    for key in left:
-        _warn_once(document, f"{material.where}: pbr has no parameter {key} (left out)", key)
-    return cls.from_dict(taken, None, f"{document.name}: {material.where}")
-
-
-def _standard(material: GltfMaterial, document: GltfDocument) -> Material:
-    """The ``standard`` material standing in for ``pbr``: the base colour (linear RGB) and
-    its texture, a dull highlight where the surface is rough."""
-    values = material.values
-    color = tuple(min(1.0, max(0.0, c)) for c in values["base_color"][:3])
-    params: dict[str, Any] = {"color": color,
-                              "specular_intensity": 0.5 * (1.0 - values["roughness"]) + 0.05,
-                              "specular_exponent": 8.0 + 120.0 * (1.0 - values["roughness"])}
-    if "base_color_texture" in values:
-        params["texture"] = values["base_color_texture"]["path"]
-    return registry.materials.get("standard").from_dict(params, None,
-                                                        f"{document.name}: {material.where}")
-
-
-def _warn_once(document: GltfDocument, message: str, key: str) -> None:
-    said = document.__dict__.setdefault("_said", set())
-    if key not in said:
-        said.add(key)
-        document.warn(message)
+    """The framework's material of ``material``: ``pbr`` with its values (errors name the
+    file and the material)."""
+    return registry.materials.get("pbr").from_dict(dict(material.values), None,
+                                                   f"{document.name}: {material.where}")
