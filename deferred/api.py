@@ -21,6 +21,9 @@ A plugin (the built-in materials, lights and effects, and the example package in
   (``LIGHT_ACCUMULATION``, ``COMPOSITE``, ``FINAL`` and their specs).
 - **parameters**: the validated types (:data:`Albedo`, :data:`Radiance`, :data:`NonZeroVec3`),
   :class:`Params` and ``UniformOverrides``; ``require_regular_file`` for file parameters.
+- **cost**: what a material's, simulation's or effect's ``work`` returns for the cost model,
+  :class:`Work` terms (``Per`` render, frame or sample) from a :class:`WorkObject` and the
+  :class:`RenderWork` asked for; ``check_memory`` refuses an allocation past the memory budget.
 - **data**: :class:`MeshData` and :class:`GpuMesh` (the vertex format), the disk cache
   (:func:`cache_folder`, :func:`write_cached_arrays`, :func:`file_digest`), :class:`SceneObject`
   and :class:`Scene` (what passes are made for), images (:func:`read_image`,
@@ -107,8 +110,10 @@ from deferred.interfaces.techniques import (
     SurfacePasses,
     Technique,
 )
+from deferred.interfaces.work import Per, RenderWork, Work, WorkObject, counted
 from deferred.io.cache import cache_folder, file_digest, write_cached_arrays
 from deferred.io.images import check_image, read_channels, read_image, srgb_decode
+from deferred.io.memory import check_memory
 from deferred.names import LightPath, LightVolume, Pipeline, ShadowProjection
 from deferred.params import Params, UniformOverrides
 from deferred.scene import Scene, SceneObject
@@ -172,11 +177,11 @@ __all__ = [
     "MeshPrimitives", "Motion", "NoShadow", "SHADOW_CASTER_DEFINES", "ShadowCaster",
     "ShadowParams", "ShadowProjection", "ShadowView",
     "NonZeroVec3", "ObjectPass", "Order", "Params", "PassInput", "Phase", "PhasePasses",
-    "Pipeline", "Radiance", "ReachMotion",
-    "RenderError", "RenderPass", "Scene", "SceneObject", "ShadingModel", "Shape",
+    "Per", "Pipeline", "Radiance", "ReachMotion",
+    "RenderError", "RenderPass", "RenderWork", "Scene", "SceneObject", "ShadingModel", "Shape",
     "Simulation", "SurfacePasses", "TargetSpec", "Technique",
-    "UniformOverrides", "builtin_head_spheres", "cache_folder", "check_image", "copy_pass",
-    "effects", "file_digest", "halton",
+    "UniformOverrides", "Work", "WorkObject", "builtin_head_spheres", "cache_folder",
+    "check_image", "check_memory", "copy_pass", "counted", "effects", "file_digest", "halton",
     "image_texture_bytes", "lights", "materials",
     "radiances", "read_channels", "read_image", "register_shader_root", "require_regular_file",
     "srgb_decode",

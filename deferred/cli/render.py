@@ -4,7 +4,9 @@ needs the scene."""
 
 from __future__ import annotations
 
+import functools
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -12,6 +14,7 @@ from typing import TYPE_CHECKING
 import click
 
 from deferred.cli import options
+from deferred.cli.budget import StepClock, before_meshes, check_render, warn
 from deferred.cli.options import FiniteFloat, check_not_inputs, parse_size_option, stderr
 from deferred.cli.view_option import (
     LISTING,
@@ -31,6 +34,7 @@ from deferred.io.progress import Progress
 from deferred.scene.loader import load_scene
 
 if TYPE_CHECKING:
+    from deferred.io.cost import Prediction
     from deferred.render.renderer import Renderer
     from deferred.scene import Scene
 
@@ -159,34 +163,49 @@ def run_render(job: RenderJob, progress: Progress) -> Rendered:
     progress.status(f"loading {job.scene or 'the demo scene'} (meshes, UV unwraps)")
     loaded, size = _load(job)
     loaded, buffer = material_view(loaded, job.view_name, job.pipeline)
+    predicted, long = check_render(loaded, size or loaded.size, job.samples, job.times,
+                                   job.pipeline, size is not None)
     progress.status("starting the renderer")
     with Renderer(loaded, job.pipeline, size, strict=job.strict or None,
                   light_path=job.light_path) as renderer:
         renderer.check_times(job.times)  # a simulation cannot reach the last frame: refuse now
+        warn(long)  # every check passed: the work starts
         if job.kind == "image":
-            frame_ms = _render_image(renderer, loaded, job, buffer, progress)
+            frame_ms = _render_image(renderer, loaded, job, buffer, progress, predicted)
             written = str(job.out)
         else:
-            written, frame_ms = _render_animation(renderer, job, progress)
+            written, frame_ms = _render_animation(renderer, job, progress, predicted)
     return Rendered(renderer.size, renderer.light_path, written, frame_ms)
 
 
 def _load(job: RenderJob) -> tuple[Scene, tuple[int, int] | None]:
     """The scene, set up as ``job`` asks, and the size that overrides its own; ``InputError``
-    where an output would replace one of its files or a video cannot hold its frames."""
-    from deferred.io.video import check_animation_memory, check_video_size
+    where an output would replace one of its files, a video cannot hold its frames or the work
+    is past the time budget (both said before the meshes load)."""
+    size = parse_size_option(job.size)
+    weigh = before_meshes(size, job.samples, job.times, job.pipeline)
+
+    def check(scene: Scene, objects: list) -> None:
+        _check_video(job, size or scene.size)
+        weigh(scene, objects)  # a scene too heavy for the time budget: before its meshes
 
     chosen = {key: value for key, value in (("camera", job.gltf_camera),
                                             ("animation", job.animation)) if value is not None}
-    loaded = load_scene(job.scene, **chosen)
+    loaded = load_scene(job.scene, **chosen, before_meshes=check)
     if job.turntable is not None:
         loaded.set_turntable(job.turntable / job.fps, job.start_time)
     check_not_inputs(_outputs(job), loaded, job.scene, "-o")
-    size = parse_size_option(job.size)
-    if job.kind == "video":
-        check_video_size(job.out, size or loaded.size)
-        check_animation_memory(job.out, size or loaded.size, job.frames)
+    _check_video(job, size or loaded.size)  # a glTF file is a scene without before_meshes
     return loaded, size
+
+
+def _check_video(job: RenderJob, size: tuple[int, int]) -> None:
+    """A video's size and, for a GIF, the memory of its frames."""
+    from deferred.io.video import check_animation_memory, check_video_size
+
+    if job.kind == "video":
+        check_video_size(job.out, size)
+        check_animation_memory(job.out, size, job.frames)
 
 
 def _outputs(job: RenderJob) -> list[Path]:
@@ -199,21 +218,25 @@ def _outputs(job: RenderJob) -> list[Path]:
 
 
 def _render_image(renderer: Renderer, loaded: Scene, job: RenderJob, buffer: str | None,
-                  progress: Progress) -> list[float]:
+                  progress: Progress, predicted: Prediction) -> list[float]:
     """The one frame to ``job.out``, the final image or the buffer ``buffer``: its time in ms.
     Written while the renderer lives: the result may read its buffers lazily."""
     captured_after = view_pass(renderer, buffer) if buffer is not None else None  # bad names fail
-    progress.status("rendering the frame (shaders compile, simulations settle)")
     at = job.times[0]
     start = time.perf_counter()
     if buffer is not None:
+        progress.status(first_frame_stage(loaded))
         capture = capture_view(renderer, loaded, captured_after, at, job.fps)
     elif job.samples > 1:
-        result = renderer.render_samples(job.samples, at)
+        on_sample = _counted_steps(progress, job.samples, "samples", f"rendering {job.out.name}",
+                                   predicted, first_frame_stage(loaded))
+        result = renderer.render_samples(job.samples, at, on_sample)
     else:
+        progress.status(first_frame_stage(loaded))
         result = renderer.render(readback=True, time=at)
     renderer.gl.ctx.finish()
     frame_ms = [(time.perf_counter() - start) * 1000.0]
+    progress.status(f"writing {job.out.name}")
     if buffer is not None:
         write_captured_view(job.out, capture, buffer)
     elif job.out.suffix.lower() == ".exr":
@@ -223,10 +246,33 @@ def _render_image(renderer: Renderer, loaded: Scene, job: RenderJob, buffer: str
     return frame_ms
 
 
-def _render_animation(renderer: Renderer, job: RenderJob,
-                      progress: Progress) -> tuple[str, list[float]]:
+def first_frame_stage(loaded: Scene) -> str:
+    """What the first render of a command does besides drawing."""
+    simulated = any(obj.material.simulation is not None for obj in loaded.objects)
+    return "the first frame: compiling shaders" + (", simulating" if simulated else "")
+
+
+def _counted_steps(progress: Progress, total: int, unit: str, text: str,
+                   predicted: Prediction, first: str) -> Callable[[int], None]:
+    """Counted progress of ``total`` samples or frames, the time left from the prediction
+    until steps are measured (:class:`StepClock`): the callback to call with the count done."""
+    each = predicted.seconds / max(total, 1)
+    clock = StepClock(total, each)
+    progress.count(total, unit, f"{text} ({first})")
+    progress.advance(0, seconds_left=predicted.seconds)
+    clock.start()
+
+    def step(done: int) -> None:
+        progress.advance(done, text, clock.done(done))
+
+    return step
+
+
+def _render_animation(renderer: Renderer, job: RenderJob, progress: Progress,
+                      predicted: Prediction) -> tuple[str, list[float]]:
     """Every frame of ``job`` to its sequence or video, each averaged over ``job.samples``
-    sub-pixel renders: (what was written, the frame times in ms)."""
+    sub-pixel renders: (what was written, the frame times in ms). A sample is a step of the
+    progress (frames x samples in all)."""
     from deferred.io.video import AnimationWriter, check_animation_memory, describe_written
 
     if job.kind == "video":  # the frames a GIF holds with what the renderer holds
@@ -234,11 +280,14 @@ def _render_animation(renderer: Renderer, job: RenderJob,
                                renderer_bytes=renderer.memory_bytes())
     out, frame_ms = job.out, []
     with AnimationWriter(out, job.fps) as writer:
-        progress.count(job.frames, "frames", f"rendering {out.name}")
+        unit = "samples" if job.samples > 1 else "frames"
+        step = _counted_steps(progress, job.frames * job.samples, unit, f"rendering {out.name}",
+                              predicted, first_frame_stage(renderer.scene))
         for index, at in enumerate(job.times):
             start = time.perf_counter()
             if job.samples > 1:
-                averaged = renderer.render_samples(job.samples, at)
+                averaged = renderer.render_samples(
+                    job.samples, at, functools.partial(_after, step, index * job.samples))
                 frame_ms.append((time.perf_counter() - start) * 1000.0)
                 writer.write(averaged.hdr if writer.wants_hdr else averaged.image)
             else:
@@ -246,10 +295,14 @@ def _render_animation(renderer: Renderer, job: RenderJob,
                 renderer.gl.ctx.finish()
                 frame_ms.append((time.perf_counter() - start) * 1000.0)
                 writer.write(renderer.read_hdr() if writer.wants_hdr else renderer.read_final())
-            progress.advance(index + 1, f"rendering {out.name}")
+                step(index + 1)
         progress.status(f"writing {out.name}")
         written = writer.close()
     return describe_written(written), frame_ms
+
+
+def _after(step: Callable[[int], None], before: int, count: int) -> None:
+    step(before + count)
 
 
 def summary(job: RenderJob, rendered: Rendered) -> str:

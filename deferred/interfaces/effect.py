@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from deferred.core.frame import OfferedUniforms
+from deferred.interfaces.work import EFFECT_PIXEL_SECONDS, Per, RenderWork, Work, counted
 from deferred.names import Pipeline
 from deferred.params import Params, UniformOverrides, params_uniforms, validate_params
 from deferred.revision import Revisioned
@@ -109,6 +110,13 @@ class Effect(Revisioned):
         history kept from frame to frame), by what they are; counted with the render targets
         against the memory budget. By default nothing."""
         return {}
+
+    def work(self, job: RenderWork) -> list[Work]:
+        """The work of the effect's passes in a render ``job``, as the cost model counts it
+        (:mod:`deferred.interfaces.work`): by default its passes over every pixel once a
+        sample."""
+        return [Work(f"effect {self.name}: {counted(job.pixels)} pixels", job.pixels,
+                     EFFECT_PIXEL_SECONDS, f"effect {self.name}", Per.SAMPLE)]
 
     def jitter(self, index: int) -> tuple[float, float]:
         """A temporal effect's sub-pixel offset (x, y in pixels) of sample ``index`` since the

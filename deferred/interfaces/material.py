@@ -43,6 +43,8 @@ from deferred.interfaces import registry
 from deferred.interfaces.shadow_casting import ShadowCaster
 from deferred.interfaces.simulation import Motion, Simulation
 from deferred.interfaces.techniques import SurfacePasses, Technique
+from deferred.interfaces.work import RenderWork, WorkObject
+from deferred.io.cost import Work
 from deferred.memo import kept_while
 from deferred.params import Params, UniformOverrides, params_uniforms, validate_params
 from deferred.revision import Revisioned
@@ -262,6 +264,13 @@ class Material(Revisioned):
         before the first frame: a key names the thing (``texture /path/fur.png``), so a texture
         objects share counts once. Files are sized by their headers. By default nothing."""
         return {}
+
+    def work(self, obj: WorkObject, job: RenderWork) -> list[Work]:
+        """The work this material's passes do for ``obj`` in a render ``job``, as the cost
+        model counts it (:mod:`deferred.interfaces.work`): by default its mesh drawn once a
+        sample. A material drawing more (shells, tubes, strokes) counts it here; its
+        simulation counts its own (``Simulation.work``)."""
+        return [obj.surface_work()]
 
     # -- passes ------------------------------------------------------------------------------
     def passes(self, phase: Phase, obj: SceneObjectLike) -> list[RenderPass]:

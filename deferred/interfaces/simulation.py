@@ -20,6 +20,7 @@ if TYPE_CHECKING:
 
     from deferred.core.frame import Frame
     from deferred.core.protocols import SceneObjectLike
+    from deferred.interfaces.work import RenderWork, Work, WorkObject
 
 SIMULATED = "simulated"  # a frame's blackboard: (key, node) -> the state brought to its time
 
@@ -74,6 +75,11 @@ class Simulation(ABC):
         """Bytes the state of ``obj`` will hold by what they are (see
         ``Material.held_memory``)."""
         return {}
+
+    def work(self, obj: WorkObject, job: RenderWork) -> list[Work]:
+        """The work of bringing ``obj``'s state to the latest time of ``job`` (steps from 0),
+        as the cost model counts it (:mod:`deferred.interfaces.work`). By default none."""
+        return []
 
     def state(self, frame: Frame, obj: SceneObjectLike) -> Any:
         """``obj``'s state at the frame's time: made the first time, advanced once a frame."""

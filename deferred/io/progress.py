@@ -26,8 +26,8 @@ LINE_INTERVAL_S = 5.0  # off a terminal: at most one line this often
 
 
 def duration(seconds: float) -> str:
-    """``7 s``, ``2 min 5 s``, ``1 h 4 min``: a time left, rounded as people say it (at least
-    ``1 s``)."""
+    """``7 s``, ``2 min 5 s``, ``1 h 4 min``, ``3 days 2 h``: a time left, rounded as people
+    say it (at least ``1 s``)."""
     seconds = max(1.0, seconds)
     if seconds < 59.5:
         return f"{seconds:.0f} s"
@@ -35,7 +35,10 @@ def duration(seconds: float) -> str:
     if minutes < 60:
         return f"{minutes} min {rest} s" if rest else f"{minutes} min"
     hours, minutes = divmod(minutes, 60)
-    return f"{hours} h {minutes} min" if minutes else f"{hours} h"
+    if hours < 48:
+        return f"{hours} h {minutes} min" if minutes else f"{hours} h"
+    days, hours = divmod(hours, 24)
+    return f"{days:,} days {hours} h" if hours else f"{days:,} days"
 
 
 class _CountedBar(BarColumn):

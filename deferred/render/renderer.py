@@ -379,12 +379,14 @@ class Renderer:
                 self._pending_hdr = weakref.ref(result)
         return result
 
-    def render_samples(self, samples: int, time: float = 0.0) -> RenderResult:
+    def render_samples(self, samples: int, time: float = 0.0,
+                       on_sample: Callable[[int], None] | None = None) -> RenderResult:
         """The frame at ``time`` averaged over ``samples`` renders, each moved by a sub-pixel
         offset of the Halton (2, 3) sequence: the image averaged in linear light (its sRGB
         decoded, then encoded again) and the float composite averaged, converging to a
-        supersampled frame (a box filter over the pixel). One sample is :meth:`render`."""
-        return render_samples(self, samples, time)
+        supersampled frame (a box filter over the pixel). One sample is :meth:`render`.
+        ``on_sample(done)`` is called after each sample."""
+        return render_samples(self, samples, time, on_sample)
 
     def _keep_pending_hdr(self) -> None:
         """Read the last frame's HDR composite into its result before the targets are drawn

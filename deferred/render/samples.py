@@ -4,6 +4,7 @@ by an offset of the Halton (2, 3) sequence, the images averaged in linear light.
 from __future__ import annotations
 
 import numbers
+from collections.abc import Callable
 from typing import Any, Protocol
 
 import numpy as np
@@ -32,17 +33,22 @@ def halton_offsets(count: int) -> list[tuple[float, float]]:
     return [(halton(k, 2) - 0.5, halton(k, 3) - 0.5) for k in range(1, count + 1)]
 
 
-def render_samples(renderer: SampledRenderer, samples: int, time: float = 0.0) -> RenderResult:
+def render_samples(renderer: SampledRenderer, samples: int, time: float = 0.0,
+                   on_sample: Callable[[int], None] | None = None) -> RenderResult:
     """:meth:`Renderer.render_samples`: the frame at ``time`` averaged over ``samples``
     renders; the image averaged in linear light (its sRGB decoded, then encoded again) and the
     float composite averaged, converging to a supersampled frame (a box filter over the
-    pixel). One sample is a plain render."""
+    pixel). One sample is a plain render. ``on_sample(done)`` is called after each sample
+    (progress)."""
     if isinstance(samples, bool) or not isinstance(samples, numbers.Integral) or \
             not 1 <= samples <= MAX_SAMPLES:
         raise InputError(f"must be a whole number 1..{MAX_SAMPLES}, got {samples!r}",
                          "samples")
     if samples == 1:
-        return renderer.render(time=time, hdr=True)
+        result = renderer.render(time=time, hdr=True)
+        if on_sample is not None:
+            on_sample(1)
+        return result
     light = composite = None
     for index, jitter in enumerate(halton_offsets(samples)):
         # each sample its own parity of the stipple pattern (sample_index), which the
@@ -54,6 +60,8 @@ def render_samples(renderer: SampledRenderer, samples: int, time: float = 0.0) -
         light = decoded if light is None else light + decoded
         composite = result.hdr.astype(np.float64) if composite is None \
             else composite + result.hdr
+        if on_sample is not None:
+            on_sample(index + 1)
     image = np.clip(np.rint(srgb_encode(light / samples) * 255.0), 0, 255).astype(np.uint8)
     return RenderResult(image, result.draw_calls * samples,
                         {name: count * samples for name, count in result.draws_by_pass.items()},

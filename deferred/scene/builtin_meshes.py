@@ -150,7 +150,16 @@ _BUILTIN_TRIANGLES = {
     "torus": lambda a: 2 * a["segments"] * a["sides"],
     "plane": lambda a: 2 * a["divisions"] ** 2,
     "head": lambda a: 2 * a["segments"] * a["rings"],
+    "cube": lambda a: 12,
 }
+
+
+def builtin_triangles(shape: str, arguments: dict[str, int | float]) -> int:
+    """The triangles ``builtin:<shape>`` makes with ``arguments`` (its defaults for the rest),
+    counted without building it."""
+    parameters = inspect.signature(BUILTIN_SHAPES[shape], eval_str=True).parameters
+    return _BUILTIN_TRIANGLES[shape]({name: p.default for name, p in parameters.items()}
+                                     | arguments)
 
 
 def builtin_arguments(spec: str, where: str | None = None) -> tuple[str, dict[str, int | float]]:
@@ -180,8 +189,7 @@ def builtin_arguments(spec: str, where: str | None = None) -> tuple[str, dict[st
             raise InputError(f"builtin:{shape} parameter '{key}' is given twice", where)
         arguments[key] = _builtin_argument(shape, key, text, kinds[key], where)
     if shape in _BUILTIN_TRIANGLES:
-        counted = {name: p.default for name, p in parameters.items()} | arguments
-        triangles = _BUILTIN_TRIANGLES[shape](counted)
+        triangles = builtin_triangles(shape, arguments)
         if triangles > MAX_TRIANGLES:
             raise InputError(f"builtin:{shape} with these arguments has {triangles:,} "
                              f"triangles, more than the {MAX_TRIANGLES:,} a mesh may have",

@@ -25,6 +25,7 @@ from deferred.gl.meshes import MeshData
 from deferred.interfaces import registry
 from deferred.interfaces.material import Material
 from deferred.scene.camera import Camera
+from deferred.scene.census import BeforeMeshes, object_materials, weigh_objects
 from deferred.scene.gltf import GLTF_SUFFIXES, add_gltf, fill_scene, read_gltf
 from deferred.scene.gltf.building import animate, choose_animation
 from deferred.scene.graph import Hierarchy
@@ -63,12 +64,12 @@ def builtin_scenes() -> list[str]:
 
 
 def load_scene(path: str | Path | None = None, camera: str | None = None,
-               animation: str | None = None) -> Scene:
+               animation: str | None = None, before_meshes: BeforeMeshes | None = None) -> Scene:
     """Load a scene file; ``None`` loads the built-in demo scene, ``builtin:<name>`` another
     scene shipped with the package (``builtin:overdraw``, the bench scene with overdraw). A
     glTF file (.gltf, .glb) is a scene of its own (:func:`deferred.scene.gltf.fill_scene`):
     ``camera`` names one of its cameras, ``animation`` one of its animations (or ``none``);
-    either with another file is an error."""
+    either with another file is an error. ``before_meshes``: :class:`SceneBuilder`'s."""
     if path is not None and Path(path).suffix.lower() in GLTF_SUFFIXES:
         return fill_scene(Scene(source=Path(path).name), Path(path), camera, animation)
     for value, option in ((camera, "--camera"), (animation, "--animation")):
@@ -83,17 +84,18 @@ def load_scene(path: str | Path | None = None, camera: str | None = None,
             raise InputError(f"no built-in scene '{name}' (choose from "
                              f"{', '.join(builtin_scenes())})", path)
         text = resources.files("deferred").joinpath("scenes", f"{name}.toml").read_text("utf-8")
-        return scene_from_toml(text, name=f"builtin:{name}.toml", base_dir=None)
+        return scene_from_toml(text, f"builtin:{name}.toml", None, before_meshes)
     path = Path(path)
     require_regular_file(path, "scene file", str(path))
     try:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise InputError(f"cannot read scene file: {exc}", str(path)) from None
-    return scene_from_toml(text, name=path.name, base_dir=path.parent)
+    return scene_from_toml(text, path.name, path.parent, before_meshes)
 
 
-def scene_from_toml(text: str, name: str = "<string>", base_dir: Path | None = None) -> Scene:
+def scene_from_toml(text: str, name: str = "<string>", base_dir: Path | None = None,
+                    before_meshes: BeforeMeshes | None = None) -> Scene:
     """A scene from the text of a scene file; ``name`` is what errors call it, ``base_dir``
     where relative mesh and texture paths are found."""
     try:
@@ -102,15 +104,15 @@ def scene_from_toml(text: str, name: str = "<string>", base_dir: Path | None = N
         raise InputError(f"malformed TOML: {exc}", name) from None
     except RecursionError:
         raise InputError("malformed TOML: arrays or tables nested too deep", name) from None
-    return scene_from_dict(data, name, base_dir)
+    return scene_from_dict(data, name, base_dir, before_meshes)
 
 
-def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
-                    base_dir: Path | None = None) -> Scene:
+def scene_from_dict(data: dict[str, Any], name: str = "<dict>", base_dir: Path | None = None,
+                    before_meshes: BeforeMeshes | None = None) -> Scene:
     """The scene ``data`` describes (a scene file's tables). Every problem is found before one
     is raised: an :class:`InputError` for one, :class:`InputErrors` naming each (in the file's
     order) for several; unknown keys and names say the closest known one."""
-    builder = SceneBuilder(data, name, base_dir)
+    builder = SceneBuilder(data, name, base_dir, before_meshes)
     builder.build()
     if builder.problems:
         order = {key: position for position, key in enumerate(data)}
@@ -120,10 +122,13 @@ def scene_from_dict(data: dict[str, Any], name: str = "<dict>",
 
 
 class SceneBuilder:
-    """Makes a scene from a scene file's tables, collecting every problem (:meth:`build`)."""
+    """Makes a scene from a scene file's tables, collecting every problem (:meth:`build`);
+    ``before_meshes``: :func:`deferred.scene.census.weigh_objects`."""
 
-    def __init__(self, data: dict[str, Any], name: str, base_dir: Path | None):
+    def __init__(self, data: dict[str, Any], name: str, base_dir: Path | None,
+                 before_meshes: BeforeMeshes | None = None):
         self.name = name
+        self.before_meshes = before_meshes
         self.base_dir = base_dir
         self.problems: list[InputError] = []
         try:
@@ -165,10 +170,10 @@ class SceneBuilder:
                                        model.shadows.opacity_scale))
         if c.parent is not None:
             self.children.append((self.scene.camera, f"{name}: camera.parent"))
+        self.lights()  # lights and effects first: the objects are weighed with them
+        self.effects()
         self.objects()
         self.groups()
-        self.lights()
-        self.effects()
         self.events()
         self.tracks()
         self.parents()
@@ -197,6 +202,8 @@ class SceneBuilder:
             self.children.append((node, f"{where}.parent"))
 
     def objects(self) -> None:
+        materials = object_materials(self)
+        weigh_objects(self, materials)  # before any mesh: a refusal there is final
         meshes: dict[str, MeshData | None] = {}
         taken: set[str] = set()  # the labels, for unique_label
         next_index: dict[str, int] = {}  # unique_label's, for every unnamed object
@@ -205,13 +212,7 @@ class SceneBuilder:
             where = f"{self.name}: object[{index}]"
             if obj is None:
                 continue
-            material = material_cls = None
-            if "material" not in bad:
-                material_cls = self.collect(registry.materials.get, obj.material,
-                                            f"{where}.material")
-                if material_cls is not None and "params" not in bad:
-                    material = self.collect(material_cls.from_dict, obj.params, self.base_dir,
-                                            f"{where}.params")
+            material_cls, material = materials[index]
             if "mesh" not in bad and Path(obj.mesh).suffix.lower() in GLTF_SUFFIXES:
                 self._gltf_object(obj, bad, where, material, material_cls)
                 continue

@@ -44,7 +44,10 @@ from deferred.api import (
     InputError,
     Material,
     ReachMotion,
+    RenderWork,
     SurfacePasses,
+    Work,
+    WorkObject,
     builtin_head_spheres,
     materials,
 )
@@ -52,9 +55,15 @@ from deferred.api import (
 from ..shading_models import Toon
 from ..techniques.hair_strands import grow_strands, load_strands, resample_strand, scalp_roots
 from ..techniques.xtoon import XTOON_UNIFORM_OVERRIDES, XToonRamp
-from .params import STRAND_IDS, CartoonHairParams
+from .params import (
+    SILHOUETTE_TRIANGLE_SECONDS,
+    STRAND_IDS,
+    TUBE_TRIANGLE_SECONDS,
+    CartoonHairParams,
+    tube_counts,
+)
 from .passes import TUBES, HairStrokes
-from .state import DYNAMICS
+from .state import DYNAMICS, hair_shape
 
 if TYPE_CHECKING:
     from deferred.api import Frame, SceneObject
@@ -119,11 +128,31 @@ class CartoonHairMaterial(Material):
     # -- the strands ----------------------------------------------------------------------
     def spheres(self, obj: SceneObject) -> np.ndarray:
         """Object-space collision spheres: the params', or builtin:head's, or none."""
+        return self.spheres_of(obj.mesh.name)
+
+    def spheres_of(self, mesh_name: str) -> np.ndarray:
+        """The collision spheres on the mesh named ``mesh_name`` (a spec names it too)."""
         if self.params.collision_spheres is not None:
             return np.asarray(self.params.collision_spheres, np.float64).reshape(-1, 4)
-        if obj.mesh.name == "builtin:head":
+        if mesh_name.partition("?")[0] == "builtin:head":
             return builtin_head_spheres()
         return np.zeros((0, 4))
+
+    def work(self, obj: WorkObject, job: RenderWork) -> list[Work]:
+        """The head, then the tubes drawn (with the hatching, a second pass over them) and
+        their silhouette strokes, each a sample."""
+        p = self.params
+        strands, _ = hair_shape(self)
+        _, triangles = tube_counts(strands, p)
+        shape = f"{strands:,} strands x {p.hair_samples} samples x {p.sides} sides"
+        passes = 1 + (p.hatching != "none")
+        works = [*super().work(obj, job),
+                 Work(f"{obj.label}: tubes of {shape}{', hatched' * (passes > 1)}",
+                      triangles * passes, TUBE_TRIANGLE_SECONDS, obj.key("strands"))]
+        if p.silhouettes:
+            works.append(Work(f"{obj.label}: silhouettes of {shape}", triangles,
+                              SILHOUETTE_TRIANGLE_SECONDS, obj.key("silhouettes")))
+        return works
 
     def rest_strands(self, obj: SceneObject) -> np.ndarray:
         """The style: ``(S, P, 3)`` object-space strands, root first."""

@@ -19,6 +19,23 @@ MAX_HAIR_OBJECTS = (1 << 24) // STRAND_IDS  # ids stay whole numbers in the R32F
 # costs): more is refused rather than left to run for hours
 MAX_HAIR_STEPS = 20_000
 MAX_HAIR_STRAND_STEPS = 50_000_000
+MAX_COLLISION_SPHERES = 256  # each is tested against every particle at every step
+
+# The cost model's seconds (benchmarks/cost_model.py calibrate; benchmarks/README.md): a
+# particle of the simulated chains a step, and a collision sphere tested against one; a tube
+# vertex made once (numpy's tubes, the vertex format, the buffers) and built again each frame
+# (compute shaders); a tube triangle drawn (each pass over the tubes: G-buffer or lit pass,
+# hatching) and its silhouette strokes (a geometry shader over triangles with adjacency)
+PARTICLE_STEP_SECONDS = 33e-9
+SPHERE_TEST_SECONDS = 3e-9
+TUBE_VERTEX_MADE_SECONDS = 1.5e-6
+TUBE_VERTEX_FRAME_SECONDS = 40e-9
+TUBE_TRIANGLE_SECONDS = 200e-9
+SILHOUETTE_TRIANGLE_SECONDS = 390e-9
+# Bytes a tube vertex takes, held and at the peak of making the tubes (numpy's float64 arrays,
+# the vertex format, its GPU buffers), and a tube triangle's adjacency for the strokes
+TUBE_BYTES_PER_VERTEX = 240
+SILHOUETTE_BYTES_PER_TRIANGLE = 50
 
 
 class CartoonHairParams(BlinnPhongParams, XToonParams):
@@ -53,7 +70,8 @@ class CartoonHairParams(BlinnPhongParams, XToonParams):
     settle: float = Field(0.0, ge=0.0, le=60.0,
                           description="seconds simulated before t = 0 (the hair at rest)")
     collision_spheres: tuple[tuple[float, float, float, float], ...] | None = Field(
-        None, description="object-space (x, y, z, radius); default: builtin:head's own")
+        None, max_length=MAX_COLLISION_SPHERES,
+        description="object-space (x, y, z, radius); default: builtin:head's own")
     # tubes (4.3.1-4.3.2)
     hair_samples: int = Field(8, ge=2, le=64, description="spline samples a strand")
     sides: int = Field(6, ge=3, le=16, description="sides of a tube")
@@ -91,3 +109,10 @@ class CartoonHairParams(BlinnPhongParams, XToonParams):
 def settle_steps(params: CartoonHairParams) -> int:
     """Steps simulated before t = 0."""
     return int(round(params.settle / params.time_step))
+
+
+def tube_counts(strands: int, params: CartoonHairParams) -> tuple[int, int]:
+    """The tubes' vertices and triangles for ``strands`` strands: ``hair_samples`` rings of
+    ``sides`` and two cap centres a strand; the rings' quads and the caps' fans."""
+    rings = params.hair_samples * params.sides
+    return strands * (rings + 2), strands * 2 * rings

@@ -10,13 +10,36 @@ from typing import TYPE_CHECKING
 import moderngl
 import numpy as np
 
-from deferred.api import GpuMesh, InputError, MeshData, MeshPrimitives, Simulation
+from deferred.api import (
+    GpuMesh,
+    InputError,
+    MeshData,
+    MeshPrimitives,
+    Per,
+    RenderWork,
+    Simulation,
+    Work,
+    WorkObject,
+    counted,
+)
 
 from ..techniques.hair_dynamics import HairPhysics, HairSimulation
 from ..techniques.hair_silhouettes import silhouette_geometry, tube_adjacency
 from ..techniques.hair_strands import load_strands
 from ..techniques.hair_tubes import GpuTubes, build_tubes
-from .params import MAX_HAIR_STEPS, MAX_HAIR_STRAND_STEPS, CartoonHairParams, settle_steps
+from .params import (
+    MAX_HAIR_STEPS,
+    MAX_HAIR_STRAND_STEPS,
+    PARTICLE_STEP_SECONDS,
+    SILHOUETTE_BYTES_PER_TRIANGLE,
+    SPHERE_TEST_SECONDS,
+    TUBE_BYTES_PER_VERTEX,
+    TUBE_VERTEX_FRAME_SECONDS,
+    TUBE_VERTEX_MADE_SECONDS,
+    CartoonHairParams,
+    settle_steps,
+    tube_counts,
+)
 
 if TYPE_CHECKING:
     from deferred.api import Frame, SceneObject
@@ -181,18 +204,78 @@ class HairDynamics(Simulation):
         state.advance(frame.time, frame)
 
     def check_time(self, obj: SceneObject, time: float, where: str) -> None:
+        params = obj.material.params
+        check_steps(params, time, hair_shape(obj.material)[0], obj.label, where)
+
+    def work(self, obj: WorkObject, job: RenderWork) -> list[Work]:
+        """The chains stepped to the latest frame (their particles, and each against the
+        collision spheres), the tubes made once and built again each frame; refused past the
+        step limits (:func:`check_steps`)."""
         material = obj.material
         params = material.params
-        steps = round(time / params.time_step) + settle_steps(params)
-        strands = params.strands if params.strands_file is None else \
-            len(load_strands(material.resolve_path(params.strands_file), "strands_file"))
-        if steps > MAX_HAIR_STEPS or steps * strands > MAX_HAIR_STRAND_STEPS:
-            settling = " (with settle)" if params.settle > 0.0 else ""
-            raise InputError(f"t = {time:g} s needs {steps:,} simulation steps of "
-                             f"{params.time_step:g} s{settling} for {strands:,} strands "
-                             f"({obj.label}); the most is {MAX_HAIR_STEPS:,} steps and "
-                             f"{MAX_HAIR_STRAND_STEPS:,} strand steps: render an earlier time, "
-                             "raise time_step or grow fewer strands", where)
+        strands, points = hair_shape(material)
+        check_steps(params, job.latest_time, strands, obj.label, job.time_key)
+        steps = hair_steps(params, job.latest_time)
+        particles = strands * (2 * points + 1)  # the chains: points and their middles
+        spheres = len(material.spheres_of(obj.mesh))
+        vertices, _ = tube_counts(strands, params)
+        shape = f"{strands:,} strands x {params.hair_samples} samples x {params.sides} sides"
+        works = [Work(f"{obj.label}: {steps:,} steps x {counted(particles)} particles",
+                      steps * particles, PARTICLE_STEP_SECONDS, obj.key("strands"), Per.RENDER),
+                 Work(f"{obj.label}: making the tubes, {shape}", vertices,
+                      TUBE_VERTEX_MADE_SECONDS, obj.key("strands"), Per.RENDER),
+                 Work(f"{obj.label}: the tubes built, {shape}", vertices,
+                      TUBE_VERTEX_FRAME_SECONDS, obj.key("strands"), Per.FRAME)]
+        if spheres:
+            works.append(Work(f"{obj.label}: {steps:,} steps x {counted(particles)} particles x "
+                              f"{spheres} collision spheres", steps * particles * spheres,
+                              SPHERE_TEST_SECONDS, obj.key("collision_spheres"), Per.RENDER))
+        return works
+
+    def held_memory(self, obj: SceneObject) -> dict[str, int]:
+        """The tubes (made by numpy, in the vertex format and its buffers), their triangles'
+        adjacency for the silhouette strokes, and the simulated chains."""
+        params = obj.material.params
+        strands, points = hair_shape(obj.material)
+        vertices, triangles = tube_counts(strands, params)
+        held = {f"hair tubes of {obj.label}": vertices * TUBE_BYTES_PER_VERTEX,
+                f"hair chains of {obj.label}": strands * (2 * points + 1) * CHAIN_BYTES}
+        if params.silhouettes:
+            held[f"hair silhouettes of {obj.label}"] = triangles * SILHOUETTE_BYTES_PER_TRIANGLE
+        return held
+
+
+# bytes a particle of the chains takes (positions, velocities, the step's scratch: float32)
+CHAIN_BYTES = 12 * 3 * 4
+
+
+def hair_shape(material) -> tuple[int, int]:
+    """The strands and the points a strand of a cartoon_hair material: its file's (read once
+    and kept), or ``strands`` of ``segments + 1`` points."""
+    params = material.params
+    if params.strands_file is None:
+        return params.strands, params.segments + 1
+    strands = load_strands(material.resolve_path(params.strands_file), "strands_file")
+    return strands.shape[0], strands.shape[1]
+
+
+def hair_steps(params: CartoonHairParams, time: float) -> int:
+    """Steps simulated to reach ``time``, the settling with them."""
+    return round(time / params.time_step) + settle_steps(params)
+
+
+def check_steps(params: CartoonHairParams, time: float, strands: int, label: str,
+                where: str) -> None:
+    """Refuse (naming ``where``) a frame ``time`` whose steps, or steps times ``strands``, pass
+    the limits."""
+    steps = hair_steps(params, time)
+    if steps > MAX_HAIR_STEPS or steps * strands > MAX_HAIR_STRAND_STEPS:
+        settling = " (with settle)" if params.settle > 0.0 else ""
+        raise InputError(f"t = {time:g} s needs {steps:,} simulation steps of "
+                         f"{params.time_step:g} s{settling} for {strands:,} strands "
+                         f"({label}); the most is {MAX_HAIR_STEPS:,} steps and "
+                         f"{MAX_HAIR_STRAND_STEPS:,} strand steps: render an earlier time, "
+                         "raise time_step or grow fewer strands", where)
 
 
 DYNAMICS = HairDynamics()

@@ -66,6 +66,10 @@ class ShellFurMaterial(FurMaterial):
     uniform_overrides = {**FUR_UNIFORM_OVERRIDES, **{key: None for key in NOT_UNIFORMS},
                          "shells": layers_uniform}
     # the simulation's set-up (ShellFurState), and the passes built once
+    # the cost model's seconds (benchmarks/cost_model.py calibrate)
+    shell_triangle_seconds = 360e-9
+    shell_pixel_seconds = 510e-9
+    fin_triangle_seconds = 1.6e-6
     timeline_growing = ("droplets",)  # fallen droplets stay (Algorithm 1 blends, never removes)
     timeline_fixed = ("fur_length", "mask_size", "wetness_mask", "time_step", "settle", "seed",
                       "fins", "shading", "strand_variation", "curl_variation")

@@ -20,6 +20,7 @@ MAX_SIMULATION_STEPS = 100_000
 # Steps x strands a render may simulate: the work grows with both, so a fine mesh reaches the
 # limit at an earlier time (benchmarks/README.md has what a strand step costs)
 MAX_STRAND_STEPS = 200_000_000
+STRAND_STEP_SECONDS = 100e-9  # a strand step, for the cost model (63-96 ns measured)
 # Wetness-mask texels the droplets of a render may blend (each droplet blends the texels under
 # it: radius^2 x droplets); benchmarks/README.md has what a texel costs
 MAX_DROPLET_TEXELS = 400_000_000

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 import moderngl
 import numpy as np
 
-from deferred.api import InputError, Simulation
+from deferred.api import InputError, Per, RenderWork, Simulation, Work, WorkObject, counted
 
 from ..techniques.strands import (
     StrandForces,
@@ -39,6 +39,7 @@ from .params import (
     MAX_DROPLET_TEXELS,
     MAX_SIMULATION_STEPS,
     MAX_STRAND_STEPS,
+    STRAND_STEP_SECONDS,
     ShellFurParams,
     simulation_steps,
 )
@@ -253,20 +254,7 @@ class ShellFurSimulation(Simulation):
         state.advance(frame.time)
 
     def check_time(self, obj: SceneObject, time: float, where: str) -> None:
-        params = obj.material.params
-        steps = simulation_steps(params, time)
-        if steps > MAX_SIMULATION_STEPS:
-            raise InputError(f"t = {time:g} s needs {steps:,} simulation steps of "
-                             f"{params.time_step:g} s (with settle); the most is "
-                             f"{MAX_SIMULATION_STEPS:,}: render an earlier time or raise "
-                             "time_step", where)
-        strands = len(obj.mesh.indices)
-        if steps * strands > MAX_STRAND_STEPS:
-            raise InputError(f"t = {time:g} s needs {steps:,} simulation steps of "
-                             f"{strands:,} strands ({obj.label}: one a triangle), "
-                             f"{steps * strands:,} strand steps; the most is "
-                             f"{MAX_STRAND_STEPS:,}: render an earlier time, raise time_step "
-                             "or give the object a coarser mesh", where)
+        check_steps(obj.material.params, time, len(obj.mesh.indices), obj.label, where)
         texels, blame = droplet_texels(obj, time)
         if texels > MAX_DROPLET_TEXELS:
             droplets = _params_at(obj, time).droplets
@@ -278,6 +266,34 @@ class ShellFurSimulation(Simulation):
 
     def held_memory(self, obj: SceneObject) -> dict[str, int]:
         return {f"wetness mask of {obj.label}": 2 * obj.material.params.mask_size ** 2 * 16}
+
+    def work(self, obj: WorkObject, job: RenderWork) -> list[Work]:
+        """The strand steps to the latest frame (one strand a triangle), refused past the
+        limits before the mesh is made (:func:`check_steps`)."""
+        params = obj.material.params
+        strands = obj.triangles
+        check_steps(params, job.latest_time, strands, obj.label, job.time_key)
+        steps = simulation_steps(params, job.latest_time)
+        return [Work(f"{obj.label}: {steps:,} simulation steps x {counted(strands)} strands",
+                     steps * strands, STRAND_STEP_SECONDS, obj.key("time_step"), Per.RENDER)]
+
+
+def check_steps(params: ShellFurParams, time: float, strands: int, label: str,
+                where: str) -> None:
+    """Refuse (naming ``where``) a frame ``time`` whose steps, or steps times ``strands``, pass
+    the limits."""
+    steps = simulation_steps(params, time)
+    if steps > MAX_SIMULATION_STEPS:
+        raise InputError(f"t = {time:g} s needs {steps:,} simulation steps of "
+                         f"{params.time_step:g} s (with settle); the most is "
+                         f"{MAX_SIMULATION_STEPS:,}: render an earlier time or raise "
+                         "time_step", where)
+    if steps * strands > MAX_STRAND_STEPS:
+        raise InputError(f"t = {time:g} s needs {steps:,} simulation steps of "
+                         f"{strands:,} strands ({label}: one a triangle), "
+                         f"{steps * strands:,} strand steps; the most is "
+                         f"{MAX_STRAND_STEPS:,}: render an earlier time, raise time_step "
+                         "or give the object a coarser mesh", where)
 
 
 SIMULATION = ShellFurSimulation()

@@ -22,13 +22,23 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
 import moderngl
 import numpy as np
 from pydantic import Field, model_validator
 
-from deferred.api import Material, MaterialParams, ReachMotion, check_image
+from deferred.api import (
+    Material,
+    MaterialParams,
+    Per,
+    ReachMotion,
+    RenderWork,
+    Work,
+    WorkObject,
+    check_image,
+    counted,
+)
 
 from .fur_volume import FurPattern, pattern, strand_volume, volume_texture
 from .heightfield import (
@@ -43,6 +53,8 @@ if TYPE_CHECKING:
 
 # A heightfield image tile counts as this many strands when density converts to tiles per unit.
 IMAGE_TILE_STRANDS = 1024
+# The cost model's seconds of making a fur volume (0.24-1.5 s by pattern, once a renderer)
+FUR_VOLUME_SECONDS = 0.5
 
 
 class FurParams(MaterialParams):
@@ -194,6 +206,11 @@ class FurMaterial(Material):
 
     params: FurParams
     motion = ReachMotion("fur_length")
+    # the cost model's seconds (benchmarks/cost_model.py calibrate): a shell over a triangle
+    # and over a covered pixel, and the fins' geometry over a triangle, each a sample
+    shell_triangle_seconds: ClassVar[float] = 330e-9
+    shell_pixel_seconds: ClassVar[float] = 540e-9
+    fin_triangle_seconds: ClassVar[float] = 3.5e-6
 
     def check_files(self, where: str | None) -> None:
         """Bad input for a heightfield image that is missing, not a file or unreadable
@@ -203,6 +220,33 @@ class FurMaterial(Material):
         key = f"{where}.heightfield" if where else "heightfield"
         load_heightfield(self.file_parameter(self.params.heightfield, "heightfield image",
                                              key), key)
+
+    def work(self, obj: WorkObject, job: RenderWork) -> list[Work]:
+        """The mesh, then its shells (each over the triangles and the pixels the fur covers)
+        and fins, as many shells as the level of detail gives where the object comes
+        nearest (before the mesh loads, the fewest: a lower bound)."""
+        p = self.params
+        works = [*super().work(obj, job),
+                 Work(f"{obj.label}: the fur volume", 1, FUR_VOLUME_SECONDS, obj.key("pattern"),
+                      Per.RENDER)]
+        if p.shells == 0:
+            return works
+        low = min(p.min_shells, p.shells)
+        shells = float(low) if obj.screen is None else float(np.clip(
+            obj.screen.pixels_across(p.fur_length) / p.lod_error, low, p.shells))
+        key = obj.key("shells")
+        works.append(Work(f"{obj.label}: {shells:.0f} shells x {counted(obj.triangles)} "
+                          "triangles", shells * obj.triangles, self.shell_triangle_seconds,
+                          key))
+        covered = obj.covered_pixels(job, p.fur_length * (obj.screen.scale if obj.screen
+                                                          else 1.0))
+        if covered is not None:
+            works.append(Work(f"{obj.label}: {shells:.0f} shells over {counted(covered)} "
+                              "pixels", shells * covered, self.shell_pixel_seconds, key))
+        if p.fins:
+            works.append(Work(f"{obj.label}: fins over {counted(obj.triangles)} triangles",
+                              obj.triangles, self.fin_triangle_seconds, obj.key("fins")))
+        return works
 
     def held_memory(self, obj: SceneObject) -> dict[str, int]:
         path = self.heightfield_path()

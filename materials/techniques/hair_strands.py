@@ -31,10 +31,16 @@ from typing import Literal
 
 import numpy as np
 
-from deferred.api import InputError, MeshData, require_regular_file
+from deferred.api import InputError, MeshData, check_memory, require_regular_file
 
 STRAND_SUFFIXES = (".json", ".obj")
 MAX_STRAND_FILE_BYTES = 256 << 20
+# Peak bytes parsing a strand file takes a byte of it (a JSON number's text of about 9 bytes
+# becomes a Python float in a list; measured 6.7-15 on files of 73-85 MB), checked against the
+# memory budget before the file is read
+PARSE_BYTES_PER_BYTE = 16
+PARSED_KEPT = 4  # strand files kept parsed (path, size, time): their strands are read thrice
+_PARSED: dict[tuple[str, int, int], np.ndarray] = {}
 MAX_STRANDS = 1_000_000
 MAX_STRAND_POINTS = 20_000_000  # strands x points, after resampling to the longest
 MAX_STRAND_POINTS = 4096
@@ -155,10 +161,18 @@ def load_strands(path: str | Path, where: str | None = None) -> np.ndarray:
     if suffix not in STRAND_SUFFIXES:
         raise InputError(f"unsupported strand file format '{path.suffix}' (use "
                          f"{', '.join(STRAND_SUFFIXES)})", where)
-    size = path.stat().st_size
+    stat = path.stat()
+    size = stat.st_size
     if size > MAX_STRAND_FILE_BYTES:
         raise InputError(f"strand file is {size:,} bytes, more than the "
                          f"{MAX_STRAND_FILE_BYTES:,} read", where)
+    known = (str(path.resolve()), size, stat.st_mtime_ns)
+    if known in _PARSED:  # a file is asked for again by the checks, the cost model, the state
+        return _PARSED[known].copy()
+    # before the text is read: parsing holds Python lists of every number
+    check_memory(size * PARSE_BYTES_PER_BYTE, f"parsing the {size:,}-byte strand file "
+                                              f"{path.name} needs about {{}}", where,
+                 "a smaller file, or fewer points a strand")
     try:
         text = path.read_text(encoding="utf-8")
     except UnicodeDecodeError as exc:
@@ -166,7 +180,12 @@ def load_strands(path: str | Path, where: str | None = None) -> np.ndarray:
     except OSError as exc:
         raise InputError(f"cannot read strand file: {exc.strerror or exc}", where) from None
     strands = _json_strands(text, where) if suffix == ".json" else _obj_strands(text, where)
-    return _common_points(strands, where)
+    del text
+    loaded = _common_points(strands, where)
+    if len(_PARSED) >= PARSED_KEPT:
+        del _PARSED[next(iter(_PARSED))]
+    _PARSED[known] = loaded.copy()
+    return loaded
 
 
 def _json_strands(text: str, where: str) -> list[np.ndarray]:

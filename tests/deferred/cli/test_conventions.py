@@ -148,9 +148,9 @@ def test_a_warning_is_one_line_without_a_source_path(tmp_path, capsys, monkeypat
 
     load = render_module.load_scene
 
-    def warning_load(path):
+    def warning_load(path, **options):
         warnings.warn("something odd\nover two lines", UserWarning, stacklevel=1)
-        return load(path)
+        return load(path, **options)
 
     monkeypatch.setattr(render_module, "load_scene", warning_load)
     code, _, err = run(capsys, "render", "--size", "32x18", "-o", tmp_path / "a.png")
