@@ -13,7 +13,9 @@ from deferred.bench.harness import (
     parse_light_paths,
     parse_pipelines,
     run_bench,
+    sweep_points,
     sweep_runs,
+    sweep_shells,
 )
 from deferred.bench.report import (
     BenchReport,
@@ -32,5 +34,6 @@ from deferred.bench.timing import cpu_frame, time_cpu, time_passes
 __all__ = ["BenchReport", "BenchResult", "Sweep", "SweepProgress", "check_output", "check_sweep",
            "cpu_frame", "crossovers", "describe_sweep", "growth", "parse_counts",
            "parse_light_paths", "parse_pipelines", "results_table", "run_bench",
-           "shell_objects", "speedups", "sweep_runs", "time_cpu", "time_passes",
+           "shell_objects", "speedups", "sweep_points", "sweep_runs", "sweep_shells",
+           "time_cpu", "time_passes",
            "with_extra_lights", "with_shells", "write_csv", "write_json", "write_plot"]

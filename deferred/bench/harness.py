@@ -42,8 +42,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from deferred.bench.budget import ROUND_FRAMES, interleaved_groups
 from deferred.bench.report import BenchReport, BenchResult, renderer_info
-from deferred.bench.scenes import MAX_LIGHTS, shell_objects, with_extra_lights, with_shells
+from deferred.bench.scenes import MAX_LIGHTS, LightSweep, shell_objects, with_shells
 from deferred.bench.timing import (
     cpu_frame,
     gpu_frame,
@@ -56,6 +57,8 @@ from deferred.bench.timing import (
 from deferred.errors import InputError
 from deferred.gl.context import GLContext, create_context
 from deferred.io.extras import PLOT, require_extra
+from deferred.io.images import amount
+from deferred.io.memory import BUDGET_VARIABLE, memory_budget
 from deferred.io.paths import check_output_path
 from deferred.names import LIGHT_PATHS, LightPath, Pipeline
 from deferred.render.pipeline import PIPELINES
@@ -64,7 +67,6 @@ from deferred.scene.scene import Scene
 
 DEFAULT_LIGHTS = (1, 16, 64, 256, 1024)
 ROUND_ORDER_SEED = 0  # run_bench: the order of the points in each round
-ROUND_FRAMES = 5  # the most frames a point renders back to back in a round (Sweep.round_ms)
 OUTPUT_SUFFIXES = {"--json": ".json", "--csv": ".csv", "--plot": ".png"}
 
 
@@ -289,7 +291,8 @@ class _SweepClock:
 
 
 def run_bench(scene: Scene, sweep: Sweep, gl: GLContext | None = None,
-              progress: Callable[[SweepProgress], None] | None = None) -> BenchReport:
+              progress: Callable[[SweepProgress], None] | None = None,
+              note: Callable[[str], None] | None = None) -> BenchReport:
     """Render every (pipeline, light path, lights, shells) point of ``sweep`` and time it.
 
     With ``sweep.interleave`` (the default) the points of one shell count are timed together:
@@ -303,9 +306,11 @@ def run_bench(scene: Scene, sweep: Sweep, gl: GLContext | None = None,
     the same work as another's, ran 40% slower (benchmarks/README.md). Ratios between points
     (a light count against another, a path against another) hold where timing one point after
     another moved them by 40%. The cost: all those renderers are alive at once (about 50-90 MB
-    each at 1280x720 on lights.toml). Without it, one point is built, timed and released
-    after another. ``progress`` is called with a :class:`SweepProgress` before each warm-up
-    and each run (a configuration's round).
+    each on the demo, whatever the size), so they are counted against the memory budget
+    before any is made, and where they do not fit at once they are timed in groups that do
+    (:func:`~deferred.bench.budget.interleaved_groups`; ``note`` is told). Without it, one
+    point is built, timed and released after another. ``progress`` is called with a
+    :class:`SweepProgress` before each warm-up and each run (a configuration's round).
     """
     check_sweep(scene, sweep)
     points = sweep_points(sweep)
@@ -324,38 +329,55 @@ def run_bench(scene: Scene, sweep: Sweep, gl: GLContext | None = None,
     try:
         timers = timer_queries_work(gl)
         for shells in sweep_shells(scene, sweep.shells):
-            shelled = _shelled(scene, sweep, shells)
-            lit = {lights: with_extra_lights(shelled, lights, aspect) for lights in sweep.lights}
-            groups = [points] if sweep.interleave else [[point] for point in points]
+            lit = LightSweep(_shelled(scene, sweep, shells), max(sweep.lights, default=0),
+                             aspect)
+            if sweep.interleave:
+                groups, held = interleaved_groups(points, lit.at(max(sweep.lights, default=0)),
+                                                 size)
+                if len(groups) > 1 and note is not None:
+                    note(f"bench: the {len(points)} renderers of a round need about "
+                         f"{amount(held)} together, more than the memory budget of "
+                         f"{amount(memory_budget())} ({BUDGET_VARIABLE}): timed in "
+                         f"{len(groups)} groups of up to {max(map(len, groups))}")
+            else:
+                groups = [[point] for point in points]
             for group in groups:
-                order = random.Random(ROUND_ORDER_SEED)  # the same orders in every sweep
-                timed: list[_TimedPoint] = []
-                try:
-                    for lights, pipeline, path in group:
-                        report(f"warm-up: {pipeline} ({path}), {lights} lights, {shells} shells")
-                        start = time.perf_counter()
-                        renderer = Renderer(lit[lights], pipeline, size, gl=gl, light_path=path)
-                        timed.append(_TimedPoint(lights, pipeline, path, renderer,
-                                                 timer_queries(renderer) if timers else None))
-                        for _ in range(sweep.warmup):
-                            renderer.render(readback=False)
-                        clock.warmed_up(time.perf_counter() - start)
-                    for round_index in range(sweep.runs):
-                        for k in order.sample(range(len(timed)), len(timed)):
-                            point = timed[k]
-                            report(f"round {round_index + 1} of {sweep.runs}: {point.pipeline} "
-                                   f"({point.light_path}), {point.lights} lights, "
-                                   f"{shells} shells")
-                            start = time.perf_counter()
-                            point.time_round(sweep.round_ms)
-                            clock.ran(time.perf_counter() - start)
-                    results += [point.result(shells) for point in timed]
-                finally:
-                    for point in timed:
-                        point.renderer.release()
+                results += _time_group(group, lit, shells, sweep, size, gl, timers, clock,
+                                       report)
         info = {**renderer_info(gl, scene), "gl_timer_queries": timers,
                 "interleaved": sweep.interleave}
     finally:
         if owns:
             gl.release()
     return BenchReport(info, results)
+
+
+def _time_group(group: list[tuple[int, str, str]], lit: LightSweep, shells: int, sweep: Sweep,
+                size: tuple[int, int], gl: GLContext, timers: bool, clock: _SweepClock,
+                report: Callable[[str], None]) -> list[BenchResult]:
+    """The points of ``group`` timed together: each built and warmed up, then the rounds,
+    the points in a shuffled order each round; every renderer released at the end."""
+    order = random.Random(ROUND_ORDER_SEED)  # the same orders in every sweep
+    timed: list[_TimedPoint] = []
+    try:
+        for lights, pipeline, path in group:
+            report(f"warm-up: {pipeline} ({path}), {lights} lights, {shells} shells")
+            start = time.perf_counter()
+            renderer = Renderer(lit.at(lights), pipeline, size, gl=gl, light_path=path)
+            timed.append(_TimedPoint(lights, pipeline, path, renderer,
+                                     timer_queries(renderer) if timers else None))
+            for _ in range(sweep.warmup):
+                renderer.render(readback=False)
+            clock.warmed_up(time.perf_counter() - start)
+        for round_index in range(sweep.runs):
+            for k in order.sample(range(len(timed)), len(timed)):
+                point = timed[k]
+                report(f"round {round_index + 1} of {sweep.runs}: {point.pipeline} "
+                       f"({point.light_path}), {point.lights} lights, {shells} shells")
+                start = time.perf_counter()
+                point.time_round(sweep.round_ms)
+                clock.ran(time.perf_counter() - start)
+        return [point.result(shells) for point in timed]
+    finally:
+        for point in timed:
+            point.renderer.release()

@@ -95,6 +95,20 @@ def with_extra_lights(scene: Scene, count: int, aspect: float, seed: int = LIGHT
     return replace(scene, lights=[*scene.lights, *extra_point_lights(scene, count, aspect, seed)])
 
 
+class LightSweep:
+    """``scene`` with each count of extra point lights up to ``largest``: the largest count's
+    lights made once and each smaller count given its first ones (what
+    :func:`with_extra_lights` gives it), so a sweep of many counts does not make their lights
+    again for each."""
+
+    def __init__(self, scene: Scene, largest: int, aspect: float, seed: int = LIGHT_SEED):
+        self.scene = scene
+        self.extra = extra_point_lights(scene, largest, aspect, seed)
+
+    def at(self, count: int) -> Scene:
+        return replace(self.scene, lights=[*self.scene.lights, *self.extra[:count]])
+
+
 def has_shells(obj: SceneObject) -> bool:
     return SHELLS in type(obj.material.params).model_fields
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import os
 import sys
+import warnings
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -14,7 +15,8 @@ from rich.console import Console
 from deferred.cli import options
 from deferred.cli.options import check_not_inputs, parse_size_option, stderr
 from deferred.errors import RenderError
-from deferred.io.progress import Progress, duration
+from deferred.io.cost import Prediction, WorkWarning, check_time, duration
+from deferred.io.progress import Progress
 from deferred.scene.loader import load_scene
 
 if TYPE_CHECKING:
@@ -103,20 +105,41 @@ def run_sweep(loaded: Scene, sweep: Sweep) -> BenchReport:
     """Time every point of ``sweep``, the progress and the time left on stderr."""
     from deferred import bench as benchmark
 
-    stderr.print(f"bench: {benchmark.describe_sweep(loaded, sweep)}; time: estimating",
-                 markup=False, highlight=False)
+    predicted = check_sweep_time(loaded, sweep)
+    stderr.print(f"bench: {benchmark.describe_sweep(loaded, sweep)}; time: about "
+                 f"{duration(predicted.seconds)} predicted", markup=False, highlight=False)
     with Progress("bench", stderr) as progress:
         progress.count(benchmark.sweep_runs(loaded, sweep), "runs", "starting")
+        progress.advance(0, "starting", predicted.seconds)
         estimated = []
 
         def step(at: benchmark.SweepProgress) -> None:
-            progress.advance(at.runs_done, at.description, at.seconds_left)
+            left = at.seconds_left
+            if left is None:  # until a warm-up and a run are measured: the prediction's
+                left = predicted.seconds * (1.0 - at.runs_done / max(at.runs_total, 1))
+            progress.advance(at.runs_done, at.description, left)
             if at.seconds_left is not None and not estimated:  # the first measured run
                 estimated.append(at.seconds_left)
                 progress.note(f"bench: about {duration(at.seconds_left)} left, from the "
                               "first warm-up and run")
 
-        return benchmark.run_bench(loaded, sweep, progress=step)
+        return benchmark.run_bench(loaded, sweep, progress=step, note=progress.note)
+
+
+def check_sweep_time(loaded: Scene, sweep: Sweep) -> Prediction:
+    """The sweep's predicted time (:func:`deferred.bench.budget.predict_sweep`), refused past
+    the time budget naming --runs, and warned of past a minute."""
+    from deferred import bench as benchmark
+    from deferred.bench.budget import BENCH_REMEDY, predict_sweep
+
+    predicted = predict_sweep(loaded, benchmark.sweep_points(sweep),
+                              len(benchmark.sweep_shells(loaded, sweep.shells)),
+                              sweep.size or loaded.size, sweep.runs, sweep.warmup,
+                              sweep.round_ms)
+    said = check_time(predicted, "bench", BENCH_REMEDY)
+    if said is not None:
+        warnings.warn(said, WorkWarning, stacklevel=2)
+    return predicted
 
 
 def print_results(report: BenchReport, to_stderr: bool) -> None:

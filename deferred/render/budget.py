@@ -31,6 +31,22 @@ def check_target_memory(graph: PassGraph, size: tuple[int, int], where: str = "s
                      f"{size[0]}x{size[1]} need {{}}", held_where)
 
 
+# What a renderer holds that neither its targets nor its materials count: its compiled programs
+# and the driver's state for them, its buffers of lights and lists. Measured as the growth of
+# RSS for each renderer kept alive at 64x64 (benchmarks/README.md, "The cost model"): 6-45 MB
+# on lights.toml (standard surfaces), 38-85 MB on the demo (fur and ssao).
+RENDERER_BYTES = 24 << 20
+MATERIAL_TYPE_BYTES = 16 << 20  # each material type's programs
+
+
+def renderer_overhead(scene: FrameState) -> int:
+    """Bytes a renderer of ``scene`` holds besides its targets and what its materials,
+    shadows and effects say they hold: :data:`RENDERER_BYTES` and
+    :data:`MATERIAL_TYPE_BYTES` for each material type."""
+    kinds = {type(obj.material) for obj in scene.objects}
+    return RENDERER_BYTES + MATERIAL_TYPE_BYTES * len(kinds)
+
+
 def held_memory(scene: FrameState) -> dict[str, int]:
     """What every object's material will hold, by what it is (a shared texture once): the
     textures it loads and its simulation's state."""
