@@ -319,7 +319,8 @@ def check(quick: bool, names: list[str]) -> None:
             except Exception as exc:  # noqa: BLE001 - a refusal before the meshes load
                 predicted = f"refused before loading: {exc}"[:60]
             start = time.perf_counter()
-            done = subprocess.run(["/usr/bin/time", "-f", "peak RSS %M KB", sys.executable,
+            done = subprocess.run(["/usr/bin/time", "-f", "peak RSS %M KB, CPU %U + %S s",
+                                   sys.executable,
                                    "-m", "deferred", "render", *arguments, "-o",
                                    str(Path(folder) / "out.png")], env=env_run,
                                   capture_output=True, text=True)

@@ -58,11 +58,13 @@ class Work:
 
 @dataclass(frozen=True)
 class Prediction:
-    """The work of a command: its terms and how many frames of how many samples it renders."""
+    """The work of a command: its terms and how many frames of how many samples it renders;
+    ``lower_bound`` where some of its work is not counted (it is said as "at least")."""
 
     works: tuple[Work, ...]
     frames: int = 1
     samples: int = 1
+    lower_bound: bool = False
 
     def repeats(self, work: Work) -> int:
         """How many times the command does ``work``."""
@@ -117,7 +119,7 @@ class Prediction:
         return work.where
 
     def add(self, works: Iterable[Work]) -> Prediction:
-        return Prediction((*self.works, *works), self.frames, self.samples)
+        return Prediction((*self.works, *works), self.frames, self.samples, self.lower_bound)
 
 
 def duration(seconds: float) -> str:
@@ -146,17 +148,18 @@ def check_time(prediction: Prediction, command: str, remedy: str,
     """Refuse ``prediction`` past the time budget: an ``InputError`` naming the key to change
     (:meth:`Prediction.key`), with the predicted time, the budget and the largest terms;
     ``remedy`` says what to ask for instead. Past :data:`WARN_SECONDS` (and within the budget)
-    the warning to say is returned; else None."""
+    the warning to say is returned; else None (and for a lower bound, which is only refused)."""
     seconds = prediction.seconds
     budget = time_budget()
     repeated = prediction.repetition()
     shown = f"{repeated}: " if repeated else ""
     if seconds > budget:
-        raise InputError(f"{command} predicted to take {duration(seconds)} on the reference "
+        least = "at least " if prediction.lower_bound else ""
+        raise InputError(f"{command} predicted to take {least}{duration(seconds)} on the reference "
                          f"machine ({shown}{prediction.breakdown()}); the budget is "
                          f"{duration(budget)} ({BUDGET_VARIABLE}, seconds): {remedy}",
                          prediction.key(options))
-    if seconds > min(WARN_SECONDS, budget):
+    if seconds > min(WARN_SECONDS, budget) and not prediction.lower_bound:
         return (f"{command} predicted to take about {duration(seconds)} ({shown}"
                 f"{prediction.breakdown()})")
     return None

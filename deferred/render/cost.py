@@ -140,4 +140,5 @@ def predict_render(job: RenderWork, lights: Sequence, effects: Sequence,
         works += material.work(obj, job)
         if material.simulation is not None:
             works += material.simulation.work(obj, job)
-    return Prediction(tuple(works), job.frames, job.samples)
+    unplaced = any(obj.screen is None for obj in objects)  # before the meshes load
+    return Prediction(tuple(works), job.frames, job.samples, lower_bound=unplaced)

@@ -79,3 +79,13 @@ def test_the_variable_raises_the_budget_and_a_bad_value_is_named(monkeypatch):
                                            (3840, "1 h 4 min"), (266400, "3 days 2 h")])
 def test_durations_as_people_say_them(seconds, said):
     assert duration(seconds) == said
+
+
+def test_a_lower_bound_is_refused_as_at_least_and_never_warned_of(monkeypatch):
+    monkeypatch.delenv(BUDGET_VARIABLE, raising=False)
+    counted = prediction(samples=1024, sample_seconds=10.0)
+    lower = Prediction(counted.works, counted.frames, counted.samples, lower_bound=True)
+    with pytest.raises(InputError, match="render predicted to take at least 2 h 50 min"):
+        check_time(lower, "render", "less", OPTIONS)
+    warned = Prediction(lower.works, 1, 100, lower_bound=True)
+    assert check_time(warned, "render", "less", OPTIONS) is None
