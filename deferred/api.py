@@ -20,7 +20,8 @@ A plugin (the built-in materials, lights and effects, and the example package in
   ``LINEAR_DEPTH``, ``DEPTH``, ``GBUFFER_COLOR_TARGETS``) and the frame's
   (``LIGHT_ACCUMULATION``, ``COMPOSITE``, ``FINAL`` and their specs).
 - **parameters**: the validated types (:data:`Albedo`, :data:`Radiance`, :data:`NonZeroVec3`),
-  :class:`Params` and ``UniformOverrides``; ``require_regular_file`` for file parameters.
+  :class:`Params` and ``UniformOverrides``; ``require_regular_file`` for file parameters,
+  ``number_too_long`` for a file whose parser refuses an integer of too many digits.
 - **cost**: what a material's, simulation's or effect's ``work`` returns for the cost model,
   :class:`Work` terms (``Per`` render, frame or sample) from a :class:`WorkObject` and the
   :class:`RenderWork` asked for; ``check_memory`` refuses an allocation past the memory budget.
@@ -29,7 +30,8 @@ A plugin (the built-in materials, lights and effects, and the example package in
   and :class:`Scene` (what passes are made for), images (:func:`read_image`,
   :func:`read_channels`, :func:`check_image`), the light helpers (``view_point(s)``,
   ``view_direction(s)``, ``radiances``), the names (:class:`LightVolume`, :class:`Pipeline`,
-  :class:`LightPath`) and the errors (:class:`InputError`, :class:`RenderError`).
+  :class:`LightPath`), the errors (:class:`InputError`, :class:`RenderError`) and
+  ``MAX_COORDINATE``, the bound on a mesh's coordinates (a plugin reading points keeps it).
 - **GLSL**: :data:`GLSL_INCLUDES`, the framework's shader files a plugin's GLSL may include,
   each with what it gives; :func:`register_shader_root` for a folder of GLSL every scene
   searches (a class's own is its ``shader_root``).
@@ -118,7 +120,14 @@ from deferred.names import LightPath, LightVolume, Pipeline, ShadowProjection
 from deferred.params import Params, UniformOverrides
 from deferred.scene import Scene, SceneObject
 from deferred.scene.builtin_meshes import builtin_head_spheres
-from deferred.validation import Albedo, NonZeroVec3, Radiance, require_regular_file
+from deferred.scene.geometry import MAX_COORDINATE
+from deferred.validation import (
+    Albedo,
+    NonZeroVec3,
+    Radiance,
+    number_too_long,
+    require_regular_file,
+)
 
 # The framework's GLSL a plugin may include (``#include "<file>"``), and what each gives.
 GLSL_INCLUDES: dict[str, str] = {
@@ -169,7 +178,8 @@ GLSL_INCLUDES: dict[str, str] = {
 __all__ = [
     "ALBEDO_SPECULAR", "AMBIENT_OCCLUSION", "COMPOSITE", "COMPOSITE_SPEC", "DEPTH", "FINAL",
     "FINAL_SPEC", "FrameMoment", "GBUFFER_COLOR_TARGETS", "GLSL_INCLUDES", "LIGHT_ACCUMULATION",
-    "LIGHT_ACCUMULATION_SPEC", "LINEAR_DEPTH", "MOTION", "MOTION_SPEC", "NORMAL_EXPONENT_ID",
+    "LIGHT_ACCUMULATION_SPEC", "LINEAR_DEPTH", "MAX_COORDINATE", "MOTION", "MOTION_SPEC",
+    "NORMAL_EXPONENT_ID",
     "Albedo",
     "BlinnPhongParams", "ClearPass", "Effect", "EffectParams", "ForwardLitPass", "Frame",
     "FullscreenPass", "GBufferData", "GBufferPass", "GpuMesh", "InputError", "Light",
@@ -182,7 +192,7 @@ __all__ = [
     "Simulation", "SurfacePasses", "TargetSpec", "Technique",
     "UniformOverrides", "Work", "WorkObject", "builtin_head_spheres", "cache_folder",
     "check_image", "check_memory", "copy_pass", "counted", "effects", "file_digest", "halton",
-    "image_texture_bytes", "lights", "materials",
+    "image_texture_bytes", "lights", "materials", "number_too_long",
     "radiances", "read_channels", "read_image", "register_shader_root", "require_regular_file",
     "srgb_decode",
     "shading_models",

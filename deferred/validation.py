@@ -6,7 +6,9 @@ import collections.abc
 import difflib
 import math
 import numbers
+import re
 import stat
+import sys
 import types
 import typing
 from collections.abc import Iterable
@@ -156,6 +158,20 @@ def did_you_mean(name: object, choices: Iterable[str]) -> str:
     close."""
     match = closest(name, choices)
     return f" (did you mean '{match}'?)" if match is not None else ""
+
+
+def number_too_long(text: str) -> str:
+    """Where ``text`` (JSON, TOML) holds an integer of more digits than Python converts (a
+    ``ValueError`` from the parser), said as ``line L, column C: a number of N digits (at most
+    M are read)``."""
+    limit = sys.get_int_max_str_digits() if hasattr(sys, "get_int_max_str_digits") else 4300
+    found = re.search(rf"\d{{{limit + 1},}}", text)
+    if found is None:
+        return "a number too long to read"
+    line = text.count("\n", 0, found.start()) + 1
+    column = found.start() - (text.rfind("\n", 0, found.start()) + 1) + 1
+    return (f"line {line}, column {column}: a number of {len(found.group()):,} digits (at "
+            f"most {limit:,} are read)")
 
 
 def join_where(where: str | None, key: str) -> str | None:

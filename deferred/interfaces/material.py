@@ -48,7 +48,7 @@ from deferred.io.cost import Work
 from deferred.memo import kept_while
 from deferred.params import Params, UniformOverrides, params_uniforms, validate_params
 from deferred.revision import Revisioned
-from deferred.validation import require_regular_file
+from deferred.validation import join_where, require_regular_file
 
 if sys.version_info >= (3, 11):
     from importlib.resources.abc import Traversable
@@ -152,12 +152,16 @@ class Material(Revisioned):
     def __init__(self, params: MaterialParams | None = None, base_dir: Path | None = None):
         self.params = params if params is not None else self.Params()
         self.base_dir = base_dir
+        # where the params came from (``scene.toml: object[0].params``): what a problem found
+        # later, reading a file the params name, is said under (:meth:`key_where`)
+        self.where: str | None = None
 
     @classmethod
     def from_dict(cls, values: dict[str, Any], base_dir: Path | None = None,
                   where: str | None = None) -> Material:
         """Validate ``values`` against ``Params``; errors name the offending key."""
         material = cls(validate_params(cls.Params, values, where), base_dir)
+        material.where = where
         registry.shading_models.get(material.shading_model,
                                     f"{where}: shading model" if where else "shading model")
         material.check_files(where)
@@ -165,6 +169,11 @@ class Material(Revisioned):
 
     def check_files(self, where: str | None) -> None:
         """Raise ``InputError`` for parameters naming files that do not exist."""
+
+    def key_where(self, key: str) -> str:
+        """What an error about parameter ``key`` names: ``scene.toml: object[0].params.key``
+        for a material from a scene file, ``key`` alone for one made in Python."""
+        return join_where(self.where, key) or key
 
     def resolve_path(self, value: str | Path) -> Path:
         path = Path(value)

@@ -274,7 +274,8 @@ def _check_values(band: np.ndarray, first: int, pixels: np.ndarray, count: int, 
     total = int(bad.sum()) + sum(
         int(bad_values(_rgba(pixels[start:start + rows], count)).sum())
         for start in range(first + rows, len(pixels), rows))
-    raise InputError(f"image {_culprit(path, where)} has {total:,} values that are "
+    values = "a value that is" if total == 1 else f"{total:,} values that are"
+    raise InputError(f"image {_culprit(path, where)} has {values} "
                      f"NaN, infinite or negative (the first at pixel {x}, {first + y}: "
                      f"{np.array2string(band[y, x], precision=3)}); images hold values "
                      ">= 0", where)

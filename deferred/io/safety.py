@@ -153,7 +153,7 @@ def scene_inputs(scene: Any, scene_file: str | Path | None = None) -> list[Path]
         found.append(path)
         try:
             data: Any = tomllib.loads(path.read_text(encoding="utf-8"))
-        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        except (OSError, ValueError):  # undecodable, malformed, a number too long
             data = {}
         for text in _strings(data):
             candidate = Path(text)

@@ -16,7 +16,7 @@ import numbers
 import os
 import warnings
 import weakref
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
@@ -106,6 +106,25 @@ def _frame_time(time: object) -> float:
         raise InputError(f"frame time must be a finite number of seconds >= 0, got {time!r}",
                          "time")
     return float(time)
+
+
+MAX_JITTER = 1.0  # pixels: a jitter moves the image by a sub-pixel offset (samples: +-0.5)
+
+
+def _jitter(jitter: object) -> tuple[float, float] | None:
+    """``render(jitter=...)`` checked: None, or (x, y) finite and within +-MAX_JITTER."""
+    if jitter is None:
+        return None
+    shaped = isinstance(jitter, Sequence | np.ndarray) and not isinstance(jitter, str | bytes) \
+        and len(jitter) == 2
+    values = list(jitter) if shaped else []
+    if not shaped or not all(isinstance(v, numbers.Real) and not isinstance(v, bool | np.bool_)
+                             and math.isfinite(v) and abs(v) <= MAX_JITTER for v in values):
+        shown = repr(jitter)
+        shown = shown if len(shown) <= 60 else f"{shown[:57]}..."
+        raise InputError(f"a jitter is a sub-pixel offset (x, y) of finite numbers within "
+                         f"+-{MAX_JITTER:g} pixel, got {shown}", "jitter")
+    return float(values[0]), float(values[1])
 
 
 class Renderer:
@@ -297,8 +316,9 @@ class Renderer:
         ``on_pass``/``before_pass`` are called around each pass; ``readback=False`` skips
         reading the images back (timing loops); ``hdr=True`` reads the float composite now
         (else when ``result.hdr`` is first asked for); ``jitter`` moves the image by a
-        fraction of a pixel (x, y; see :meth:`render_samples`; by default none, or a temporal
-        effect's (taa) for the frame's sample since its history started); ``sample_index``
+        fraction of a pixel (x, y, each finite and within +-1 pixel, else ``InputError``; see
+        :meth:`render_samples`; by default none, or a temporal effect's (taa) for the frame's
+        sample since its history started); ``sample_index``
         picks per-sample patterns (the stipple's parity; by default that sample, else 0);
         ``time_gl_calls`` measures the CPU time of the drawing GL calls
         (``RenderResult.gl_call_seconds``, for the bench: two clock reads per call).
@@ -312,6 +332,7 @@ class Renderer:
         if hdr and not readback:
             raise ValueError("hdr=True reads the composite back: not with readback=False")
         time = _frame_time(time)
+        jitter = _jitter(jitter)
         self._keep_pending_hdr()
         state = self.state_at(time)
         self.gl.make_current()

@@ -44,7 +44,12 @@ from deferred.scene.tables import (
     TypedModel,
 )
 from deferred.scene.tracks import make_track, parse_target
-from deferred.validation import closest, require_regular_file, validation_problems
+from deferred.validation import (
+    closest,
+    number_too_long,
+    require_regular_file,
+    validation_problems,
+)
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -104,6 +109,8 @@ def scene_from_toml(text: str, name: str = "<string>", base_dir: Path | None = N
         raise InputError(f"malformed TOML: {exc}", name) from None
     except RecursionError:
         raise InputError("malformed TOML: arrays or tables nested too deep", name) from None
+    except ValueError:  # an integer of more digits than Python converts
+        raise InputError(f"malformed TOML: {number_too_long(text)}", name) from None
     return scene_from_dict(data, name, base_dir, before_meshes)
 
 

@@ -79,7 +79,7 @@ def load_mesh(spec: str, base_dir: Path | None = None, where: str | None = None)
     visual = loaded.visual
     if getattr(visual, "kind", None) == "texture" and getattr(visual, "uv", None) is not None:
         uvs = np.asarray(visual.uv, dtype=np.float64)
-    colors = _vertex_colours(loaded)
+    colors = _vertex_colours(loaded, path.name, where)
     try:
         mesh = build_mesh(path.name, positions, indices, normals, uvs, colors)
     except InputError as exc:
@@ -140,12 +140,15 @@ def _regular_file_resolver(trimesh, path: Path):
     return RegularFileResolver(str(path), [], [])
 
 
-def _vertex_colours(loaded) -> np.ndarray | None:
-    """Per-vertex RGBA in [0, 1], wherever trimesh put them (None when the file has none).
+def _vertex_colours(loaded, name: str, where: str) -> np.ndarray | None:
+    """Per-vertex RGBA in [0, 1], wherever trimesh put them (None when the file has none);
+    ``InputError`` naming the file for a colour that is not a finite number (trimesh would
+    turn a NaN into 0).
 
     With UVs, trimesh keeps a texture visual and moves vertex colours (OBJ ``v x y z r g b``,
     glTF ``COLOR_0``) into vertex attributes; without UVs they form a vertex-colour visual.
     """
+    _check_ply_colours(loaded, name, where)
     visual = loaded.visual
     if getattr(visual, "kind", None) == "vertex":
         return np.asarray(visual.vertex_colors, dtype=np.float64) / 255.0
@@ -154,6 +157,35 @@ def _vertex_colours(loaded) -> np.ndarray | None:
         colours = attributes.get("color") if attributes is not None else None
         if colours is not None and len(colours) == len(loaded.vertices):
             colours = np.asarray(colours)
+            _check_finite_colours(colours, name, where)
             scale = 255.0 if colours.dtype == np.uint8 or colours.max() > 1.0 else 1.0
             return colours.astype(np.float64) / scale
     return None
+
+
+PLY_COLOUR_CHANNELS = ("red", "green", "blue", "alpha")
+
+
+def _check_ply_colours(loaded, name: str, where: str) -> None:
+    """A PLY's float colour properties as stored (trimesh keeps them raw beside the mesh)."""
+    raw = getattr(loaded, "metadata", {}).get("_ply_raw")
+    data = raw.get("vertex", {}).get("data") if isinstance(raw, dict) else None
+    if not isinstance(data, dict):
+        return
+    channels = [np.asarray(data[c], dtype=np.float64).reshape(-1) for c in PLY_COLOUR_CHANNELS
+                if c in data and np.asarray(data[c]).dtype.kind == "f"]
+    if channels:
+        _check_finite_colours(np.stack(channels, axis=-1), name, where)
+
+
+def _check_finite_colours(colours: np.ndarray, name: str, where: str) -> None:
+    if colours.dtype.kind != "f" or np.isfinite(colours).all():
+        return
+    bad = ~np.isfinite(colours)
+    vertex = int(np.argwhere(bad)[0][0])
+    count = int(bad.any(axis=-1).sum())
+    said = "a vertex colour that is not a finite number" if count == 1 else \
+        f"{count:,} vertex colours that are not finite numbers"
+    raise InputError(f"mesh {name} has {said} (the first at vertex {vertex}: "
+                     f"{np.array2string(colours[vertex], precision=3)}); colours are numbers "
+                     "in [0, 1]", where)

@@ -271,7 +271,7 @@ def _parse_toml(text: str) -> Any:
         return None
     try:
         value = tomllib.loads(f"v = {text}")["v"]
-    except tomllib.TOMLDecodeError:
+    except ValueError:  # not TOML (a number of too many digits too): the text itself
         return text
     return tuple(value) if isinstance(value, list) else value
 

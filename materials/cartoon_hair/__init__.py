@@ -49,6 +49,7 @@ from deferred.api import (
     Work,
     WorkObject,
     builtin_head_spheres,
+    check_image,
     materials,
 )
 
@@ -106,19 +107,31 @@ class CartoonHairMaterial(Material):
 
     def check_files(self, where: str | None) -> None:
         super().check_files(where)
-        for key, names in (("strands_file", [self.params.strands_file]),
-                           ("keyframes", list(self.params.keyframes))):
-            for index, name in enumerate(names):
-                if name is None:
-                    continue
-                at = f"{where}.{key}" if where else key
-                at = at if key == "strands_file" else f"{at}[{index}]"
-                load_strands(self.file_parameter(name, "strand file", at), at)
+        params = self.params
+
+        def at(key: str) -> str:
+            return f"{where}.{key}" if where else key
+
+        strands = params.strands
+        if params.strands_file is not None:
+            strands = len(load_strands(self.file_parameter(params.strands_file, "strand file",
+                                                           at("strands_file")),
+                                       at("strands_file")))
+        for index, name in enumerate(params.keyframes):
+            key = at(f"keyframes[{index}]")
+            pose = load_strands(self.file_parameter(name, "strand file", key), key)
+            if len(pose) != strands:
+                source = "strands_file" if params.strands_file is not None else "strands"
+                raise InputError(f"{Path(name).name} has {strand_count(len(pose))}; the hair has "
+                                 f"{strands:,} ({source}): a keyframe poses each strand", key)
+        if params.ramp_image is not None:
+            check_image(self.file_parameter(params.ramp_image, "ramp image", at("ramp_image")),
+                        at("ramp_image"))
 
     def xtoon_ramp(self) -> XToonRamp:
         image = None if self.params.ramp_image is None else \
             self.resolve_path(self.params.ramp_image)
-        return XToonRamp.from_params(self.params, image)
+        return XToonRamp.from_params(self.params, image, self.key_where("ramp_image"))
 
     def uniforms(self, frame: Frame) -> dict[str, Any]:  # the ramp's layer: the scene's
         return {**super().uniforms(frame), "u_hair": False, "u_strand_base": 0.0,
@@ -158,10 +171,11 @@ class CartoonHairMaterial(Material):
         """The style: ``(S, P, 3)`` object-space strands, root first."""
         p = self.params
         if p.strands_file is not None:
-            strands = load_strands(self.resolve_path(p.strands_file), "strands_file")
+            where = self.key_where("strands_file")
+            strands = load_strands(self.resolve_path(p.strands_file), where)
             if len(strands) >= STRAND_IDS:
                 raise InputError(f"{len(strands):,} strands; a hair object holds fewer than "
-                                 f"{STRAND_IDS:,}", "strands_file")
+                                 f"{STRAND_IDS:,}", where)
             return strands
         roots = scalp_roots(obj.mesh, p.strands, p.seed)
         return grow_strands(roots, p.length, p.segments, p.style, p.seed, self.spheres(obj),
@@ -171,9 +185,14 @@ class CartoonHairMaterial(Material):
         """The keyframes' strands, each resampled to the rest strands' points."""
         poses = []
         for index, name in enumerate(self.params.keyframes):
-            strands = load_strands(self.resolve_path(name), f"keyframes[{index}]")
+            where = self.key_where(f"keyframes[{index}]")
+            strands = load_strands(self.resolve_path(name), where)
             if len(strands) != shape[0]:
-                raise InputError(f"{Path(name).name} has {len(strands)} strands; the hair "
-                                 f"has {shape[0]}", f"keyframes[{index}]")
+                raise InputError(f"{Path(name).name} has {strand_count(len(strands))}; the "
+                                 f"hair has {shape[0]:,}", where)
             poses.append(np.stack([resample_strand(s, shape[1]) for s in strands]))
         return np.stack(poses)
+
+
+def strand_count(count: int) -> str:
+    return f"{count:,} strand{'s' * (count != 1)}"

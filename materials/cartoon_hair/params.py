@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import Field, model_validator
+from pydantic import Field, field_validator, model_validator
 
 from deferred.api import BlinnPhongParams
 
@@ -94,6 +94,24 @@ class CartoonHairParams(BlinnPhongParams, XToonParams):
                                   description="surface hatching: the map's repeats along a "
                                               "strand (screen hatching: a map texel a pixel)")
 
+    @field_validator("collision_spheres")
+    @classmethod
+    def _sphere_radii(cls, spheres: tuple[tuple[float, float, float, float], ...] | None
+                      ) -> tuple[tuple[float, float, float, float], ...] | None:
+        for index, sphere in enumerate(spheres or ()):
+            if sphere[3] < 0.0:
+                raise ValueError(f"sphere {index} has radius {sphere[3]:g}; a radius is >= 0")
+        return spheres
+
+    @field_validator("taper")
+    @classmethod
+    def _some_radius(cls, taper: Vec3) -> Vec3:
+        if quadratic_peak(taper) <= 0.0:
+            raise ValueError("gives the tube no radius anywhere along the strand (a x^2 + b x + "
+                             "c is <= 0 for every x in [0, 1], root to tip; the default, "
+                             "(0, -1, 1), tapers from the root's radius to 0)")
+        return taper
+
     @model_validator(mode="after")
     def _keys(self) -> CartoonHairParams:
         if len(self.key_times) != len(self.keyframes):
@@ -116,3 +134,12 @@ def tube_counts(strands: int, params: CartoonHairParams) -> tuple[int, int]:
     ``sides`` and two cap centres a strand; the rings' quads and the caps' fans."""
     rings = params.hair_samples * params.sides
     return strands * (rings + 2), strands * 2 * rings
+
+
+def quadratic_peak(coefficients: Vec3) -> float:
+    """The largest value of ``a x^2 + b x + c`` for ``x`` in [0, 1]."""
+    a, b, c = coefficients
+    candidates = [0.0, 1.0]
+    if a < 0.0 and 0.0 < -b / (2.0 * a) < 1.0:  # a maximum inside
+        candidates.append(-b / (2.0 * a))
+    return max(a * x * x + b * x + c for x in candidates)

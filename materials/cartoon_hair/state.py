@@ -255,7 +255,8 @@ def hair_shape(material) -> tuple[int, int]:
     params = material.params
     if params.strands_file is None:
         return params.strands, params.segments + 1
-    strands = load_strands(material.resolve_path(params.strands_file), "strands_file")
+    strands = load_strands(material.resolve_path(params.strands_file),
+                           material.key_where("strands_file"))
     return strands.shape[0], strands.shape[1]
 
 

@@ -31,7 +31,14 @@ from typing import Literal
 
 import numpy as np
 
-from deferred.api import InputError, MeshData, check_memory, require_regular_file
+from deferred.api import (
+    MAX_COORDINATE,
+    InputError,
+    MeshData,
+    check_memory,
+    number_too_long,
+    require_regular_file,
+)
 
 STRAND_SUFFIXES = (".json", ".obj")
 MAX_STRAND_FILE_BYTES = 256 << 20
@@ -42,8 +49,10 @@ PARSE_BYTES_PER_BYTE = 16
 PARSED_KEPT = 4  # strand files kept parsed (path, size, time): their strands are read thrice
 _PARSED: dict[tuple[str, int, int], np.ndarray] = {}
 MAX_STRANDS = 1_000_000
-MAX_STRAND_POINTS = 20_000_000  # strands x points, after resampling to the longest
-MAX_STRAND_POINTS = 4096
+MAX_POINTS_PER_STRAND = 4096
+# the strands resampled to the longest one's points: strands x that count
+MAX_STRAND_POINTS = 20_000_000
+MAX_STRAND_COORDINATE = MAX_COORDINATE  # as a mesh's: a stray point or the wrong units
 HairStyle = Literal["combed", "spiky"]
 HAIR_STYLES: tuple[str, ...] = ("combed", "spiky")
 
@@ -196,6 +205,8 @@ def _json_strands(text: str, where: str) -> list[np.ndarray]:
                          where) from None
     except RecursionError:
         raise InputError("not valid JSON: nested too deeply", where) from None
+    except ValueError:  # an integer of more digits than Python converts
+        raise InputError(f"{number_too_long(text)}: not a coordinate", where) from None
     if not isinstance(document, dict) or "strands" not in document:
         raise InputError('expected an object {"strands": [[[x, y, z], ...], ...]}', where)
     listed = document["strands"]
@@ -265,12 +276,18 @@ def _checked_strand(strand: np.ndarray, number: int, where: str) -> np.ndarray:
     if len(strand) < 2:
         raise InputError(f"strand {number} has {len(strand)} point{'s' * (len(strand) != 1)}; "
                          "a strand needs at least 2", where)
-    if len(strand) > MAX_STRAND_POINTS:
+    if len(strand) > MAX_POINTS_PER_STRAND:
         raise InputError(f"strand {number} has {len(strand):,} points, more than the "
-                         f"{MAX_STRAND_POINTS:,} allowed", where)
+                         f"{MAX_POINTS_PER_STRAND:,} a strand may have", where)
     if not np.isfinite(strand).all():
         raise InputError(f"strand {number} has a coordinate that is not a finite number "
                          "(NaN or infinity)", where)
+    beyond = np.abs(strand) > MAX_STRAND_COORDINATE
+    if beyond.any():
+        point, axis = np.argwhere(beyond)[0]
+        raise InputError(f"strand {number} point {point} has {'xyz'[axis]} = "
+                         f"{strand[point, axis]:g}, beyond +-{MAX_STRAND_COORDINATE:.0e} (as a "
+                         "mesh's coordinates): a stray point or the wrong units", where)
     if not (np.linalg.norm(np.diff(strand, axis=0), axis=1) > 0.0).all():
         raise InputError(f"strand {number} repeats a point (a segment of length 0)", where)
     return strand
@@ -282,9 +299,9 @@ def _common_points(strands: list[np.ndarray], where: str | None = None) -> np.nd
     strands and one long one would ask for tens of gigabytes)."""
     count = max(len(s) for s in strands)
     if len(strands) * count > MAX_STRAND_POINTS:
-        raise InputError(f"{len(strands):,} strands of {count:,} points (each resampled to the "
-                         f"longest) are more than the {MAX_STRAND_POINTS:,} points allowed",
-                         where)
+        raise InputError(f"{len(strands):,} strands resampled to the longest one's {count:,} "
+                         f"points are {len(strands) * count:,} points, more than the "
+                         f"{MAX_STRAND_POINTS:,} held", where)
     return np.stack([s if len(s) == count else resample_strand(s, count) for s in strands])
 
 

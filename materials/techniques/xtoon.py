@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Literal
 
@@ -117,19 +117,24 @@ class XToonRamp:
     metric_constants: tuple[float, float]  # depth: z_min, z_max; backlight: r; specular: c
     backlight_color: tuple[float, float, float]
     highlight_color: tuple[float, float, float]
+    # the scene key naming the image, for its errors (not part of the ramp's value)
+    where: str | None = field(default=None, compare=False)
 
     @classmethod
-    def from_params(cls, params: XToonParams, image: Path | None = None) -> XToonRamp:
+    def from_params(cls, params: XToonParams, image: Path | None = None,
+                    where: str | None = None) -> XToonRamp:
         constants = {"none": (0.0, 0.0), "depth": tuple(params.depth_range),
                      "backlight": (params.backlight_power, 0.0),
                      "specular": (params.ramp_shininess, 0.0)}[params.ramp_metric]
         return cls(tuple((float(x), c) for x, c in params.ramp), image, params.ramp_metric,
-                   constants, tuple(params.backlight_color), tuple(params.highlight_color))
+                   constants, tuple(params.backlight_color), tuple(params.highlight_color),
+                   where)
 
     def texels(self) -> np.ndarray:
         """(RAMP_HEIGHT, RAMP_WIDTH, 3) linear RGB, row 0 at y = 0."""
         if self.image is not None:
-            pixels = read_image(self.image, srgb_to_linear=True)[::-1, :, :3]  # bottom row 0
+            pixels = read_image(self.image, srgb_to_linear=True,
+                                where=self.where)[::-1, :, :3]  # bottom row 0
             rows = (np.arange(RAMP_HEIGHT) + 0.5) / RAMP_HEIGHT * pixels.shape[0]
             cols = (np.arange(RAMP_WIDTH) + 0.5) / RAMP_WIDTH * pixels.shape[1]
             return np.ascontiguousarray(pixels[rows.astype(int)][:, cols.astype(int)],

@@ -79,7 +79,8 @@ def cascade_frusta(light: Light, scene: Scene, inverse_view: np.ndarray, aspect:
     params = light.params
     camera = scene.camera
     near = camera.near
-    far = min(camera.far, params.shadow_distance)
+    # a shadow distance short of the near plane shadows nothing in view: the cascades end there
+    far = max(min(camera.far, params.shadow_distance), near)
     splits = practical_splits(near, far, params.cascades, params.cascade_lambda)
     direction = unit(params.direction)
     light_view = look_at((0.0, 0.0, 0.0), direction, light_up(direction))
