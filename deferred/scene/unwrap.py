@@ -2,9 +2,17 @@
 (``UNWRAP_TIMEOUT_S``, environment variable ``DEFERRED_UNWRAP_TIMEOUT``), so a mesh that defeats
 xatlas is an error after that time and Ctrl-C stops it (inside xatlas, the interpreter never sees
 the signal).
+
+xatlas crashes (SIGSEGV in a worker thread) on some meshes whatever their size: the exact
+icosphere of 81,920 triangles and UV spheres of 124,500, where a UV sphere of 158,400 and a
+torus of 180,000 unwrap. No size bound makes it safe, so a crashed child is said by its signal
+and the mesh gets a chart per triangle instead (:func:`triangle_charts`: numpy, no library
+that could crash), with a warning naming the mesh. A child killed (SIGKILL: the out-of-memory
+killer) is an error.
 """
 from __future__ import annotations
 
+import faulthandler
 import math
 import multiprocessing
 import os
@@ -83,6 +91,7 @@ def _unwrap_child(connection, positions: np.ndarray, indices: np.ndarray,
     # command line's one-line errors.
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    faulthandler.disable()  # a crash is the parent's to say (python -X faulthandler, pytest)
     _die_with_parent(parent)
     devnull = os.open(os.devnull, os.O_WRONLY)
     os.dup2(devnull, 1)
@@ -135,10 +144,7 @@ def unwrap_uvs(positions: np.ndarray, indices: np.ndarray,
             status, payload = receiver.recv()
         except EOFError:
             child.join(5.0)
-            code = child.exitcode
-            how = f"signal {-code}" if code is not None and code < 0 else f"exit code {code}"
-            raise InputError(f"UV unwrap failed: the unwrapping process died ({how}; out of "
-                             f"memory?); give the mesh UVs or simplify it", name) from None
+            return _after_death(child.exitcode, positions, indices, name)
         child.join(2.0)  # it only has to exit now
         if status != "ok":
             raise InputError(f"UV unwrap failed: {payload}; give the mesh UVs", name)
@@ -150,3 +156,78 @@ def unwrap_uvs(positions: np.ndarray, indices: np.ndarray,
             # signals up would take SIGTERM through the parent's handler and print a traceback
             child.kill()
         child.join()
+
+
+# Signals a crash ends a process with (a bug in xatlas), not a lack of memory: the mesh is then
+# unwrapped a triangle a chart
+CRASH_SIGNALS = frozenset({signal.SIGSEGV, signal.SIGBUS, signal.SIGFPE, signal.SIGILL,
+                           signal.SIGABRT})
+
+
+class UnwrapWarning(UserWarning):
+    """xatlas crashed on a mesh: it has a UV chart per triangle instead."""
+
+
+def _after_death(code: int | None, positions: np.ndarray, indices: np.ndarray,
+                 name: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The unwrap of a mesh whose unwrapping process ended without an answer: a chart per
+    triangle after a crash (with a warning), else an ``InputError`` saying how it ended."""
+    how = signal_name(-code) if code is not None and code < 0 else f"exit code {code}"
+    if code is not None and code < 0 and -code in CRASH_SIGNALS:
+        warnings.warn(f"{name}: xatlas crashed unwrapping the mesh, {how}; each triangle is "
+                      "a UV chart of its own instead (give the mesh UVs for charts that span "
+                      "triangles)", UnwrapWarning, stacklevel=4)
+        return triangle_charts(positions, indices)
+    ended = f"was killed by {how}: out of memory?" if code == -signal.SIGKILL else \
+        f"ended by {how}" if code is not None and code < 0 else f"ended with {how}"
+    raise InputError(f"UV unwrap failed: the unwrapping process {ended}; give the mesh UVs or "
+                     "simplify it", name)
+
+
+def signal_name(number: int) -> str:
+    """``SIGSEGV (signal 11)``, or ``signal N`` for a number no signal has."""
+    try:
+        return f"{signal.Signals(number).name} (signal {number})"
+    except ValueError:
+        return f"signal {number}"
+
+
+def triangle_charts(positions: np.ndarray, indices: np.ndarray,
+                    gap: float = 0.25) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(vmapping, indices, uvs)`` as xatlas gives them, each triangle its own chart: laid
+    flat at its true shape, one scale for all (the texel density of the mesh is uniform), in
+    shelves of rising height sorted tallest first, ``gap`` times the mean chart height apart,
+    in [0, 1]^2. Vectorised numpy: it cannot crash, and takes about a second a million
+    triangles."""
+    faces = np.asarray(indices, dtype=np.int64).reshape(-1, 3)
+    corners = np.asarray(positions, dtype=np.float64)[faces]
+    edge1 = corners[:, 1] - corners[:, 0]
+    edge2 = corners[:, 2] - corners[:, 0]
+    length1 = np.linalg.norm(edge1, axis=1)
+    along = edge1 / np.maximum(length1, 1e-30)[:, None]
+    x2 = (edge2 * along).sum(axis=1)
+    y2 = np.linalg.norm(edge2 - x2[:, None] * along, axis=1)
+    flat = np.zeros((len(faces), 3, 2))
+    flat[:, 1, 0] = length1
+    flat[:, 2, 0], flat[:, 2, 1] = x2, y2
+    flat[:, :, 0] -= flat[:, :, 0].min(axis=1, keepdims=True)  # the corner x2 < 0 at 0
+    width, height = flat[:, :, 0].max(axis=1), flat[:, 2, 1]
+    spacing = gap * max(float(height.mean()), float(width.mean()), 1e-30)
+    cell_width, cell_height = width + spacing, height + spacing
+    order = np.argsort(-cell_height, kind="stable")
+    # shelves of about the atlas' side: a chart starting past a shelf's end opens the next
+    side = math.sqrt(float((cell_width * cell_height).sum()))
+    start = np.cumsum(cell_width[order]) - cell_width[order]
+    shelf = (start // max(side, 1e-30)).astype(np.int64)
+    shelf_start = np.searchsorted(shelf, np.arange(shelf[-1] + 1))
+    x = start - start[shelf_start][shelf]
+    shelf_heights = cell_height[order][shelf_start]  # the tallest chart of each shelf: its first
+    y = (np.cumsum(shelf_heights) - shelf_heights)[shelf]
+    offsets = np.zeros((len(faces), 2))
+    offsets[order, 0], offsets[order, 1] = x, y
+    placed = flat + offsets[:, None, :]
+    extent = max(float(placed[..., 0].max()), float(placed[..., 1].max()), 1e-30) + spacing
+    uvs = ((placed + 0.5 * spacing) / extent).reshape(-1, 2)
+    vmapping = faces.reshape(-1)
+    new_indices = np.arange(len(vmapping), dtype=np.int64).reshape(-1, 3)
+    return vmapping, new_indices, uvs

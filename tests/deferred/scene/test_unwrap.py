@@ -26,8 +26,12 @@ def _sleep_for_ever(positions, indices):
     time.sleep(3600)  # xatlas lost in a bad mesh: only ending the process stops it
 
 
-def _crash(positions, indices):
-    os.kill(os.getpid(), signal.SIGKILL)  # a segfault or the OOM killer
+def _killed(positions, indices):
+    os.kill(os.getpid(), signal.SIGKILL)  # the OOM killer
+
+
+def _segfault(positions, indices):
+    os.kill(os.getpid(), signal.SIGSEGV)  # what xatlas does on some meshes
 
 
 def _raise(positions, indices):
@@ -84,14 +88,78 @@ def test_ctrl_c_ends_the_unwrap(tmp_path, monkeypatch):
     assert multiprocessing.active_children() == []
 
 
-@pytest.mark.parametrize("child, fragment", [(_crash, "died (signal 9"),
-                                             (_raise, "ValueError: xatlas said no")])
+@pytest.mark.parametrize("child, fragment", [
+    (_killed, "was killed by SIGKILL (signal 9): out of memory?"),
+    (_raise, "ValueError: xatlas said no")])
 def test_unwrap_failures_name_the_mesh(tmp_path, monkeypatch, child, fragment):
     (tmp_path / "tet.obj").write_text(TETRAHEDRON)
     monkeypatch.setattr(deferred.scene.unwrap, "_xatlas_parametrize", child)
     with pytest.raises(InputError, match="UV unwrap failed") as caught:
         load_mesh("tet.obj", tmp_path)
     assert fragment in str(caught.value) and "tet.obj" in str(caught.value)
+
+
+def test_a_crash_of_the_unwrap_is_said_and_each_triangle_gets_a_chart(tmp_path, monkeypatch):
+    (tmp_path / "tet.obj").write_text(TETRAHEDRON)
+    monkeypatch.setattr(deferred.scene.unwrap, "_xatlas_parametrize", _segfault)
+    with pytest.warns(deferred.scene.unwrap.UnwrapWarning,
+                      match="tet.obj: xatlas crashed unwrapping the mesh, SIGSEGV \\(signal 11\\); "
+                            "each triangle is a UV chart of its own"):
+        mesh = load_mesh("tet.obj", tmp_path)
+    assert_charts_apart(mesh)
+
+
+def assert_charts_apart(mesh):
+    """UVs in [0, 1], every triangle its own vertices, no two triangles' UV boxes overlapping."""
+    uvs = np.asarray(mesh.uvs, np.float64)
+    faces = np.asarray(mesh.indices, np.int64).reshape(-1, 3)
+    assert np.isfinite(uvs).all() and uvs.min() >= 0.0 and uvs.max() <= 1.0
+    assert len(np.unique(faces)) == faces.size
+    boxes = uvs[faces]
+    low, high = boxes.min(axis=1), boxes.max(axis=1)
+    order = np.argsort(low[:, 0])
+    for a, i in enumerate(order):  # a sweep along u
+        for j in order[a + 1:]:
+            if low[j, 0] >= high[i, 0]:
+                break
+            assert not (low[j, 1] < high[i, 1] and low[i, 1] < high[j, 1]), (i, j)
+
+
+def test_the_icosphere_xatlas_crashes_on_renders(tmp_path, capfd):
+    """The exact icosphere of 81,920 triangles, without UVs, crashed xatlas (SIGSEGV) and was
+    said as "out of memory?": it renders, each triangle a chart (or xatlas' charts, should a
+    later xatlas unwrap it)."""
+    trimesh = pytest.importorskip("trimesh")
+    sphere = trimesh.creation.icosphere(subdivisions=6)
+    assert len(sphere.faces) == 81_920
+    (tmp_path / "ico.obj").write_text(trimesh.exchange.obj.export_obj(
+        sphere, include_normals=False, include_texture=False))
+    code, err, out = render_scene(tmp_path, capfd, {"mesh": "ico.obj", "material": "standard"})
+    assert code == 0 and out.exists(), err
+    assert "out of memory" not in err
+    for line in err.strip().splitlines()[:-1]:
+        assert line.startswith("warning: ico.obj: xatlas crashed unwrapping the mesh, SIGSEGV")
+
+
+def test_triangle_charts_of_many_triangles_are_apart():
+    trimesh = pytest.importorskip("trimesh")
+    sphere = trimesh.creation.icosphere(subdivisions=3)
+    vmapping, indices, uvs = deferred.scene.unwrap.triangle_charts(
+        np.asarray(sphere.vertices), np.asarray(sphere.faces))
+
+    class Unwrapped:
+        pass
+
+    mesh = Unwrapped()
+    mesh.uvs, mesh.indices = uvs, indices
+    assert_charts_apart(mesh)
+    np.testing.assert_array_equal(vmapping.reshape(-1, 3), sphere.faces)
+    # one scale for every chart: a triangle's UV edge lengths over its own are the same
+    corners = np.asarray(sphere.vertices)[sphere.faces]
+    flat = uvs[indices]
+    ratio = np.linalg.norm(flat[:, 1] - flat[:, 0], axis=1) / \
+        np.linalg.norm(corners[:, 1] - corners[:, 0], axis=1)
+    np.testing.assert_allclose(ratio, ratio[0], rtol=1e-9)
 
 
 @pytest.mark.parametrize("value", ["soon", "0", "-1", "nan"])
