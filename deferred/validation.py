@@ -226,6 +226,11 @@ def lax_problem(value: Any, annotation: Any) -> str | None:
         problems = [lax_problem(value, member) for member in members]
         if any(problem is None for problem in problems):
             return None
+        # None is a default, not a shape to ask for: "expected nothing" says nothing useful
+        if len(members) > 1 and type(None) in members:
+            members, problems = zip(*[(member, problem) for member, problem
+                                      in zip(members, problems, strict=True)
+                                      if member is not type(None)], strict=True)
         # the member of the value's shape (a list or a scalar) says what is wrong with it
         shaped = [problem for member, problem in zip(members, problems, strict=True)
                   if _is_sequence(value) == (typing.get_origin(_bare(member)) in (tuple, list))]
@@ -257,7 +262,7 @@ def lax_problem(value: Any, annotation: Any) -> str | None:
         return None if isinstance(value, str) else "expected a string"
     sequences = (tuple, list, collections.abc.Sequence)
     if origin in sequences and not _is_sequence(value):
-        return f"expected a list, not {type(value).__name__}"
+        return f"expected {_sequence_shape(annotation)}, not {_kind(value)}"
     if origin in sequences:
         arguments = typing.get_args(annotation)
         if origin is not tuple or (len(arguments) == 2 and arguments[1] is Ellipsis):
@@ -307,6 +312,29 @@ class LaxValueError(ValueError):
     def __init__(self, problem: str):
         super().__init__(str(problem))
         self.problem = problem
+
+
+def _kind(value: Any) -> str:
+    """What a value is, as a scene file says it: ``a string``, ``a number``, ``a table``."""
+    if isinstance(value, str):
+        return "a string"
+    if isinstance(value, bool | np.bool_):
+        return "true or false"
+    if isinstance(value, numbers.Real):
+        return "a number"
+    if isinstance(value, dict):
+        return "a table"
+    return type(value).__name__
+
+
+def _sequence_shape(annotation: Any) -> str:
+    """What a sequence annotation asks for: ``3 numbers`` for a fixed tuple of numbers,
+    else ``a list``."""
+    arguments = typing.get_args(annotation)
+    if typing.get_origin(annotation) is tuple and arguments and Ellipsis not in arguments and \
+            all(_bare(argument) in (int, float) for argument in arguments):
+        return f"{len(arguments)} numbers"
+    return "a list"
 
 
 def _bare(annotation: Any) -> Any:

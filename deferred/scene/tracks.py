@@ -268,7 +268,8 @@ def make_track(target: str, keys: Any, interpolation: Any = "linear",
             hint = closest(stray, allowed)
             said = f" (did you mean '{hint}'?)" if hint else ""
             problems.append(InputError(
-                f"a {kind}'s keys set time and {', '.join(allowed)}, not "
+                f"{'an' if kind[0] in 'aeiou' else 'a'} {kind}'s keys set time and "
+                f"{', '.join(allowed)}, not "
                 f"{str(stray)[:40]!r}{said}",
                 join_where(at, str(stray)[:80])))
         try:

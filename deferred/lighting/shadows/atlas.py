@@ -23,7 +23,7 @@ from deferred.lighting.shadows.frusta import (
     unit,
 )
 from deferred.lighting.shadows.opacity import OPACITY_FAR, OPACITY_LAYERS
-from deferred.lighting.shadows.plan import plan_atlas
+from deferred.lighting.shadows.plan import left_out_warning, plan_atlas
 from deferred.names import ShadowProjection
 
 if TYPE_CHECKING:
@@ -180,8 +180,7 @@ class ShadowAtlas:
             self._plan, left_out = plan_atlas(scene.lights, self.size, self.max_lights)
             self._plan_key = key
             if left_out:  # stacklevel: update's caller
-                warnings.warn(f"{scene.source}: unshadowed, over the shadow budget: "
-                              f"{'; '.join(left_out)}", stacklevel=3)
+                warnings.warn(left_out_warning(scene.source, left_out), stacklevel=3)
 
     def _add_tiles(self, light: Light, slot: int, squares: list[tuple[int, int, int]],
                    frusta: list[tuple], row: np.ndarray, inverse_view: np.ndarray) -> None:

@@ -63,11 +63,13 @@ def _place_tiles(lights: list[Light], atlas_size: int
 
 
 def plan_atlas(lights: list[Light], atlas_size: int, max_lights: int
-               ) -> tuple[dict[int, tuple[int, list[tuple[int, int, int]]]], list[str]]:
+               ) -> tuple[dict[int, tuple[int, list[tuple[int, int, int]]]],
+                          list[tuple[int, str]]]:
     """Slots and tiles for the shadowed ``lights`` (scene order): ``{id(light): (slot,
-    [(x, y, size), ...])}``, and why each light left out is (for the warning)."""
+    [(x, y, size), ...])}``, and each light left out as (its index, why), for the warning."""
+    index_of = {id(light): index for index, light in enumerate(lights)}
     wanted = [light for light in lights if light.casts_shadows]
-    left_out = [f"light {lights.index(light)} (max_shadowed_lights = {max_lights})"
+    left_out = [(index_of[id(light)], f"max_shadowed_lights = {max_lights}")
                 for light in wanted[max_lights:]]
     wanted = wanted[:max_lights]
     # Largest maps first packs best; the first light to run out of room is left out and the
@@ -82,10 +84,30 @@ def plan_atlas(lights: list[Light], atlas_size: int, max_lights: int
     plan: dict[int, tuple[int, list[tuple[int, int, int]]]] = {}
     for light in wanted:
         if id(light) in failed:
-            left_out.append(f"light {lights.index(light)} (its {tile_counts(light)} map(s) of "
-                            f"{light.params.shadow_resolution}^2 do not fit the "
-                            f"{atlas_size}^2 atlas)")
+            left_out.append((index_of[id(light)],
+                             f"{tile_counts(light)} map(s) of {light.params.shadow_resolution}^2 "
+                             f"each do not fit the {atlas_size}^2 atlas"))
         else:
             plan[id(light)] = (len(plan) + 1, tiles[id(light)])
     return plan, left_out
+
+
+SHOWN_LEFT_OUT = 5  # lights a budget warning names for each reason; the rest are counted
+
+
+def left_out_warning(source: str, left_out: list[tuple[int, str]]) -> str:
+    """One short line for the lights left unshadowed: their count, and for each reason the
+    first :data:`SHOWN_LEFT_OUT` of them and how many more."""
+    by_reason: dict[str, list[int]] = {}
+    for index, reason in left_out:
+        by_reason.setdefault(reason, []).append(index)
+    parts = []
+    for reason, indices in sorted(by_reason.items(), key=lambda item: item[1][0]):
+        shown = ", ".join(map(str, indices[:SHOWN_LEFT_OUT]))
+        more = f" and {len(indices) - SHOWN_LEFT_OUT:,} more" \
+            if len(indices) > SHOWN_LEFT_OUT else ""
+        parts.append(f"light{'s' * (len(indices) > 1)} {shown}{more} ({reason})")
+    count = len(left_out)
+    return (f"{source}: {count:,} light{'s' * (count != 1)} unshadowed, over the shadow "
+            f"budget: {'; '.join(parts)}")
 

@@ -346,7 +346,8 @@ def test_a_light_whose_maps_do_not_fit_leaves_its_squares_to_the_others(point_fi
     point, spot = the_scene.lights
     plan, left_out = plan_atlas([point, spot] if point_first else [spot, point], 256, 16)
     assert list(plan) == [id(spot)] and len(plan[id(spot)][1]) == 1
-    assert len(left_out) == 1 and "6 map(s) of 128^2 do not fit the 256^2 atlas" in left_out[0]
+    assert len(left_out) == 1 and left_out[0][0] == (0 if point_first else 1)  # the point light
+    assert left_out[0][1] == "6 map(s) of 128^2 each do not fit the 256^2 atlas"
 
 
 @pytest.mark.parametrize(("text", "expected"), [

@@ -305,6 +305,11 @@ BAD = [
      "must be in (1, 179)): use linear or add a key"),
     ('target = "object:ball"\nkeys = [{ time = 0.0, scale = 1.0 }, { time = 1.0, scale = -1.0 }]',
      "s.toml: track[0].keys[1].scale: between keys 0 and 1 the scale passes through 0"),
+    ('target = "object:ball"\nkeys = [{ time = 0.0, position = "up" }]',
+     "s.toml: track[0].keys[0].position: expected 3 numbers, not a string (got 'up')"),
+    ('target = "object:ball"\nkeys = [{ time = 0.0, colour = [1.0, 1.0, 1.0] }]',
+     "s.toml: track[0].keys[0].colour: an object's keys set time and position, rotation, "
+     "scale, not 'colour'"),
     ('target = "camera"\nkeys = [{ time = 0.0 }]',
      "s.toml: track[0].keys[0]: sets nothing: give one of position, target, fov"),
     ('target = "camera"\nkeys = [{ time = 0.0, target = [0.0, 0.5, 3.0] }]',
