@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from deferred.errors import InputError, RenderError
-from deferred.io.paths import temporary_path
+from deferred.io.paths import temporary_path, written_through
 from deferred.io.safety import raise_if_stop_requested
 
 
@@ -180,7 +180,9 @@ def _write_atomically(path: Path, write: Callable[[str], None]) -> None:
     """``write(temporary)`` next to ``path``, then rename over it: readers never see half a file,
     and a failure (an error, Ctrl-C) leaves the old file as it was and no temporary.
 
-    OS errors become a ``RenderError`` naming the file and the reason."""
+    OS errors become a ``RenderError`` naming the file and the reason. A symbolic link is
+    written through: the file it points to is replaced, the link stays."""
+    path = written_through(path)
     temporary = str(temporary_path(path))
     try:
         write(temporary)

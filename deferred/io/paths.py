@@ -4,6 +4,7 @@ under before it is renamed over the old one."""
 
 from __future__ import annotations
 
+import os
 import re
 import secrets
 from collections.abc import Sequence
@@ -22,6 +23,14 @@ NAME_MAX = 255
 PATH_MAX = 4096  # bytes of a whole path (Linux)
 # What temporary_path adds to a name: ".", ".", 12 hex digits, ".tmp".
 _TEMPORARY_EXTRA = 18
+
+
+def written_through(path: str | Path) -> Path:
+    """The file a write to ``path`` replaces: ``path`` itself, or, where ``path`` is a
+    symbolic link, the file it points to (an output is written through a link, which stays a
+    link: the temporary file is made and renamed beside the target)."""
+    path = Path(path)
+    return Path(os.path.realpath(path)) if path.is_symlink() else path
 
 
 def temporary_path(path: str | Path) -> Path:
@@ -65,6 +74,10 @@ def check_output_path(path: str | Path, where: str = "-o",
         raise InputError(f"file name longer than {NAME_MAX} bytes: {first.name[:40]}...", where)
     if first.is_dir():
         raise InputError(f"output is a folder, not a file: {first}", where)
+    target = written_through(first)
+    if target != first and not target.parent.is_dir():
+        raise InputError(f"output {first.name} is a symbolic link to {target}, whose folder "
+                         "does not exist", where)
     return path
 
 

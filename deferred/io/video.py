@@ -29,7 +29,7 @@ from deferred.errors import InputError, RenderError
 from deferred.io.extras import VIDEO, require_extra
 from deferred.io.images import first_line, sync_file, write_image
 from deferred.io.memory import check_memory
-from deferred.io.paths import expand_pattern, output_kind, temporary_path
+from deferred.io.paths import expand_pattern, output_kind, temporary_path, written_through
 from deferred.io.safety import raise_if_stop_requested
 
 GIF_TICK_MS = 10  # GIF frame delays are whole hundredths of a second
@@ -174,7 +174,7 @@ class AnimationWriter:
         if self._video is None:
             import imageio.v2 as iio
 
-            self._temporary = temporary_path(self.path)
+            self._temporary = temporary_path(written_through(self.path))
             self._video = iio.get_writer(
                 str(self._temporary), format="FFMPEG", mode="I", fps=self.fps,
                 codec="libx264", pixelformat="yuv420p", quality=MP4_QUALITY,
@@ -197,7 +197,7 @@ class AnimationWriter:
                 sync_file(self._temporary, self.path)
                 check_video_file(self._temporary, self.path, self.suffix)
                 raise_if_stop_requested()  # a signal's exception lost on the way
-                os.replace(self._temporary, self.path)
+                os.replace(self._temporary, written_through(self.path))
                 self._temporary = None
                 self.written.append(self.path)
         except Exception as exc:
@@ -212,7 +212,7 @@ class AnimationWriter:
     def _write_gif(self) -> None:
         # Pillow directly, into a file this writer closes: its errors (a full or read-only
         # disk) surface here, once, with no writer object left to fail again when collected
-        self._temporary = temporary_path(self.path)
+        self._temporary = temporary_path(written_through(self.path))
         frames, self._gif_frames = self._gif_frames, []
         with open(self._temporary, "wb") as file:
             frames[0].save(file, format="GIF", save_all=True, append_images=frames[1:],

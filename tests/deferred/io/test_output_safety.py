@@ -286,3 +286,35 @@ def test_bench_json_to_a_full_stdout_exits_1(tmp_path):
     assert result.stderr.strip().splitlines()[-1] == \
         "render failed: cannot write standard output: No space left on device"
     assert "Traceback" not in result.stderr and "Exception ignored" not in result.stderr
+
+
+SPHERE_SCENE = '[[object]]\nmesh = "builtin:sphere"\nmaterial = "standard"\n'
+
+
+@pytest.mark.parametrize("name, frames", [("out.png", 1), ("out.exr", 1), ("out.gif", 2),
+                                          ("out_#.png", 2)])
+def test_an_output_that_is_a_symbolic_link_is_written_through(tmp_path, capsys, name, frames):
+    """-o onto a link replaces the file it points to and keeps the link (a link replaced by a
+    regular file would silently cut it from what it shared)."""
+    (tmp_path / "scene.toml").write_text(SPHERE_SCENE)
+    shared = tmp_path / "shared"
+    shared.mkdir()
+    first = name.replace("#", "0")
+    (shared / first).write_bytes(b"old")
+    (tmp_path / first).symlink_to(shared / first)
+    code, _, err = run(capsys, "render", tmp_path / "scene.toml", "-o", tmp_path / name,
+                       "--size", "32x24", "--frames", frames)
+    assert code == 0, err
+    assert (tmp_path / first).is_symlink() and os.readlink(tmp_path / first) == str(shared / first)
+    assert (shared / first).read_bytes() != b"old" and (shared / first).stat().st_size > 100
+    assert leftovers(tmp_path) == []
+
+
+def test_a_link_to_a_missing_folder_is_refused_before_rendering(tmp_path, capsys):
+    (tmp_path / "scene.toml").write_text(SPHERE_SCENE)
+    (tmp_path / "out.png").symlink_to(tmp_path / "nowhere" / "out.png")
+    code, _, err = run(capsys, "render", tmp_path / "scene.toml", "-o", tmp_path / "out.png")
+    assert code == 2 and one_line(err) == (
+        f"error: -o: output out.png is a symbolic link to {tmp_path}/nowhere/out.png, whose "
+        "folder does not exist")
+    assert (tmp_path / "out.png").is_symlink()
