@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import re
 import sys
+import warnings
 from collections.abc import Callable
 from importlib import resources
 from pathlib import Path
@@ -96,7 +97,17 @@ def load_scene(path: str | Path | None = None, camera: str | None = None,
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise InputError(f"cannot read scene file: {exc}", str(path)) from None
-    return scene_from_toml(text, path.name, path.parent, before_meshes)
+    scene = scene_from_toml(text, path.name, path.parent, before_meshes)
+    if not scene.objects:
+        # valid (a background plate, the frame's fixed cost) but most likely a mistake: an
+        # empty file, the wrong file, every [[object]] commented out
+        warnings.warn(f"{path.name}: the scene has no [[object]]: the image is its background "
+                      "alone", EmptySceneWarning, stacklevel=2)
+    return scene
+
+
+class EmptySceneWarning(UserWarning):
+    """A scene file with no objects: it renders its background alone."""
 
 
 def scene_from_toml(text: str, name: str = "<string>", base_dir: Path | None = None,

@@ -146,3 +146,17 @@ def test_a_camera_pulled_back_keeps_its_direction_and_scales_its_distance():
     offset, far_offset = (np.subtract(c.position, c.target) for c in (camera, far))
     np.testing.assert_allclose(far_offset, 3.0 * offset)
     assert (far.target, far.up, far.fov) == (camera.target, camera.up, camera.fov)
+
+
+@pytest.mark.parametrize("text", ["", 'size = [64, 48]\n\n[[light]]\ntype = "ambient"\n'])
+def test_a_scene_file_without_objects_renders_its_background_with_a_warning(tmp_path, capsys,
+                                                                            text):
+    """Valid (a background plate, the frame's fixed cost), but most likely a mistake: said."""
+    from command_line import run
+
+    (tmp_path / "empty.toml").write_text(text)
+    code, _, err = run(capsys, "render", tmp_path / "empty.toml", "-o", tmp_path / "out.png",
+                       "--size", "32x24")
+    assert code == 0 and (tmp_path / "out.png").exists(), err
+    assert err.splitlines()[0] == ("warning: empty.toml: the scene has no [[object]]: the image "
+                                   "is its background alone")
