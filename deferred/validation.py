@@ -32,6 +32,11 @@ from pydantic import (
 
 from deferred.errors import InputError, input_error
 
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
 # Floats beyond this are refused (world units, intensities, rates): float32 shading has lost
 # every digit by then and a product of two overflows to inf.
 FLOAT_LIMIT = 1e9
@@ -158,6 +163,19 @@ def did_you_mean(name: object, choices: Iterable[str]) -> str:
     close."""
     match = closest(name, choices)
     return f" (did you mean '{match}'?)" if match is not None else ""
+
+
+def parse_toml(text: str, name: str) -> dict[str, Any]:
+    """The tables of TOML ``text``; ``InputError`` naming ``name`` where it is malformed,
+    nested too deep, or holds an integer of more digits than Python converts."""
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"malformed TOML: {exc}", name) from None
+    except RecursionError:
+        raise InputError("malformed TOML: arrays or tables nested too deep", name) from None
+    except ValueError:
+        raise InputError(f"malformed TOML: {number_too_long(text)}", name) from None
 
 
 def number_too_long(text: str) -> str:

@@ -16,7 +16,7 @@ import numbers
 import os
 import warnings
 import weakref
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 
 import numpy as np
 
@@ -42,7 +42,13 @@ from deferred.render.caches import (
 from deferred.render.frame_run import PassCallback, prepare_passes, run_passes
 from deferred.render.pipeline import PIPELINES, TONEMAPS, sort_blended
 from deferred.render.result import RenderResult
-from deferred.render.samples import MAX_SAMPLES, halton, halton_offsets, render_samples
+from deferred.render.samples import (
+    MAX_SAMPLES,
+    check_jitter,
+    halton,
+    halton_offsets,
+    render_samples,
+)
 from deferred.render.setup import (
     FULL_FEATURES,
     RenderSetup,
@@ -106,25 +112,6 @@ def _frame_time(time: object) -> float:
         raise InputError(f"frame time must be a finite number of seconds >= 0, got {time!r}",
                          "time")
     return float(time)
-
-
-MAX_JITTER = 1.0  # pixels: a jitter moves the image by a sub-pixel offset (samples: +-0.5)
-
-
-def _jitter(jitter: object) -> tuple[float, float] | None:
-    """``render(jitter=...)`` checked: None, or (x, y) finite and within +-MAX_JITTER."""
-    if jitter is None:
-        return None
-    shaped = isinstance(jitter, Sequence | np.ndarray) and not isinstance(jitter, str | bytes) \
-        and len(jitter) == 2
-    values = list(jitter) if shaped else []
-    if not shaped or not all(isinstance(v, numbers.Real) and not isinstance(v, bool | np.bool_)
-                             and math.isfinite(v) and abs(v) <= MAX_JITTER for v in values):
-        shown = repr(jitter)
-        shown = shown if len(shown) <= 60 else f"{shown[:57]}..."
-        raise InputError(f"a jitter is a sub-pixel offset (x, y) of finite numbers within "
-                         f"+-{MAX_JITTER:g} pixel, got {shown}", "jitter")
-    return float(values[0]), float(values[1])
 
 
 class Renderer:
@@ -332,7 +319,7 @@ class Renderer:
         if hdr and not readback:
             raise ValueError("hdr=True reads the composite back: not with readback=False")
         time = _frame_time(time)
-        jitter = _jitter(jitter)
+        jitter = check_jitter(jitter)
         self._keep_pending_hdr()
         state = self.state_at(time)
         self.gl.make_current()

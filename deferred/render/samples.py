@@ -1,10 +1,12 @@
 """A frame averaged over sub-pixel samples (``deferred render --samples N``): each sample moved
-by an offset of the Halton (2, 3) sequence, the images averaged in linear light."""
+by an offset of the Halton (2, 3) sequence, the images averaged in linear light; and the check
+of a frame's jitter (:func:`check_jitter`)."""
 
 from __future__ import annotations
 
+import math
 import numbers
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any, Protocol
 
 import numpy as np
@@ -25,7 +27,27 @@ class SampledRenderer(Protocol):
 
 MAX_SAMPLES = 1024  # sub-pixel samples a frame
 
-__all__ = ["MAX_SAMPLES", "halton", "halton_offsets", "render_samples"]
+__all__ = ["MAX_JITTER", "MAX_SAMPLES", "check_jitter", "halton", "halton_offsets",
+           "render_samples"]
+
+
+MAX_JITTER = 1.0  # pixels: a jitter moves the image by a sub-pixel offset (ours: +-0.5)
+
+
+def check_jitter(jitter: object) -> tuple[float, float] | None:
+    """``render(jitter=...)`` checked: None, or (x, y) finite and within +-MAX_JITTER."""
+    if jitter is None:
+        return None
+    shaped = isinstance(jitter, Sequence | np.ndarray) and not isinstance(jitter, str | bytes) \
+        and len(jitter) == 2
+    values = list(jitter) if shaped else []
+    if not shaped or not all(isinstance(v, numbers.Real) and not isinstance(v, bool | np.bool_)
+                             and math.isfinite(v) and abs(v) <= MAX_JITTER for v in values):
+        shown = repr(jitter)
+        shown = shown if len(shown) <= 60 else f"{shown[:57]}..."
+        raise InputError(f"a jitter is a sub-pixel offset (x, y) of finite numbers within "
+                         f"+-{MAX_JITTER:g} pixel, got {shown}", "jitter")
+    return float(values[0]), float(values[1])
 
 
 def halton_offsets(count: int) -> list[tuple[float, float]]:

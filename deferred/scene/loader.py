@@ -12,7 +12,6 @@ with no cycle).
 from __future__ import annotations
 
 import re
-import sys
 import warnings
 from collections.abc import Callable
 from importlib import resources
@@ -45,17 +44,7 @@ from deferred.scene.tables import (
     TypedModel,
 )
 from deferred.scene.tracks import make_track, parse_target
-from deferred.validation import (
-    closest,
-    number_too_long,
-    require_regular_file,
-    validation_problems,
-)
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover
-    import tomli as tomllib
+from deferred.validation import closest, parse_toml, require_regular_file, validation_problems
 
 DEMO_SCENE = "demo.toml"
 T = TypeVar("T")
@@ -98,31 +87,17 @@ def load_scene(path: str | Path | None = None, camera: str | None = None,
     except (OSError, UnicodeDecodeError) as exc:
         raise InputError(f"cannot read scene file: {exc}", str(path)) from None
     scene = scene_from_toml(text, path.name, path.parent, before_meshes)
-    if not scene.objects:
-        # valid (a background plate, the frame's fixed cost) but most likely a mistake: an
-        # empty file, the wrong file, every [[object]] commented out
+    if not scene.objects:  # valid, but most likely an emptied or the wrong file
         warnings.warn(f"{path.name}: the scene has no [[object]]: the image is its background "
-                      "alone", EmptySceneWarning, stacklevel=2)
+                      "alone", stacklevel=2)
     return scene
-
-
-class EmptySceneWarning(UserWarning):
-    """A scene file with no objects: it renders its background alone."""
 
 
 def scene_from_toml(text: str, name: str = "<string>", base_dir: Path | None = None,
                     before_meshes: BeforeMeshes | None = None) -> Scene:
     """A scene from the text of a scene file; ``name`` is what errors call it, ``base_dir``
     where relative mesh and texture paths are found."""
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"malformed TOML: {exc}", name) from None
-    except RecursionError:
-        raise InputError("malformed TOML: arrays or tables nested too deep", name) from None
-    except ValueError:  # an integer of more digits than Python converts
-        raise InputError(f"malformed TOML: {number_too_long(text)}", name) from None
-    return scene_from_dict(data, name, base_dir, before_meshes)
+    return scene_from_dict(parse_toml(text, name), name, base_dir, before_meshes)
 
 
 def scene_from_dict(data: dict[str, Any], name: str = "<dict>", base_dir: Path | None = None,
