@@ -180,8 +180,7 @@ def parse_toml(text: str, name: str) -> dict[str, Any]:
 
 def number_too_long(text: str) -> str:
     """Where ``text`` (JSON, TOML) holds an integer of more digits than Python converts (a
-    ``ValueError`` from the parser), said as ``line L, column C: a number of N digits (at most
-    M are read)``."""
+    ``ValueError`` from the parser): its line and column, its digits and the most read."""
     limit = sys.get_int_max_str_digits() if hasattr(sys, "get_int_max_str_digits") else 4300
     found = re.search(rf"\d{{{limit + 1},}}", text)
     if found is None:
