@@ -303,9 +303,8 @@ class Renderer:
         ``on_pass``/``before_pass`` are called around each pass; ``readback=False`` skips
         reading the images back (timing loops); ``hdr=True`` reads the float composite now
         (else when ``result.hdr`` is first asked for); ``jitter`` moves the image by a
-        fraction of a pixel (x, y, each finite and within +-1 pixel, else ``InputError``; see
-        :meth:`render_samples`; by default none, or a temporal effect's (taa) for the frame's
-        sample since its history started); ``sample_index``
+        fraction of a pixel (x, y within +-1, :meth:`render_samples`; by default none, or a
+        temporal effect's (taa) for the frame's sample since its history started); ``sample_index``
         picks per-sample patterns (the stipple's parity; by default that sample, else 0);
         ``time_gl_calls`` measures the CPU time of the drawing GL calls
         (``RenderResult.gl_call_seconds``, for the bench: two clock reads per call).
