@@ -32,6 +32,7 @@ from deferred.interfaces.simulation import advance_simulations
 from deferred.io.safety import raise_if_stop_requested
 from deferred.names import ENVIRONMENT_BACKGROUND, Pipeline
 from deferred.params import validate_params
+from deferred.render import samples as sampling
 from deferred.render.budget import check_target_memory, held_memory, renderer_holdings
 from deferred.render.caches import (
     FrameInputs,
@@ -42,13 +43,7 @@ from deferred.render.caches import (
 from deferred.render.frame_run import PassCallback, prepare_passes, run_passes
 from deferred.render.pipeline import PIPELINES, TONEMAPS, sort_blended
 from deferred.render.result import RenderResult
-from deferred.render.samples import (
-    MAX_SAMPLES,
-    check_jitter,
-    halton,
-    halton_offsets,
-    render_samples,
-)
+from deferred.render.samples import MAX_SAMPLES, halton, halton_offsets, render_samples
 from deferred.render.setup import (
     FULL_FEATURES,
     RenderSetup,
@@ -318,7 +313,7 @@ class Renderer:
         if hdr and not readback:
             raise ValueError("hdr=True reads the composite back: not with readback=False")
         time = _frame_time(time)
-        jitter = check_jitter(jitter)
+        jitter = sampling.check_jitter(jitter)
         self._keep_pending_hdr()
         state = self.state_at(time)
         self.gl.make_current()
