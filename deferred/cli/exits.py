@@ -15,7 +15,7 @@ MAX_PROBLEM_LINES = 50  # a scene file's problems shown; the rest are counted
 
 # The Python API names its arguments in errors; the command line's options carry them
 PYTHON_ARGUMENTS = {"light_path": "--light-path", "pipeline": "--pipeline", "size": "--size",
-                    "time": "--time"}
+                    "time": "--time", "samples": "--samples"}
 
 
 class Settings:

@@ -159,16 +159,19 @@ def _turntable_frames(out: Path, kind: str, frames: int, turntable: int) -> int:
 def run_render(job: RenderJob, progress: Progress) -> Rendered:
     """Load the scene, render every frame of ``job`` and write them."""
     from deferred.render.renderer import Renderer
+    from deferred.render.samples import check_samples_memory
 
     progress.status(f"loading {job.scene or 'the demo scene'} (meshes, UV unwraps)")
     loaded, size = _load(job)
     loaded, buffer = material_view(loaded, job.view_name, job.pipeline)
     predicted, long = check_render(loaded, size or loaded.size, job.samples, job.times,
                                    job.pipeline, size is not None)
+    check_samples_memory(size or loaded.size, job.samples)  # the renderer's are counted later
     progress.status("starting the renderer")
     with Renderer(loaded, job.pipeline, size, strict=job.strict or None,
                   light_path=job.light_path) as renderer:
         renderer.check_times(job.times)  # a simulation cannot reach the last frame: refuse now
+        check_samples_memory(renderer.size, job.samples, renderer.memory_bytes())
         warn(long)  # every check passed: the work starts
         if job.kind == "image":
             frame_ms = _render_image(renderer, loaded, job, buffer, progress, predicted)

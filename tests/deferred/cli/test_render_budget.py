@@ -162,3 +162,12 @@ def test_the_step_clock_predicts_then_measures_without_the_first_step():
     assert clock.done(2) == pytest.approx(8 * 1.0)
     now[0] = 9.0
     assert clock.done(3) == pytest.approx(7 * 2.0)  # the median of 1 s and 3 s
+
+
+def test_the_arrays_averaging_samples_are_counted_against_the_memory_budget(
+        tmp_path, capsys, monkeypatch):
+    monkeypatch.setenv("DEFERRED_TARGET_MEMORY", "12000000")  # 256x256: 14.7 MB of arrays
+    line = refused(tmp_path, capsys, monkeypatch, ["render", "s.toml", "-o", "out.png",
+                                                   "--size", "256x256", "--samples", "4"], SMALL)
+    assert line.startswith("error: --samples: averaging 4 samples of 256x256 needs"), line
+    assert main(["render", "s.toml", "-o", "out.png", "--size", "256x256"]) == 0  # one holds none
