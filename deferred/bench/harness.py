@@ -245,6 +245,12 @@ def check_sweep(scene: Scene, sweep: Sweep) -> None:
     if not sweep_points(sweep):
         raise InputError("no light path of the pipelines chosen is in --light-paths",
                          "--light-paths")
+    ran = {path for pipeline in sweep.pipelines for path in pipeline_paths(pipeline, None)}
+    dropped = [path for path in sweep.light_paths or () if path not in ran]
+    if dropped:  # a path of a pipeline not chosen would be left out without a word
+        raise InputError(f"{', '.join(dropped)} is no light path of "
+                         f"{', '.join(sweep.pipelines)} (add its pipeline to --pipelines)",
+                         "--light-paths")
     for shells in sweep_shells(scene, sweep.shells):
         _shelled(scene, sweep, shells)  # each material's range of shells
 

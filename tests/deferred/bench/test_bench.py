@@ -214,6 +214,8 @@ def test_self_shadow_density_set_on_every_fur_and_nothing_else():
     (["--light-paths", "fast"], "--light-paths: unknown light path 'fast'"),
     (["--light-paths", "clustered", "--pipelines", "forward"],
      "--light-paths: no light path of the pipelines chosen"),
+    (["--light-paths", "volumes,naive", "--pipelines", "forward"],
+     "--light-paths: volumes is no light path of forward (add its pipeline to --pipelines)"),
     (["--runs", "0"], "Invalid value for '--runs'"),
     (["--warmup", "-1"], "Invalid value for '--warmup'"),
     (["--pipelines", "deferred,raytrace"], "--pipelines: unknown pipeline 'raytrace'"),
