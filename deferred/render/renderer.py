@@ -30,8 +30,7 @@ from deferred.gl.targets import COMPOSITE, FINAL
 from deferred.interfaces.material import Material
 from deferred.interfaces.simulation import advance_simulations
 from deferred.io.safety import raise_if_stop_requested
-from deferred.names import ENVIRONMENT_BACKGROUND, Pipeline
-from deferred.params import validate_params
+from deferred.names import Pipeline
 from deferred.render import samples as sampling
 from deferred.render.budget import check_target_memory, held_memory, renderer_holdings
 from deferred.render.caches import (
@@ -41,9 +40,10 @@ from deferred.render.caches import (
     ShadingTextures,
 )
 from deferred.render.frame_run import PassCallback, prepare_passes, run_passes
-from deferred.render.pipeline import PIPELINES, TONEMAPS, sort_blended
+from deferred.render.pipeline import PIPELINES, sort_blended
 from deferred.render.result import RenderResult
 from deferred.render.samples import MAX_SAMPLES, halton, halton_offsets, render_samples
+from deferred.render.scene_values import check_scene_values
 from deferred.render.setup import (
     FULL_FEATURES,
     RenderSetup,
@@ -52,7 +52,6 @@ from deferred.render.setup import (
     structure_key,
 )
 from deferred.render.temporal import TemporalState, temporal_effect
-from deferred.scene.camera import CameraModel, camera_values
 from deferred.scene.scene import Scene
 from deferred.scene.size import check_size
 from deferred.scene.state import FrameState
@@ -65,32 +64,6 @@ __all__ = ["FULL_FEATURES", "MAX_SAMPLES", "PassCallback", "RenderResult", "Rend
 def strict_default() -> bool:
     """Whether renderers are strict when not told: ``DEFERRED_STRICT=1`` (the tests set it)."""
     return os.environ.get("DEFERRED_STRICT", "") in ("1", "true", "yes")
-
-
-def check_scene_values(scene: Scene) -> None:
-    """The scene's own values as a scene file's are checked (a scene built or changed in
-    Python skips the loader): the camera, the tone mapping operator, the background and the
-    exposure; ``InputError`` naming the attribute."""
-    validate_params(CameraModel, camera_values(scene.camera), "camera")
-    if scene.tonemap not in TONEMAPS:
-        raise InputError(f"unknown tone mapping operator {scene.tonemap!r} (choose from "
-                         f"{', '.join(TONEMAPS)})", "tonemap")
-    if isinstance(scene.background, str):
-        if scene.background != ENVIRONMENT_BACKGROUND:
-            raise InputError(f"expected three numbers or \"environment\", got "
-                             f"{scene.background!r}", "background")
-        if not any(light.name == ENVIRONMENT_BACKGROUND for light in scene.lights):
-            raise InputError("\"environment\" shows the environment light's map: add a light "
-                             "of type \"environment\"", "background")
-    else:
-        background = np.asarray(scene.background, dtype=np.float64)
-        if background.shape != (3,) or not np.all(np.isfinite(background)) or \
-                np.any(background < 0):
-            raise InputError(f"expected three finite numbers >= 0, got {scene.background!r}",
-                             "background")
-    if not (isinstance(scene.exposure, float | int) and math.isfinite(scene.exposure) and
-            scene.exposure > 0.0):
-        raise InputError(f"expected a finite number > 0, got {scene.exposure!r}", "exposure")
 
 
 def _restarts(material_cls: type[Material], before: object, after: object) -> bool:
@@ -332,6 +305,15 @@ class Renderer:
         self.temporal.end(history, state)
         self._frame_number += 1
         return self._result(frame, readback, hdr)
+
+    def simulate(self, time: float) -> None:
+        """Bring the scene's simulations to ``time`` as a frame at ``time`` would, drawing
+        nothing: a frame rendered apart from those before it (``deferred.farm``) first replays
+        the times a single renderer would have drawn, so its simulations step alike."""
+        self._check_alive()
+        state = self.state_at(_frame_time(time))
+        self.gl.make_current()
+        advance_simulations(self._begin_frame(state, time, None, None, False)[0])
 
     def _begin_frame(self, state: FrameState, time: float,
                      jitter: tuple[float, float] | None, sample_index: int | None,
