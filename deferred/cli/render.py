@@ -15,6 +15,7 @@ import click
 
 from deferred.cli import options
 from deferred.cli.budget import StepClock, before_meshes, check_render, warn
+from deferred.cli.farm_options import check_farm_options, farm_options
 from deferred.cli.options import FiniteFloat, check_not_inputs, parse_size_option, stderr
 from deferred.cli.view_option import (
     LISTING,
@@ -59,6 +60,14 @@ class RenderJob:
     view_name: str | None
     gltf_camera: str | None = None
     animation: str | None = None
+    workers: int | None = None  # --workers: local worker processes
+    ray: str | None = None  # --ray: the cluster's address, "" for a local instance
+    resume: bool = False
+
+    @property
+    def farmed(self) -> bool:
+        """Whether the frames go to workers (and a manifest): --workers, --ray, --resume."""
+        return self.workers is not None or self.ray is not None or self.resume
 
     @property
     def frames(self) -> int:
@@ -102,10 +111,12 @@ class Rendered:
 @options.strict_option
 @view_option(RENDER_HELP)
 @options.gltf_options
+@farm_options
 def render(scene: str | None, output: str, pipeline: str, size: str | None, frames: int,
            fps: float, start_time: float, turntable: int | None, samples: int,
            light_path: str | None, strict: bool, view_name: str | None,
-           gltf_camera: str | None, animation: str | None) -> None:
+           gltf_camera: str | None, animation: str | None, workers: int | None,
+           ray: str | None, resume: bool) -> None:
     """Render SCENE (a TOML file or a glTF file; the built-in demo when omitted) to an image,
     a numbered image sequence or a video."""
     if view_name == LISTING:
@@ -113,7 +124,9 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
         return
     job = render_job(scene, output, pipeline, size, frames, fps, start_time, turntable, samples,
                      light_path, strict, view_name)
-    job = replace(job, gltf_camera=gltf_camera, animation=animation)
+    job = replace(job, gltf_camera=gltf_camera, animation=animation, workers=workers, ray=ray,
+                  resume=resume)
+    check_farm_options(job.kind, workers, ray, resume)
     with Progress("render", stderr) as progress:
         rendered = run_render(job, progress)
     stderr.print(summary(job, rendered), markup=False, highlight=False)
@@ -167,6 +180,9 @@ def run_render(job: RenderJob, progress: Progress) -> Rendered:
     predicted, long = check_render(loaded, size or loaded.size, job.samples, job.times,
                                    job.pipeline, size is not None)
     check_samples_memory(size or loaded.size, job.samples)  # the renderer's are counted later
+    if job.farmed:
+        warn(long)
+        return _render_farmed(job, loaded, size, progress)
     progress.status("starting the renderer")
     with Renderer(loaded, job.pipeline, size, strict=job.strict or None,
                   light_path=job.light_path) as renderer:
@@ -304,6 +320,30 @@ def _render_animation(renderer: Renderer, job: RenderJob, progress: Progress,
     return describe_written(written), frame_ms
 
 
+def _render_farmed(job: RenderJob, loaded: Scene, size: tuple[int, int] | None,
+                   progress: Progress) -> Rendered:
+    """The frames rendered by workers (:mod:`deferred.farm`): the scene sent by content."""
+    from deferred.farm.bundle import bundle_scene
+    from deferred.farm.sequence import make_pool, render_sequence
+    from deferred.farm.worker import FrameJob
+    from deferred.scene.timeline import SceneEvaluator
+
+    loaded.check_tracks(job.times)  # as the renderer does, before any worker starts
+    SceneEvaluator(loaded).check_simulation_times(max(job.times), "--time")
+    frames = FrameJob(bundle_scene(job.scene, loaded), job.pipeline, size, job.times, job.fps,
+                      job.start_time, job.samples, job.light_path, job.strict, job.turntable,
+                      job.gltf_camera, job.animation,
+                      job.out.suffix.lower() if job.kind == "sequence" else ".png")
+    temporal = any(effect.temporal for effect in loaded.effects)
+    result = render_sequence(frames, job.out, job.kind,
+                             functools.partial(make_pool, frames, job.workers, job.ray),
+                             progress, job.resume, temporal)
+    from deferred.io.video import describe_written
+
+    return Rendered(size or loaded.size, result.light_path or "-",
+                    describe_written(result.written), result.frame_ms)
+
+
 def _after(step: Callable[[int], None], before: int, count: int) -> None:
     step(before + count)
 
@@ -311,8 +351,9 @@ def _after(step: Callable[[int], None], before: int, count: int) -> None:
 def summary(job: RenderJob, rendered: Rendered) -> str:
     """``wrote OUT (WxH, PIPELINE, PATH lights[, view V][, t = ...], TIMING)``."""
     frame_ms = rendered.frame_ms
-    timing = f"{min(frame_ms):.1f} ms" if job.frames == 1 else \
-        f"median {sorted(frame_ms)[len(frame_ms) // 2]:.1f} ms over {job.frames} frames"
+    timing = f"{min(frame_ms):.1f} ms" if job.frames == 1 and frame_ms else \
+        f"median {sorted(frame_ms)[len(frame_ms) // 2]:.1f} ms over {len(frame_ms)} frames" \
+        if frame_ms else "every frame was done already"
     shown = f", view {job.view_name}" if job.view_name is not None else ""
     clock = ""
     if job.frames > 1 or job.start_time > 0.0:

@@ -91,13 +91,17 @@ def detect_features(ctx: moderngl.Context, allow_gl43: bool = True) -> Features:
 def create_context(backend: str | None = None, allow_gl43: bool | None = None) -> GLContext:
     """Create a headless context: EGL by default (Mesa llvmpipe on CI machines).
 
-    ``DEFERRED_GL_BACKEND`` overrides the backend; ``DEFERRED_GL33=1`` forces the GL 3.3 paths.
+    ``DEFERRED_GL_BACKEND`` overrides the backend; ``DEFERRED_GL33=1`` forces the GL 3.3 paths;
+    ``DEFERRED_EGL_DEVICE=N`` picks EGL's device N (a render worker given GPU N, ``--ray``).
     """
     backend = backend or os.environ.get("DEFERRED_GL_BACKEND", "egl")
     if allow_gl43 is None:
         allow_gl43 = os.environ.get("DEFERRED_GL33", "") not in ("1", "true", "yes")
+    device = os.environ.get("DEFERRED_EGL_DEVICE", "")
+    chosen = {"device_index": int(device)} if backend == "egl" and device.isdigit() else {}
     try:
-        ctx = moderngl.create_standalone_context(backend=backend, require=MIN_GL_VERSION)
+        ctx = moderngl.create_standalone_context(backend=backend, require=MIN_GL_VERSION,
+                                                 **chosen)
     except Exception as exc:  # noqa: BLE001 - moderngl raises plain Exception for missing drivers
         raise RenderError("cannot create a GL 3.3 core context "
                           f"(backend {backend}): {exc}") from exc

@@ -175,6 +175,21 @@ def write_text(path: str | Path, text: str) -> Path:
     return path
 
 
+def write_bytes(path: str | Path, data: bytes) -> Path:
+    """Write a file's bytes atomically, flushed before the rename (a frame a worker encoded):
+    readers see the old file or the whole new one, never part of it."""
+    path = Path(path)
+
+    def write(temporary: str) -> None:
+        with open(temporary, "wb") as handle:
+            handle.write(data)
+            handle.flush()
+            os.fsync(handle.fileno())
+
+    _write_atomically(path, write)
+    return path
+
+
 NEGATIVE_TOLERANCE = 1e-3  # image values this far below 0 read as 0 (HDR filter ringing)
 def _write_atomically(path: Path, write: Callable[[str], None]) -> None:
     """``write(temporary)`` next to ``path``, then rename over it: readers never see half a file,

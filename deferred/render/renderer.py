@@ -409,10 +409,7 @@ class Renderer:
                 latest <= self._times_checked[0]:
             return
         if checked:
-            state = self.evaluator.evaluate(latest)
-            for obj in checked:  # most materials have no simulation
-                evaluated = state.object_state(obj)
-                evaluated.material.simulation.check_time(evaluated, latest, where)
+            self.evaluator.check_simulation_times(latest, where)
         self._times_checked = (latest, revisions)
 
     def _check_gl(self, stage: str) -> None:

@@ -179,6 +179,17 @@ class SceneEvaluator:
             self._hierarchy = (key, hierarchy_of(scene))
         return self._hierarchy[1]
 
+    def check_simulation_times(self, latest: float, where: str) -> None:
+        """Every simulated object's ``Simulation.check_time`` for ``latest``, the latest time
+        a render asks for (``InputError`` naming ``where`` for one it cannot reach)."""
+        simulated = [obj for obj in self.scene.objects if obj.material.simulation is not None]
+        if not simulated:  # most materials have no simulation
+            return
+        state = self.evaluate(latest)
+        for obj in simulated:
+            evaluated = state.object_state(obj)
+            evaluated.material.simulation.check_time(evaluated, latest, where)
+
     def evaluate(self, time: float) -> FrameState:
         """The scene at ``time``."""
         scene = self.scene
