@@ -10,13 +10,19 @@ from __future__ import annotations
 import hashlib
 import os
 import shutil
+import sys
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from deferred.errors import InputError
-from deferred.io.safety import scene_inputs
+from deferred.io.safety import scene_inputs, strings_in
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # Python 3.10: the same parser, as a package
+    import tomli as tomllib
 
 BUILTIN = "builtin:"
 
@@ -53,7 +59,12 @@ def bundle_scene(scene_file: str | None, loaded: Any) -> SceneBundle:
         return SceneBundle(scene=None, builtin=scene_file)
     inputs = [Path(os.path.abspath(path)) for path in scene_inputs(loaded, scene_file)]
     scene_path = Path(os.path.abspath(scene_file))
-    root = Path(os.path.commonpath([path.parent for path in [scene_path, *inputs]]))
+    # a path that climbs out of the scene's folder and back in (../scenes/tex.png) must find
+    # the same folders on a worker: the root holds every folder the scene's paths pass through
+    anchor = scene_path.parent
+    for _ in range(_climbs(scene_path)):
+        anchor = anchor.parent
+    root = Path(os.path.commonpath([anchor, *(path.parent for path in inputs)]))
     files = {}
     for path in inputs:
         try:
@@ -62,6 +73,19 @@ def bundle_scene(scene_file: str | None, loaded: Any) -> SceneBundle:
             raise InputError(f"cannot read {path} to send it to the workers: "
                              f"{exc.strerror or exc}", str(path)) from None
     return SceneBundle(scene=scene_path.relative_to(root).as_posix(), files=files)
+
+
+def _climbs(scene_path: Path) -> int:
+    """The most ``..`` a path in the scene file starts with."""
+    try:
+        data = tomllib.loads(scene_path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):  # a glTF file, or one the loader read otherwise
+        return 0
+    most = 0
+    for text in strings_in(data):
+        parts = Path(text).parts
+        most = max(most, next((n for n, part in enumerate(parts) if part != ".."), len(parts)))
+    return most
 
 
 class UnpackedScene:

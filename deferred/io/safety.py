@@ -121,16 +121,16 @@ def signals_deferred() -> Iterator[None]:
 
 # -- the files a scene reads ---------------------------------------------------------------------
 
-def _strings(value: Any) -> Iterator[str]:
+def strings_in(value: Any) -> Iterator[str]:
     """Every string inside nested tables and lists."""
     if isinstance(value, str):
         yield value
     elif isinstance(value, Mapping):
         for item in value.values():
-            yield from _strings(item)
+            yield from strings_in(item)
     elif isinstance(value, list | tuple):
         for item in value:
-            yield from _strings(item)
+            yield from strings_in(item)
 
 
 def _is_file(path: Path) -> bool:
@@ -155,7 +155,7 @@ def scene_inputs(scene: Any, scene_file: str | Path | None = None) -> list[Path]
             data: Any = tomllib.loads(path.read_text(encoding="utf-8"))
         except (OSError, ValueError):  # undecodable, malformed, a number too long
             data = {}
-        for text in _strings(data):
+        for text in strings_in(data):
             candidate = Path(text)
             found.append(candidate if candidate.is_absolute() else path.parent / candidate)
     for obj in getattr(scene, "objects", ()):
@@ -166,7 +166,7 @@ def scene_inputs(scene: Any, scene_file: str | Path | None = None) -> list[Path]
             if params is None:
                 continue
             values = params.model_dump() if hasattr(params, "model_dump") else params
-            for text in _strings(values):
+            for text in strings_in(values):
                 try:
                     found.append(material.resolve_path(text))
                 except (TypeError, ValueError):
