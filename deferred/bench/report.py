@@ -178,13 +178,16 @@ def results_table(report: BenchReport):
     from rich.table import Table
 
     table = Table(title=plot_title(report), title_justify="left")
-    for column in ("pipeline", "path", "lights", "shells", "median ms", "min ms", "max ms",
-                   "stddev", "cpu ms", "us/draw", "slowest pass"):
+    sized = len({(r.width, r.height) for r in report.results}) > 1  # a --sweep of sizes
+    for column in ("pipeline", "path", *(("size",) if sized else ()), "lights", "shells",
+                   "median ms", "min ms", "max ms", "stddev", "cpu ms", "us/draw",
+                   "slowest pass"):
         table.add_column(column, no_wrap=True, justify="left" if column in (
-            "pipeline", "path", "slowest pass") else "right")
+            "pipeline", "path", "size", "slowest pass") else "right")
     for r in report.results:
         slowest = max(r.passes_ms.items(), key=lambda item: item[1], default=None)
-        table.add_row(r.pipeline, r.light_path, str(r.lights), str(r.shells),
+        table.add_row(r.pipeline, r.light_path, *((f"{r.width}x{r.height}",) if sized else ()),
+                      str(r.lights), str(r.shells),
                       f"{r.median_ms:.2f}", f"{r.min_ms:.2f}", f"{r.max_ms:.2f}",
                       f"{r.stddev_ms:.2f}", f"{r.cpu_ms:.2f}", f"{r.cpu_us_per_draw:.1f}",
                       f"{slowest[0]} {slowest[1]:.2f} ms" if slowest else "")

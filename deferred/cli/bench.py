@@ -14,8 +14,9 @@ from rich.console import Console
 
 from deferred.cli import options
 from deferred.cli.options import check_not_inputs, parse_size_option, stderr
-from deferred.errors import RenderError
+from deferred.errors import InputError, RenderError
 from deferred.io.cost import Prediction, WorkWarning, check_time, duration
+from deferred.io.extras import require_extra
 from deferred.io.progress import Progress
 from deferred.scene.loader import load_scene
 
@@ -26,7 +27,7 @@ if TYPE_CHECKING:
 OUTPUT_OPTIONS = ("--json", "--csv", "--plot")
 
 
-@click.command()
+@click.command(context_settings={"allow_extra_args": True})
 @options.scene_argument
 @click.option("--lights", default="1,16,64,256,1024", show_default=True, metavar="N,...",
               help="Extra point lights added to the scene's own, one sweep point each.")
@@ -52,15 +53,26 @@ OUTPUT_OPTIONS = ("--json", "--csv", "--plot")
 @click.option("--plot", "plot_path", metavar="FILE.png",
               help="ms against light count (needs the plot extra: pip install "
                    "'deferred[plot]').")
-def bench(scene: str | None, lights: str, shells: str | None, size: str | None, runs: int,
-          warmup: int,
+@click.option("--sweep", "grid", multiple=True, metavar="KEY=V,... [KEY=V,...]",
+              help="Time every point of a grid of lights=N,..., shells=N,... and "
+                   "size=WxH,..., each point a task of its own (here, or on --workers/--ray).")
+@click.option("--workers", type=click.IntRange(min=1, max=256), metavar="N",
+              help="With --sweep: N local worker processes, each pinned to its own cores.")
+@click.option("--ray", is_flag=False, flag_value="", default=None, metavar="[ADDRESS]",
+              help="With --sweep: the points on a Ray cluster, one at a time on each node "
+                   "(needs the ray extra).")
+@click.pass_context
+def bench(context: click.Context, scene: str | None, lights: str, shells: str | None,
+          size: str | None, runs: int, warmup: int,
           pipelines: str, light_paths: str, interleave: bool, json_path: str | None,
-          csv_path: str | None, plot_path: str | None) -> None:
+          csv_path: str | None, plot_path: str | None, grid: tuple[str, ...],
+          workers: int | None, ray: str | None) -> None:
     """Time SCENE (the built-in demo when omitted) in each pipeline over a sweep of light and
     shell counts. The table goes to stdout, progress and the sweep's size and time to stderr;
     benchmarks/README.md describes the method and the results."""
     from deferred import bench as benchmark
 
+    scene, grid = _scene_and_grid(context, scene, grid, workers, ray)
     # Every option is checked before the first frame: bad input never costs a sweep.
     sweep = benchmark.Sweep(lights=benchmark.parse_counts(lights, "--lights"),
                             shells=None if shells is None else
@@ -73,11 +85,14 @@ def bench(scene: str | None, lights: str, shells: str | None, size: str | None, 
     loaded = load_scene(scene)
     for where, path in outputs.items():
         check_not_inputs([path], loaded, scene, where)
-    benchmark.check_sweep(loaded, sweep)
-    if shells is not None and not benchmark.shell_objects(loaded):
-        stderr.print(f"{loaded.source}: no object has a 'shells' parameter; shell sweep "
-                     "skipped (shells 0)")
-    report = run_sweep(loaded, sweep)
+    if grid:
+        report = run_grid(scene, loaded, sweep, grid, workers, ray)
+    else:
+        benchmark.check_sweep(loaded, sweep)
+        if shells is not None and not benchmark.shell_objects(loaded):
+            stderr.print(f"{loaded.source}: no object has a 'shells' parameter; shell sweep "
+                         "skipped (shells 0)")
+        report = run_sweep(loaded, sweep)
     print_results(report, to_stderr=json_path == "-")
     if json_path == "-":
         _json_to_stdout(report)
@@ -87,6 +102,50 @@ def bench(scene: str | None, lights: str, shells: str | None, size: str | None, 
         writers[where](report, path)
     if outputs:
         stderr.print(f"wrote {', '.join(str(path) for path in outputs.values())}")
+
+
+def _scene_and_grid(context: click.Context, scene: str | None, grid: tuple[str, ...],
+                    workers: int | None, ray: str | None) -> tuple[str | None, list[str]]:
+    """The scene and the grid's entries: ``--sweep lights=1,64 shells=16,64`` leaves the
+    entries after the first as words of their own, where click puts the scene."""
+    from deferred.bench.grid import is_grid_entry
+
+    words = ([scene] if scene is not None else []) + list(context.args)
+    entries = [word for word in words if is_grid_entry(word) and not Path(word).exists()]
+    others = [word for word in words if word not in entries]
+    if len(others) > 1:
+        raise click.UsageError(f"got unexpected extra arguments ({' '.join(others[1:])})")
+    if entries and not grid:
+        raise click.UsageError(f"{entries[0]} is a grid entry: put it after --sweep")
+    if (workers is not None or ray is not None) and not grid:
+        raise InputError("times the points of a --sweep grid on workers: add --sweep",
+                         "--workers" if workers is not None else "--ray")
+    if ray is not None:
+        require_extra("ray", ("ray",), "--ray", "--ray")
+    return (others[0] if others else None), [*grid, *entries]
+
+
+def run_grid(scene: str | None, loaded: Scene, sweep: Sweep, entries: list[str],
+             workers: int | None, ray: str | None) -> BenchReport:
+    """The grid's points as tasks (:mod:`deferred.bench.grid`), the progress on stderr."""
+    from deferred.bench import grid as grids
+    from deferred.farm.bundle import bundle_scene
+    from deferred.farm.tasks import placement
+
+    sweeps = grids.grid_sweeps(sweep, grids.parse_grid(entries))
+    grids.check_grid(loaded, sweeps)
+    for point in sweeps:
+        check_sweep_time(loaded, point)
+    stderr.print(f"bench: {len(sweeps)} grid points, {placement(workers, ray)}",
+                 markup=False, highlight=False)
+    bundle = bundle_scene(scene, loaded)
+    with Progress("bench", stderr) as progress:
+        progress.count(len(sweeps), "points", "timing the grid")
+
+        def done(count: int, total: int) -> None:
+            progress.advance(count, "timing the grid")
+
+        return grids.run_grid(bundle, sweeps, workers, ray, done)
 
 
 def _output_files(json_path: str | None, csv_path: str | None,

@@ -132,3 +132,49 @@ class RayPool:
             ray.kill(actor)
         if self._started:
             ray.shutdown()
+
+
+class _TaskActor:
+    """Runs tasks one at a time on the node it is pinned to."""
+
+    def call(self, function, *args):
+        return function(*args)
+
+
+def run_on_nodes(function, tasks, address: str | None, on_done) -> list:
+    """``function(*task)`` for every task, one task at a time on each node of the cluster
+    (an actor pinned to each live node): timings taken on a machine doing nothing else of
+    ours."""
+    import ray
+    from ray.util.scheduling_strategies import NodeAffinitySchedulingStrategy
+
+    started = _connect(address)
+    actors = []
+    try:
+        for node in ray.nodes():
+            if node.get("Alive"):
+                strategy = NodeAffinitySchedulingStrategy(node["NodeID"], soft=False)
+                actors.append(ray.remote(_TaskActor).options(
+                    num_cpus=1, scheduling_strategy=strategy, max_restarts=RESTARTS,
+                    max_task_retries=RESTARTS).remote())
+        queue = deque(enumerate(tasks))
+        results: list = [None] * len(tasks)
+        running: dict[Any, tuple[int, Any]] = {}
+        idle = deque(actors)
+        while queue or running:
+            while queue and idle:
+                actor = idle.popleft()
+                number, task = queue.popleft()
+                running[actor.call.remote(function, *task)] = (number, actor)
+            ready, _ = ray.wait(list(running), num_returns=1)
+            for reference in ready:
+                number, actor = running.pop(reference)
+                results[number] = ray.get(reference)
+                idle.append(actor)
+                on_done(len(tasks) - len(queue) - len(running), len(tasks))
+        return results
+    finally:
+        for actor in actors:
+            ray.kill(actor)
+        if started:
+            ray.shutdown()
