@@ -24,15 +24,6 @@ from deferred.farm.manifest import manifest_path
 FRAMES = 12
 
 
-@pytest.fixture(scope="module")
-def local_ray():
-    """A local Ray instance of two CPUs for the module's tests, stopped after them."""
-    ray = pytest.importorskip("ray")
-    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
-    yield ray
-    ray.shutdown()
-
-
 def render_frames(capsys, scene: Path, out: Path, count: int, *options) -> str:
     out.mkdir(exist_ok=True)
     code, _, err = run(capsys, "render", scene, "--frames", count, "-o", out / "f_##.png",
