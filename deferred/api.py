@@ -14,7 +14,12 @@ A plugin (the built-in materials, lights and effects, and the example package in
   register them with: ``materials``, ``lights``, ``shading_models``, ``effects``.
 - **passes**: :class:`RenderPass`, :class:`ObjectPass` (with the :class:`PassInput` and
   :class:`Shape` it composes), :class:`FullscreenPass`, :class:`ClearPass`, :func:`copy_pass`,
-  :class:`Phase` and :class:`Order`; the :class:`Frame` a pass runs against;
+  compositions of passes (:func:`compose_runs`, ``BEGIN``, ``END``: order-independent
+  transparency),
+  :class:`Phase` and :class:`Order`; :class:`Blend` (a pass output's blend factors and
+  equations, beside the named modes); :func:`select_surfaces` (a full-screen pass's
+  defines selecting one material's or shading model's pixels, ``gbuffer/select.glsl``); the
+  :class:`Frame` a pass runs against;
   :class:`TargetSpec` for the targets a pass creates.
 - **targets by name**: the G-buffer's (``ALBEDO_SPECULAR``, ``NORMAL_EXPONENT_ID``,
   ``LINEAR_DEPTH``, ``DEPTH``, ``GBUFFER_COLOR_TARGETS``) and the frame's
@@ -45,6 +50,8 @@ from __future__ import annotations
 
 from deferred.core.frame import Frame
 from deferred.core.passes import (
+    BEGIN,
+    END,
     ClearPass,
     FullscreenPass,
     ObjectPass,
@@ -53,6 +60,7 @@ from deferred.core.passes import (
     Phase,
     RenderPass,
     Shape,
+    compose_runs,
     copy_pass,
 )
 from deferred.errors import InputError, RenderError
@@ -66,6 +74,7 @@ from deferred.gbuffer import (
     NORMAL_EXPONENT_ID,
     GBufferData,
 )
+from deferred.gl.blend import Blend
 from deferred.gl.meshes import GpuMesh, MeshData, MeshPrimitives
 from deferred.gl.resources import image_texture_bytes
 from deferred.gl.shaderlib import register_shader_root
@@ -97,6 +106,7 @@ from deferred.interfaces.light import (
 )
 from deferred.interfaces.material import BlinnPhongParams, Material, MaterialParams
 from deferred.interfaces.registry import effects, lights, materials, shading_models
+from deferred.interfaces.selection import select_surfaces
 from deferred.interfaces.shading import ShadingModel
 from deferred.interfaces.shadow_casting import (
     SHADOW_CASTER_DEFINES,
@@ -154,6 +164,9 @@ GLSL_INCLUDES: dict[str, str] = {
                                  "radiance by roughness (a shading model's environment "
                                  "function)",
     "gbuffer/layout.glsl": "the G-buffer's encoding and decoding",
+    "gbuffer/select.glsl": "surface_selected(surface id), pixel_selected(sampler, pixel): "
+                           "whether a pixel is one of the materials or shading models "
+                           "select_surfaces(...) names (its defines)",
     "gbuffer/write.glsl": "the G-buffer's outputs and gbuffer_write (G-buffer passes)",
     "materials/techniques/stipple.glsl": "stipple patterns (Revie 2.3.4, Listing 2.6)",
     "materials/techniques/rim.glsl": "rim scattering by bent normals (Revie 2.3.2, Listing 2.3)",
@@ -176,11 +189,12 @@ GLSL_INCLUDES: dict[str, str] = {
 }
 
 __all__ = [
-    "ALBEDO_SPECULAR", "AMBIENT_OCCLUSION", "COMPOSITE", "COMPOSITE_SPEC", "DEPTH", "FINAL",
+    "ALBEDO_SPECULAR", "AMBIENT_OCCLUSION", "BEGIN", "COMPOSITE", "COMPOSITE_SPEC", "DEPTH",
+    "END", "FINAL",
     "FINAL_SPEC", "FrameMoment", "GBUFFER_COLOR_TARGETS", "GLSL_INCLUDES", "LIGHT_ACCUMULATION",
     "LIGHT_ACCUMULATION_SPEC", "LINEAR_DEPTH", "MAX_COORDINATE", "MOTION", "MOTION_SPEC",
     "NORMAL_EXPONENT_ID",
-    "Albedo",
+    "Albedo", "Blend",
     "BlinnPhongParams", "ClearPass", "Effect", "EffectParams", "ForwardLitPass", "Frame",
     "FullscreenPass", "GBufferData", "GBufferPass", "GpuMesh", "InputError", "Light",
     "LightParams", "LightPath", "LightVolume", "Material", "MaterialParams", "MeshData",
@@ -191,9 +205,11 @@ __all__ = [
     "RenderError", "RenderPass", "RenderWork", "Scene", "SceneObject", "ShadingModel", "Shape",
     "Simulation", "SurfacePasses", "TargetSpec", "Technique",
     "UniformOverrides", "Work", "WorkObject", "builtin_head_spheres", "cache_folder",
-    "check_image", "check_memory", "copy_pass", "counted", "effects", "file_digest", "halton",
+    "check_image", "check_memory", "compose_runs", "copy_pass", "counted", "effects",
+    "file_digest", "halton",
     "image_texture_bytes", "lights", "materials", "number_too_long",
     "radiances", "read_channels", "read_image", "register_shader_root", "require_regular_file",
+    "select_surfaces",
     "srgb_decode",
     "shading_models",
     "view_direction", "view_directions", "view_point", "view_points", "write_cached_arrays",

@@ -91,6 +91,8 @@ def heading(entry: dict[str, Any]) -> str:
         details.append(f"shading model {entry['shading_model']}")
     if entry.get("volume"):
         details.append(f"volume {entry['volume']}")
+    if entry.get("pipelines") is not None and len(entry["pipelines"]) == 1:
+        details.append(f"{entry['pipelines'][0]} pipeline only")
     if entry.get("glsl_file"):
         details.append(entry["glsl_file"])
     if "materials" in entry:

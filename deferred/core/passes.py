@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, Protocol
 
 import moderngl
 
+from deferred.gl.blend import PassBlend, blend_outputs, blended_outputs
 from deferred.gl.target_spec import TargetSpec
 from deferred.memo import overrides
 
@@ -69,6 +70,13 @@ class RenderPass(ABC):
     writes: tuple[str, ...] = ()
     samples: tuple[str, ...] = ()  # the reads bound as textures: never also written (GL feedback)
     order: int = Order.OPAQUE
+    # a transparent surface: drawn over what lies behind it and hiding nothing, so Forward+'s
+    # depth pre-pass leaves it out (a lit pass of it laid down there would hide what it shows)
+    transparent: bool = False
+    # the composition this pass is a member of, by name, and for one of a composition's own
+    # passes (name, BEGIN or END): compose_runs
+    composition: str | None = None
+    brackets: tuple[str, str] | None = None
 
     def prepare(self, frame: Frame) -> None:  # noqa: B027 - optional hook
         """Upload per-frame data; called once per frame before any pass runs."""
@@ -86,15 +94,77 @@ class RenderPass(ABC):
         return f"<{type(self).__name__} {self.name} ({self.phase.value})>"
 
 
+BEGIN, END = "begin", "end"  # the roles of a composition's own passes (RenderPass.brackets)
+
+
+def compose_runs(passes: list[RenderPass],
+                 brackets: list[RenderPass] | None = None) -> list[RenderPass]:
+    """``passes`` with each composition's ``begin`` and ``end`` passes (those among
+    ``passes``, or among ``brackets`` where given) taken from where they are and put around
+    every run of its members (consecutive passes whose ``composition`` is its name): the same
+    list where they already are so.
+
+    A composition is a group of object passes composed together, order-independently
+    (weighted blended or per-pixel sorted transparency). Each frame, every run of them that no
+    other pass interrupts in the order the frame runs them (blended object passes far to near)
+    is opened by the composition's begin passes (clearing what the members accumulate into)
+    and closed by its end passes (resolving that over what lies behind): a fur volume between
+    two glass panes splits them into two runs, so each pane is composed over what lies
+    behind it, the fur included. A pass is one of those by its ``brackets``: (the
+    composition's name, :data:`BEGIN` or :data:`END`); they keep their order among
+    themselves."""
+    roles: dict[str, dict[str, list[RenderPass]]] = {}
+    for render_pass in passes if brackets is None else brackets:
+        if render_pass.brackets is not None:
+            name, role = render_pass.brackets
+            listed = roles.setdefault(name, {BEGIN: [], END: []})[role]
+            if not any(known is render_pass for known in listed):  # once though run twice
+                listed.append(render_pass)
+    if not roles:
+        return passes
+    out: list[RenderPass] = []
+    current: str | None = None
+    for render_pass in passes:
+        if render_pass.brackets is not None:
+            continue
+        group = render_pass.composition
+        if group not in roles:
+            group = None  # none of its passes in this list: composed on its own
+        if group != current:
+            if current is not None:
+                out += roles[current][END]
+            if group is not None:
+                out += roles[group][BEGIN]
+            current = group
+        out.append(render_pass)
+    if current is not None:
+        out += roles[current][END]
+    return passes if same_passes(out, passes) else out
+
+
+def without_brackets(passes: list[RenderPass]) -> list[RenderPass]:
+    """``passes`` without the compositions' begin and end passes (the same list where it has
+    none)."""
+    if not any(p.brackets is not None for p in passes):
+        return passes
+    return [p for p in passes if p.brackets is None]
+
+
+def same_passes(first: list[RenderPass], second: list[RenderPass]) -> bool:
+    """Whether two pass lists hold the same passes in the same order."""
+    return len(first) == len(second) and all(a is b for a, b in zip(first, second, strict=True))
+
+
 def drawn_targets(samples: tuple[str, ...], colors: tuple[str, ...] | list[str],
-                  blend: str | None, depth: str | None, depth_test: bool,
+                  blend: PassBlend, depth: str | None, depth_test: bool,
                   depth_write: bool) -> tuple[tuple[str, ...], tuple[str, ...]]:
     """(reads, writes) of a pass drawing into ``colors`` and ``depth`` with this state: it reads
-    what it samples, the colours it blends over, and the depth it tests against or has bound
-    without writing it (the depth of earlier passes, kept); it writes its colours and, with
-    depth writes, the depth."""
+    what it samples, the colours it blends over (``blend``: any form of
+    :mod:`deferred.gl.blend`, an output whose state is ``None`` is written, not read), and the
+    depth it tests against or has bound without writing it (the depth of earlier passes,
+    kept); it writes its colours and, with depth writes, the depth."""
     reads = tuple(dict.fromkeys(
-        [*samples, *(colors if blend else ()),
+        [*samples, *(blended_outputs(blend, tuple(colors)) if blend is not None else ()),
          *((depth,) if depth and (depth_test or not depth_write) else ())]))
     writes = tuple(colors) + ((depth,) if depth and depth_write else ())
     return reads, writes
@@ -106,7 +176,9 @@ class ClearPass(RenderPass):
 
     order = Order.FIRST
 
-    def __init__(self, name: str, phase: Phase, creates: dict[str, TargetSpec]):
+    def __init__(self, name: str, phase: Phase, creates: dict[str, TargetSpec],
+                 brackets: tuple[str, str] | None = None):
+        self.brackets = brackets
         missing = [target for target, spec in creates.items() if spec.clear is None]
         if missing:
             raise ValueError(f"{name}: targets without a clear value: {', '.join(missing)}")
@@ -123,22 +195,26 @@ class FullscreenPass(RenderPass):
     """Run a fragment shader over every pixel (``post/fullscreen.vert``)."""
 
     def __init__(self, name: str, phase: Phase, fragment: str, inputs: dict[str, str],
-                 outputs: tuple[str, ...], blend: str | None = None,
+                 outputs: tuple[str, ...], blend: PassBlend = None,
                  defines: dict[str, str] | None = None,
                  uniforms: Callable[[Frame], dict[str, Any]] | None = None,
                  depth: str | None = None, depth_test: bool = False, depth_func: str = "less",
                  depth_write: bool = False, instances: Callable[[Frame], int] | None = None,
                  vertex: str = "post/fullscreen.vert", creates: dict[str, TargetSpec] | None = None,
-                 order: int = Order.OPAQUE):
+                 order: int = Order.OPAQUE, transparent: bool = False,
+                 brackets: tuple[str, str] | None = None):
         self.name = name
         self.creates = dict(creates or {})
+        self.transparent = transparent
+        self.brackets = brackets
         self.order = order
         self.phase = phase
         self.fragment = fragment
         self.vertex = vertex
         self.inputs = inputs  # sampler uniform -> target name
         self.outputs = outputs
-        self.blend = blend
+        blend_outputs(blend, len(outputs), f"pass {name}: blend")  # checked now, not drawing
+        self.blend = tuple(blend) if isinstance(blend, list) else blend
         self.defines = defines or {}
         self.uniforms = uniforms
         self.depth = depth
@@ -162,11 +238,12 @@ class FullscreenPass(RenderPass):
 
 
 def copy_pass(name: str, phase: Phase, source: str, target: str, spec: TargetSpec,
-              order: int = Order.OPAQUE) -> FullscreenPass:
+              order: int = Order.OPAQUE,
+              brackets: tuple[str, str] | None = None) -> FullscreenPass:
     """A pass creating ``target`` as a copy of ``source`` (a snapshot a later pass reads while it
     writes ``source``: GL forbids reading a texture while rendering into it)."""
     return FullscreenPass(name, phase, "post/copy.frag", {"u_source": source}, (target,),
-                          creates={target: spec}, order=order)
+                          creates={target: spec}, order=order, brackets=brackets)
 
 
 class PassInput:
@@ -224,7 +301,9 @@ class ObjectPass(RenderPass):
     depth_func: str = "less"
     depth_write: bool = True
     cull: str | None = "back"
-    blend: str | None = None
+    blend: PassBlend = None  # a name, a Blend, or one of those per colour (deferred.gl.blend)
+    transparent: bool = False  # RenderPass.transparent
+    composition: str | None = None  # RenderPass.composition
     depth_offset: tuple[float, float] = (0.0, 0.0)  # glPolygonOffset (factor, units)
     extra_reads: tuple[str, ...] = ()
     constants: dict[str, Any] | None = None  # uniforms fixed at construction
@@ -255,6 +334,9 @@ class ObjectPass(RenderPass):
                 raise TypeError(f"{type(self).__name__} has no option '{key}'")
             setattr(self, key, value)
         self.inputs = tuple(self.inputs)
+        if isinstance(self.blend, list):
+            self.blend = tuple(self.blend)  # a state compared from pass to pass
+        blend_outputs(self.blend, len(self.colors), f"pass {name}: blend")
         self.samples = tuple(dict.fromkeys(
             [*self.extra_reads, *(target for given in self.inputs for target in given.reads)]))
         # one draw of the material's inputs alone: the pass's hooks are not asked (execute)

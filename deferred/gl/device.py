@@ -18,23 +18,11 @@ from typing import Any
 
 import moderngl
 
+from deferred.gl.blend import IndexedBlend, PassBlend, blend_outputs, shared_blend
 from deferred.gl.meshes import MeshData
 from deferred.gl.resources import Resources
 from deferred.gl.targets import FrameTargets
 
-# Blend modes by name: passes say what they want, not GL enums.
-BLEND_MODES = {
-    "add": (moderngl.ONE, moderngl.ONE),
-    # alpha stays coverage: a over background (0) gives a, over a surface (1) stays 1
-    "alpha": (moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA, moderngl.ONE,
-              moderngl.ONE_MINUS_SRC_ALPHA),
-    "premultiplied": (moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA),
-    # colour times the source (a tint over what is there); alpha kept
-    "multiply": (moderngl.DST_COLOR, moderngl.ZERO, moderngl.ZERO, moderngl.ONE),
-    # the smaller of source and destination, channel by channel (the factors play no part)
-    "min": (moderngl.ONE, moderngl.ONE),
-}
-BLEND_EQUATIONS = {"min": moderngl.MIN}
 DEPTH_FUNCS = {"less": "<", "lequal": "<=", "gequal": ">=", "greater": ">", "equal": "==",
                "always": "1"}
 
@@ -69,6 +57,7 @@ class Device:
         # the last framebuffer request set in full, (key, depth_write, framebuffer, viewport):
         # the same request again, with nothing changed since, sets nothing (use_framebuffer)
         self._bound: tuple | None = None
+        self._indexed_blend: IndexedBlend | None = None  # loaded at the first per-output state
 
     # -- timing ----------------------------------------------------------------------------------
     def gl_call(self, call: Callable[[], Any]) -> Any:
@@ -125,11 +114,13 @@ class Device:
 
     # -- fixed-function state ----------------------------------------------------------------
     def set_state(self, depth_test: bool = False, depth_func: str = "less",
-                  cull: str | None = None, blend: str | None = None,
+                  cull: str | None = None, blend: PassBlend = None,
                   depth_offset: tuple[float, float] = (0.0, 0.0)) -> None:
         """Set the fixed-function state a pass needs; every pass states all of it. The frame
         sets GL state only here and in :meth:`set_depth_offset`, so a pass stating what the
-        last one did sets nothing (one program drawing many objects)."""
+        last one did sets nothing (one program drawing many objects). ``blend`` is any form
+        :mod:`deferred.gl.blend` takes; a tuple gives each draw buffer of the bound
+        framebuffer its own state."""
         state = (depth_test, depth_func, cull, blend, depth_offset)
         if state == self._state:
             return
@@ -142,11 +133,27 @@ class Device:
         if cull:
             flags |= moderngl.CULL_FACE
             self.ctx.cull_face = cull
-        if blend:
-            flags |= moderngl.BLEND
-            self.ctx.blend_func = BLEND_MODES[blend]
-            self.ctx.blend_equation = BLEND_EQUATIONS.get(blend, moderngl.FUNC_ADD)
-        self.ctx.enable_only(flags)
+        if blend is None:
+            self.ctx.enable_only(flags)
+            return
+        if isinstance(blend, str) or not isinstance(blend, (tuple, list)):
+            states = blend_outputs(blend, 1)
+        else:
+            states = blend_outputs(blend, len(blend))
+        shared, single = shared_blend(states)
+        if shared and single is None:
+            self.ctx.enable_only(flags)
+            return
+        flags |= moderngl.BLEND
+        if shared:  # one state for every draw buffer: GL's plain calls
+            self.ctx.blend_func = single.factors
+            self.ctx.blend_equation = single.equations
+            self.ctx.enable_only(flags)
+            return
+        self.ctx.enable_only(flags)  # blending on for every buffer, then each buffer's own
+        if self._indexed_blend is None:
+            self._indexed_blend = IndexedBlend(self.ctx)
+        self._indexed_blend.apply(states)
 
     def set_depth_offset(self, depth_offset: tuple[float, float]) -> None:
         """Change only the depth offset (``glPolygonOffset``) of the state the pass set, for

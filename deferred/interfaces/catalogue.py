@@ -71,6 +71,8 @@ def describe_type(kind: str, name: str, cls: type) -> dict[str, Any]:
     if kind == "light":
         volume = getattr(cls, "volume", None)
         entry["volume"] = volume.value if isinstance(volume, Enum) else volume
+    if kind == "effect":
+        entry["pipelines"] = [str(getattr(p, "value", p)) for p in getattr(cls, "pipelines", ())]
     if kind == "shading_model":
         entry["glsl_file"] = getattr(cls, "glsl_file", None)
         entry["materials"] = [material for material, owner in registry.materials.items()

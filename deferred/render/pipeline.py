@@ -29,7 +29,10 @@ from deferred.core.passes import (
     Order,
     Phase,
     RenderPass,
+    compose_runs,
     copy_pass,
+    same_passes,
+    without_brackets,
 )
 from deferred.errors import InputError
 from deferred.gbuffer.layout import (
@@ -140,30 +143,35 @@ def camera_distance(scene: FrameState, obj: ObjectState) -> float:
 def sort_blended(passes: list[RenderPass], scene: FrameState) -> list[RenderPass]:
     """``passes`` with each run of blended object passes (volumes, transparent surfaces) of
     one phase and rank put far to near for the camera and transforms of this frame (the
-    order the passes were built in holds the first frame's): the same list where it already
-    is so."""
+    order the passes were built in holds the first frame's), and each composition's begin
+    and end passes around the runs of its members (:func:`compose_runs`): the same list
+    where it already is so."""
+    bare = without_brackets(passes)
     index_of = {obj.node: k for k, obj in enumerate(scene.objects)}
-    out = passes
+    out = bare
     start = 0
-    while start < len(passes):
-        first = passes[start]
+    while start < len(bare):
+        first = bare[start]
         end = start + 1
         if _blended_object_pass(first):
-            while end < len(passes) and _blended_object_pass(passes[end]) and \
-                    passes[end].phase == first.phase and passes[end].order == first.order:
+            while end < len(bare) and _blended_object_pass(bare[end]) and \
+                    bare[end].phase == first.phase and bare[end].order == first.order:
                 end += 1
             if end - start > 1:
-                run = passes[start:end]
+                run = bare[start:end]
                 distances = {p.node: camera_distance(scene, scene.object_state(p.node))
                              for p in run}
                 ordered = sorted(run, key=lambda p: (-distances[p.node],
                                                      index_of.get(p.node, 0)))
                 if ordered != run:
-                    if out is passes:
-                        out = list(passes)
+                    if out is bare:
+                        out = list(bare)
                     out[start:end] = ordered
         start = end
-    return out
+    if bare is passes:
+        return out
+    out = compose_runs(out, brackets=passes)
+    return passes if same_passes(out, passes) else out
 
 
 def _blended_object_pass(render_pass: RenderPass) -> bool:
@@ -184,7 +192,9 @@ def phase_passes(scene: FrameState, phase: Phase, fixed: list[RenderPass],
             blended = render_pass.order >= Order.VOLUME
             keyed.append(((render_pass.order, OBJECT_PASS, -distance if blended else 0.0, index),
                           render_pass))
-    return [render_pass for _, render_pass in sorted(keyed, key=lambda item: item[0])]
+    # a composition's begin and end passes around the runs of its members
+    return compose_runs([render_pass for _, render_pass in sorted(keyed,
+                                                                  key=lambda item: item[0])])
 
 
 class Pipeline:
@@ -277,7 +287,7 @@ class ForwardPipeline(Pipeline):
             creates[LINEAR_DEPTH] = GBUFFER_TARGETS[LINEAR_DEPTH]
             fixed += [depth_prepass(p) for obj in scene.objects
                       for p in obj.material.passes(Phase.FORWARD, obj)
-                      if isinstance(p, ForwardLitPass)]
+                      if isinstance(p, ForwardLitPass) and not p.transparent]
             fixed.append(LightCullPass("forward.cull_tiles", Phase.FORWARD, clustered=False,
                                        from_near=True))
         clear = ClearPass("forward.clear", Phase.FORWARD, creates)
