@@ -13,6 +13,7 @@ BUILTINS = {
     "standard": "deferred.materials.standard:StandardMaterial",
     "stipple_glass": "deferred.materials.stipple_glass:StippleGlassMaterial",
     "pbr": "deferred.materials.pbr:PbrMaterial",
+    "glass": "deferred.materials.glass:GlassMaterial",
 }
 
 # One package for the four: small classes sharing G-buffer data (the strand tangent), loaded

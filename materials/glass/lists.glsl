@@ -1,0 +1,18 @@
+// Per-pixel linked lists of glass fragments (the exact mode): glass_count counts the nodes
+// taken, glass_heads[pixel] is the last node a pixel took (GLASS_NONE: none), and node k holds
+// a layer (materials/glass/layer.glsl) in glass_layers[k]: the emitted light and the coverage
+// as half floats and the depth, and in glass_links[k] its refraction offset (two halves) and
+// the pixel's node before it.
+layout(std430, binding = GLASS_HEADS_BINDING) buffer GlassHeads {
+    uint glass_count;
+    uint glass_heads[];
+};
+layout(std430, binding = GLASS_LAYERS_BINDING) buffer GlassLayers {
+    uvec4 glass_layers[];
+};
+layout(std430, binding = GLASS_LINKS_BINDING) buffer GlassLinks {
+    uvec2 glass_links[];
+};
+
+const uint GLASS_NONE = 0xffffffffu;
+uniform int u_glass_width;  // pixels a row of the frame: heads are row after row
