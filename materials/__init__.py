@@ -16,7 +16,7 @@ BUILTINS = {
     "glass": "deferred.materials.glass:GlassMaterial",
 }
 
-# One package for the four: small classes sharing G-buffer data (the strand tangent), loaded
+# One package for them all: small classes sharing G-buffer data (the strand tangent), loaded
 # together
 SHADING_MODELS = {
     "blinn_phong": "deferred.materials.shading_models:BlinnPhong",
@@ -24,4 +24,5 @@ SHADING_MODELS = {
     "toon": "deferred.materials.shading_models:Toon",
     "marschner": "deferred.materials.shading_models:Marschner",
     "pbr": "deferred.materials.shading_models:Pbr",
+    "toon_strands": "deferred.materials.shading_models:ToonStrands",
 }

@@ -84,7 +84,7 @@ def shading_figures() -> None:
         ("4.8 back lighting", {"ramp_metric": "backlight", "backlight_power": 3.0,
                                "backlight_color": [0.5, 0.45, 0.35]}),
         ("4.9 Blinn band", {"specular_intensity": 0.6, "specular_exponent": 60.0}),
-        ("4.10 ramp specular", {"ramp_metric": "specular", "ramp_shininess": 30.0}),
+        ("4.10 ramp specular", {"ramp_metric": "specular", "ramp_shininess": 15.0}),
     ]
     images = [labelled(render(head(params))[0], label) for label, params in panels]
     write_image(FIGURES / "fig4_7_to_4_10_shading.png", row(*images))

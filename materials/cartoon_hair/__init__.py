@@ -15,9 +15,14 @@ head) is drawn too, in ``skin_color``.
 - tubes (4.3.1-4.3.2): :mod:`.techniques.hair_tubes`, ``hair_samples`` spline samples swept by a
   ``sides``-gon tapered by the quadratic ``taper``, built every frame by compute shaders where
   the context has them (:class:`.techniques.hair_tubes.GpuTubes`), else by numpy;
-- shading (4.3.3-4.3.6): X-toon (:mod:`.techniques.xtoon`), the G-buffer datum ``strand_id``
-  (0 on the head; on the hair 1 + the object's first id + the strand's index) lets the
-  ``edges`` effect outline strands of one colour where they overlap (4.3.7);
+- shading (4.3.3-4.3.6): X-toon (:mod:`.techniques.xtoon`) through the ``toon_strands`` model:
+  the hair's specular (the band of ``specular_intensity`` and ``specular_exponent``, or the
+  ramp's specular metric) along its strands, Kajiya-Kay's sin(T, H) for N.H, the head's band of
+  ``skin_specular_intensity`` and ``skin_specular_exponent`` on its normal;
+- outlines (4.3.7, image space): the G-buffer datum ``strand_id`` (0 on the head; on the hair
+  1 + the object's first id + the strand's index, and the same of its clump: k-means clusters
+  of about ``clump_size`` strands) lets the ``edges`` effect outline the hair against the
+  head and the background and clumps where they overlap, not every strand;
 - silhouette strokes (4.3.7, object space): :mod:`.techniques.hair_silhouettes` with
   ``silhouettes = true``, strokes ``stroke_width`` pixels wide in ``stroke_color`` along the
   tubes' silhouette edges, faded toward the roots by the quadratic ``stroke_fade``; drawn over
@@ -29,7 +34,8 @@ the material's simulation), ``passes.py`` (the tubes as an input, the hatching a
 strokes), this module (the material).
 
 The tubes carry each vertex's strand in the vertex format's comb slot (the hair has no comb):
-``comb.x`` the strand's index, ``comb.y`` the parameter along it; ``uv`` is (along, around).
+``comb.x`` the strand's index, ``comb.y`` the parameter along it, ``comb.z`` its clump; ``uv``
+is (along, around).
 """
 
 from __future__ import annotations
@@ -54,7 +60,13 @@ from deferred.api import (
 )
 
 from ..shading_models import Toon
-from ..techniques.hair_strands import grow_strands, load_strands, resample_strand, scalp_roots
+from ..techniques.hair_strands import (
+    grow_strands,
+    load_strands,
+    resample_strand,
+    scalp_roots,
+    strand_clumps,
+)
 from ..techniques.xtoon import XTOON_UNIFORM_OVERRIDES, XToonRamp
 from .params import (
     SILHOUETTE_TRIANGLE_SECONDS,
@@ -70,9 +82,9 @@ if TYPE_CHECKING:
     from deferred.api import Frame, SceneObject
 
 SURFACE = "materials/cartoon_hair/surface.glsl"
-STRAND_ID = GBufferData("strand_id", "R32F", ("id",),
+STRAND_ID = GBufferData("strand_id", "RG32F", ("id", "clump"),
                         "cartoon_hair: 1 + the object's first id + the strand's index on "
-                        "hair, 0 elsewhere")
+                        "hair, and the same of the strand's clump; 0 elsewhere")
 
 
 @materials.register
@@ -80,7 +92,7 @@ class CartoonHairMaterial(Material):
     name = "cartoon_hair"
     Params = CartoonHairParams
     surface_shader = SURFACE
-    shading_model = "toon"
+    shading_model = "toon_strands"
     gbuffer_data = (STRAND_ID,)
     uniform_overrides = {
         **XTOON_UNIFORM_OVERRIDES,
@@ -89,15 +101,17 @@ class CartoonHairMaterial(Material):
             "seed", "edge_stiffness", "bend_stiffness", "torsion_stiffness",
             "anchor_stiffness", "anchor_curve", "keyframes", "key_times", "gravity", "wind",
             "drag", "time_step", "settle", "collision_spheres", "hair_samples", "sides",
-            "radius", "taper",
-            "silhouettes", "stroke_width", "stroke_color", "stroke_fade", "hatching",
+            "radius", "taper", "clump_size", "skin_specular_intensity",
+            "skin_specular_exponent",
+            "silhouettes", "stroke_width", "stroke_world_width", "stroke_color", "stroke_fade",
+            "hatching",
             "hatching_strength", "hatching_scale")},
         "color": lambda value: {},  # the head's pass takes skin_color, the hair's color
     }
     # read once, at t = 0: the strands, the simulation's structure and the tubes' topology
     # (the dynamics' parameters follow the timeline step by step: HairState.physics_at)
     timeline_fixed = ("strands_file", "strands", "length", "segments", "style", "parting",
-                      "seed", "keyframes", "key_times", "hair_samples", "sides",
+                      "seed", "clump_size", "keyframes", "key_times", "hair_samples", "sides",
                       "collision_spheres", "time_step", "settle")
     # the head's surface, then the tubes' (its second surface), then their strokes
     techniques = (SurfacePasses(), SurfacePasses(name="hair", inputs=(TUBES,), shape=TUBES),
@@ -136,6 +150,8 @@ class CartoonHairMaterial(Material):
     def uniforms(self, frame: Frame) -> dict[str, Any]:  # the ramp's layer: the scene's
         return {**super().uniforms(frame), "u_hair": False, "u_strand_base": 0.0,
                 "u_color": self.params.skin_color,
+                "u_specular_intensity": self.params.skin_specular_intensity,
+                "u_specular_exponent": self.params.skin_specular_exponent,
                 "u_ramp_row": Toon.xtoon_row(frame.scene, self.xtoon_ramp())}
 
     # -- the strands ----------------------------------------------------------------------
@@ -180,6 +196,11 @@ class CartoonHairMaterial(Material):
         roots = scalp_roots(obj.mesh, p.strands, p.seed)
         return grow_strands(roots, p.length, p.segments, p.style, p.seed, self.spheres(obj),
                             p.parting)
+
+    def clumps(self, rest: np.ndarray) -> np.ndarray:
+        """``(S,)``: each rest strand's clump (:func:`.techniques.hair_strands.strand_clumps`,
+        about ``clump_size`` strands a clump): the edges effect outlines clumps, not strands."""
+        return strand_clumps(rest, self.params.clump_size, self.params.seed)
 
     def keyframe_strands(self, shape: tuple[int, ...]) -> np.ndarray:
         """The keyframes' strands, each resampled to the rest strands' points."""

@@ -42,7 +42,13 @@ class CartoonHairParams(BlinnPhongParams, XToonParams):
     color: Vec3 = Field((0.55, 0.35, 0.85), description="hair albedo, linear RGB")
     skin_color: Vec3 = Field((0.95, 0.78, 0.66), description="the head's albedo, linear RGB")
     specular_intensity: float = Field(0.0, ge=0.0, le=1.0,
-                                      description="the toon model's hard specular band")
+                                      description="the hair's hard specular band, across the "
+                                                  "strands where they run perpendicular to the "
+                                                  "half vector (Kajiya-Kay's sin(T, H))")
+    skin_specular_intensity: float = Field(0.0, ge=0.0, le=1.0,
+                                           description="the head's hard specular band (N.H)")
+    skin_specular_exponent: float = Field(40.0, ge=1.0, le=2048.0,
+                                          description="the head's band: (N.H)^exponent")
     # strands in (4.1-4.2.1)
     strands_file: str | None = Field(None, description="guide strands: JSON {\"strands\": "
                                                        "[[[x, y, z], ...], ...]} or OBJ l lines")
@@ -52,6 +58,9 @@ class CartoonHairParams(BlinnPhongParams, XToonParams):
     style: Literal["combed", "spiky"] = Field("spiky", description="how grown strands lie")
     parting: float = Field(0.0, ge=-1.0, le=1.0, description="combed: the parting's x")
     seed: int = Field(1, ge=0, le=2**31 - 1, description="roots and styles")
+    clump_size: int = Field(6, ge=1, le=1000,
+                            description="strands a clump (k-means over the strands' shapes); "
+                                        "the edges effect outlines clumps, 1: every strand")
     # dynamics (4.2.2-4.2.4)
     edge_stiffness: float = Field(1.0, ge=0.0, le=1.0, description="edge springs")
     bend_stiffness: float = Field(0.8, ge=0.0, le=1.0, description="bend springs")
@@ -79,7 +88,12 @@ class CartoonHairParams(BlinnPhongParams, XToonParams):
     taper: Vec3 = Field((0.0, -1.0, 1.0), description="radius along the strand: a x^2 + b x + c")
     # silhouette strokes (4.3.7, object space)
     silhouettes: bool = Field(False, description="strokes along the tubes' silhouette edges")
-    stroke_width: float = Field(3.0, gt=0.0, le=64.0, description="silhouette strokes, pixels")
+    stroke_width: float = Field(3.0, gt=0.0, le=64.0,
+                                description="silhouette strokes, pixels (at most the tube's "
+                                            "radius on screen)")
+    stroke_world_width: float | None = Field(
+        None, gt=0.0, le=10.0, description="silhouette strokes in object units at their depth "
+                                           "(thinning with distance) instead of stroke_width")
     stroke_color: Vec3 = Field((0.08, 0.05, 0.12), description="silhouette strokes, linear RGB")
     stroke_fade: Vec3 = Field((-1.0, 2.0, 0.0),
                               description="stroke alpha along the strand (0 root, 1 tip): "

@@ -46,7 +46,10 @@ class HairTubes(PassInput):
     object's mesh (the head), in the hair's ``color``, with its strands' ids."""
 
     def uniforms(self, frame: Frame, obj: SceneObject) -> dict[str, Any]:
-        return {"u_hair": True, "u_color": obj.params.color,
+        params = obj.params
+        return {"u_hair": True, "u_color": params.color,
+                "u_specular_intensity": params.specular_intensity,
+                "u_specular_exponent": params.specular_exponent,
                 "u_strand_base": strand_base(frame.scene, obj)}
 
     def draw(self, frame: Frame, obj: SceneObject, program: moderngl.Program) -> None:
@@ -105,7 +108,9 @@ class HairSilhouettePass(SilhouettePass):
     def stroke_settings(self, frame: Frame) -> dict[str, Any]:
         p = self.object(frame).params
         # a tube's own front surface lies up to its radius nearer than its silhouette
-        return {"width": p.stroke_width, "color": p.stroke_color, "fade": p.stroke_fade,
+        return {"width": p.stroke_width, "world_width": p.stroke_world_width,
+                "color": p.stroke_color, "fade": p.stroke_fade, "radius": p.radius,
+                "taper": p.taper,
                 "tolerance": float(tube_radii(p.hair_samples, p.radius, p.taper).max())}
 
 

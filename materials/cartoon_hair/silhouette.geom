@@ -2,7 +2,8 @@
 // al.). Input: a triangle with its neighbours (triangles_adjacency: 0, 2, 4 the triangle; 1, 3,
 // 5 the vertices opposite its edges 0-2, 2-4, 4-0 across them). An edge between a front- and a
 // back-facing triangle is a silhouette edge; the front-facing triangle emits it (each edge
-// once) as a quad u_stroke_width pixels wide, extruded in screen space either side of the edge
+// once) as a quad u_stroke_width pixels (or u_stroke_world_width view units) wide, at most the
+// tube's radius, extruded in screen space either side of the edge
 // along its vertices' normals as they project on screen, so the quads of neighbouring edges
 // meet at their shared vertices (the thesis' strip joints, Fig. 4.16, without chaining the
 // edges). Without STROKE_ID_BUFFER the quad is pulled u_stroke_tolerance toward the eye (the
@@ -17,8 +18,11 @@ in float vs_strand[];
 
 uniform mat4 u_projection;
 uniform vec2 u_resolution;
-uniform float u_stroke_width;      // pixels
-uniform float u_stroke_tolerance;  // view units
+uniform float u_stroke_width;        // pixels
+uniform float u_stroke_world_width;  // view units at the stroke's depth (0: u_stroke_width)
+uniform float u_tube_radius;         // view units at the root
+uniform vec3 u_tube_taper;           // the radius along the strand: a x^2 + b x + c
+uniform float u_stroke_tolerance;    // view units
 
 out vec2 g_stroke_uv;      // (along the strand, across the stroke 0..1)
 out float g_view_depth;    // -z of the silhouette edge
@@ -68,6 +72,24 @@ vec2 extrusion(int i, vec4 c, vec2 across) {
     return along_across < 0.0 ? -d : d;
 }
 
+// Pixels a view unit at clip position c: the projection's y scale over w (the depth; 1 in an
+// orthographic projection).
+float pixels_per_unit(vec4 c) {
+    return 0.5 * u_resolution.y * u_projection[1][1] / c.w;
+}
+
+// Half the stroke's width in pixels at vertex i: u_stroke_width pixels, or u_stroke_world_width
+// view units there; at most half the tube's radius there on screen, so a stroke never buries a
+// thin (far, or tapering) tube: at least half of each tube's width keeps its colour.
+float half_width(int i, vec4 c) {
+    float scale = pixels_per_unit(c);
+    float width = u_stroke_world_width > 0.0 ? u_stroke_world_width * scale : u_stroke_width;
+    float x = vs_along[i];
+    float radius = u_tube_radius * max((u_tube_taper.x * x + u_tube_taper.y) * x + u_tube_taper.z,
+                                       0.0);
+    return 0.5 * min(width, radius * scale);
+}
+
 void stroke(int i, int j) {
     vec4 c0 = pulled_clip(vs_position[i]);
     vec4 c1 = pulled_clip(vs_position[j]);
@@ -80,9 +102,8 @@ void stroke(int i, int j) {
     vec2 across = vec2(-d.y, d.x) / len;
     // Each end is pushed along its vertex's normal on screen: the edges meeting at a vertex
     // push it alike, so neighbouring quads join without gaps or overlaps (no chaining).
-    float half_width = 0.5 * u_stroke_width;
-    vec2 e0 = extrusion(i, c0, across) * half_width;
-    vec2 e1 = extrusion(j, c1, across) * half_width;
+    vec2 e0 = extrusion(i, c0, across) * half_width(i, c0);
+    vec2 e1 = extrusion(j, c1, across) * half_width(j, c1);
     float z0 = -vs_position[i].z;
     float z1 = -vs_position[j].z;
     emit_corner(c0, -e0, vec2(vs_along[i], 0.0), z0);

@@ -82,8 +82,9 @@ class HairState:
                                          self.model_at(0.0), settle_steps(params))
         self.inverse_model = np.linalg.inv(self.model_at(0.0))
         tubes = self._tubes(params)
+        self.clumps = material.clumps(rest)
         self.mesh = MeshData("cartoon_hair tubes", tubes[0], tubes[1],
-                             *self._constant_attributes(tubes[2]), tubes[3])
+                             *self._constant_attributes(tubes[2], self.clumps), tubes[3])
         self.gpu = GpuMesh(ctx, self.mesh, moving=True)
         self.ctx = ctx
         self._gpu_tubes: GpuTubes | None = None
@@ -138,13 +139,15 @@ class HairState:
         return positions.astype(np.float32), normals.astype(np.float32), tubes, tubes.indices
 
     @staticmethod
-    def _constant_attributes(tubes) -> tuple[np.ndarray, ...]:
+    def _constant_attributes(tubes, clumps: np.ndarray) -> tuple[np.ndarray, ...]:
+        """uv (along, around), no tangent frame, and the comb slot: (strand, along, clump)."""
         count = len(tubes.positions)
         uvs = np.stack([tubes.along, tubes.around], axis=1).astype(np.float32)
         zeros = np.zeros((count, 3), np.float32)
         comb = np.zeros((count, 4), np.float32)
         comb[:, 0] = tubes.strand_ids
         comb[:, 1] = tubes.along
+        comb[:, 2] = clumps[tubes.strand_ids]
         return uvs, zeros, zeros.copy(), comb
 
     def advance(self, time: float, frame: Frame | None = None) -> None:

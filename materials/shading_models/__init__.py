@@ -10,6 +10,9 @@ registers them.
   longitudinal roughness (radians), ``specular_intensity`` scales R.
 - ``toon``: N.L through a ramp texture (a row per ramp, chosen per pixel by G-buffer data) and
   a hard-edged specular band (X-toon, Costigan's cartoon shading).
+- ``toon_strands``: ``toon`` whose specular (the band and the ramp's specular metric) follows
+  the strand tangent where a surface has one (G-buffer data ``strand_tangent``): Kajiya-Kay's
+  sin(T, H) in place of N.H, a highlight band across the strands (cartoon_hair's tubes).
 - ``pbr``: glTF 2.0's metallic-roughness as Filament lights it (``pbr.glsl``): GGX, Smith
   height-correlated visibility, Schlick Fresnel, multiple-scattering energy compensation from
   its DFG table (``dfg.py``), Lambert diffuse; its ambient and environment answers split the
@@ -139,6 +142,19 @@ class Toon(ShadingModel):
     def xtoon_row(scene, ramp: XToonRamp) -> float:
         """The ``toon_ramp`` value selecting X-toon ``ramp`` in ``scene``."""
         return ramp_layer(scene, ramp, len(TOON_RAMP_NAMES)) / 255.0
+
+
+@shading_models.register
+class ToonStrands(Toon):
+    """:class:`Toon` with a specular along strands: where the surface writes a strand tangent
+    (``strand_tangent``; a surface without one writes ``u = 4``, outside the octahedral
+    square) the band and the X-toon specular metric take sin(T, H) for N.H
+    (``toon_strands.glsl``). Its ramps are the toon model's (the same texture array)."""
+
+    name = "toon_strands"
+    glsl_file = "materials/shading_models/toon_strands.glsl"
+    glsl_function = "toon_strands"
+    gbuffer_data = (TOON_RAMP, STRAND_TANGENT)
 
 
 @shading_models.register

@@ -12,14 +12,16 @@ and Northrup et al.).
   emitted once, by its front-facing triangle. Faces without area (the tip ring of a tube
   tapered to a point) face as the sum of their vertices' normals.
 - **Strokes** (Figs. 4.16-4.17): each silhouette edge becomes a quad ``stroke_width`` pixels
-  wide, extruded in screen space. Edges are not chained into strips (the thesis' insertion
-  sort): each end of a quad is pushed either side along its vertex's normal as it projects on
-  screen (the edge's own normal where that looks along the edge), so the quads of two edges
-  meeting at a vertex share their corners there: joints neither overlap (no doubled ink) nor
-  gap at bends, the role of the thesis' extrusion along the sum of neighbouring edges
-  (Fig. 4.16); the stroke keeps ``stroke_width`` across a straight strand and thins a little
-  where the normal leans along the edge. The stroke image runs along
-  the whole strand (its ``u`` is the parameter along the strand, 0 root to 1 tip) and across
+  wide (or ``stroke_world_width`` object units at its depth: it thins with distance), at most
+  the tube's radius on screen (so a thin tube, far or tapering to its tip, keeps at least half
+  its width in its colour), extruded in screen space. Edges are not chained into strips (the
+  thesis' insertion sort): each end of a quad is pushed either side along its vertex's normal
+  as it projects on screen (the edge's own normal where that looks along the edge), so the
+  quads of two edges meeting at a vertex share their corners there: joints neither overlap
+  (no doubled ink) nor gap at bends, the role of the thesis' extrusion along the sum of
+  neighbouring edges (Fig. 4.16); the stroke keeps its width across a straight strand and
+  thins a little where the normal leans along the edge. The stroke image runs along the whole
+  strand (its ``u`` is the parameter along the strand, 0 root to 1 tip) and across
   the quad, so strokes are coherent from frame to frame without chaining; it is the hatching
   generator's soft-ended stroke (:func:`.tam.default_stroke`).
 - **Fade** (Fig. 4.19): the stroke's alpha times ``clamp(a x^2 + b x + c, 0, 1)`` of the
@@ -160,8 +162,9 @@ class SilhouettePass(ObjectPass):
         raise NotImplementedError
 
     def stroke_settings(self, frame) -> dict[str, Any]:
-        """``width`` (pixels), ``color`` (linear RGB), ``fade`` (a, b, c) and ``tolerance``
-        (object units) of the object as ``frame`` has it."""
+        """``width`` (pixels), ``world_width`` (object units, or None: ``width`` pixels),
+        ``color`` (linear RGB), ``fade`` (a, b, c), ``tolerance`` (object units), the tubes'
+        ``radius`` (object units) and ``taper`` (a, b, c) of the object as ``frame`` has it."""
         raise NotImplementedError
 
     def defines(self, frame) -> dict[str, str]:
@@ -173,7 +176,11 @@ class SilhouettePass(ObjectPass):
         # the tolerance in view units: the object's largest scale
         scale = float(np.max(np.linalg.norm(np.asarray(self.object(frame).model)[:3, :3],
                                             axis=0)))
+        world_width = settings.get("world_width")
         return {"u_stroke_width": float(settings["width"]),
+                "u_stroke_world_width": 0.0 if world_width is None else world_width * scale,
+                "u_tube_radius": float(settings["radius"]) * scale,
+                "u_tube_taper": tuple(float(c) for c in settings["taper"]),
                 "u_stroke_color": tuple(float(c) for c in settings["color"]),
                 "u_stroke_fade": tuple(float(c) for c in settings["fade"]),
                 "u_stroke_tolerance": float(settings["tolerance"]) * scale}

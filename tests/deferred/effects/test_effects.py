@@ -279,3 +279,50 @@ def test_the_two_pass_dilation_is_the_disc(gl, width):
     assert raw.sum() > 200
     # in GL's orientation (bottom row first), where an even width's disc sits up and right
     np.testing.assert_array_equal(edges[::-1], disc_dilation(raw[::-1], width))
+
+
+def test_creases_fire_on_a_cube_not_on_a_smooth_surface_however_tight(gl):
+    """Creases (a turn of the normal in one pixel step with none beside it) line a cube's
+    edges inside its silhouette, and never a smooth surface's curvature: a torus thin enough
+    that its tube is a few pixels across, whose rims a Sobel of the normals outlines."""
+    camera = {"position": [0.0, 0.0, 4.0], "target": [0.0, 0.0, 0.0]}
+    cube = [{"mesh": "builtin:cube", "rotation": [25.0, 35.0, 0.0], "scale": 0.8}]
+    _, targets, _ = render(gl, scene([{"type": "edges", "ids": False, "depth_threshold": 10.0}],
+                                     objects=cube, size=(120, 90), camera=camera))
+    raw = targets["edges_raw"][..., 0] > 0.0
+    covered = targets["linear_depth"][..., 0] > 0.0
+    inner = covered.copy()
+    for axis, shift in ((0, 1), (0, -1), (1, 1), (1, -1)):
+        inner &= np.roll(covered, shift, axis)
+    assert raw[inner].sum() > 60  # the three visible faces meet along three creases
+    for torus_scale in (1.0, 0.25):
+        torus = [{"mesh": "builtin:torus?minor=0.08", "rotation": [70.0, 0.0, 0.0],
+                  "scale": torus_scale}]
+        _, targets, _ = render(gl, scene([{"type": "edges", "ids": False,
+                                           "depth_threshold": 10.0}],
+                                         objects=torus, size=(120, 90), camera=camera))
+        assert (targets["linear_depth"][..., 0] > 0.0).sum() > 30
+        assert targets["edges_raw"].max() == 0.0, torus_scale
+
+
+def test_world_width_lines_thin_with_distance(gl):
+    """world_width: the line is that many view units wide at its surface's depth: a cube twice
+    as far has lines half as wide (in pixels, within [1, width])."""
+    cubes = [{"mesh": "builtin:cube", "position": [-0.6, 0.0, 0.0], "scale": 0.3},
+             {"mesh": "builtin:cube", "position": [1.2, 0.0, -4.0], "scale": 0.6}]
+    camera = {"position": [0.0, 0.0, 4.0], "target": [0.3, 0.0, -2.0], "fov": 40.0}
+    _, targets, _ = render(gl, scene([{"type": "edges", "width": 16, "world_width": 0.1}],
+                                     objects=cubes, size=(240, 120), camera=camera))
+    raw = targets["edges_raw"][..., 0]
+    edges = targets["edges"][..., 0] > 0.5
+    depth = targets["linear_depth"][..., 0]
+    # the half width in pixels each edge pixel holds: 0.05 units at its depth
+    focal = 0.5 * 120 / np.tan(np.radians(20.0))
+    lined = raw > 0.0
+    np.testing.assert_allclose(raw[lined], np.clip(0.05 * focal / depth[lined], 0.5, 8.0),
+                               rtol=1e-3)
+    # the lines' area over their length: their width, each cube in its half of the frame
+    widths = [edges[:, half].sum() / lined[:, half].sum()
+              for half in (slice(0, 120), slice(120, 240))]
+    assert lined[:, :120].sum() > 40 and lined[:, 120:].sum() > 40
+    assert widths[0] > 3.0 and 1.6 < widths[0] / widths[1] < 2.6, widths

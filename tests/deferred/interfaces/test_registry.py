@@ -79,7 +79,8 @@ BUILTIN_IDS = {
     "materials": {"cartoon_hair": 1, "revie_fur": 2, "shell_fur": 3, "standard": 4,
                   "stipple_glass": 5, "pbr": 6, "glass": 7},
     "lights": {"ambient": 1, "directional": 2, "point": 3, "spot": 4, "environment": 5},
-    "shading_models": {"blinn_phong": 1, "kajiya_kay": 2, "toon": 3, "marschner": 4, "pbr": 5},
+    "shading_models": {"blinn_phong": 1, "kajiya_kay": 2, "toon": 3, "marschner": 4, "pbr": 5,
+                       "toon_strands": 6},
     "effects": {"edges": 1, "fxaa": 2, "ssao": 3, "taa": 4},
 }
 

@@ -55,21 +55,36 @@ def test_forward_and_deferred_agree_without_outlines(gl):
     assert psnr(deferred.hdr[..., :3], forward.hdr[..., :3]) > 35.0
 
 
-def test_overlapping_strands_of_one_colour_are_outlined(gl):
-    """Where two strands meet (4-neighbours of different strand ids, one nearer), the nearer
-    side is an edge: the surface id alone (one material) would draw nothing there."""
-    _, targets = capture(gl, head_scene(effects=[{"type": "edges", "width": 1}]))
-    ids = targets["strand_id"][..., 0]
-    depth = targets["linear_depth"][..., 0]
-    edges = targets["edges_raw"][..., 0] > 0.5
-    near_side = np.zeros_like(edges)
+def near_sides(ids: np.ndarray, depth: np.ndarray) -> np.ndarray:
+    """Pixels with a 4-neighbour of another (non-zero) id that lies farther away."""
+    near_side = np.zeros(ids.shape, bool)
     for axis, shift in ((0, 1), (0, -1), (1, 1), (1, -1)):
         other_id, other_depth = np.roll(ids, shift, axis), np.roll(depth, shift, axis)
         near_side |= (ids > 0.5) & (other_id > 0.5) & (np.abs(other_id - ids) > 0.5) & \
             (other_depth > depth)
     near_side[[0, -1], :] = near_side[:, [0, -1]] = False
-    assert near_side.sum() > 100
-    assert edges[near_side].all()
+    return near_side
+
+
+def test_overlapping_clumps_of_one_colour_are_outlined_not_strands(gl):
+    """Where two clumps meet (4-neighbours of different clump ids, one nearer), the nearer
+    side is an edge: the surface id alone (one material) would draw nothing there. Strands of
+    one clump crossing each other are not outlined (4.3.7: Costigan outlines the hair and its
+    clumps, not every strand), unless one lies well in front of the other (a depth break)."""
+    _, targets = capture(gl, head_scene(effects=[{"type": "edges", "width": 1}]))
+    strands, clumps = targets["strand_id"][..., 0], targets["strand_id"][..., 1]
+    depth = targets["linear_depth"][..., 0]
+    edges = targets["edges_raw"][..., 0] > 0.5
+    between_clumps = near_sides(clumps, depth)
+    assert between_clumps.sum() > 100
+    assert edges[between_clumps].all()
+    within_clumps = near_sides(strands, depth) & ~between_clumps
+    assert within_clumps.sum() > 50
+    assert edges[within_clumps].mean() < 0.5
+    # a clump is several strands, whole numbers like the strands' ids
+    hair = strands > 0.5
+    assert len(np.unique(clumps[hair])) < 0.5 * len(np.unique(strands[hair]))
+    assert np.all(clumps[hair] == np.round(clumps[hair])) and np.all(clumps[~hair] == 0.0)
 
 
 def test_a_frame_depends_only_on_its_time(gl):
@@ -284,3 +299,118 @@ def test_settle_counts_toward_the_bound_on_steps(tmp_path, capsys):
     err = capsys.readouterr().err
     assert code == 2 and "needs 22,500 simulation steps of 0.004 s (with settle)" in err, err
     assert not (tmp_path / "out.png").exists()
+
+
+def random_walk_strands(count: int = 400, points: int = 9, seed: int = 7) -> np.ndarray:
+    """Guide strands the material did not grow: random walks from roots on the upper part of
+    a unit sphere, drooping, kept outside it."""
+    rng = np.random.default_rng(seed)
+    roots = rng.normal(size=(3 * count, 3))
+    roots /= np.linalg.norm(roots, axis=1, keepdims=True)
+    roots = roots[roots[:, 1] > -0.2][:count]
+    strands = []
+    for root in roots:
+        point, direction = root.copy(), root + 0.3 * rng.normal(size=3)
+        strand = [point]
+        step = 0.9 / (points - 1) * rng.uniform(0.8, 1.2)
+        for _ in range(points - 1):
+            direction = direction / np.linalg.norm(direction) + [0.0, -0.35, 0.0] + \
+                0.25 * rng.normal(size=3)
+            point = strand[-1] + step * direction / np.linalg.norm(direction)
+            point = point * max(1.0, 1.02 / np.linalg.norm(point))
+            strand.append(point)
+        strands.append(strand)
+    return np.asarray(strands)
+
+
+def write_obj_strands(path, strands: np.ndarray) -> None:
+    lines = [f"v {x:.6f} {y:.6f} {z:.6f}" for x, y, z in strands.reshape(-1, 3)]
+    points = strands.shape[1]
+    for s in range(len(strands)):
+        lines.append("l " + " ".join(str(s * points + k + 1) for k in range(points)))
+    path.write_text("\n".join(lines) + "\n")
+
+
+STROKE_COLOR = [0.31, 0.25, 0.38]  # cartoon_hair's default stroke_color, sRGB
+
+
+def outline_ink(plain: np.ndarray, outlined: np.ndarray, lines) -> np.ndarray:
+    """Pixels the outlines ink: moved visibly (more than 10 levels) and more than halfway from
+    their colour without outlines toward a line's colour (sRGB): a line's faint fringe and a
+    stroke faded toward the roots (Fig. 4.19) under half opacity are not ink."""
+    a, b = plain[..., :3] / 255.0, outlined[..., :3] / 255.0
+    moved = np.linalg.norm(b - a, axis=-1)
+    ink = np.zeros(moved.shape, bool)
+    for line in lines:
+        toward = np.linalg.norm(np.asarray(line) - a, axis=-1)
+        ink |= (moved > 10.0 / 255.0) & (moved > 0.5 * toward)
+    return ink
+
+
+def sphere_hair_scene(path, params: dict | None = None, effects=(), size=(320, 320)):
+    return scene_from_dict({
+        "size": list(size), "tonemap": "none", "background": [0.93, 0.93, 0.96],
+        "camera": {"position": [0.0, 0.2, 2.2], "target": [0.0, -0.05, 0.0], "fov": 40.0},
+        "object": [{"name": "ball", "mesh": "builtin:sphere", "material": "cartoon_hair",
+                    "scale": 0.5,
+                    "params": {"strands_file": str(path), "radius": 0.04,
+                               "color": [0.85, 0.55, 0.25],
+                               "collision_spheres": [[0.0, 0.0, 0.0, 1.0]], **(params or {})}}],
+        "light": [{"type": "directional", "direction": [-0.5, -0.6, -0.6]}],
+        "effect": list(effects)})
+
+
+def test_hair_from_a_file_on_another_mesh_is_outlined_not_buried(gl, tmp_path):
+    """400 guide strands the material did not grow (random walks, an OBJ file) on a sphere,
+    with the edges effect and the silhouette strokes at their defaults: at most 40% of the
+    hair's pixels are outline ink, and at least half of the hair's silhouette against the
+    background is outlined (Costigan 4.3.7: the hair's outline and its clumps', not every
+    strand buried in ink)."""
+    path = tmp_path / "walk.obj"
+    write_obj_strands(path, random_walk_strands())
+    plain, targets = capture(gl, sphere_hair_scene(path))
+    outlined, _ = capture(gl, sphere_hair_scene(path, {"silhouettes": True},
+                                                [{"type": "edges"}]))
+    hair = targets["strand_id"][..., 0] > 0.5
+    background = targets["linear_depth"][..., 0] <= 0.0
+    assert hair.mean() > 0.3
+    ink = outline_ink(plain.image, outlined.image, ([0.0, 0.0, 0.0], STROKE_COLOR))
+    rim = np.zeros_like(hair)
+    for axis, shift in ((0, 1), (0, -1), (1, 1), (1, -1)):
+        rim |= hair & np.roll(background, shift, axis)
+    assert rim.sum() > 500
+    assert ink[hair].mean() <= 0.4, ink[hair].mean()
+    assert ink[rim].mean() >= 0.5, ink[rim].mean()
+
+
+def test_the_moving_head_example_is_not_buried_in_ink():
+    """examples/cartoon_hair/moving_head.toml at t = 0.5 s (the edges effect on combed hair):
+    under a quarter of the covered pixels are near black."""
+    from deferred.scene.loader import load_scene
+
+    with Renderer(load_scene(ROOT / "examples" / "cartoon_hair" / "moving_head.toml")) as r:
+        image = r.render(time=0.5).image[..., :3] / 255.0
+        covered = r.targets.read("linear_depth")[::-1][..., 0] > 0.0
+    luminance = image @ [0.2126, 0.7152, 0.0722]
+    assert covered.mean() > 0.2
+    assert (luminance[covered] < 0.1).mean() < 0.25
+
+
+@pytest.mark.parametrize("params", [{"specular_intensity": 0.6, "specular_exponent": 60.0},
+                                    {"ramp_metric": "specular", "ramp_shininess": 15.0}],
+                         ids=["band", "ramp"])
+def test_the_hair_shines_along_its_strands_and_the_skin_apart(gl, params):
+    """Figs. 4.9-4.10 on the hair: the band (and the ramp's specular metric) follow the strand
+    tangent (sin(T, H)), a band across the strands: at least a tenth of the hair's pixels
+    change against the unlit Fig. 4.7; the band leaves the skin alone, whose own highlight
+    (skin_specular_intensity) changes only the head."""
+    plain, targets = capture(gl, head_scene(size=(192, 192)))
+    shiny, _ = capture(gl, head_scene(params, size=(192, 192)))
+    hair = targets["strand_id"][..., 0] > 0.5
+    changed = np.abs(shiny.hdr[..., :3] - plain.hdr[..., :3]).max(axis=-1) > 1e-3
+    assert changed[hair].mean() >= 0.1, changed[hair].mean()
+    if "specular_intensity" in params:
+        assert not changed[~hair].any()
+        skin, _ = capture(gl, head_scene({"skin_specular_intensity": 0.6}, size=(192, 192)))
+        skin_changed = np.abs(skin.hdr[..., :3] - plain.hdr[..., :3]).max(axis=-1) > 1e-3
+        assert skin_changed.sum() > 20 and not skin_changed[hair].any()
