@@ -82,7 +82,10 @@ class CartoonHairParams(BlinnPhongParams, XToonParams):
         None, max_length=MAX_COLLISION_SPHERES,
         description="object-space (x, y, z, radius); default: builtin:head's own")
     # tubes (4.3.1-4.3.2)
-    hair_samples: int = Field(8, ge=2, le=64, description="spline samples a strand")
+    hair_samples: int = Field(15, ge=2, le=64,
+                              description="spline samples a strand (4.3.1: more than the "
+                                          "segments + 1 simulated points, so the spline "
+                                          "rounds the bends between them)")
     sides: int = Field(6, ge=3, le=16, description="sides of a tube")
     radius: float = Field(0.012, gt=0.0, le=1.0, description="tube radius at the root")
     taper: Vec3 = Field((0.0, -1.0, 1.0), description="radius along the strand: a x^2 + b x + c")

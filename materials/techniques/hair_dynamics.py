@@ -41,7 +41,12 @@ iteration count. Velocities are what the step moved, divided by the step.
 
 **Anchors (4.2.3).** Blending springs pull every particle toward its anchor, the same particle of
 a keyframed strand set moved along a Catmull-Rom spline over the keyframe times (several poses
-of the same strands; with none, the rest pose: anchors then keep the style, 3.1), with stiffness
+of the same strands; with none, the rest pose: anchors then keep the style, 3.1): the spline
+runs over each strand's shape, its bends and segment lengths, not over the particles'
+positions (:func:`.hair_strands.interpolate_shapes`: positions blended between a strand combed
+left and combed right collapse it into the head halfway, which the collisions and springs fold
+into kinks; bends blended stay within the poses' own), and the structural particles are laid on
+the pose as on the rest strands, with stiffness
 ``anchor_stiffness`` scaled along the strand by the quadratic ``anchor_curve`` (uniform by
 default). At 1 the strand is its keyframe pose.
 
@@ -69,7 +74,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .hair_strands import interpolate_keyframes, quadratic, rotation_minimising_frames
+from .hair_strands import (
+    PolylineShapes,
+    interpolate_shapes,
+    quadratic,
+    rotation_minimising_frames,
+)
 
 PINNED = 3  # chain particles p_-1, q_-1, p_0
 COLLISION_ROUNDS = 8
@@ -237,8 +247,10 @@ class HairSimulation:
                 raise ValueError("key_times must be increasing, one per keyframe")
             self._key_chains = np.stack([structured_chain(k, offset) for k in keyframes])
             self._key_times = times
+            self._key_shapes = PolylineShapes.of(keyframes)
         else:
             self._key_chains, self._key_times = self._rest_chain[None], np.zeros(1)
+            self._key_shapes = PolylineShapes.of(rest[None])
         rest_chain = np.moveaxis(self._rest_chain, 1, 0).astype(np.float32)  # (C, S, 3)
         self._order = solve_order(self.chain_length)
         # each free particle's edge springs' rest lengths, in solve_order
@@ -303,8 +315,9 @@ class HairSimulation:
         x[:, :PINNED] = self._pinned(model)
         anchors = None
         if p.anchor_stiffness > 0.0:
-            pose = interpolate_keyframes(self._key_chains, self._key_times,
-                                         (self.steps + 1) * p.time_step)
+            pose = structured_chain(interpolate_shapes(self._key_shapes, self._key_times,
+                                                       (self.steps + 1) * p.time_step),
+                                    self.physics.structure_offset)
             anchors = transform_points(model, pose).transpose(2, 1, 0).astype(np.float32)
             anchor = self._per_round(p.anchor_stiffness * np.clip(
                 quadratic(p.anchor_curve, self._along[PINNED:]), 0.0, 1.0))
@@ -312,12 +325,20 @@ class HairSimulation:
         edge = np.float32(self._per_round(p.edge_stiffness))
         shape = (np.float32(self._per_round(p.bend_stiffness)),  # strand particles (even b)
                  np.float32(self._per_round(p.torsion_stiffness)))  # structural ones (odd b)
+        spheres = self._spheres_at(model)
         for _ in range(p.iterations):
             for b, frame, _ in self._order:
                 self._solve_particle(b, frame, edge, shape[b % 2])
-            if anchors is not None:
-                x[:, PINNED:] += anchor * (anchors[:, PINNED:] - x[:, PINNED:])
-        self._collide(model)
+                strand_particle = b % 2 == 0
+                if anchors is not None:
+                    x[:, b] += anchor[b - PINNED] * (anchors[:, b] - x[:, b])
+                    if strand_particle:  # toward the anchor, at the pose's length from its
+                        # parent (no kink where the pull bends it) as far as it is not held
+                        a = self._edges[b][0][0]
+                        length = np.linalg.norm(anchors[:, b] - anchors[:, a], axis=0)
+                        self._project_edge(b, a, length, edge * (1.0 - anchor[b - PINNED, 0]))
+                if strand_particle and spheres is not None:
+                    self._collide(x[:, b:b + 1], *spheres)
         np.subtract(x, before, out=v)
         v /= dt
         v[:, :PINNED] = 0.0
@@ -336,6 +357,22 @@ class HairSimulation:
         moved = model[:3, :3] @ rest.reshape(3, -1) + model[:3, 3, None]
         return moved.reshape(rest.shape)
 
+    def _project_edge(self, b: int, a: int, rest: np.ndarray, edge: np.float32) -> None:
+        """Particle ``b`` moved toward its rest length ``rest`` from particle ``a`` by the
+        fraction ``edge`` of the error (a distance projection), in place."""
+        if edge <= 0.0:
+            return
+        x, d, length = self._x, self._d, self._length
+        xb = x[:, b]
+        np.subtract(xb, x[:, a], out=d)
+        _norm(d, length)
+        np.maximum(length, 1e-30, out=length)
+        np.divide(rest, length, out=length)  # rest / length
+        length *= -edge
+        length += edge  # edge (1 - rest / length)
+        d *= length
+        xb -= d
+
     def _solve_particle(self, b: int, frame: tuple[int, int, int], edge: np.float32,
                         shape: np.float32) -> None:
         """Particle ``b`` of every strand moved by its springs (see :func:`solve_order`); the
@@ -343,19 +380,11 @@ class HairSimulation:
         particle are the simulation's cost)."""
         x = self._x
         xb = x[:, b]
-        d, length = self._d, self._length
+        d = self._d
         springs = self._edges[b]
         # a structural particle has two edge springs: two rounds of projections nearly meet both
         for a, rest in springs * 2 if len(springs) > 1 else springs:
-            if edge > 0.0:
-                np.subtract(xb, x[:, a], out=d)
-                _norm(d, length)
-                np.maximum(length, 1e-30, out=length)
-                np.divide(rest, length, out=length)  # rest / length
-                length *= -edge
-                length += edge  # edge (1 - rest / length)
-                d *= length
-                xb -= d
+            self._project_edge(b, a, rest, edge)
         if shape > 0.0:
             back, middle, last = (x[:, i] for i in frame)
             e1, e2, e3, dot = self._e1, self._e2, self._e3, self._dot
@@ -379,17 +408,23 @@ class HairSimulation:
             e1 *= shape
             xb += e1
 
-    def _collide(self, model: np.ndarray) -> None:
+    def _spheres_at(self, model: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        """The collision spheres' centres (float32) and radii moved by ``model`` (None: no
+        spheres)."""
         if not len(self._spheres):
-            return
+            return None
         axis_scale = np.linalg.norm(model[:3, :3], axis=0).max()
-        centres = transform_points(model, self._spheres[:, :3])
-        radii = self._spheres[:, 3] * axis_scale + self.physics.collision_margin
-        free = self._x[:, PINNED + 1::2]  # the strand particles p_1 .. p_(P-1)
+        centres = transform_points(model, self._spheres[:, :3]).astype(np.float32)
+        return centres, self._spheres[:, 3] * axis_scale + self.physics.collision_margin
+
+    @staticmethod
+    def _collide(free: np.ndarray, centres: np.ndarray, radii: np.ndarray) -> None:
+        """The particles ``free`` ``(3, n, S)`` (a view of the state) pushed radially out of
+        every sphere, in place."""
         # out of one sphere may be into an overlapping one: rounds until none is inside
         for _ in range(COLLISION_ROUNDS):
             moved = False
-            for centre, radius in zip(centres.astype(np.float32), radii, strict=True):
+            for centre, radius in zip(centres, radii, strict=True):
                 offset = free - centre[:, None, None]
                 distance = np.sqrt(offset[0] ** 2 + offset[1] ** 2 + offset[2] ** 2)
                 inside = distance < radius

@@ -54,6 +54,7 @@ MAX_POINTS_PER_STRAND = 4096
 MAX_STRAND_POINTS = 20_000_000
 MAX_STRAND_COORDINATE = MAX_COORDINATE  # as a mesh's: a stray point or the wrong units
 HairStyle = Literal["combed", "spiky"]
+COMBED_TURN = 35.0  # degrees a combed strand turns at most from one segment to the next
 HAIR_STYLES: tuple[str, ...] = ("combed", "spiky")
 
 
@@ -120,6 +121,89 @@ def interpolate_keyframes(keyframes: np.ndarray, key_times: np.ndarray, time: fl
     m1 = 0.5 * (keyframes[k + 2] - start) if k + 2 < keys else 0.5 * (end - start)
     return ((2 * u ** 3 - 3 * u * u + 1) * start + (u ** 3 - 2 * u * u + u) * m0
             + (-2 * u ** 3 + 3 * u * u) * end + (u ** 3 - u * u) * m1)
+
+
+@dataclass(frozen=True)
+class PolylineShapes:
+    """Keyframed polylines ``(K, S, N, 3)`` as what :func:`interpolate_shapes` blends: each
+    polyline's first point ``(K, S, 1, 3)``, its first segment's direction and the normal of
+    its frame there ``(K, S, 3)`` each, and every later segment's direction in the frame of the
+    segment before it ``(K, S, N - 2, 3)`` (the frames carried along the polyline by the
+    smallest rotation from each segment to the next: parallel transport), and the segments'
+    lengths ``(K, S, N - 1, 1)``."""
+
+    starts: np.ndarray
+    first: np.ndarray
+    normal: np.ndarray
+    bends: np.ndarray
+    lengths: np.ndarray
+
+    @classmethod
+    def of(cls, keyframes: np.ndarray) -> PolylineShapes:
+        keyframes = np.asarray(keyframes, dtype=np.float64)
+        segments = np.diff(keyframes, axis=2)
+        lengths = np.linalg.norm(segments, axis=-1, keepdims=True)
+        directions = segments / np.maximum(lengths, 1e-30)
+        first = directions[:, :, 0]
+        # one normal for every pose of a strand: the first pose's least axis, made normal
+        axis = np.eye(3)[np.abs(first[0]).argmin(axis=-1)]
+        normal = _unit(axis - (axis * first).sum(-1, keepdims=True) * first)
+        bends = np.empty(directions[:, :, 1:].shape)
+        here, across = first, normal
+        for i in range(directions.shape[2] - 1):
+            following = directions[:, :, i + 1]
+            binormal = np.cross(here, across)
+            bends[:, :, i] = np.stack([(following * e).sum(-1) for e in (here, across, binormal)],
+                                      axis=-1)
+            across = _transport(across, here, following)
+            here = following
+        return cls(keyframes[:, :, :1], first, normal, bends, lengths)
+
+
+def _transport(vectors: np.ndarray, start: np.ndarray, end: np.ndarray) -> np.ndarray:
+    """``vectors`` (..., 3) turned by the smallest rotation taking the unit ``start`` to the
+    unit ``end`` (for opposite ones, whose rotation is not one, a half turn about the vector
+    itself's plane: it is left as it is)."""
+    middle = start + end
+    along = 1.0 + (start * end).sum(-1, keepdims=True)
+    turned = vectors - (vectors * middle).sum(-1, keepdims=True) / np.maximum(along, 1e-12) * \
+        middle + 2.0 * (vectors * start).sum(-1, keepdims=True) * end
+    return np.where(along > 1e-9, turned, vectors)
+
+
+def interpolate_shapes(shapes: PolylineShapes, key_times: np.ndarray, time: float) -> np.ndarray:
+    """The polylines ``(S, N, 3)`` at ``time`` between keyframed poses, shape by shape: the
+    first point, the first segment's direction and frame, each later segment's bend in the frame
+    of the one before (:class:`PolylineShapes`) and the lengths, each on
+    :func:`interpolate_keyframes`' Catmull-Rom spline in time (directions made unit again), and
+    the polyline laid segment after segment. Positions blended point by point shorten a
+    strand's segments where its poses disagree (a strand combed left and combed right is,
+    halfway, a stub through the head, which collisions and springs fold into kinks); bends
+    blended in each segment's own frame keep every pose on the way as bent as the poses are
+    at most (halfway between combed left and combed right the strand stands up)."""
+    def unit_spline(values: np.ndarray) -> np.ndarray:
+        blended = interpolate_keyframes(values, key_times, time)
+        norm = np.linalg.norm(blended, axis=-1, keepdims=True)
+        # opposite values in two poses cancel: the nearest key's there
+        nearest = values[int(np.abs(np.asarray(key_times) - time).argmin())]
+        return np.where(norm > 1e-6, blended / np.maximum(norm, 1e-30), nearest)
+
+    start = interpolate_keyframes(shapes.starts, key_times, time)
+    here = unit_spline(shapes.first)
+    across = unit_spline(shapes.normal)
+    across = _unit(across - (across * here).sum(-1, keepdims=True) * here)
+    bends = unit_spline(shapes.bends)
+    lengths = interpolate_keyframes(shapes.lengths, key_times, time)
+    directions = [here]
+    for i in range(bends.shape[1]):
+        binormal = np.cross(here, across)
+        following = (bends[:, i, :1] * here + bends[:, i, 1:2] * across +
+                     bends[:, i, 2:] * binormal)
+        across = _transport(across, here, following)
+        here = following
+        directions.append(here)
+    steps = np.stack(directions, axis=1) * lengths
+    return np.concatenate([start, start + np.cumsum(steps, axis=1)], axis=1)
 
 
 def rotation_minimising_frames(points: np.ndarray, tangents: np.ndarray,
@@ -384,15 +468,21 @@ def grow_strands(roots: ScalpRoots, length: float, segments: int, style: HairSty
         half_width = max(np.abs(root[:, 0]).max(), 1e-9)
         side = np.where(root[:, 0] >= parting * half_width, 1.0, -1.0)[:, None] * [1.0, 0.0, 0.0]
         points = [root]
+        previous = None
         for k in range(segments):
             s = (k + 0.5) / segments
             # leave along the normal, sweep away from the parting, fall with gravity
             direction = _unit((1.0 - s) ** 2 * 1.5 * normal + 2.0 * s * (1.0 - s) * side
                               + s * s * 2.0 * down)
+            if spheres is not None:  # slide over the head rather than bounce off it
+                direction = _slide(points[-1], direction, spheres, segment_length)
+            if previous is not None:
+                direction = _turn_at_most(previous, direction, COMBED_TURN)
             nxt = points[-1] + scale[:, None] * direction
             if spheres is not None:
                 nxt = _outside(nxt, spheres, 0.25 * segment_length)
                 nxt = points[-1] + scale[:, None] * _unit(nxt - points[-1])
+            previous = _unit(nxt - points[-1])
             points.append(nxt)
         return np.stack(points, axis=1)
     clumps = max(1, round(count / max(clump_size, 1)))
@@ -445,6 +535,32 @@ def strand_clumps(strands: np.ndarray, clump_size: int, seed: int = 0) -> np.nda
     # numbered by first strand, so a clump's number does not depend on the centres' order
     _, first, inverse = np.unique(member, return_index=True, return_inverse=True)
     return np.argsort(np.argsort(first))[inverse]
+
+
+def _slide(points: np.ndarray, directions: np.ndarray, spheres: np.ndarray,
+           reach: float) -> np.ndarray:
+    """``directions`` ``(S, 3)`` from ``points`` with their way into each sphere taken out,
+    fully at its surface and fading out ``reach`` beyond it: a strand combed over a head
+    bends round it instead of being pushed back out in a kink."""
+    directions = directions.copy()
+    for cx, cy, cz, radius in np.asarray(spheres, dtype=np.float64):
+        offset = points - (cx, cy, cz)
+        distance = np.linalg.norm(offset, axis=1, keepdims=True)
+        outward = offset / np.maximum(distance, 1e-12)
+        weight = np.clip(1.0 - (distance - radius) / reach, 0.0, 1.0)
+        inward = np.minimum((directions * outward).sum(axis=1, keepdims=True), 0.0)
+        directions = _unit(directions - weight * inward * outward)
+    return directions
+
+
+def _turn_at_most(previous: np.ndarray, directions: np.ndarray, degrees: float) -> np.ndarray:
+    """Unit ``directions`` turned back toward the unit ``previous`` ones where they turn away
+    from them by more than ``degrees`` (in the plane of the two)."""
+    cosine = np.clip((previous * directions).sum(axis=1, keepdims=True), -1.0, 1.0)
+    limit = np.cos(np.radians(degrees))
+    across = _unit(directions - cosine * previous)
+    limited = limit * previous + np.sqrt(1.0 - limit * limit) * across
+    return np.where(cosine < limit, limited, directions)
 
 
 def _unit(v: np.ndarray) -> np.ndarray:

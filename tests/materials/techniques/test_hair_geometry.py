@@ -9,12 +9,16 @@ import trimesh
 
 from deferred.errors import InputError
 from deferred.materials.techniques.hair_strands import (
+    COMBED_TURN,
+    PolylineShapes,
     catmull_rom_weights,
     grow_strands,
     interpolate_keyframes,
+    interpolate_shapes,
     load_strands,
     sample_spline,
     scalp_roots,
+    strand_clumps,
 )
 from deferred.materials.techniques.hair_tubes import (
     GpuTubes,
@@ -143,6 +147,43 @@ def test_keyframes_interpolate_through_each_key():
     np.testing.assert_allclose(interpolate_keyframes(keys, times, 9.0), keys[-1])
 
 
+def test_shapes_interpolate_through_each_key_keeping_lengths_and_bends():
+    """interpolate_shapes (the anchors' poses, 4.2.3) passes through every key, keeps each
+    segment's length where the keys agree, and bends no more than the keys do where they
+    mirror each other (a strand bent left, then right: halfway, straight)."""
+    keys = np.cumsum(RNG.normal(size=(3, 4, 6, 3)), axis=2)
+    times = np.array([0.0, 1.0, 2.5])
+    shapes = PolylineShapes.of(keys)
+    for key, time in zip(keys, times, strict=True):
+        np.testing.assert_allclose(interpolate_shapes(shapes, times, time), key, atol=1e-9)
+    angle = np.linspace(0.0, 1.2, 6)[None, :]
+    bent = np.stack([np.sin(angle), np.cos(angle), 0.0 * angle], axis=-1)  # unit segments
+    left = np.concatenate([np.zeros((1, 1, 3)), np.cumsum(bent, axis=1)], axis=1)
+    right = left * [-1.0, 1.0, 1.0]
+    mirrored = PolylineShapes.of(np.stack([left, right]))
+    halfway = interpolate_shapes(mirrored, np.array([0.0, 1.0]), 0.5)
+    np.testing.assert_allclose(np.linalg.norm(np.diff(halfway, axis=1), axis=-1), 1.0)
+    np.testing.assert_allclose(halfway[0, :, 0], 0.0, atol=1e-12)  # straight up
+    points = interpolate_keyframes(np.stack([left, right]), np.array([0.0, 1.0]), 0.5)
+    assert np.linalg.norm(np.diff(points, axis=1), axis=-1).min() < 0.4  # positions: shrunk
+
+
+def test_clumps_gather_strands_that_run_together():
+    """strand_clumps: about clump_size strands a clump, the strands of a grown spiky clump
+    (one shared tip) mostly in one clump, deterministic, 1: every strand its own."""
+    head = builtin_head(32, 24)
+    roots = scalp_roots(head, 120, seed=4)
+    spiky = grow_strands(roots, 0.15, 6, "spiky", seed=4, clump_size=6)
+    clumps = strand_clumps(spiky, 6)
+    np.testing.assert_array_equal(clumps, strand_clumps(spiky, 6))
+    assert clumps.min() == 0 and 12 <= clumps.max() + 1 <= 28
+    _, tip_groups = np.unique(spiky[:, -1].round(9), axis=0, return_inverse=True)
+    together = [len(np.unique(clumps[tip_groups.ravel() == g])) == 1
+                for g in range(tip_groups.max() + 1)]
+    assert np.mean(together) > 0.6  # most spikes are one clump (a big one may split)
+    np.testing.assert_array_equal(strand_clumps(spiky, 1), np.arange(120))
+
+
 # --------------------------------------------------------------------------- head and growing
 
 def test_head_scalp_lies_on_its_collision_spheres():
@@ -183,6 +224,11 @@ def test_combed_strands_fall_away_from_the_parting_and_spiky_ones_clump():
     combed = grow_strands(roots, 0.15, 8, "combed", seed=2, spheres=builtin_head_spheres(),
                           parting=0.3)
     assert (combed[:, -1, 1] < combed[:, 0, 1]).mean() > 0.95  # gravity
+    # over the head without knees: each segment turns at most COMBED_TURN from the last
+    segments = np.diff(combed, axis=1)
+    segments /= np.linalg.norm(segments, axis=-1, keepdims=True)
+    turns = np.degrees(np.arccos(np.clip((segments[:, 1:] * segments[:, :-1]).sum(-1), -1, 1)))
+    assert turns.max() <= COMBED_TURN + 1e-6
     half_width = np.abs(roots.positions[:, 0]).max()
     side = np.sign(roots.positions[:, 0] - 0.3 * half_width)
     far = np.abs(roots.positions[:, 0] - 0.3 * half_width) > 0.01
