@@ -16,7 +16,8 @@ import numpy as np
 
 from deferred.debug import preview
 from deferred.io.images import write_image
-from deferred.materials.techniques.hatching import TamSettings, tonal_art_map
+from deferred.materials.cartoon_hair.params import CartoonHairParams
+from deferred.materials.cartoon_hair.passes import hatching_map
 from deferred.render.renderer import Renderer
 from deferred.scene.loader import scene_from_dict
 
@@ -126,17 +127,19 @@ def silhouette_figures() -> None:
 
 
 def hatching_figures() -> None:
-    """Fig. 4.20: the hair hatched over the screen (a, Lake) and along its tubes (b, Praun), on
-    wider strands than the default and the map once along a strand, so the map's strokes
-    are not squeezed past its smallest mip into blotches; Figs. 4.21-4.22: the tones of a tonal
-    art map, and one tone tiled 2 x 2."""
-    wide = {"color": FAIR, "radius": 0.02}
-    screen, _ = render(head({**wide, "hatching": "screen"}))
-    surface, _ = render(head({**wide, "hatching": "surface", "hatching_scale": 1.0}))
-    write_image(FIGURES / "fig4_20_hatching_screen_and_surface.png",
-                row(labelled(screen, "4.20a screen hatching"),
-                    labelled(surface, "4.20b surface hatching")))
-    tam = tonal_art_map(TamSettings(size=256, tones=6, mips=3, strokes=78, candidates=10))
+    """Fig. 4.20: the hair hatched over the screen (a, Lake) and along its tubes (b, Praun) as
+    pen strokes hatching_width pixels wide, at 320 px and, cropped, at 1280 px (the same
+    strokes' width in pixels, the map read at about a texel a pixel); Figs. 4.21-4.22: the
+    tones of a tonal art map, and one tone tiled 2 x 2."""
+    panels = []
+    for size in (320, 1280):
+        for mode, letter in (("screen", "a"), ("surface", "b")):
+            image, _ = render(head({"color": FAIR, "hatching": mode}, size=(size, size)))
+            if size > 320:  # a 320-pixel crop: the strokes at the same width in pixels
+                image = image[100:420, 380:700]
+            panels.append(labelled(image, f"4.20{letter} {mode} hatching, {size} px"))
+    write_image(FIGURES / "fig4_20_hatching_screen_and_surface.png", row(*panels))
+    tam = hatching_map(CartoonHairParams().hatching_width)  # the hair's own map
     ink = tam.levels[0]  # (tones, size, size) uint8 ink
     paper = 255 - ink
     tones = np.concatenate(list(paper), axis=1)

@@ -105,7 +105,7 @@ class CartoonHairMaterial(Material):
             "skin_specular_exponent",
             "silhouettes", "stroke_width", "stroke_world_width", "stroke_color", "stroke_fade",
             "hatching",
-            "hatching_strength", "hatching_scale")},
+            "hatching_strength", "hatching_scale", "hatching_width")},
         "color": lambda value: {},  # the head's pass takes skin_color, the hair's color
     }
     # read once, at t = 0: the strands, the simulation's structure and the tubes' topology

@@ -110,6 +110,9 @@ class CartoonHairParams(BlinnPhongParams, XToonParams):
     hatching_scale: float = Field(3.0, gt=0.0, le=64.0,
                                   description="surface hatching: the map's repeats along a "
                                               "strand (screen hatching: a map texel a pixel)")
+    hatching_width: float = Field(1.5, ge=0.75, le=6.0,
+                                  description="hatching strokes' width in pixels (the tonal "
+                                              "art map's, read at about a texel a pixel)")
 
     @field_validator("collision_spheres")
     @classmethod

@@ -4,7 +4,10 @@
 
 from __future__ import annotations
 
+from functools import lru_cache
 from typing import TYPE_CHECKING, Any
+
+import numpy as np
 
 from deferred.api import (
     COMPOSITE,
@@ -74,23 +77,38 @@ class HatchingPass(ObjectPass):
 
     def uniforms(self, frame: Frame) -> dict[str, Any]:
         params = self.object(frame).params
-        tam = hatching_map()
-        return {"u_tam_tones": tam.tones,
-                "u_tam_gutter": tam.gutter, "u_hatching_strength": params.hatching_strength,
-                # screen hatching keeps the map's strokes at their width in pixels
-                "u_hatching_scale": 1.0 if params.hatching == "screen" else params.hatching_scale,
+        tam = hatching_map(params.hatching_width)
+        means = np.zeros(MAX_TAM_TONES)
+        means[:tam.tones] = tam.ink(tam.mips - 1).mean(axis=(1, 2))
+        return {"u_tam_tones": tam.tones, "u_tam_gutter": tam.gutter, "u_tam_mips": tam.mips,
+                "u_tam_mean": tuple(float(m) for m in means),
+                "u_hatching_strength": params.hatching_strength,
+                "u_hatching_scale": params.hatching_scale,
                 "u_hatching_screen": params.hatching == "screen"}
 
     def textures(self, frame: Frame) -> dict[str, moderngl.Texture]:
-        texture = frame.resources.cached("cartoon_hair_tam",
-                                         lambda ctx: tam_texture(ctx, hatching_map()))
+        width = self.object(frame).params.hatching_width
+        texture = frame.resources.cached(("cartoon_hair_tam", width),
+                                         lambda ctx: tam_texture(ctx, hatching_map(width)))
         return {"u_tam": texture}
 
 
-def hatching_map():
-    """The hatching's tonal art map: the thesis' 6 tones x 3 mips of 78 strokes at 256^2
-    (cached on disk by :func:`.techniques.hatching.tonal_art_map`)."""
-    return tonal_art_map(TamSettings(size=256, tones=6, mips=3, strokes=78, candidates=10))
+MAX_TAM_TONES = 64  # hatching.glsl's u_tam_mean
+
+
+@lru_cache(maxsize=8)
+def hatching_map(width: float):
+    """The hatching's tonal art map for strokes ``width`` pixels wide (4.3.8 as pen strokes):
+    the thesis' 6 tones, at 256^2 with 4 levels (strokes still cover several pixels at the
+    coarsest, 32^2), strokes 0.3 of the tile long along the strand (hair is hatched along its
+    grain, not crossed), enough of them that the darkest tone is about half ink (cached on disk
+    by :func:`.techniques.hatching.tonal_art_map`)."""
+    strokes = int(round(TAM_INK_STROKES / width))
+    return tonal_art_map(TamSettings(size=256, tones=6, mips=4, strokes=strokes, candidates=10,
+                                     stroke_length=0.3, stroke_width=float(width)))
+
+
+TAM_INK_STROKES = 900.0  # strokes times their width (pixels): the darkest tone's ink
 
 
 class HairSilhouettePass(SilhouettePass):

@@ -140,7 +140,8 @@ class HairState:
 
     @staticmethod
     def _constant_attributes(tubes, clumps: np.ndarray) -> tuple[np.ndarray, ...]:
-        """uv (along, around), no tangent frame, and the comb slot: (strand, along, clump)."""
+        """uv (along, around), no tangent frame, and the comb slot: (strand, along, clump,
+        around + 1/2 wrapped: the hatching's seamless lookup round the tube)."""
         count = len(tubes.positions)
         uvs = np.stack([tubes.along, tubes.around], axis=1).astype(np.float32)
         zeros = np.zeros((count, 3), np.float32)
@@ -148,6 +149,7 @@ class HairState:
         comb[:, 0] = tubes.strand_ids
         comb[:, 1] = tubes.along
         comb[:, 2] = clumps[tubes.strand_ids]
+        comb[:, 3] = np.mod(tubes.around + 0.5, 1.0)
         return uvs, zeros, zeros.copy(), comb
 
     def advance(self, time: float, frame: Frame | None = None) -> None:
