@@ -60,13 +60,8 @@ from deferred.api import (
 )
 
 from ..shading_models import Toon
-from ..techniques.hair_strands import (
-    grow_strands,
-    load_strands,
-    resample_strand,
-    scalp_roots,
-    strand_clumps,
-)
+from ..techniques.hair_clumps import strand_clumps
+from ..techniques.hair_strands import grow_strands, load_strands, resample_strand, scalp_roots
 from ..techniques.xtoon import XTOON_UNIFORM_OVERRIDES, XToonRamp
 from .params import (
     SILHOUETTE_TRIANGLE_SECONDS,

@@ -74,12 +74,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .hair_strands import (
-    PolylineShapes,
-    interpolate_shapes,
-    quadratic,
-    rotation_minimising_frames,
-)
+from .hair_poses import PolylineShapes, interpolate_shapes
+from .hair_strands import quadratic, rotation_minimising_frames
 
 PINNED = 3  # chain particles p_-1, q_-1, p_0
 COLLISION_ROUNDS = 8

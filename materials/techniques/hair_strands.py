@@ -123,89 +123,6 @@ def interpolate_keyframes(keyframes: np.ndarray, key_times: np.ndarray, time: fl
             + (-2 * u ** 3 + 3 * u * u) * end + (u ** 3 - u * u) * m1)
 
 
-@dataclass(frozen=True)
-class PolylineShapes:
-    """Keyframed polylines ``(K, S, N, 3)`` as what :func:`interpolate_shapes` blends: each
-    polyline's first point ``(K, S, 1, 3)``, its first segment's direction and the normal of
-    its frame there ``(K, S, 3)`` each, and every later segment's direction in the frame of the
-    segment before it ``(K, S, N - 2, 3)`` (the frames carried along the polyline by the
-    smallest rotation from each segment to the next: parallel transport), and the segments'
-    lengths ``(K, S, N - 1, 1)``."""
-
-    starts: np.ndarray
-    first: np.ndarray
-    normal: np.ndarray
-    bends: np.ndarray
-    lengths: np.ndarray
-
-    @classmethod
-    def of(cls, keyframes: np.ndarray) -> PolylineShapes:
-        keyframes = np.asarray(keyframes, dtype=np.float64)
-        segments = np.diff(keyframes, axis=2)
-        lengths = np.linalg.norm(segments, axis=-1, keepdims=True)
-        directions = segments / np.maximum(lengths, 1e-30)
-        first = directions[:, :, 0]
-        # one normal for every pose of a strand: the first pose's least axis, made normal
-        axis = np.eye(3)[np.abs(first[0]).argmin(axis=-1)]
-        normal = _unit(axis - (axis * first).sum(-1, keepdims=True) * first)
-        bends = np.empty(directions[:, :, 1:].shape)
-        here, across = first, normal
-        for i in range(directions.shape[2] - 1):
-            following = directions[:, :, i + 1]
-            binormal = np.cross(here, across)
-            bends[:, :, i] = np.stack([(following * e).sum(-1) for e in (here, across, binormal)],
-                                      axis=-1)
-            across = _transport(across, here, following)
-            here = following
-        return cls(keyframes[:, :, :1], first, normal, bends, lengths)
-
-
-def _transport(vectors: np.ndarray, start: np.ndarray, end: np.ndarray) -> np.ndarray:
-    """``vectors`` (..., 3) turned by the smallest rotation taking the unit ``start`` to the
-    unit ``end`` (for opposite ones, whose rotation is not one, a half turn about the vector
-    itself's plane: it is left as it is)."""
-    middle = start + end
-    along = 1.0 + (start * end).sum(-1, keepdims=True)
-    turned = vectors - (vectors * middle).sum(-1, keepdims=True) / np.maximum(along, 1e-12) * \
-        middle + 2.0 * (vectors * start).sum(-1, keepdims=True) * end
-    return np.where(along > 1e-9, turned, vectors)
-
-
-def interpolate_shapes(shapes: PolylineShapes, key_times: np.ndarray, time: float) -> np.ndarray:
-    """The polylines ``(S, N, 3)`` at ``time`` between keyframed poses, shape by shape: the
-    first point, the first segment's direction and frame, each later segment's bend in the frame
-    of the one before (:class:`PolylineShapes`) and the lengths, each on
-    :func:`interpolate_keyframes`' Catmull-Rom spline in time (directions made unit again), and
-    the polyline laid segment after segment. Positions blended point by point shorten a
-    strand's segments where its poses disagree (a strand combed left and combed right is,
-    halfway, a stub through the head, which collisions and springs fold into kinks); bends
-    blended in each segment's own frame keep every pose on the way as bent as the poses are
-    at most (halfway between combed left and combed right the strand stands up)."""
-    def unit_spline(values: np.ndarray) -> np.ndarray:
-        blended = interpolate_keyframes(values, key_times, time)
-        norm = np.linalg.norm(blended, axis=-1, keepdims=True)
-        # opposite values in two poses cancel: the nearest key's there
-        nearest = values[int(np.abs(np.asarray(key_times) - time).argmin())]
-        return np.where(norm > 1e-6, blended / np.maximum(norm, 1e-30), nearest)
-
-    start = interpolate_keyframes(shapes.starts, key_times, time)
-    here = unit_spline(shapes.first)
-    across = unit_spline(shapes.normal)
-    across = _unit(across - (across * here).sum(-1, keepdims=True) * here)
-    bends = unit_spline(shapes.bends)
-    lengths = interpolate_keyframes(shapes.lengths, key_times, time)
-    directions = [here]
-    for i in range(bends.shape[1]):
-        binormal = np.cross(here, across)
-        following = (bends[:, i, :1] * here + bends[:, i, 1:2] * across +
-                     bends[:, i, 2:] * binormal)
-        across = _transport(across, here, following)
-        here = following
-        directions.append(here)
-    steps = np.stack(directions, axis=1) * lengths
-    return np.concatenate([start, start + np.cumsum(steps, axis=1)], axis=1)
-
-
 def rotation_minimising_frames(points: np.ndarray, tangents: np.ndarray,
                                reference: np.ndarray | None = None) -> np.ndarray:
     """Unit normals ``(S, N, 3)`` of rotation-minimising frames along ``points`` ``(S, N, 3)``
@@ -439,7 +356,7 @@ def scalp_roots(mesh: MeshData, count: int, seed: int = 0) -> ScalpRoots:
     bary = np.stack([1.0 - s, s * (1.0 - r2), s * r2], axis=1)
     root = np.einsum("sk,skc->sc", bary, corners[chosen])
     normal = np.einsum("sk,skc->sc", bary, normals[faces[chosen]])
-    return ScalpRoots(root, _unit(normal))
+    return ScalpRoots(root, unit_vectors(normal))
 
 
 def grow_strands(roots: ScalpRoots, length: float, segments: int, style: HairStyle = "combed",
@@ -461,7 +378,7 @@ def grow_strands(roots: ScalpRoots, length: float, segments: int, style: HairSty
     rng = np.random.default_rng(seed)
     root, normal = roots.positions, roots.normals
     count = len(root)
-    down = _unit(np.asarray(gravity, dtype=np.float64)[None])[0]
+    down = unit_vectors(np.asarray(gravity, dtype=np.float64)[None])[0]
     segment_length = length / segments
     if style == "combed":
         scale = segment_length * rng.uniform(0.85, 1.0, count)
@@ -472,7 +389,7 @@ def grow_strands(roots: ScalpRoots, length: float, segments: int, style: HairSty
         for k in range(segments):
             s = (k + 0.5) / segments
             # leave along the normal, sweep away from the parting, fall with gravity
-            direction = _unit((1.0 - s) ** 2 * 1.5 * normal + 2.0 * s * (1.0 - s) * side
+            direction = unit_vectors((1.0 - s) ** 2 * 1.5 * normal + 2.0 * s * (1.0 - s) * side
                               + s * s * 2.0 * down)
             if spheres is not None:  # slide over the head rather than bounce off it
                 direction = _slide(points[-1], direction, spheres, segment_length)
@@ -481,8 +398,8 @@ def grow_strands(roots: ScalpRoots, length: float, segments: int, style: HairSty
             nxt = points[-1] + scale[:, None] * direction
             if spheres is not None:
                 nxt = _outside(nxt, spheres, 0.25 * segment_length)
-                nxt = points[-1] + scale[:, None] * _unit(nxt - points[-1])
-            previous = _unit(nxt - points[-1])
+                nxt = points[-1] + scale[:, None] * unit_vectors(nxt - points[-1])
+            previous = unit_vectors(nxt - points[-1])
             points.append(nxt)
         return np.stack(points, axis=1)
     clumps = max(1, round(count / max(clump_size, 1)))
@@ -490,7 +407,7 @@ def grow_strands(roots: ScalpRoots, length: float, segments: int, style: HairSty
     member = _nearest(root, root[seeds])
     clump_normal = normal[seeds]
     droop = rng.uniform(0.2, 0.6, clumps)[:, None]
-    direction = _unit(clump_normal + droop * down)
+    direction = unit_vectors(clump_normal + droop * down)
     clump_length = length * rng.uniform(0.85, 1.0, clumps)
     tip = root[seeds] + clump_length[:, None] * direction
     tip = tip[member]
@@ -502,39 +419,6 @@ def grow_strands(roots: ScalpRoots, length: float, segments: int, style: HairSty
         inner = _outside(points[:, 1:].reshape(-1, 3), spheres, 0.25 * segment_length)
         points[:, 1:] = inner.reshape(count, segments, 3)
     return points
-
-
-CLUMP_ROUNDS = 12  # k-means rounds: clumps settle in a few; they are outlines, not physics
-
-
-def strand_clumps(strands: np.ndarray, clump_size: int, seed: int = 0) -> np.ndarray:
-    """``(S,)`` int: the clump of each strand ``(S, P, 3)``, about ``clump_size`` strands a
-    clump, 0 ... clumps - 1, deterministic for ``seed``. Clumps are k-means clusters of the
-    strands' shapes (root, middle and tip: strands that run together, as a grown spiky clump's
-    do to their shared tip), so a clump is found in hair from a file too. ``clump_size`` 1:
-    every strand its own clump."""
-    strands = np.asarray(strands, np.float64)
-    count = len(strands)
-    clumps = max(1, int(round(count / max(int(clump_size), 1))))
-    if clumps >= count:
-        return np.arange(count)
-    features = strands[:, [0, strands.shape[1] // 2, -1]].reshape(count, -1)
-    rng = np.random.default_rng(seed)
-    centres = features[np.sort(rng.choice(count, size=clumps, replace=False))]
-    member = _nearest_centre(features, centres)
-    for _ in range(CLUMP_ROUNDS):
-        sums = np.zeros_like(centres)
-        np.add.at(sums, member, features)
-        sizes = np.bincount(member, minlength=clumps)[:, None]
-        # an emptied clump keeps its centre (it may win strands back)
-        centres = np.where(sizes > 0, sums / np.maximum(sizes, 1), centres)
-        updated = _nearest_centre(features, centres)
-        if np.array_equal(updated, member):
-            break
-        member = updated
-    # numbered by first strand, so a clump's number does not depend on the centres' order
-    _, first, inverse = np.unique(member, return_index=True, return_inverse=True)
-    return np.argsort(np.argsort(first))[inverse]
 
 
 def _slide(points: np.ndarray, directions: np.ndarray, spheres: np.ndarray,
@@ -549,7 +433,7 @@ def _slide(points: np.ndarray, directions: np.ndarray, spheres: np.ndarray,
         outward = offset / np.maximum(distance, 1e-12)
         weight = np.clip(1.0 - (distance - radius) / reach, 0.0, 1.0)
         inward = np.minimum((directions * outward).sum(axis=1, keepdims=True), 0.0)
-        directions = _unit(directions - weight * inward * outward)
+        directions = unit_vectors(directions - weight * inward * outward)
     return directions
 
 
@@ -558,12 +442,13 @@ def _turn_at_most(previous: np.ndarray, directions: np.ndarray, degrees: float) 
     from them by more than ``degrees`` (in the plane of the two)."""
     cosine = np.clip((previous * directions).sum(axis=1, keepdims=True), -1.0, 1.0)
     limit = np.cos(np.radians(degrees))
-    across = _unit(directions - cosine * previous)
+    across = unit_vectors(directions - cosine * previous)
     limited = limit * previous + np.sqrt(1.0 - limit * limit) * across
     return np.where(cosine < limit, limited, directions)
 
 
-def _unit(v: np.ndarray) -> np.ndarray:
+def unit_vectors(v: np.ndarray) -> np.ndarray:
+    """Vectors ``(..., 3)`` made unit length (zero ones left zero)."""
     return v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-12)
 
 
@@ -574,18 +459,6 @@ def _nearest(points: np.ndarray, centres: np.ndarray, block: int = 4096) -> np.n
         part = points[start:start + block]
         distance = ((part[:, None, :] - centres[None, :, :]) ** 2).sum(axis=2)
         out[start:start + block] = distance.argmin(axis=1)
-    return out
-
-
-def _nearest_centre(points: np.ndarray, centres: np.ndarray, block: int = 1024) -> np.ndarray:
-    """:func:`_nearest` for many centres of many coordinates (k-means over strands)."""
-    out = np.empty(len(points), dtype=np.int64)
-    squares = (centres * centres).sum(axis=1)
-    for start in range(0, len(points), block):
-        part = points[start:start + block]
-        # |p - c|^2 less |p|^2, the same for every centre: a matrix product, not a difference
-        # array of points x centres x coordinates
-        out[start:start + block] = (squares[None, :] - 2.0 * part @ centres.T).argmin(axis=1)
     return out
 
 

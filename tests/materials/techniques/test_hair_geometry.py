@@ -8,17 +8,16 @@ import pytest
 import trimesh
 
 from deferred.errors import InputError
+from deferred.materials.techniques.hair_clumps import strand_clumps
+from deferred.materials.techniques.hair_poses import PolylineShapes, interpolate_shapes
 from deferred.materials.techniques.hair_strands import (
     COMBED_TURN,
-    PolylineShapes,
     catmull_rom_weights,
     grow_strands,
     interpolate_keyframes,
-    interpolate_shapes,
     load_strands,
     sample_spline,
     scalp_roots,
-    strand_clumps,
 )
 from deferred.materials.techniques.hair_tubes import (
     GpuTubes,
