@@ -22,7 +22,7 @@ from deferred.api import (
     Technique,
 )
 
-from ..techniques.hair_silhouettes import SilhouettePass
+from ..techniques.hair_silhouettes import SilhouetteEdges, SilhouettePass
 from ..techniques.hair_tubes import tube_radii
 from ..techniques.hatching import TamSettings, tam_texture, tonal_art_map
 from .params import MAX_HAIR_OBJECTS, STRAND_IDS
@@ -116,6 +116,12 @@ class HairSilhouettePass(SilhouettePass):
 
     def silhouette_geometry(self, frame: Frame) -> MeshPrimitives:
         return DYNAMICS.state(frame, self.object(frame)).silhouettes
+
+    def silhouette_edges(self, frame: Frame) -> SilhouetteEdges:
+        return DYNAMICS.state(frame, self.object(frame)).silhouette_edges
+
+    def tube_vertices(self, frame: Frame) -> moderngl.Buffer:
+        return DYNAMICS.state(frame, self.object(frame)).gpu.surface_vbo
 
     def uniforms(self, frame: Frame) -> dict[str, Any]:
         uniforms = super().uniforms(frame)

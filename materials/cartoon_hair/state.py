@@ -24,7 +24,7 @@ from deferred.api import (
 )
 
 from ..techniques.hair_dynamics import HairPhysics, HairSimulation
-from ..techniques.hair_silhouettes import silhouette_geometry, tube_adjacency
+from ..techniques.hair_silhouettes import SilhouetteEdges, silhouette_geometry, tube_adjacency
 from ..techniques.hair_strands import load_strands
 from ..techniques.hair_tubes import GpuTubes, build_tubes
 from .params import (
@@ -89,6 +89,7 @@ class HairState:
         self.ctx = ctx
         self._gpu_tubes: GpuTubes | None = None
         self._silhouettes: MeshPrimitives | None = None
+        self._silhouette_edges: SilhouetteEdges | None = None
         self.time: float | None = None
         self._placed = self._placement()
 
@@ -117,14 +118,25 @@ class HairState:
         return model_at(time) if model_at is not None else self.obj.model
 
     @property
+    def topology(self) -> tuple[int, int, int]:
+        """The tubes' strands, samples and sides."""
+        return self.simulation.strand_count, self.params.hair_samples, self.params.sides
+
+    @property
     def silhouettes(self) -> MeshPrimitives:
-        """The tubes with each triangle's neighbours (made the first time it is asked for)."""
+        """The tubes with each triangle's neighbours (made the first time it is asked for: the
+        geometry shader's silhouettes, GL 3.3)."""
         if self._silhouettes is None:
-            p = self.params
-            topology = (self.simulation.strands.shape[0], p.hair_samples, p.sides)
             self._silhouettes = silhouette_geometry(self.ctx, self.gpu,
-                                                    tube_adjacency(*topology))
+                                                    tube_adjacency(*self.topology))
         return self._silhouettes
+
+    @property
+    def silhouette_edges(self) -> SilhouetteEdges:
+        """The tubes' silhouette edges on the GPU (made the first time it is asked for)."""
+        if self._silhouette_edges is None:
+            self._silhouette_edges = SilhouetteEdges(self.ctx, *self.topology)
+        return self._silhouette_edges
 
     def _tubes(self, params: CartoonHairParams):
         """The tubes by numpy (:func:`build_tubes`), in object space."""
@@ -188,6 +200,8 @@ class HairState:
     def release(self) -> None:
         if self._silhouettes is not None:
             self._silhouettes.release()
+        if self._silhouette_edges is not None:
+            self._silhouette_edges.release()
         if self._gpu_tubes is not None:
             self._gpu_tubes.release()
         self.gpu.release()

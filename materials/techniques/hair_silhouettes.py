@@ -128,14 +128,121 @@ def silhouette_geometry(ctx: moderngl.Context, gpu_mesh: GpuMesh,
     return MeshPrimitives(ctx, gpu_mesh, adjacency, moderngl.TRIANGLES_ADJACENCY)
 
 
+EDGES_COMPUTE = "materials/cartoon_hair/silhouette_edges.comp"
+STROKES_VERTEX = "materials/cartoon_hair/silhouette_strokes.vert"
+EDGE_GROUP = 64  # invocations (strands) a work group
+MAX_SIDES = 16  # silhouette_edges.comp's ring arrays (cartoon_hair's sides go to 16)
+STROKES_A_RING = 4  # the stroke buffer's room: a tube seen side on has about 2.6 a ring
+FIND_TEXTURE_UNIT = 12  # the edge pass's first texture unit (GL 4.3 gives a stage 16)
+STROKE_CORNER_BYTES = 32  # NDC x, y, z, view depth, along, across, strand and one unused
+
+
+def edges_on_gpu(gl) -> bool:
+    """Whether the silhouette strokes are made by a compute shader and drawn from a storage
+    buffer (GL 4.3, and storage buffers in vertex shaders: GL 4.3 requires none there)."""
+    if not gl.features.compute_shaders:
+        return False
+    return int(gl.ctx.info.get("GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS", 0) or 0) >= 2
+
+
+class SilhouetteEdges:
+    """The silhouette strokes of a set of tubes made on the GPU (Costigan 4.3.7, Figs.
+    4.14-4.17): ``materials/cartoon_hair/silhouette_edges.comp``, an invocation a strand,
+    walks the tube's rings, classifies the edges of its fixed topology (no adjacency buffer: a
+    tube's neighbours follow from its vertex order) against the eye and writes each
+    silhouette edge's stroke quad, its 4 corners, into :attr:`strokes`, counting 6 indices a
+    quad into :attr:`command`, a ``glDrawElementsIndirect`` command over a fixed index buffer
+    of two triangles a quad: every stroke in one draw, and nothing back to the CPU. The quads
+    are made once, in the compute pass: drawn as an instance an edge, or with each of 6
+    vertices making its quad again, the strokes of 10,000 strands took llvmpipe half a second.
+    :attr:`capacity` strokes (``STROKES_A_RING`` a ring) fit; more are dropped."""
+
+    def __init__(self, ctx: moderngl.Context, strands: int, samples: int, sides: int):
+        if sides > MAX_SIDES:
+            raise ValueError(f"the GPU silhouettes take tubes of at most {MAX_SIDES} sides")
+        self.ctx = ctx
+        self.strands, self.samples, self.sides = strands, samples, sides
+        self.capacity = strands * samples * STROKES_A_RING
+        self.strokes = ctx.buffer(reserve=4 * STROKE_CORNER_BYTES * self.capacity)
+        quads = np.arange(self.capacity, dtype=np.uint32)[:, None] * 4
+        indices = (quads + np.array([0, 1, 2, 2, 1, 3], np.uint32)).astype(np.uint32)
+        self.indices = ctx.buffer(indices.tobytes())
+        self.command = ctx.buffer(reserve=20)
+        self._arrays: dict[int, moderngl.VertexArray] = {}
+
+    @property
+    def nbytes(self) -> int:
+        """Bytes of GPU memory held."""
+        return self.strokes.size + self.indices.size + self.command.size
+
+    def find(self, shaders, vertices: moderngl.Buffer, model_view: np.ndarray,
+             stroke: dict[str, Any], defines: dict[str, str] | None = None,
+             textures: dict[str, moderngl.Texture] | None = None, stride: int = 6) -> None:
+        """Make the strokes of the tubes in ``vertices`` (``stride`` floats a vertex, position
+        and normal first, object space) seen through the 4x4 ``model_view``; ``stroke``: the
+        values of ``silhouette_stroke.glsl``'s uniforms (and ``u_strand_base``), ``defines`` the
+        stroke pass's (with ``STROKE_ID_BUFFER``, strokes the G-buffer's ``textures``,
+        ``u_linear_depth`` and ``u_strand_id``, hide are not made)."""
+        self.command.write(np.array([0, 1, 0, 0, 0], np.uint32).tobytes())
+        shader = shaders.compute(EDGES_COMPUTE, {**(defines or {}),
+                                                 "EDGE_GROUP": str(EDGE_GROUP)})
+        model_view = np.asarray(model_view, np.float64)
+        normal = np.linalg.inv(model_view[:3, :3]).T
+        values = {
+            "u_strands": self.strands, "u_samples": self.samples, "u_sides": self.sides,
+            "u_stride": stride, "u_capacity": self.capacity,
+            # GL's matrices are column-major: the transpose's rows are the columns
+            "u_model_view": tuple(float(v) for v in model_view.T.reshape(-1)),
+            "u_normal_matrix": tuple(float(v) for v in normal.T.reshape(-1)), **stroke}
+        shaders.uniforms(shader).set({name: value for name, value in values.items()
+                                      if name in shader})
+        # texture units above the stroke program's: the pass has bound its samplers already
+        for unit, (name, texture) in enumerate((textures or {}).items(), FIND_TEXTURE_UNIT):
+            if name in shader:
+                texture.use(unit)
+                shader[name].value = unit
+        vertices.bind_to_storage_buffer(0)
+        self.strokes.bind_to_storage_buffer(1)
+        self.command.bind_to_storage_buffer(2)
+        shader.run(-(-self.strands // EDGE_GROUP))
+        self.ctx.memory_barrier()
+
+    def draw(self, program: moderngl.Program) -> None:
+        """The strokes :meth:`find` made, in one indexed draw."""
+        vertex_array = self._arrays.get(program.glo)
+        if vertex_array is None:
+            vertex_array = self._arrays[program.glo] = self.ctx.vertex_array(
+                program, [], index_buffer=self.indices, index_element_size=4)
+        self.strokes.bind_to_storage_buffer(1)
+        vertex_array.render_indirect(self.command, moderngl.TRIANGLES, count=1)
+
+    def count(self) -> int:
+        """The strokes made last (read back: tests and figures only)."""
+        return int(np.frombuffer(self.command.read(), np.uint32)[0]) // 6
+
+    def corners(self) -> np.ndarray:
+        """``(count, 4, 7)`` float32: the corners of the strokes made last (read back): NDC x,
+        y, z, view depth, along, across, strand."""
+        count = self.count()
+        raw = np.frombuffer(self.strokes.read(4 * STROKE_CORNER_BYTES * count), np.float32)
+        return raw.reshape(count, 4, 8)[..., :7]
+
+    def release(self) -> None:
+        for vertex_array in self._arrays.values():
+            vertex_array.release()
+        for buffer in (self.strokes, self.indices, self.command):
+            buffer.release()
+
+
 class SilhouettePass(ObjectPass):
     """Silhouette strokes of an object's hair tubes over the composition buffer.
 
-    A subclass gives the tubes (:meth:`silhouette_geometry`, made by the owner of the tubes'
-    buffers and released with them) and the stroke
-    parameters (:meth:`stroke_settings`). ``id_buffer=True`` (deferred) tests visibility
-    against the G-buffer's ``strand_id`` and ``linear_depth``; ``False`` (forward) against the
-    depth buffer."""
+    A subclass gives the tubes (:meth:`tube_vertices`; and, made by the owner of the tubes'
+    buffers and released with them, :meth:`silhouette_edges` where compute shaders make the
+    strokes, else :meth:`silhouette_geometry` for the geometry shader over their adjacency)
+    and the stroke parameters (:meth:`stroke_settings`). ``id_buffer=True`` (deferred) tests
+    visibility against the G-buffer's ``strand_id`` and ``linear_depth``; ``False`` (forward)
+    against the depth buffer."""
 
     vertex = SILHOUETTE_VERTEX
     geometry = SILHOUETTE_GEOMETRY
@@ -158,7 +265,15 @@ class SilhouettePass(ObjectPass):
         super().__init__(name, phase, obj, **options)
 
     def silhouette_geometry(self, frame) -> MeshPrimitives:
-        """The tubes with their neighbours this frame."""
+        """The tubes with their neighbours this frame (the geometry shader's path)."""
+        raise NotImplementedError
+
+    def silhouette_edges(self, frame) -> SilhouetteEdges:
+        """The tubes' :class:`SilhouetteEdges` (the compute path)."""
+        raise NotImplementedError
+
+    def tube_vertices(self, frame) -> moderngl.Buffer:
+        """The buffer of the tubes' positions and normals (6 floats a vertex)."""
         raise NotImplementedError
 
     def stroke_settings(self, frame) -> dict[str, Any]:
@@ -171,9 +286,16 @@ class SilhouettePass(ObjectPass):
         defines = super().defines(frame)
         return {**defines, "STROKE_ID_BUFFER": "1"} if self.id_buffer else defines
 
-    def uniforms(self, frame) -> dict[str, Any]:
+    def program(self, frame, obj=None) -> moderngl.Program:
+        if not edges_on_gpu(frame.gl):
+            return super().program(frame, obj)
+        return frame.shaders.program(STROKES_VERTEX, self.fragment, None,
+                                     defines=self.defines(frame))
+
+    def stroke_uniforms(self, frame) -> dict[str, Any]:
+        """The values of ``silhouette_stroke.glsl``'s uniforms (where the quads are made)."""
         settings = self.stroke_settings(frame)
-        # the tolerance in view units: the object's largest scale
+        # view units: times the object's largest scale
         scale = float(np.max(np.linalg.norm(np.asarray(self.object(frame).model)[:3, :3],
                                             axis=0)))
         world_width = settings.get("world_width")
@@ -181,15 +303,37 @@ class SilhouettePass(ObjectPass):
                 "u_stroke_world_width": 0.0 if world_width is None else world_width * scale,
                 "u_tube_radius": float(settings["radius"]) * scale,
                 "u_tube_taper": tuple(float(c) for c in settings["taper"]),
-                "u_stroke_color": tuple(float(c) for c in settings["color"]),
-                "u_stroke_fade": tuple(float(c) for c in settings["fade"]),
                 "u_stroke_tolerance": float(settings["tolerance"]) * scale}
+
+    def uniforms(self, frame) -> dict[str, Any]:
+        settings = self.stroke_settings(frame)
+        stroke = self.stroke_uniforms(frame)
+        uniforms = {"u_stroke_color": tuple(float(c) for c in settings["color"]),
+                    "u_stroke_fade": tuple(float(c) for c in settings["fade"])}
+        if self.id_buffer:
+            uniforms["u_stroke_tolerance"] = stroke["u_stroke_tolerance"]
+        if not edges_on_gpu(frame.gl):  # the geometry shader makes the quads
+            uniforms.update(stroke)
+        return uniforms
 
     def textures(self, frame) -> dict[str, moderngl.Texture]:
         return {**super().textures(frame),
                 "u_stroke": frame.resources.texture("hair_silhouette_stroke", stroke_texture)}
 
     def draw(self, frame, program: moderngl.Program) -> None:
-        geometry = self.silhouette_geometry(frame)
-        frame.gl_call(lambda: geometry.render(program))
+        if edges_on_gpu(frame.gl):
+            edges, vertices = self.silhouette_edges(frame), self.tube_vertices(frame)
+            model_view = np.asarray(frame.view) @ np.asarray(self.object(frame).model)
+            stroke = {**self.stroke_uniforms(frame), **self.uniforms(frame),
+                      "u_projection": frame.projection,
+                      "u_resolution": (float(frame.width), float(frame.height))}
+            visibility = {"u_linear_depth": frame.target(LINEAR_DEPTH),
+                          "u_strand_id": frame.target(STRAND_ID)} if self.id_buffer else {}
+            frame.gl_call(lambda: edges.find(frame.shaders, vertices, model_view, stroke,
+                                             self.defines(frame), visibility))
+            frame.count_draw()
+            frame.gl_call(lambda: edges.draw(program))
+        else:
+            geometry = self.silhouette_geometry(frame)
+            frame.gl_call(lambda: geometry.render(program))
         frame.count_draw()

@@ -215,3 +215,76 @@ def test_no_silhouette_pass_unless_asked(gl):
             with Renderer(scene, pipeline, gl=gl) as renderer:
                 names = [p.name for p in renderer.passes]
             assert any("silhouettes" in name for name in names) == silhouettes
+
+
+# -- the edges found by a compute shader -------------------------------------------------------
+
+def numpy_silhouette_edges(positions: np.ndarray, normals: np.ndarray, faces: np.ndarray
+                           ) -> set[tuple[int, int]]:
+    """The edges between a front- and a back-facing triangle (view space, the eye at the
+    origin; a face without area faces as its vertices' normals), by brute force over the
+    edges' triangles."""
+    a, b, c = (positions[faces[:, k]] for k in range(3))
+    n = np.cross(b - a, c - a)
+    at = a.copy()
+    flat = (n * n).sum(-1) <= 1e-12 * ((b - a) ** 2).sum(-1) * ((c - a) ** 2).sum(-1)
+    n[flat] = normals[faces[flat]].sum(axis=1)
+    at[flat] = positions[faces[flat]].mean(axis=1)
+    front = -(n * at).sum(-1) > 0.0
+    sides: dict[tuple[int, int], list[bool]] = {}
+    for face, facing in zip(faces.tolist(), front, strict=True):
+        for k in range(3):
+            edge = tuple(sorted((face[k], face[(k + 1) % 3])))
+            sides.setdefault(edge, []).append(bool(facing))
+    return {edge for edge, facings in sides.items() if len(facings) == 2 and
+            facings[0] != facings[1]}
+
+
+def test_the_compute_pass_strokes_exactly_the_silhouette_edges(gl):
+    """SilhouetteEdges (Costigan 4.3.7 on the GPU): an invocation a strand walks its tube from
+    the tubes' vertex order alone (no adjacency buffer) and strokes every edge between a front-
+    and a back-facing triangle, once: its strokes' ends are those edges' vertices, against a
+    brute-force numpy classification of the same mesh (wavy tapered tubes, caps included; the
+    tips kept a little wide, so that each vertex projects apart from the others)."""
+    from deferred.gl.shaderlib import ShaderLibrary
+    from deferred.materials.techniques.hair_silhouettes import SilhouetteEdges, edges_on_gpu
+    from deferred.materials.techniques.hair_tubes import build_tubes
+
+    if not edges_on_gpu(gl):
+        pytest.skip("the context has no compute shaders or no vertex shader storage buffers")
+    rng = np.random.default_rng(3)
+    count, samples, sides = 12, 9, 7
+    t = np.linspace(0.0, 1.0, 6)
+    strands = np.stack([np.stack([0.3 * np.sin(3 * t + k), t - 0.5, 0.2 * np.cos(2 * t * k)], -1)
+                        + rng.normal(scale=0.05, size=3) for k in range(count)])
+    tubes = build_tubes(strands, samples, sides, 0.04, taper=(0.0, -0.7, 1.0))
+    model_view = np.eye(4)
+    model_view[:3, 3] = (0.1, -0.05, -2.5)
+    view_positions = tubes.positions.astype(np.float64) + model_view[:3, 3]
+    expected = numpy_silhouette_edges(view_positions, tubes.normals.astype(np.float64),
+                                      tubes.indices.astype(np.int64))
+    ctx = gl.ctx
+    gl.make_current()
+    vertices = ctx.buffer(np.hstack([tubes.positions, tubes.normals]).astype(np.float32))
+    edges = SilhouetteEdges(ctx, count, samples, sides)
+    shaders = ShaderLibrary(ctx, gl.features.glsl_version())
+    projection = np.array([[1.2, 0, 0, 0], [0, 1.2, 0, 0], [0, 0, -1.02, -0.2], [0, 0, -1, 0]])
+    stroke = {"u_projection": tuple(projection.T.reshape(-1)), "u_resolution": (400.0, 400.0),
+              "u_stroke_width": 2.0, "u_stroke_world_width": 0.0, "u_tube_radius": 1.0,
+              "u_tube_taper": (0.0, 0.0, 1.0), "u_stroke_tolerance": 0.0}
+    assert edges.capacity >= len(expected)
+    try:
+        edges.find(shaders, vertices, model_view, stroke)
+        corners = edges.corners()
+    finally:
+        for thing in (edges, vertices, shaders):
+            thing.release()
+    # each stroke's two ends, back to the vertices they were made from (by their NDC position)
+    clip = np.hstack([view_positions, np.ones((len(view_positions), 1))]) @ projection.T
+    ndc = clip[:, :2] / clip[:, 3:]
+    ends = (corners[:, 0::2, :2] + corners[:, 1::2, :2]) / 2.0  # the middle of each end
+    nearest = np.linalg.norm(ends[:, :, None, :] - ndc[None, None], axis=-1).argmin(axis=-1)
+    found = {tuple(sorted(map(int, pair))) for pair in nearest}
+    assert len(expected) > 100
+    assert len(corners) == len(found)  # each edge once
+    assert found == expected
