@@ -22,6 +22,7 @@ from deferred.bench.report import (
     BenchResult,
     crossovers,
     growth,
+    noise,
     results_table,
     speedups,
     write_csv,
@@ -32,7 +33,7 @@ from deferred.bench.scenes import shell_objects, with_extra_lights, with_shells
 from deferred.bench.timing import cpu_frame, time_cpu, time_passes
 
 __all__ = ["BenchReport", "BenchResult", "Sweep", "SweepProgress", "check_output", "check_sweep",
-           "cpu_frame", "crossovers", "describe_sweep", "growth", "parse_counts",
+           "cpu_frame", "crossovers", "describe_sweep", "growth", "noise", "parse_counts",
            "parse_light_paths", "parse_pipelines", "results_table", "run_bench",
            "shell_objects", "speedups", "sweep_points", "sweep_runs", "sweep_shells",
            "time_cpu", "time_passes",

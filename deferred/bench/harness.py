@@ -26,7 +26,7 @@ calls, where llvmpipe does vertex work on the calling thread: :func:`time_cpu`),
 timer-query times where the driver answers them (``gpu_passes_ms``; llvmpipe does not).
 
 JSON: ``{"renderer": {...}, "results": [{"pipeline", "light_path", "lights", "shells", "width",
-"height", "runs", "median_ms", "mean_ms", "min_ms", "max_ms", "stddev_ms", "times_ms",
+"height", "runs", "frames", "median_ms", "mean_ms", "min_ms", "max_ms", "stddev_ms", "times_ms",
 "passes_ms", "cpu_ms", "draw_calls", "cpu_us_per_draw", "gpu_passes_ms"}]}``. ``lights`` counts
 the extra lights; ``renderer`` also records the G-buffer layout and bytes per pixel, the CPU
 count and the scene. CSV: the same columns, the lists and mappings as JSON text.
@@ -37,7 +37,7 @@ from __future__ import annotations
 import random
 import statistics
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -179,6 +179,7 @@ class _TimedPoint:
     cpu_ms: list[float] = field(default_factory=list)
     gpu_ms: dict[str, list[float]] = field(default_factory=dict)
     draw_calls: int = 0
+    rounds: int = 0
 
     def time_round(self, round_ms: float) -> None:
         """Timed frames back to back until they make ``round_ms`` (at most ROUND_FRAMES; the
@@ -189,6 +190,7 @@ class _TimedPoint:
         while len(frames) < ROUND_FRAMES and sum(frames) < round_ms:
             frames.append(time_frame(self.renderer))
         self.times_ms += frames[1:] if len(frames) > 1 else frames
+        self.rounds += 1
         for name, values in pass_frame(self.renderer).items():
             self.passes_ms.setdefault(name, []).extend(values)
         cpu, self.draw_calls = cpu_frame(self.renderer)
@@ -201,7 +203,8 @@ class _TimedPoint:
         return BenchResult(self.pipeline, self.lights, shells, *self.renderer.size,
                            self.times_ms, medians(self.passes_ms), self.light_path,
                            statistics.median(self.cpu_ms), self.draw_calls,
-                           medians(self.gpu_ms) if self.queries is not None else None)
+                           medians(self.gpu_ms) if self.queries is not None else None,
+                           self.rounds)
 
 
 def sweep_points(sweep: Sweep) -> list[tuple[int, str, str]]:
@@ -268,32 +271,41 @@ class SweepProgress:
 
 
 class _SweepClock:
-    """The time a sweep has left: the warm-ups and runs still to come, each at the mean
-    duration of those measured so far."""
+    """The time a sweep has left: the warm-ups still to come at the mean of those measured,
+    and each point's runs still to come at that point's mean measured run (points are slow and
+    fast by factors: one fast point's run says little of a slow one's), a point not yet run
+    at the median of the points' means."""
 
-    def __init__(self, warmups: int, runs: int):
-        self.warmups_left, self.runs_left = warmups, runs
-        self.runs_total = runs
+    def __init__(self, warmups: int, points: Sequence[Hashable], runs: int):
+        self.warmups_left = warmups
+        self.runs = runs
+        self.runs_total = len(points) * runs
         self.warmup_s: list[float] = []
-        self.run_s: list[float] = []
+        self.run_s: dict[Hashable, list[float]] = {point: [] for point in points}
 
     def warmed_up(self, seconds: float) -> None:
         self.warmup_s.append(seconds)
         self.warmups_left -= 1
 
-    def ran(self, seconds: float) -> None:
-        self.run_s.append(seconds)
-        self.runs_left -= 1
+    def ran(self, point: Hashable, seconds: float) -> None:
+        self.run_s[point].append(seconds)
+
+    @property
+    def runs_done(self) -> int:
+        return sum(len(times) for times in self.run_s.values())
 
     def seconds_left(self) -> float | None:
-        if not self.run_s or (self.warmups_left and not self.warmup_s):
+        means = {point: statistics.fmean(times) for point, times in self.run_s.items() if times}
+        if not means or (self.warmups_left and not self.warmup_s):
             return None
+        unmeasured = statistics.median(means.values())
         warmup = statistics.fmean(self.warmup_s) if self.warmup_s else 0.0
-        return self.warmups_left * warmup + self.runs_left * statistics.fmean(self.run_s)
+        return self.warmups_left * warmup + sum(
+            (self.runs - len(times)) * means.get(point, unmeasured)
+            for point, times in self.run_s.items())
 
     def at(self, description: str) -> SweepProgress:
-        return SweepProgress(description, self.runs_total - self.runs_left, self.runs_total,
-                             self.seconds_left())
+        return SweepProgress(description, self.runs_done, self.runs_total, self.seconds_left())
 
 
 def run_bench(scene: Scene, sweep: Sweep, gl: GLContext | None = None,
@@ -322,8 +334,10 @@ def run_bench(scene: Scene, sweep: Sweep, gl: GLContext | None = None,
     points = sweep_points(sweep)
     size = sweep.size or scene.size
     aspect = size[0] / size[1]
-    clock = _SweepClock(len(points) * len(sweep_shells(scene, sweep.shells)),
-                        sweep_runs(scene, sweep))
+    shell_counts = sweep_shells(scene, sweep.shells)
+    clock = _SweepClock(len(points) * len(shell_counts),
+                        [(shells, *point) for shells in shell_counts for point in points],
+                        sweep.runs)
 
     def report(description: str) -> None:
         if progress is not None:
@@ -334,7 +348,7 @@ def run_bench(scene: Scene, sweep: Sweep, gl: GLContext | None = None,
     results = []
     try:
         timers = timer_queries_work(gl)
-        for shells in sweep_shells(scene, sweep.shells):
+        for shells in shell_counts:
             lit = LightSweep(_shelled(scene, sweep, shells), max(sweep.lights, default=0),
                              aspect)
             if sweep.interleave:
@@ -382,7 +396,8 @@ def _time_group(group: list[tuple[int, str, str]], lit: LightSweep, shells: int,
                        f"({point.light_path}), {point.lights} lights, {shells} shells")
                 start = time.perf_counter()
                 point.time_round(sweep.round_ms)
-                clock.ran(time.perf_counter() - start)
+                clock.ran((shells, point.lights, point.pipeline, point.light_path),
+                          time.perf_counter() - start)
         return [point.result(shells) for point in timed]
     finally:
         for point in timed:

@@ -6,6 +6,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import math
 import os
 import statistics
 from collections.abc import Sequence
@@ -20,7 +21,8 @@ from deferred.io.images import write_image, write_text
 from deferred.names import LightPath, Pipeline
 from deferred.scene.scene import Scene
 
-COLUMNS = ("pipeline", "light_path", "lights", "shells", "width", "height", "runs", "median_ms",
+COLUMNS = ("pipeline", "light_path", "lights", "shells", "width", "height", "runs", "frames",
+           "median_ms",
            "mean_ms", "min_ms", "max_ms", "stddev_ms", "times_ms", "passes_ms", "cpu_ms",
            "draw_calls", "cpu_us_per_draw", "gpu_passes_ms")
 JSON_COLUMNS = ("times_ms", "passes_ms", "gpu_passes_ms")
@@ -41,6 +43,7 @@ class BenchResult:
     cpu_ms: float = 0.0
     draw_calls: int = 0
     gpu_passes_ms: dict[str, float] | None = None
+    rounds: int = 0  # the sweep's runs (each a round of frames); 0: one a timed frame
 
     @property
     def cpu_us_per_draw(self) -> float:
@@ -48,6 +51,12 @@ class BenchResult:
 
     @property
     def runs(self) -> int:
+        """The runs asked for (``--runs``), each a round of one to ``ROUND_FRAMES`` frames."""
+        return self.rounds or len(self.times_ms)
+
+    @property
+    def frames(self) -> int:
+        """The frames timed over all runs (``times_ms``)."""
         return len(self.times_ms)
 
     @property
@@ -73,7 +82,8 @@ class BenchResult:
     def to_dict(self) -> dict[str, Any]:
         return {"pipeline": self.pipeline, "light_path": self.light_path, "lights": self.lights,
                 "shells": self.shells, "width": self.width, "height": self.height,
-                "runs": self.runs, "median_ms": self.median_ms, "mean_ms": self.mean_ms,
+                "runs": self.runs, "frames": self.frames, "median_ms": self.median_ms,
+                "mean_ms": self.mean_ms,
                 "min_ms": self.min_ms, "max_ms": self.max_ms, "stddev_ms": self.stddev_ms,
                 "times_ms": list(self.times_ms), "passes_ms": dict(self.passes_ms),
                 "cpu_ms": self.cpu_ms, "draw_calls": self.draw_calls,
@@ -168,9 +178,14 @@ def write_plot(report: BenchReport, path: str | Path, title: str | None = None) 
 
 
 def plot_title(report: BenchReport) -> str:
+    """``demo.toml, 64x48, 2 runs (3-8 frames timed a point), llvmpipe``: the runs asked for,
+    and the frames they timed (a run times a point's frames back to back for ``round_ms``)."""
     first = report.results[0]
+    frames = sorted({r.frames for r in report.results})
+    counted = f"{frames[0]}" if len(frames) == 1 else f"{frames[0]}-{frames[-1]}"
+    runs = f"{first.runs} run{'s' if first.runs != 1 else ''}"
     return (f"{report.renderer.get('scene', '')}, {first.width}x{first.height}, "
-            f"{first.runs} runs, {report.renderer.get('renderer', '')}")
+            f"{runs} ({counted} frames timed a point), {report.renderer.get('renderer', '')}")
 
 
 def results_table(report: BenchReport):
@@ -201,9 +216,48 @@ def _fastest(rows: list[BenchResult], pipeline: str, lights: int,
     return min(found, key=lambda r: r.median_ms, default=None)
 
 
+def spread_ms(a: BenchResult, b: BenchResult) -> float:
+    """The noise of the difference of two points' medians: their frames' standard deviations
+    combined (the root of the sum of their squares)."""
+    return math.hypot(a.stddev_ms, b.stddev_ms)
+
+
+def tied(a: BenchResult, b: BenchResult) -> bool:
+    """Whether the difference of the two medians is within :func:`spread_ms`: no winner."""
+    return abs(a.median_ms - b.median_ms) <= spread_ms(a, b)
+
+
+def _ms(r: BenchResult) -> str:
+    """``12.3 ms``, or ``12.3 ± 4.5 ms`` where the frames varied (their standard deviation)."""
+    return f"{r.median_ms:.1f} ms" if r.stddev_ms == 0.0 else \
+        f"{r.median_ms:.1f} ± {r.stddev_ms:.1f} ms"
+
+
+def _tie(a: BenchResult, b: BenchResult) -> str:
+    return (f"the difference, {abs(a.median_ms - b.median_ms):.1f} ms, is within the spread, "
+            f"{spread_ms(a, b):.1f} ms")
+
+
+def noise(report: BenchReport) -> list[str]:
+    """The sweep's noise as a line to print: the smallest and largest standard deviation of a
+    point's frames, absolute and against its median; the rule that calls a difference a tie."""
+    varied = [r for r in report.results if r.frames > 1]
+    if not varied:
+        return ["noise: one frame a point, no spread measured (more --runs measure it); "
+                "every difference is taken as it is"]
+    deviations = [r.stddev_ms for r in varied]
+    shares = [100.0 * r.stddev_ms / r.median_ms for r in varied if r.median_ms > 0.0]
+    share = f" ({min(shares):.0f}-{max(shares):.0f}% of its median)" if shares else ""
+    return [f"noise: a point's frames vary by {min(deviations):.2f}-{max(deviations):.2f} ms "
+            f"(standard deviation){share}; a difference within two points' combined spread is "
+            "a tie"]
+
+
 def crossovers(report: BenchReport) -> list[str]:
     """Per shell count: the fewest extra lights from which the fastest deferred path beats
-    naive forward (and every forward path), as lines to print."""
+    naive forward (and every forward path), as lines to print. A difference within the
+    spread (:func:`tied`) beats nothing: the light counts where it is are named, with the
+    numbers."""
     lines = []
     for shells in sorted({r.shells for r in report.results}):
         rows = [r for r in report.results if r.shells == shells]
@@ -211,28 +265,44 @@ def crossovers(report: BenchReport) -> list[str]:
 
         for against, paths in (("naive forward", (LightPath.NAIVE,)), ("every forward path", None)):
             crossing = None
+            ties = []
             for lights in counts:
                 deferred = _fastest(rows, Pipeline.DEFERRED, lights)
                 forward = _fastest(rows, Pipeline.FORWARD, lights, paths)
                 if deferred is None or forward is None:
                     continue
-                if deferred.median_ms < forward.median_ms:
+                if tied(deferred, forward):
+                    ties.append(f"{lights} ({_ms(deferred)} against {_ms(forward)})")
+                    crossing = None
+                elif deferred.median_ms < forward.median_ms:
                     crossing = crossing if crossing is not None else (lights, deferred)
                 else:
                     crossing = None
             if crossing is None:
-                lines.append(f"{shells} shells: deferred never beats {against} from some "
-                             "light count on")
+                line = (f"{shells} shells: deferred never beats {against} from some "
+                        "light count on")
             else:
                 lights, deferred = crossing
-                lines.append(f"{shells} shells: deferred ({deferred.light_path}) beats "
-                             f"{against} from {lights} extra lights on")
+                line = (f"{shells} shells: deferred ({deferred.light_path}) beats "
+                        f"{against} from {lights} extra lights on")
+            if ties:
+                line += f"; a tie within the noise at {', '.join(ties)} extra lights"
+            lines.append(line)
     return lines
+
+
+def _against(deferred: BenchResult, other: BenchResult, what: str, digits: int,
+             path: str = "") -> str:
+    said = f"{path}, {_ms(other)}" if path else _ms(other)
+    if tied(deferred, other):
+        return f"a tie with {what} ({said}: {_tie(deferred, other)})"
+    return f"{other.median_ms / deferred.median_ms:.{digits}f}x {what} ({said})"
 
 
 def speedups(report: BenchReport) -> list[str]:
     """Per shell count, at the most extra lights swept: the fastest deferred path's median
-    against naive forward's and the fastest forward path's, as lines to print."""
+    against naive forward's and the fastest forward path's, as lines to print (a tie where
+    the difference is within the spread)."""
     lines = []
     for shells in sorted({r.shells for r in report.results}):
         rows = [r for r in report.results if r.shells == shells]
@@ -244,19 +314,19 @@ def speedups(report: BenchReport) -> list[str]:
             continue
         parts = []
         if naive is not None:
-            parts.append(f"{naive.median_ms / deferred.median_ms:.1f}x naive forward "
-                         f"({naive.median_ms:.1f} ms)")
-        parts.append(f"{forward.median_ms / deferred.median_ms:.2f}x the fastest forward path "
-                     f"({forward.light_path}, {forward.median_ms:.1f} ms)")
+            parts.append(_against(deferred, naive, "naive forward", 1))
+        parts.append(_against(deferred, forward, "the fastest forward path", 2,
+                              forward.light_path))
         lines.append(f"{shells} shells, {lights} extra lights: deferred ({deferred.light_path}) "
-                     f"{deferred.median_ms:.1f} ms: {', '.join(parts)}")
+                     f"{_ms(deferred)}: {', '.join(parts)}")
     return lines
 
 
 def growth(report: BenchReport) -> list[str]:
     """Per shell count, for the deferred path fastest at the most extra lights swept: its median
     at each light count against its own at the fewest, as lines to print (interleaved, the
-    frames of a line's counts were timed in the same rounds)."""
+    frames of a line's counts were timed in the same rounds; a tie where the difference is
+    within the spread)."""
     lines = []
     for shells in sorted({r.shells for r in report.results}):
         rows = [r for r in report.results if r.shells == shells]
@@ -268,7 +338,9 @@ def growth(report: BenchReport) -> list[str]:
         if len(own) < 2:
             continue
         first = own[0]
-        ratios = ", ".join(f"{r.lights}: {r.median_ms / first.median_ms:.2f}x" for r in own[1:])
+        ratios = ", ".join(f"{r.lights}: {r.median_ms / first.median_ms:.2f}x"
+                           f"{' (a tie within the noise)' if tied(r, first) else ''}"
+                           for r in own[1:])
         lines.append(f"{shells} shells, deferred ({best.light_path}) against its frame at "
-                     f"{first.lights} extra lights ({first.median_ms:.1f} ms): {ratios}")
+                     f"{first.lights} extra lights ({_ms(first)}): {ratios}")
     return lines

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import os
 import sys
+import time
 import warnings
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -101,7 +102,11 @@ def bench(context: click.Context, scene: str | None, lights: str, shells: str | 
     for where, path in outputs.items():
         writers[where](report, path)
     if outputs:
-        stderr.print(f"wrote {', '.join(str(path) for path in outputs.values())}")
+        stderr.print(f"wrote {', '.join(str(path) for path in outputs.values())}",
+                     markup=False, highlight=False, soft_wrap=True)
+    if "--plot" in outputs:  # where to look, as a path a viewer or browser opens
+        stderr.print(f"plot: {outputs['--plot'].resolve()}", markup=False, highlight=False,
+                     soft_wrap=True)
 
 
 def _scene_and_grid(context: click.Context, scene: str | None, grid: tuple[str, ...],
@@ -170,17 +175,18 @@ def run_sweep(loaded: Scene, sweep: Sweep) -> BenchReport:
     with Progress("bench", stderr) as progress:
         progress.count(benchmark.sweep_runs(loaded, sweep), "runs", "starting")
         progress.advance(0, "starting", predicted.seconds)
+        started = time.monotonic()
         estimated = []
 
         def step(at: benchmark.SweepProgress) -> None:
             left = at.seconds_left
-            if left is None:  # until a warm-up and a run are measured: the prediction's
-                left = predicted.seconds * (1.0 - at.runs_done / max(at.runs_total, 1))
-            progress.advance(at.runs_done, at.description, left)
+            if left is None:  # until a warm-up and a run are measured: the prediction's rest
+                left = predicted.seconds - (time.monotonic() - started)
+            progress.advance(at.runs_done, at.description, left if left > 0.0 else None)
             if at.seconds_left is not None and not estimated:  # the first measured run
                 estimated.append(at.seconds_left)
                 progress.note(f"bench: about {duration(at.seconds_left)} left, from the "
-                              "first warm-up and run")
+                              "warm-ups and the first run measured")
 
         return benchmark.run_bench(loaded, sweep, progress=step, note=progress.note)
 
@@ -209,8 +215,8 @@ def print_results(report: BenchReport, to_stderr: bool) -> None:
     if not results.is_terminal:
         results = Console(stderr=to_stderr, width=160)  # pipes: not 80 columns
     results.print(benchmark.results_table(report))
-    for line in [*benchmark.crossovers(report), *benchmark.speedups(report),
-                 *benchmark.growth(report)]:
+    for line in [*benchmark.noise(report), *benchmark.crossovers(report),
+                 *benchmark.speedups(report), *benchmark.growth(report)]:
         results.print(line, markup=False, highlight=False, soft_wrap=True)
 
 

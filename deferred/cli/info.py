@@ -9,6 +9,7 @@ import click
 from rich.console import Console
 
 from deferred.cli.options import scene_argument
+from deferred.cli.scene_report import scene_lines
 from deferred.interfaces import registry
 from deferred.scene.gltf import GLTF_SUFFIXES
 from deferred.scene.gltf.summary import describe_file
@@ -19,8 +20,10 @@ from deferred.scene.loader import load_scene
 @scene_argument
 def info(scene: str | None) -> None:
     """GL vendor, renderer, version, the optional features in use, and the G-buffer layout of
-    SCENE (the built-in demo when omitted); of a glTF file, its nodes, meshes, materials,
-    textures, animations, cameras, lights and skins, and what the framework does not draw."""
+    SCENE (the built-in demo when omitted); its meshes (vertices, triangles, the materials
+    found and dropped), textures (size, memory), lights, shadow maps and the memory budget
+    used; of a glTF file, its nodes, meshes, materials, textures, animations, cameras, lights
+    and skins, and what the framework does not draw."""
     from deferred.gl.context import create_context
 
     gltf = None
@@ -32,6 +35,8 @@ def info(scene: str | None) -> None:
     try:
         console = Console(soft_wrap=True, markup=False)  # one line per entry; [..] is text
         for line in gltf or ():
+            console.print(line)
+        for line in scene_lines(loaded):
             console.print(line)
         console.print(f"gbuffer: {layout.bytes_per_pixel} bytes per pixel")
         for name, entry in layout.describe().items():

@@ -6,7 +6,7 @@ result as lines for a terminal.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -20,7 +20,12 @@ from deferred.render.renderer import Renderer
 @dataclass
 class PixelEvent:
     """What one pass did to one pixel: fragments that reached it (None for a clear) and each
-    written target's value before and after."""
+    written target's value before and after.
+
+    ``before`` is the value the pass found. For a target no earlier pass of the frame wrote
+    (``first_writes``) that is what the previous frame left, not this frame's: it is named so,
+    never compared. A target the pass creates with a clear value (``cleared_to``) is cleared
+    to it before the pass draws."""
 
     index: int
     name: str
@@ -29,6 +34,8 @@ class PixelEvent:
     before: dict[str, list[float]]
     after: dict[str, list[float]]
     cleared: bool = False  # the pass cleared a target it creates: every pixel of it
+    first_writes: tuple[str, ...] = ()  # targets no earlier pass of this frame wrote
+    cleared_to: dict[str, list[float]] = field(default_factory=dict)
 
     @property
     def changed(self) -> bool:
@@ -40,7 +47,9 @@ class PixelEvent:
 
     def describe(self) -> dict[str, Any]:
         return {"index": self.index, "pass": self.name, "phase": self.phase,
-                "fragments": self.fragments, "cleared": self.cleared, "before": self.before,
+                "fragments": self.fragments, "cleared": self.cleared,
+                "before": {t: v for t, v in self.before.items() if t not in self.first_writes},
+                "first_writes": list(self.first_writes), "cleared_to": dict(self.cleared_to),
                 "after": self.after}
 
 
@@ -72,6 +81,7 @@ def pixel_history(renderer: Renderer, x: int, y: int, time: float = 0.0) -> list
     targets = renderer.targets
     query = renderer.gl.ctx.query(samples=True)  # moderngl 5 cannot release a query
     events: list[PixelEvent] = []
+    written: set[str] = set()  # targets a pass of this frame wrote so far
     pending: list[tuple[dict[str, np.ndarray], int | None]] = []  # from before to after
 
     def read(target: str) -> np.ndarray:
@@ -102,12 +112,17 @@ def pixel_history(renderer: Renderer, x: int, y: int, time: float = 0.0) -> list
     def after(render_pass: RenderPass, frame) -> None:
         values, fragments = pending.pop()
         # a pass whose creates are cleared wrote the pixel even where no fragment reached it
-        # and the value is the one the last frame left (the background of a list shading pass)
-        cleared = any(spec.clear is not None for spec in render_pass.creates.values())
+        # (the background of a list shading pass)
+        cleared_to = {t: [float(v) for v in spec.clear[:len(values[t])]]
+                      for t, spec in render_pass.creates.items()
+                      if spec.clear is not None and t in values}
+        writes = list(dict.fromkeys(render_pass.writes))
         events.append(PixelEvent(
             len(events), render_pass.name, render_pass.phase.value, fragments,
             {t: _floats(v) for t, v in values.items()},
-            {t: _floats(read(t)) for t in dict.fromkeys(render_pass.writes)}, cleared))
+            {t: _floats(read(t)) for t in writes}, bool(cleared_to),
+            tuple(t for t in writes if t not in written), cleared_to))
+        written.update(writes)
 
     renderer.render(on_pass=after, before_pass=before, time=time)
     return events
@@ -130,9 +145,14 @@ def format_history(events: Sequence[PixelEvent], x: int, y: int,
             what = f"cleared, {what}"
         lines.append(f"{event.index:02d} {event.name} ({event.phase}): {what}")
         for target, value in event.after.items():
-            was = event.before.get(target)
-            note = "" if value != was else "  (unchanged)"
-            lines.append(f"    {target:<20} {_fmt(was)} -> {_fmt(value)}{note}")
+            if target in event.cleared_to:
+                was, note = f"cleared to {_fmt(event.cleared_to[target])}", ""
+            elif target in event.first_writes:  # what it held is the previous frame's
+                was, note = "(first write this frame)", ""
+            else:
+                was = _fmt(event.before.get(target))
+                note = "" if value != event.before.get(target) else "  (unchanged)"
+            lines.append(f"    {target:<20} {was} -> {_fmt(value)}{note}")
     return lines
 
 

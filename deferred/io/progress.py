@@ -71,6 +71,7 @@ class Progress:
         self._unit = ""
         self._done = 0
         self._seconds_left: float | None = None
+        self._estimated_at = clock()
         self._started = self._step_started = self._last_line = clock()
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
@@ -103,6 +104,7 @@ class Progress:
             if text is not None:
                 self._text = text
             self._seconds_left = seconds_left
+            self._estimated_at = self.clock()
         self._show()
 
     def note(self, line: str) -> None:
@@ -125,7 +127,9 @@ class Progress:
 
     def _time_left(self, now: float) -> float | None:
         if self._seconds_left is not None:
-            return self._seconds_left
+            # the estimate counts down between updates; once past, it no longer says anything
+            left = self._seconds_left - (now - self._estimated_at)
+            return left if left > 0.0 else None
         if self._total is None or self._done <= 0:
             return None
         return (now - self._started) / self._done * max(self._total - self._done, 0)

@@ -147,7 +147,11 @@ def _extra_attributes(document: GltfDocument, mesh: MeshData, read: dict, where:
 def _draco_attributes(document: GltfDocument, draco: dict, where: str
                       ) -> tuple[dict[str, np.ndarray | None], np.ndarray]:
     """The attributes and indices of a Draco-compressed primitive (DracoPy decodes it)."""
-    import DracoPy
+    try:
+        import DracoPy
+    except ImportError:  # a declared dependency: missing only from a broken install
+        raise document.error("a Draco-compressed mesh needs the Draco decoder, DracoPy, which "
+                             "is not installed: pip install DracoPy", where) from None
 
     from deferred.scene.gltf.accessors import buffer_view_bytes
 

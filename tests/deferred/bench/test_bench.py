@@ -52,6 +52,8 @@ def test_cli_sweep_writes_json_csv_plot(tmp_path, capsys):
                             "--plot", str(out["png"]))
     assert code == 0, err
     assert "median ms" in stdout and "median ms" not in err  # the results on stdout
+    assert f"plot: {out['png'].resolve()}" in err.splitlines()  # where to look
+    assert ", 2 runs (" in stdout  # --runs 2
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bench.csv", "bench.json",
                                                           "bench.png"]
 
@@ -76,9 +78,10 @@ def test_cli_sweep_writes_json_csv_plot(tmp_path, capsys):
     demo = load_scene(None)
     for r in results:
         assert list(r) == list(COLUMNS)
-        # two rounds, each 1-4 timed frames (back to back for 100 ms, the first dropped)
-        assert (r["width"], r["height"]) == (64, 36) and 2 <= r["runs"] <= 8
-        assert len(r["times_ms"]) == r["runs"] and all(t > 0.0 for t in r["times_ms"])
+        # two runs (rounds), each 1-4 timed frames (back to back for 100 ms, the first dropped)
+        assert (r["width"], r["height"]) == (64, 36) and r["runs"] == 2
+        assert 2 <= r["frames"] <= 8
+        assert len(r["times_ms"]) == r["frames"] and all(t > 0.0 for t in r["times_ms"])
         assert r["min_ms"] <= r["median_ms"] <= r["max_ms"]
         assert r["min_ms"] <= r["mean_ms"] <= r["max_ms"]
         assert r["min_ms"] == min(r["times_ms"]) and r["max_ms"] == max(r["times_ms"])
@@ -277,6 +280,71 @@ def test_speedups_compare_the_fastest_deferred_path_at_the_most_lights():
         "0.80x the fastest forward path (naive, 8.0 ms)"]
 
 
+def _noisy(pipeline, path, lights, median, spread, shells=0):
+    """A point whose three frames have ``median`` and standard deviation ``spread``."""
+    from deferred.bench.report import BenchResult
+
+    return BenchResult(pipeline, lights, shells, 64, 36,
+                       [median - spread, median, median + spread], light_path=path, rounds=2)
+
+
+def test_a_difference_within_the_spread_is_a_tie_with_its_numbers():
+    """The issue's case: 11.8 ms with a standard deviation of 6.96 ms against 10.0 ms is no
+    win: speedups, crossovers and growth say tie and give the numbers."""
+    from deferred.bench.report import BenchReport, crossovers, growth, noise, speedups, tied
+
+    report = BenchReport({}, [
+        _noisy("deferred", "tiled", 1, 11.8, 6.96), _noisy("forward", "naive", 1, 10.0, 0.5),
+        _noisy("deferred", "tiled", 64, 20.0, 1.0), _noisy("forward", "naive", 64, 90.0, 2.0)])
+    low = [r for r in report.results if r.lights == 1]
+    assert tied(*low) and not tied(*[r for r in report.results if r.lights == 64])
+    (at_most,) = speedups(BenchReport({}, low))
+    assert at_most == ("0 shells, 1 extra lights: deferred (tiled) 11.8 ± 7.0 ms: a tie with "
+                       "naive forward (10.0 ± 0.5 ms: the difference, 1.8 ms, is within the "
+                       "spread, 7.0 ms), a tie with the fastest forward path (naive, 10.0 ± "
+                       "0.5 ms: the difference, 1.8 ms, is within the spread, 7.0 ms)")
+    assert "x naive forward" not in at_most  # no ratio declares a winner
+    lines = crossovers(report)
+    assert lines[0] == ("0 shells: deferred (tiled) beats naive forward from 64 extra lights "
+                        "on; a tie within the noise at 1 (11.8 ± 7.0 ms against 10.0 ± 0.5 ms) "
+                        "extra lights")
+    assert growth(report) == ["0 shells, deferred (tiled) against its frame at 1 extra lights "
+                              "(11.8 ± 7.0 ms): 64: 1.69x"]
+    (said,) = noise(report)
+    assert said.startswith("noise: a point's frames vary by 0.50-6.96 ms (standard deviation) "
+                           "(2-59% of its median)"), said
+    assert "tie" in said
+
+
+def test_the_table_title_says_the_runs_asked_for_and_the_frames_they_timed():
+    """--runs 2 is "2 runs" (each a round of 1-4 frames timed back to back), not the frames
+    timed (which had read 3, 8 or 12 runs)."""
+    from deferred.bench.report import BenchReport, BenchResult, plot_title
+
+    rows = [BenchResult("deferred", 0, 0, 64, 36, [5.0] * frames, rounds=2, light_path="tiled")
+            for frames in (3, 8)]
+    title = plot_title(BenchReport({"scene": "s.toml", "renderer": "llvmpipe"}, rows))
+    assert title == "s.toml, 64x36, 2 runs (3-8 frames timed a point), llvmpipe"
+    assert rows[0].to_dict()["runs"] == 2 and rows[1].to_dict()["frames"] == 8
+
+
+def test_the_time_left_is_each_points_runs_at_its_own_measured_time():
+    """A slow point's runs are not estimated from a fast point's: each point's runs left at
+    its own mean run, a point not yet run at the median of the means, warm-ups at theirs."""
+    from deferred.bench.harness import _SweepClock
+
+    clock = _SweepClock(2, ["fast", "slow"], runs=3)
+    assert clock.seconds_left() is None  # nothing measured
+    clock.warmed_up(4.0)
+    clock.ran("fast", 0.5)
+    # a warm-up left at 4 s, fast's 2 runs at 0.5 s, slow's 3 at the median of the means
+    assert clock.seconds_left() == pytest.approx(4.0 + 2 * 0.5 + 3 * 0.5)
+    clock.warmed_up(6.0)
+    clock.ran("slow", 20.0)
+    assert clock.seconds_left() == pytest.approx(2 * 0.5 + 2 * 20.0)
+    assert clock.at("round 1").runs_done == 2 and clock.at("round 1").runs_total == 6
+
+
 def test_growth_compares_the_best_deferred_path_with_its_own_frame_at_the_fewest_lights():
     from deferred.bench.report import BenchReport, BenchResult, growth
 
@@ -383,6 +451,6 @@ def test_a_round_times_a_cheap_point_back_to_back_and_drops_the_first(gl, monkey
                                     pipelines=["forward"], round_ms=1e9), gl=gl)
     kinds = 4 if report.renderer["gl_timer_queries"] else 3
     (result,) = report.results
-    assert result.runs == len(result.times_ms) == 2 * (ROUND_FRAMES - 1)
+    assert result.runs == 2 and result.frames == len(result.times_ms) == 2 * (ROUND_FRAMES - 1)
     frames = [p for kind, p in events if kind == "frame"]
     assert len(frames) == 2 * (ROUND_FRAMES + kinds - 1)

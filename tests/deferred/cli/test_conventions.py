@@ -70,6 +70,19 @@ def test_piped_progress_prints_at_most_a_line_an_interval():
                      "bench: 6/24 runs, ~30 s left: round 2 of 10"]  # 10 s for 6: 30 s for 18
 
 
+def test_an_estimate_counts_down_and_says_nothing_once_past():
+    """A step that takes long does not repeat the same time left: the estimate counts down,
+    and once the time is past it is "estimating time", not "~1 s left"."""
+    clock, console = FakeClock(), piped()
+    with Progress("bench", console, interval=5.0, clock=clock, ticker=False) as progress:
+        progress.count(10, "runs", "warm-up")
+        progress.advance(0, "warm-up", seconds_left=40.0)
+        clock.now += 10.0
+        assert progress.describe() == "0/10 runs, ~30 s left: warm-up"
+        clock.now += 35.0
+        assert progress.describe() == "0/10 runs, estimating time: warm-up"
+
+
 def test_piped_status_says_how_long_the_step_has_taken():
     clock, console = FakeClock(), piped()
     with Progress("render", console, interval=5.0, clock=clock, ticker=False) as progress:
@@ -111,10 +124,12 @@ def test_bench_says_its_size_estimates_its_time_and_prints_results_on_stdout(cap
     assert re.fullmatch(r"bench: 2 configurations \(1 light path x 2 light counts x the "
                         r"scene's 0 shells\) x 2 runs, after 1 warm-up frame each; time: "
                         r"about \d+ s predicted", lines[0]), lines[0]
-    assert any(re.fullmatch(r"bench: about .+ left, from the first warm-up and run", line)
-               for line in lines), err
+    assert any(re.fullmatch(r"bench: about .+ left, from the warm-ups and the first run "
+                            r"measured", line) for line in lines), err
     assert any(re.match(r"bench: [0-4]/4 runs, ", line) for line in lines), err
     assert "median ms" in out and "median ms" not in err
+    assert ", 2 runs (" in out  # --runs 2 is 2 runs in the title, not the frames timed
+    assert re.search(r"^noise: a point's frames vary by", out, re.M), out
     assert "no object has a 'shells' parameter" not in err  # no --shells asked for
 
 

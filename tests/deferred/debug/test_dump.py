@@ -317,6 +317,10 @@ def test_pixel_history_lists_the_passes_that_wrote_a_pixel(renderer):
     albedo = events["ball.gbuffer"].after["albedo_specular"]
     assert np.rint(np.array(albedo[:3]) * 255).tolist() == \
         np.rint(np.array([0.8, 0.2, 0.2]) * 255).tolist()
+    assert set(events["gbuffer.clear"].cleared_to) == set(events["gbuffer.clear"].after)
+    assert events["gbuffer.clear"].cleared_to["depth"] == [1.0]
+    assert events["post.tonemap"].first_writes == ("final",)
+    assert events["lighting.point"].first_writes == ()  # the background pass wrote it first
     lit = events["lighting.point"]
     assert all(a > b for a, b in zip(lit.after["light_accumulation"][:3],
                                      lit.before["light_accumulation"][:3], strict=True))
@@ -480,6 +484,14 @@ def test_cli_dump_pixel_prints_history(tmp_path, capsys):
     lines = stdout.splitlines()
     assert lines[0].startswith("pixel 32,24 (top-down) of 64x48:")
     assert any(line.startswith("01 sphere0.gbuffer (geometry): 1 fragment") for line in lines)
+    # the clear's "before" is what it clears to, not the previous frame's value; a pass's own
+    # first write of a target (the tone map's final) is its result, never "(unchanged)"
+    clear = lines[lines.index("00 gbuffer.clear (geometry): clear") + 1:][:4]
+    assert all(" cleared to (" in line for line in clear), clear
+    assert "cleared to (0, 0, 0, 0) -> (0, 0, 0, 0)" in clear[0], clear
+    final = [line for line in lines if line.strip().startswith("final ")]
+    assert final and all("(first write this frame) -> (" in line and "unchanged" not in line
+                         for line in final), final
     manifest = json.loads((tmp_path / "d" / "manifest.json").read_text())
     history = manifest["pixel_history"]
     assert history["pixel"] == [32, 24]
