@@ -33,6 +33,7 @@ from deferred.debug.dump_folder import (
     staging_folder,
     swap_in_folder,
 )
+from deferred.debug.dump_index import index_html
 from deferred.debug.pixel_history import PixelEvent, pixel_history
 from deferred.debug.preview import Tile, contact_sheet, target_views
 from deferred.debug.views import view
@@ -103,6 +104,8 @@ def write_dump(capture: FrameCapture, directory: str | Path,
                               shadow.depth (``--view shadow_atlas``; the atlas's own size)
         DIR/passes/NN_<pass>.exr   what pass NN wrote, channels "<target>.R", ... ("<target>.Z")
         DIR/contact.png       every buffer as a labelled thumbnail, in pass order
+        DIR/index.html        a page opening without a server: the contact sheet, each pass
+                              with its thumbnails, time and file, the pixel history
         DIR/manifest.json     passes (phase, inputs, outputs, formats, time), G-buffer layout, GL
 
     A file whose buffers are all 8-bit or 16-bit is half float (8-bit codes stay distinct in half);
@@ -121,9 +124,11 @@ def write_dump(capture: FrameCapture, directory: str | Path,
     files: dict[str, str] = {}
     try:
         with staging_folder(directory) as staging:
-            _write_files(capture, staging, files, step)
+            tiles = _write_files(capture, staging, files, step)
             manifest = build_manifest(capture, files, history, pixel, scene_file)
             write_text(staging / "manifest.json", json.dumps(manifest, indent=2) + "\n")
+            step("index.html")
+            write_text(staging / "index.html", index_html(manifest, tiles))
             if directory.is_dir():
                 carry_over(directory, staging)
             swap_in_folder(staging, directory)
@@ -138,8 +143,9 @@ def _reason(exc: OSError) -> str:
 
 
 def _write_files(capture: FrameCapture, directory: Path, files: dict[str, str],
-                 step: Callable[[str], None]) -> None:
-    """Every image of the dump into ``directory``; ``files`` gets the manifest's entries."""
+                 step: Callable[[str], None]) -> list[Tile]:
+    """Every image of the dump into ``directory``; ``files`` gets the manifest's entries.
+    Returns the contact sheet's tiles (the index's thumbnails)."""
     # OIIO drops the GIL while it compresses: files compress in parallel while numpy prepares
     # the next one (this is most of a dump's time). Pass files go first so the pool starts
     # at once; the contact sheet is built in the pool too.
@@ -183,12 +189,20 @@ def _write_files(capture: FrameCapture, directory: Path, files: dict[str, str],
             files["shadow_atlas"] = "shadow_atlas.exr"
         write("final.exr", capture.target(COMPOSITE), channels=("R", "G", "B", "A"), half=True)
         write("final.png", capture.image)
-        files.update({"final": "final.exr", "final_png": "final.png", "contact": "contact.png"})
+        files.update({"final": "final.exr", "final_png": "final.png", "contact": "contact.png",
+                      "index": "index.html"})
         step("contact.png")
-        pending.append(pool.submit(lambda: write_image(
-            directory / "contact.png", contact_sheet(contact_tiles(capture)))))
+
+        def sheet() -> list[Tile]:
+            tiles = contact_tiles(capture)
+            write_image(directory / "contact.png", contact_sheet(tiles))
+            return tiles
+
+        sheet_written = pool.submit(sheet)
+        pending.append(sheet_written)
         for future in pending:
             future.result()  # re-raise the first failure here
+        return sheet_written.result()
     finally:
         # On a failure or Ctrl-C, queued files are dropped rather than written into a folder
         # about to be removed; the ones being written finish first, so nothing writes into

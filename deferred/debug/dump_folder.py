@@ -23,7 +23,7 @@ from deferred.io.safety import raise_if_stop_requested, signals_deferred
 # The files a dump writes at the top of its folder; with "passes/NN_<pass>.exr" (PASS_FILE),
 # everything else in a dump folder is the user's and is kept.
 DUMP_FILES = frozenset({"gbuffer.exr", "light.exr", "final.exr", "final.png", "contact.png",
-                        "manifest.json"})
+                        "manifest.json", "index.html"})
 PASS_FILE = re.compile(r"\d+_.+\.exr")
 
 
