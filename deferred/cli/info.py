@@ -36,8 +36,6 @@ def info(scene: str | None) -> None:
         console = Console(soft_wrap=True, markup=False)  # one line per entry; [..] is text
         for line in gltf or ():
             console.print(line)
-        for line in scene_lines(loaded):
-            console.print(line)
         console.print(f"gbuffer: {layout.bytes_per_pixel} bytes per pixel")
         for name, entry in layout.describe().items():
             channels = f"  [{' '.join(entry['channels'])}]" if "channels" in entry else ""
@@ -47,6 +45,8 @@ def info(scene: str | None) -> None:
             if model.gbuffer_budget is not None:
                 console.print(f"  shading model {model.name}: at most {model.gbuffer_budget} "
                               "bytes per pixel (its budget)")
+        for line in scene_lines(loaded):
+            console.print(line)
         for key, value in gl.info.items():
             console.print(f"{key:>16}: {value}")
         for key, value in gl.features.names().items():

@@ -43,7 +43,7 @@ def mesh_lines(state: FrameState) -> list[str]:
     """One line an object: its mesh, vertices and triangles, the material drawing it, and the
     materials its file names that do not draw (an OBJ's ``usemtl``: the object's material
     draws the whole mesh)."""
-    lines = [f"meshes: {len(state.objects)} object{'s' if len(state.objects) != 1 else ''}, "
+    lines = [f"objects: {len(state.objects)}, "
              f"{sum(o.mesh.vertex_count for o in state.objects):,} vertices, "
              f"{sum(len(o.mesh.indices) for o in state.objects):,} triangles"]
     for obj in state.objects:
@@ -87,7 +87,7 @@ def light_lines(state: FrameState) -> list[str]:
     """The lights, and the shadow atlas: which lights cast shadows, with how many tiles of
     what size, and which are left out (over the budget) and why."""
     lights = list(state.lights)
-    lines = [f"lights: {len(lights)}"]
+    lines = [f"scene lights: {len(lights)}"]
     for index, light in enumerate(lights[:20]):
         shadow = " (casts shadows)" if light.casts_shadows else ""
         lines.append(f"  light[{index}] {light.name}{shadow}")

@@ -36,7 +36,7 @@ def test_info_lists_meshes_textures_lights_shadows_and_memory(tmp_path, capsys):
     out, err = capsys.readouterr()
     assert code == 0, err
     lines = out.splitlines()
-    assert lines[0] == "scene: scene.toml, 64x48"
+    assert "scene: scene.toml, 64x48" in lines
     quad = next(line for line in lines if line.strip().startswith("quad "))
     assert re.search(r"quad\.obj: \d+ vertices, 2 triangles, material standard", quad), quad
     assert "the file's materials brick, glass dropped (the object's standard draws the whole " \
@@ -45,7 +45,8 @@ def test_info_lists_meshes_textures_lights_shadows_and_memory(tmp_path, capsys):
     assert "builtin:sphere: 45 vertices, 64 triangles" in ball, ball
     texture = next(line for line in lines if "wood.png" in line)
     assert re.search(r"wood\.png: 64x32, [\d.]+ KiB$", texture), texture
-    assert "lights: 3" in lines
+    assert "scene lights: 3" in lines
+    assert any(re.fullmatch(r"objects: 2, \d+ vertices, 66 triangles", line) for line in lines)
     assert "shadow maps: 2 of 3 shadowed lights in an atlas of 4096x4096 " \
            "(max_shadowed_lights = 2)" in lines
     assert "  light[0] spot: 1 tile of 256x256" in lines
