@@ -263,7 +263,8 @@ def materials_gallery(entries: list[dict[str, Any]]) -> str:
                 f"`{entry.get('module')}`.", "",
                 "| parameter | type | default | range | description |", "|---|---|---|---|---|"]
         for p in entry["params"]:
-            bounds = ", ".join(f"{k} {v:g}" for k, v in p["range"].items()
+            signs = {"ge": ">=", "gt": ">", "le": "<=", "lt": "<"}
+            bounds = ", ".join(f"{signs.get(k, k)} {v:g}" for k, v in p["range"].items()
                                if isinstance(v, int | float))
             if p.get("choices"):
                 bounds = " | ".join(map(str, p["choices"]))
