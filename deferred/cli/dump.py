@@ -98,7 +98,9 @@ def write_dump(scene: str | None, out_dir: Path, pipeline: str, size: str | None
     width, height = renderer.size
     stderr.print(f"wrote {out_dir}/ ({width}x{height}, {pipeline}, {light_path_ran} lights, "
                  f"{len(chosen)} of "
-                 f"{len(manifest['passes'])} passes, frame {manifest['frame_ms']:.1f} ms)")
+                 f"{len(manifest['passes'])} passes, frame {manifest['frame_ms']:.1f} ms); "
+                 f"open {(out_dir / 'index.html').resolve()} in a browser", markup=False,
+                 highlight=False, soft_wrap=True)
 
 
 def compare_dumps(first: str, second: str, output: str | None) -> bool:

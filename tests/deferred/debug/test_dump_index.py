@@ -5,6 +5,8 @@ sheet, every image loads, and the passes are named."""
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
 import re
 import shutil
@@ -36,9 +38,13 @@ class _Links(HTMLParser):
 def dump(tmp_path_factory):
     folder = tmp_path_factory.mktemp("index")
     (folder / "scene.toml").write_text(SCENE)
-    code = main(["dump", str(folder / "scene.toml"), "-o", str(folder / "d"), "--pixel",
-                 "32,24"])
+    said = io.StringIO()
+    with contextlib.redirect_stderr(said):
+        code = main(["dump", str(folder / "scene.toml"), "-o", str(folder / "d"), "--pixel",
+                     "32,24"])
     assert code == 0
+    err = said.getvalue()  # its last line says where the page is
+    assert err.rstrip().endswith(f"open {(folder / 'd' / 'index.html').resolve()} in a browser")
     return folder / "d"
 
 
