@@ -19,6 +19,9 @@ PARAMS: dict[str, dict] = {
     "standard": {"color": (0.75, 0.3, 0.2), "specular_exponent": 48.0},
     "pbr": {"base_color": (0.9, 0.7, 0.3, 1.0), "metallic": 1.0, "roughness": 0.35},
     "stipple_glass": {"color": (0.4, 0.7, 0.9)},
+    "cartoon_hair": {"strands": 300, "length": 0.45, "radius": 0.025, "color": (0.6, 0.32, 0.15),
+                     "style": "combed", "settle": 1.0,
+                     "skin_color": (0.9, 0.75, 0.6)},
 }
 
 
