@@ -23,7 +23,7 @@ from deferred.farm.worker import FrameFailed, FrameJob, FrameWorker
 RESTARTS = 3  # Ray restarts a dead actor, and retries its calls, this many times
 
 
-class _Actor:
+class RenderActor:
     """A worker inside a Ray actor."""
 
     def __init__(self, job: FrameJob, name: str):
@@ -86,7 +86,7 @@ class RayPool:
         import ray
 
         self._started = _connect(address)
-        self._remote = ray.remote(_Actor).options(**actor_options())
+        self._remote = ray.remote(RenderActor).options(**actor_options())
         self._job = ray.put(job)  # the scene's bytes once, into the object store
         count = workers or default_workers()
         self.names = [f"worker {n + 1}" for n in range(count)]
@@ -134,7 +134,7 @@ class RayPool:
             ray.shutdown()
 
 
-class _TaskActor:
+class TaskActor:
     """Runs tasks one at a time on the node it is pinned to."""
 
     def call(self, function, *args):
@@ -154,7 +154,7 @@ def run_on_nodes(function, tasks, address: str | None, on_done) -> list:
         for node in ray.nodes():
             if node.get("Alive"):
                 strategy = NodeAffinitySchedulingStrategy(node["NodeID"], soft=False)
-                actors.append(ray.remote(_TaskActor).options(
+                actors.append(ray.remote(TaskActor).options(
                     num_cpus=1, scheduling_strategy=strategy, max_restarts=RESTARTS,
                     max_task_retries=RESTARTS).remote())
         queue = deque(enumerate(tasks))

@@ -270,3 +270,54 @@ type = "ambient"
                         progress, False, False)
     assert frames(out) == frames(tmp_path / "one")
     assert len(set(frames(out).values())) == 3
+
+
+def _ray_actors() -> list[int]:
+    found = []
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit() and _command_line(int(entry.name)).startswith("ray::RenderActor"):
+            found.append(int(entry.name))
+    return found
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not Path("/proc/self/task").is_dir(), reason="needs Linux's /proc")
+def test_a_ray_actor_killed_mid_frame_is_restarted_and_its_frames_asked_again(
+        tmp_path, capsys, local_ray):
+    from deferred.cli import main
+
+    scene = write_scene(tmp_path, FUR)
+    render_frames(capsys, scene, tmp_path / "one", FRAMES)
+    out = tmp_path / "killed"
+    out.mkdir()
+    codes = []
+    driver = threading.Thread(target=lambda: codes.append(main(
+        ["render", str(scene), "--frames", str(FRAMES), "-o", str(out / "f_##.png"), "--ray",
+         "--workers", "2"])))
+    driver.start()
+    killed = None
+    deadline = time.monotonic() + 300
+    while killed is None and driver.is_alive() and time.monotonic() < deadline:
+        actors = _ray_actors()
+        if actors and any(out.glob("f_*.png")):
+            os.kill(actors[0], signal.SIGKILL)
+            killed = actors[0]
+        time.sleep(0.02)
+    driver.join(timeout=600)
+    err = capsys.readouterr().err
+    assert killed is not None and codes == [0], err
+    assert frames(out) == frames(tmp_path / "one")
+    assert leftovers(tmp_path) == []
+
+
+@pytest.mark.slow
+def test_a_video_is_made_from_the_finished_frames(tmp_path, capsys):
+    scene = write_scene(tmp_path, TAA)
+    code, _, err = run(capsys, "render", scene, "--frames", 3, "-o", tmp_path / "one.gif")
+    assert code == 0, err
+    code, _, err = run(capsys, "render", scene, "--frames", 3, "-o", tmp_path / "many.gif",
+                       "--workers", "2", "--resume")
+    assert code == 0, err
+    assert (tmp_path / "many.gif").read_bytes() == (tmp_path / "one.gif").read_bytes()
+    # the frames and their manifest were kept beside the video until it was written
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["many.gif", "one.gif", "scene.toml"]
