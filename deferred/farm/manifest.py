@@ -81,10 +81,11 @@ class Manifest:
             except (ValueError, KeyError, TypeError):
                 continue  # a line torn by a kill: its frame is rendered again
 
-    def finished(self, index: int, file: Path) -> bool:
-        """Whether frame ``index`` is recorded and ``file`` still holds its bytes."""
+    def finished(self, index: int, file: Path, time: float) -> bool:
+        """Whether frame ``index`` at ``time`` is recorded and ``file`` still holds its
+        bytes."""
         record = self.records.get(index)
-        if record is None or record.get("file") != file.name:
+        if record is None or record.get("file") != file.name or record.get("time") != time:
             return False
         try:
             if file.stat().st_size != record.get("bytes"):
@@ -93,9 +94,9 @@ class Manifest:
         except OSError:
             return False
 
-    def record(self, index: int, file: Path, data: bytes) -> None:
-        """Frame ``index`` is in place at ``file`` with ``data``."""
-        record = {"frame": index, "file": file.name, "bytes": len(data),
+    def record(self, index: int, file: Path, time: float, data: bytes) -> None:
+        """Frame ``index`` at ``time`` is in place at ``file`` with ``data``."""
+        record = {"frame": index, "time": time, "file": file.name, "bytes": len(data),
                   "sha256": hashlib.sha256(data).hexdigest()}
         self.records[index] = record
         self._file.write(json.dumps(record, sort_keys=True) + "\n")

@@ -106,7 +106,7 @@ def render_sequence(job: FrameJob, out: Path, kind: str, make_pool: Callable[[],
     try:
         files = [expand_pattern(pattern, index) for index in range(len(job.times))]
         pending = [index for index, file in enumerate(files)
-                   if not (resume and manifest.finished(index, file))]
+                   if not (resume and manifest.finished(index, file, job.times[index]))]
         skipped = len(files) - len(pending)
         if resume and skipped:
             progress.note(f"resuming: {skipped} of {len(files)} frames are done, "
@@ -149,7 +149,8 @@ def _drive(pool: Pool, job: FrameJob, files: list[Path], pending: list[int],
         for event in pool.events(0.5):
             if isinstance(event, FrameDone) and event.index in outstanding:
                 write_bytes(files[event.index], event.data)
-                manifest.record(event.index, files[event.index], event.data)
+                manifest.record(event.index, files[event.index], job.times[event.index],
+                                event.data)
                 outstanding.discard(event.index)
                 frame_ms.append(event.ms)
                 light_path[0] = event.light_path

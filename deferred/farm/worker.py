@@ -52,8 +52,10 @@ class FrameJob:
 
     def options(self) -> dict[str, object]:
         """What the manifest records of the options (with the scene's digest apart)."""
+        # not the frame count: a longer run of the same frames keeps the ones done (a frame
+        # depends on the frames before it, which the same fps and start time make the same)
         return {"pipeline": self.pipeline, "size": list(self.size) if self.size else None,
-                "times": self.times, "fps": self.fps, "samples": self.samples,
+                "fps": self.fps, "start_time": self.start_time, "samples": self.samples,
                 "light_path": self.light_path, "turntable": self.turntable,
                 "camera": self.gltf_camera, "animation": self.animation,
                 "format": self.suffix}

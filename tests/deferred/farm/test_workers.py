@@ -60,7 +60,8 @@ def test_distributed_frames_are_the_single_process_frames(tmp_path, capsys, requ
 @pytest.mark.slow
 def test_resume_renders_only_missing_frames_and_equals_an_uninterrupted_run(tmp_path, capsys):
     scene = write_scene(tmp_path, FUR)
-    render_frames(capsys, scene, tmp_path / "one", FRAMES)
+    render_frames(capsys, scene, tmp_path / "one", FRAMES + 2)
+    reference = frames(tmp_path / "one")
     out = tmp_path / "resumed"
     render_frames(capsys, scene, out, FRAMES, "--workers", "2", "--resume")
     # as a stopped run leaves it: frames missing, one not yet recorded in the manifest
@@ -75,10 +76,14 @@ def test_resume_renders_only_missing_frames_and_equals_an_uninterrupted_run(tmp_
     assert "over 4 frames" in err
     for name, (data, mtime) in kept.items():
         assert (out / name).read_bytes() == data and (out / name).stat().st_mtime_ns == mtime
-    assert frames(out) == frames(tmp_path / "one")
+    assert frames(out) == {name: reference[name] for name in list(reference)[:FRAMES]}
     # nothing missing: nothing rendered
     err = render_frames(capsys, scene, out, FRAMES, "--resume")
     assert "every frame was done already" in err
+    # more frames of the same run: the frames done are kept
+    err = render_frames(capsys, scene, out, FRAMES + 2, "--resume")
+    assert f"resuming: {FRAMES} of {FRAMES + 2} frames are done, 2 to render" in err
+    assert frames(out) == reference
 
 
 def test_resume_refuses_frames_of_other_options(tmp_path, capsys):
@@ -88,6 +93,9 @@ def test_resume_refuses_frames_of_other_options(tmp_path, capsys):
                        "--resume", "--size", "40x30")
     assert_one_line_error(code, err, "--resume: f_##.manifest.jsonl: the frames were rendered "
                           "from something else (size was None, now [40, 30])")
+    code, _, err = run(capsys, "render", scene, "--frames", 2, "-o", tmp_path / "f_##.png",
+                       "--resume", "--fps", 30)
+    assert_one_line_error(code, err, "fps was 24.0, now 30.0")
     scene.write_text(TAA.replace("scale = 0.6", "scale = 0.5"))
     code, _, err = run(capsys, "render", scene, "--frames", 2, "-o", tmp_path / "f_##.png",
                        "--resume")
