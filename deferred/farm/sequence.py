@@ -29,6 +29,7 @@ from deferred.farm.worker import FrameDone, FrameFailed, FrameJob
 from deferred.io.images import write_bytes
 from deferred.io.paths import expand_pattern
 from deferred.io.progress import Progress
+from deferred.io.safety import signals_deferred
 
 MAX_ATTEMPTS = 3  # a frame whose worker dies this often stops the run
 CHUNKS_PER_WORKER = 4  # chunks are small enough to balance the workers and retry little
@@ -148,9 +149,10 @@ def _drive(pool: Pool, job: FrameJob, files: list[Path], pending: list[int],
             rates.started(worker)
         for event in pool.events(0.5):
             if isinstance(event, FrameDone) and event.index in outstanding:
-                write_bytes(files[event.index], event.data)
-                manifest.record(event.index, files[event.index], job.times[event.index],
-                                event.data)
+                with signals_deferred():  # a frame in place is a frame recorded
+                    write_bytes(files[event.index], event.data)
+                    manifest.record(event.index, files[event.index], job.times[event.index],
+                                    event.data)
                 outstanding.discard(event.index)
                 frame_ms.append(event.ms)
                 light_path[0] = event.light_path

@@ -329,3 +329,30 @@ def test_a_video_is_made_from_the_finished_frames(tmp_path, capsys):
     assert (tmp_path / "many.gif").read_bytes() == (tmp_path / "one.gif").read_bytes()
     # the frames and their manifest were kept beside the video until it was written
     assert sorted(p.name for p in tmp_path.iterdir()) == ["many.gif", "one.gif", "scene.toml"]
+
+
+@pytest.mark.slow
+def test_ctrl_c_leaves_whole_frames_that_resume_keeps(tmp_path, capsys):
+    scene = write_scene(tmp_path, FUR)
+    render_frames(capsys, scene, tmp_path / "one", FRAMES)
+    out = tmp_path / "stopped"
+    out.mkdir()
+    command = [sys.executable, "-m", "deferred", "render", str(scene), "--frames", str(FRAMES),
+               "-o", str(out / "f_##.png"), "--workers", "2", "--resume"]
+    driver = subprocess.Popen(command, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 300
+    while len(list(out.glob("f_*.png"))) < 3 and driver.poll() is None and \
+            time.monotonic() < deadline:
+        time.sleep(0.02)
+    driver.send_signal(signal.SIGINT)
+    _, err = driver.communicate(timeout=120)
+    assert driver.returncode == 130 and err.strip().splitlines()[-1] == "interrupted", err
+    done = {path.name: (path.read_bytes(), path.stat().st_mtime_ns)
+            for path in out.glob("f_*.png")}
+    assert 3 <= len(done) < FRAMES and leftovers(tmp_path) == []
+    reference = frames(tmp_path / "one")
+    assert all(data == reference[name] for name, (data, _) in done.items())
+    err = render_frames(capsys, scene, out, FRAMES, "--workers", "2", "--resume")
+    assert f"over {FRAMES - len(done)} frames" in err
+    assert all((out / name).stat().st_mtime_ns == mtime for name, (_, mtime) in done.items())
+    assert frames(out) == reference
