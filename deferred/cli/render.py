@@ -122,6 +122,8 @@ def render(scene: str | None, output: str, pipeline: str, size: str | None, fram
     if view_name == LISTING:
         print_view_names(scene, pipeline, light_path)
         return
+    if ray and scene is None and Path(ray).is_file():  # `--ray SCENE`: the scene, no address
+        scene, ray = ray, ""
     job = render_job(scene, output, pipeline, size, frames, fps, start_time, turntable, samples,
                      light_path, strict, view_name)
     job = replace(job, gltf_camera=gltf_camera, animation=animation, workers=workers, ray=ray,
