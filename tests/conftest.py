@@ -65,3 +65,13 @@ def pytest_configure(config):
     os.environ.setdefault("DEFERRED_GL_BACKEND", "egl")
     # The tests run strict: a uniform set by name that no program declares is an error.
     os.environ.setdefault("DEFERRED_STRICT", "1")
+
+
+@pytest.fixture(scope="session")
+def local_ray():
+    """A local Ray instance of two CPUs for the tests that ask for it (``--ray``, the ray
+    extra; skipped without it), stopped at the end of the session."""
+    ray = pytest.importorskip("ray")
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
+    yield ray
+    ray.shutdown()
