@@ -136,6 +136,9 @@ def _drive(pool: Pool, job: FrameJob, files: list[Path], pending: list[int],
            manifest: Manifest, progress: Progress, temporal: bool, name: str,
            light_path: list[str]) -> list[float]:
     queue = deque(plan_chunks(pending, len(pool.names), temporal))
+    if temporal and len(pool.names) > 1:
+        progress.note("the scene has a temporal effect (taa): each frame blends the ones before "
+                      "it, so one worker renders them in order")
     outstanding = set(pending)
     attempts: Counter[int] = Counter()
     frame_ms: list[float] = []
