@@ -320,8 +320,9 @@ def test_the_declared_dependencies_and_extras():
     assert any(d.startswith("imageio-ffmpeg") for d in extras["video"])
     assert any(d.startswith("matplotlib") for d in extras["plot"])
     assert any(d.startswith("moderngl-window") for d in extras["viewer"])
+    assert any(d.startswith("ray") for d in extras["ray"]) and "ray" not in core
     # the README's test command: them all, and the documentation site's tools
-    assert "deferred[video,plot,viewer,docs]" in extras["dev"]
+    assert "deferred[video,plot,viewer,docs,ray]" in extras["dev"]
     assert any(d.startswith("mkdocs>=") for d in extras["docs"])
     assert project["requires-python"] == ">=3.10"
     assert "tomli>=2.0; python_version < '3.11'" in project["dependencies"]
