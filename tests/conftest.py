@@ -45,17 +45,6 @@ def render(gl):
         renderer.release()
 
 
-@pytest.fixture(scope="session")
-def local_ray():
-    """The farm tests' local Ray instance: two CPUs, started once for the tests that ask for it
-    and stopped after them. Here, not in a conftest of their own: a second module named
-    conftest would shadow this one for the test modules that import ``psnr`` from it."""
-    ray = pytest.importorskip("ray")
-    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
-    yield ray
-    ray.shutdown()
-
-
 def psnr(a: np.ndarray, b: np.ndarray, peak: float = 1.0) -> float:
     mse = float(np.mean((np.asarray(a, np.float64) - np.asarray(b, np.float64)) ** 2))
     return float("inf") if mse == 0.0 else 10.0 * np.log10(peak * peak / mse)
@@ -67,10 +56,12 @@ def pytest_configure(config):
     os.environ.setdefault("DEFERRED_STRICT", "1")
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="module")
 def local_ray():
-    """A local Ray instance of two CPUs for the tests that ask for it (``--ray``, the ray
-    extra; skipped without it), stopped at the end of the session."""
+    """A local Ray instance of two CPUs for the tests of a module that ask for it (``--ray``,
+    the ray extra; skipped without it), stopped after them: its processes do not load the
+    tests after. Here, not in a conftest of the farm tests' own: a second module named
+    conftest would shadow this one for the test modules that import ``psnr`` from it."""
     ray = pytest.importorskip("ray")
     ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
     yield ray
