@@ -4,7 +4,7 @@
 //
 // The neighbour must show the surface the sample covered, not an occluder beside it: among the
 // pixels around the sample (the 8 of its 3x3 block for the 1-in-4 pattern, the 4 edge-adjacent
-// for 1-in-2, all outside this pattern) those nearer than the sample are out (an occluder edge
+// for 1-in-2, those outside this pattern) those nearer than the sample are out (an occluder edge
 // stays straight), and of the rest one of an opposite pair showing the same surface, else the
 // one whose surface (id and depth) most others share.
 #include "materials/techniques/stipple.glsl"
@@ -46,7 +46,10 @@ void main() {
     ivec2 size = ivec2(u_resolution);
     for (int k = 0; k < CANDIDATES; ++k) {
         ivec2 q = pixel + OFFSETS[k];
-        valid[k] = all(greaterThanEqual(q, ivec2(0))) && all(lessThan(q, size));
+        // a neighbour that is a sample of the pattern too (tiles choose their pixel apart)
+        // holds what this pass erases
+        valid[k] = all(greaterThanEqual(q, ivec2(0))) && all(lessThan(q, size)) &&
+                   !stipple_sample(q);
         ids[k] = 0.0;
         depths[k] = 0.0;
         if (!valid[k]) continue;
