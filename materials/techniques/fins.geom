@@ -31,6 +31,12 @@ out vec3 v_strand_tangent;
 #endif
 
 uniform float u_fin_band;  // |N.V| below which an edge grows a fin
+#ifdef SHADOW_CASTER
+// Drawn from a light (materials/techniques/fur_shadow.py): the fins at the fur's silhouette as
+// the light sees it; into the depth map pushed a strand's length from the light, as the fur
+// vertex shader pushes the shells (not into the deep opacity maps: OPACITY_CASTER)
+uniform mat4 u_projection;
+#endif
 
 out vec3 v_position;
 out vec3 v_normal;
@@ -71,7 +77,12 @@ void emit(int i, bool tip, float fade) {
 #ifdef FIN_STRAND_TANGENT
     v_strand_tangent = vs_strand_tangent[i];
 #endif
+#if defined(SHADOW_CASTER) && !defined(OPACITY_CASTER)
+    vec3 p = tip ? vs_tip_position[i] : vs_position[i];
+    gl_Position = u_projection * vec4(p.xy, p.z - vs_fur_extent[i], 1.0);
+#else
     gl_Position = tip ? vs_tip_clip[i] : vs_base_clip[i];
+#endif
     EmitVertex();
 }
 
@@ -86,6 +97,9 @@ void main() {
     vec3 n1 = safe_normalize(cross(b - a, vs_position[0] - a));
     vec3 n2 = safe_normalize(cross(a - b, vs_position[3] - b));
     vec3 V = safe_normalize(-0.5 * (a + b));
+#ifdef SHADOW_CASTER
+    if (u_projection[3][3] == 1.0) V = vec3(0.0, 0.0, 1.0);  // a directional light's orthographic view
+#endif
     vec3 edge_normal = n1 + n2;
     if (dot(edge_normal, edge_normal) < 1e-8) return;  // a knife edge or a degenerate face
     float fade = 1.0 - smoothstep(0.0, u_fin_band, abs(dot(normalize(edge_normal), V)));

@@ -61,11 +61,25 @@ def fin_geometry(ctx: moderngl.Context, gpu_mesh: GpuMesh,
     return MeshPrimitives(ctx, gpu_mesh, edges, moderngl.LINES_ADJACENCY)
 
 
+FIN_GEOMETRY = "materials/techniques/fins.geom"
+
+
+def draw_fins(frame, mesh: MeshData, program: moderngl.Program) -> None:
+    """The fins of ``mesh`` through ``program`` (compiled with :data:`FIN_GEOMETRY`): its edges,
+    found once a mesh and kept with the frame's resources (the camera's and the lights')."""
+    geometry = frame.resources.cached(
+        ("fins", id(mesh)),
+        lambda ctx: fin_geometry(ctx, frame.resources.gpu_mesh(mesh), edge_adjacency(mesh)))
+    if geometry.count:  # a mesh with no interior edge has no fins
+        frame.gl_call(lambda: geometry.render(program))
+        frame.count_draw()
+
+
 class FinPass(ObjectPass):
     """Fins of an object: ``geometry = "materials/techniques/fins.geom"`` over the material's fur
     vertex shader compiled with ``FUR_FINS``; blended like shells, never culled."""
 
-    geometry = "materials/techniques/fins.geom"
+    geometry = FIN_GEOMETRY
     depth = DEPTH
     depth_test = True
     depth_func = "lequal"
@@ -87,10 +101,4 @@ class FinPass(ObjectPass):
         return 0 if self.object(frame).params.debug in NO_FINS else 1
 
     def draw(self, frame, program: moderngl.Program) -> None:
-        mesh = self.mesh
-        geometry = frame.resources.cached(
-            ("fins", id(mesh)),
-            lambda ctx: fin_geometry(ctx, frame.resources.gpu_mesh(mesh), edge_adjacency(mesh)))
-        if geometry.count:  # a mesh with no interior edge has no fins
-            frame.gl_call(lambda: geometry.render(program))
-            frame.count_draw()
+        draw_fins(frame, self.mesh, program)

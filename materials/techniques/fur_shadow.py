@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 
 from deferred.api import SHADOW_CASTER_DEFINES, PassInput, ShadowCaster
 
+from .fins import FIN_GEOMETRY, draw_fins
 from .fur import object_scale, self_shadowing, shell_count, shell_depth, vertex_constants
 from .fur_volume import VOLUME_LAYERS
 
@@ -93,6 +94,27 @@ class FurShadow(ShadowCaster):
                 frame.set_uniforms(program, {"u_shell_depth": shell_depth(k, count),
                                              "u_root_shell": False})
             frame.draw_mesh(obj.mesh, program)
+        if drawn > 1 and params.fins:
+            self._draw_fins(frame, obj, view, SHADOW_CASTER_FRAGMENT, {})
+
+    def _draw_fins(self, frame: Frame, obj: SceneObject, view: ShadowView, fragment: str,
+                   defines: dict[str, str]) -> None:
+        """The fins at the fur's silhouette as the light sees it (``fins.geom`` from the
+        light), each kept as the fins draw it: a fur edge-on to the light is all strands
+        there, which the shells' slabs cast only as thin rims."""
+        material = obj.material
+        program = frame.shaders.program(self.vertex, fragment, FIN_GEOMETRY,
+                                        defines={**material.defines(obj),
+                                                 **SHADOW_CASTER_DEFINES, **defines,
+                                                 "FUR_FINS": "1"})
+        frame.bind(program, {**vertex_constants(obj), "u_shell_depth": 0.0,
+                             "u_fin_band": material.params.fin_band},
+                   self.textures(frame, obj),
+                   # the depth caster's switch of the skin (the opacity caster has none)
+                   offered={**frame.object_uniforms(obj), **view.camera_uniforms,
+                            "u_root_shell": False, "u_shell_weight": 1.0},
+                   material=frame.material_inputs(material))
+        draw_fins(frame, obj.mesh, program)
 
     def opacity_layer(self, obj: SceneObject) -> float:
         """The fur's world thickness: a strand's length."""
@@ -135,3 +157,5 @@ class FurShadow(ShadowCaster):
             if k:
                 frame.set_uniforms(program, {"u_shell_depth": depth})
             frame.draw_mesh(obj.mesh, program)
+        if stage != "first" and material.params.fins:
+            self._draw_fins(frame, obj, view, OPACITY_FRAGMENT, {"OPACITY_CASTER": "1"})
