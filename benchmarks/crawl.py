@@ -6,11 +6,12 @@ while the camera pans.
 
 A scene (the built-in demo, or ``--scene FILE``: benchmarks/crawl_bunny.toml is the held-out
 one) at 320x180 with the camera pulled back (its objects far away) and panned sideways by 0.25
-pixel a frame at the objects' distance: frame k + 4 should be frame k moved one pixel left. The residual is the mean absolute difference, in 8-bit levels, between them on
-the fur's interior (its pixels 2 away from its silhouette) and its edges (the band 2 pixels
-either side), averaged over pairs of frames, for revie_fur in the deferred and the forward
-pipeline and for the same meshes with the standard material (bare), each without and with
-``[[effect]] type = "taa"`` (pairs taken once the history has built up).
+pixel a frame at the objects' distance: frame k + 4 should be frame k moved one pixel left. The
+residual is the mean absolute difference, in 8-bit levels, between them on the fur's interior
+(its pixels 2 away from its silhouette) and its edges (the band 2 pixels either side), averaged
+over pairs of frames, for revie_fur in the deferred and the forward pipeline and for the same
+meshes with the standard material (bare), each without and with ``[[effect]] type = "taa"``
+(pairs taken once the history has built up).
 
 ``--shift`` also prints the residual of a pure one-pixel shift without taa (the projection moved
 by exactly one pixel, no parallax: what of the image stays on the screen), on the interior.

@@ -16,9 +16,6 @@ in vec3 v_fur_normal;
 in float v_shell_depth;
 
 uniform float u_shell_weight;  // volume slices a shell stands for (techniques/shells.py)
-#ifdef FUR_FINS
-in float v_fin_fade;  // a fin (fins.geom), drawn with the density stage
-#endif
 #ifndef OPACITY_FIRST
 uniform sampler2D u_opacity_first;
 uniform vec4 u_opacity_layers;
@@ -32,11 +29,7 @@ void main() {
     out_value = vec4(depth, -depth, 0.0, 0.0);
 #else
     float coverage = fur_sample(v_fur_position, v_fur_normal, v_shell_depth).x;
-    float opacity = shell_opacity(coverage, u_shell_weight);
-#ifdef FUR_FINS
-    opacity *= v_fin_fade * smoothstep(0.0, 0.35, v_shell_depth);  // as the fins draw
-#endif
-    opacity = min(opacity, 0.999);
+    float opacity = min(shell_opacity(coverage, u_shell_weight), 0.999);
     float first = texelFetch(u_opacity_first, ivec2(gl_FragCoord.xy), 0).r;
     vec4 in_layer = vec4(lessThanEqual(vec4(depth - first), u_opacity_layers));
     out_value = -u_self_shadow_density * log(1.0 - opacity) * in_layer;

@@ -15,29 +15,30 @@
 
 uniform int u_sample_index;
 
-// Which pixel of each 2x2 tile a class takes is decorrelated from the screen: every tile XORs
-// the class with its own shift, a hash of the tile and of the block of four samples (a per-tile
-// permutation of the tile's pixels, drawn again every four samples). A fixed grid (Listing 2.6)
-// has all its error at the frequencies of the 2x2 tile, where it stays on the screen as the
-// image moves (the crawl) and beats with taa's 4-sample cycle; per tile the error is noise that
-// an average resolves. Within a block of four samples the tile's shifts are the four
-// different ones, so four samples still cover every pixel of the tile, and since every user's
-// class moves by the same shift, the users still interleave.
-uint stipple_hash(uvec3 v) {  // integer mixing (Jarzynski and Olano's PCG3D)
-    v = v * 1664525u + 1013904223u;
-    v.x += v.y * v.z;
-    v.y += v.z * v.x;
-    v.z += v.x * v.y;
-    v ^= v >> 16u;
-    v.x += v.y * v.z;
-    return v.x;
+// Which pixel of its 2x2 tile a class takes is decorrelated from the screen: tile (x, y) takes
+// the shift x + 2y + 2 (f(x) + g(y)) + sample (mod 4, in SHIFTS' order), f and g a random bit
+// per column and per row of tiles. Listing 2.6's grid, the same pixel in every tile, puts all
+// of the pattern's error at the frequencies of the 2x2 tile, a dot grid fixed to the screen
+// that taa could not tell from the image; here each tile row runs through the four pixels
+// and the rows and columns are flipped at random, so the pattern has no energy there (its
+// parities balance) and no period of its own. Two samples are never side by side (the
+// steps between neighbouring tiles: 1 or 3 along a row, 0 or 2 along a column), so the
+// obliteration always has the pixels either side of a sample; over any four samples every
+// tile takes each of its pixels once, and every user's class moves by the same shift, so the
+// users still interleave (2.3.4).
+uint stipple_hash(uint v) {  // integer mixing (a PCG step, Jarzynski and Olano 2020)
+    uint state = v * 747796405u + 2891336453u;
+    uint word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
 }
 
 // The parity class of `pixel`'s tile for this sample: STIPPLE_PARITY XOR the tile's shift.
 ivec2 stipple_parity_at(ivec2 pixel) {
     const ivec2 SHIFTS[4] = ivec2[](ivec2(0, 0), ivec2(1, 1), ivec2(1, 0), ivec2(0, 1));
-    uint h = stipple_hash(uvec3(ivec3(pixel >> 1, u_sample_index >> 2)));
-    ivec2 shift = SHIFTS[(u_sample_index + int(h & 3u)) & 3] ^ SHIFTS[int((h >> 2) & 3u)];
+    ivec2 tile = pixel >> 1;
+    int flips = int((stipple_hash(uint(tile.x)) & 1u) +
+                    (stipple_hash(uint(tile.y) ^ 0x9e3779b9u) & 1u));
+    ivec2 shift = SHIFTS[(u_sample_index + tile.x + 2 * tile.y + 2 * flips) & 3];
     return (STIPPLE_PARITY ^ shift) & 1;
 }
 
