@@ -85,6 +85,66 @@ Surface strand_surface(vec3 position, bool rim) {
     return s;
 }
 
+#ifdef FUR_RIM
+// The back-lit rim (Revie 2.3.2, Listing 2.3) of this fragment, every light evaluated here with
+// the rim-bent normal, as the forward shells take it (the brighter of it and the grain's light).
+// The stipple samples carry the rim of the outer shell only, and at a silhouette of leaning fur
+// the shells showing there stand on base points whose normals are edge-on while the outer
+// shell's samples in front face the viewer: lit from behind they stayed dark. Evaluated only
+// where the normal bends (near silhouettes), faded in over RIM_BAND so no edge shows where it
+// starts; its cost there grows with the lights.
+#define RIM_BAND vec2(0.1, 0.3)
+vec3 rim_light(float gamma) {
+    vec3 V = normalize(-v_position);
+    float weight = u_rim_strength * pow(1.0 - clamp(dot(normalize(v_normal), V), 0.0, 1.0),
+                                        u_rim_falloff);
+    float fade = smoothstep(RIM_BAND.x, RIM_BAND.y, weight);
+    if (fade <= 0.0) return vec3(0.0);
+    Surface rim = strand_surface(v_position, true);
+#if defined(SHADOWS) && defined(OPACITY_SHADOWS) && defined(OPACITY_RECEIVER)
+    // as the forward shells: a shadowed light through the fur in front (the opacity maps),
+    // gamma(h) on the rest; gamma divided out, the caller multiplies by it
+    opacity_split = false;
+    opacity_fallback = gamma;
+    rim.occlusion = gamma;
+#endif
+    vec3 light = evaluate_fullscreen_lights(rim, v_position, V) +
+                 evaluate_volume_lights(rim, v_position, V);
+#if defined(SHADOWS) && defined(OPACITY_SHADOWS) && defined(OPACITY_RECEIVER)
+    light /= max(gamma, 1e-3);
+#endif
+    return fade * light / max(rim.albedo, vec3(1.0 / 255.0));
+}
+#endif
+
+#ifdef FUR_STIPPLE
+// The outer shell's light at the strand's tip: the stipple samples around the tip's point
+// (its tile's and the tiles' beside it) that hold this fur, weighted by a tent of their
+// distance to it. Each tile takes its own pixel (materials/techniques/stipple.glsl), so the
+// nearest sample is often a neighbouring tile's; the weights follow the point across the
+// samples as the image moves, where the tile's own sample jumped from one to the next.
+#ifndef TIP_RADIUS
+#define TIP_RADIUS 2.0
+#endif
+bool tip_irradiance(vec4 clip, float expected_depth, float tolerance, out vec3 irradiance) {
+    vec2 point = (clip.xy / clip.w * 0.5 + 0.5) * u_resolution;
+    ivec2 pixel = ivec2(floor(point));
+    vec3 sum = vec3(0.0);
+    float total = 0.0;
+    for (int dy = -2; dy <= 2; dy += 2) {
+        for (int dx = -2; dx <= 2; dx += 2) {
+            ivec2 q = stipple_pixel_of(pixel + ivec2(dx, dy));
+            float weight = max(0.0, 1.0 - length(vec2(q) + 0.5 - point) / TIP_RADIUS);
+            if (weight <= 0.0 || !holds_fur(q, expected_depth, tolerance)) continue;
+            sum += weight * irradiance_at(q);
+            total += weight;
+        }
+    }
+    irradiance = total > 0.0 ? sum / total : vec3(0.0);
+    return total > 0.0;
+}
+#endif
+
 #if defined(SHADOWS) || defined(FUR_FINS)
 // The full-screen lights at the shell (t): where a light casts shadows, what the samples' light
 // moves to; in fins, also the light of a fragment with no sample (a fin at a back-lit
@@ -163,9 +223,7 @@ void main() {
     bool base_valid = base_irradiance(pixel_of(v_base_clip), v_base_depth, tolerance, base_light);
     bool tip_valid = false;
 #ifdef FUR_STIPPLE
-    ivec2 tip = stipple_pixel_in(pixel_of(v_tip_clip));
-    tip_valid = holds_fur(tip, v_tip_depth, tolerance);
-    if (tip_valid) tip_light = irradiance_at(tip);
+    tip_valid = tip_irradiance(v_tip_clip, v_tip_depth, tolerance, tip_light);
 #endif
     // Both hidden (the base off-screen, the tip occluded): the light of the fur under this
     // fragment itself, if its pixel holds this fur, rather than a hole onto the dark skin.
@@ -201,6 +259,9 @@ void main() {
     out_color = vec4(max(opacity_seen, vec3(0.0)), 1.0);
     return;
 #endif
+#endif
+#ifdef FUR_RIM
+    irradiance = max(irradiance, rim_light(gamma));
 #endif
     float brightness = strand_brightness(strands);
     vec3 albedo = mix(u_albedo_base, u_albedo_tip, v_shell_depth) * gamma;
