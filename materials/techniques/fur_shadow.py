@@ -95,24 +95,23 @@ class FurShadow(ShadowCaster):
                                              "u_root_shell": False})
             frame.draw_mesh(obj.mesh, program)
         if drawn > 1 and params.fins:
-            self._draw_fins(frame, obj, view, SHADOW_CASTER_FRAGMENT, {})
+            self._draw_fins(frame, obj, view)
 
-    def _draw_fins(self, frame: Frame, obj: SceneObject, view: ShadowView, fragment: str,
-                   defines: dict[str, str]) -> None:
+    def _draw_fins(self, frame: Frame, obj: SceneObject, view: ShadowView) -> None:
         """The fins at the fur's silhouette as the light sees it (``fins.geom`` from the
-        light), each kept as the fins draw it: a fur edge-on to the light is all strands
-        there, which the shells' slabs cast only as thin rims."""
+        light) into the depth map, each texel kept as the fins draw it: a fur edge-on to the
+        light is all strands there, which the shells' slabs cast only as thin rims. Not into
+        the deep opacity maps: there the shells' slabs crossing the light at grazing angles
+        hold the fur's optical depth already, and the fins on top shadowed it twice."""
         material = obj.material
-        program = frame.shaders.program(self.vertex, fragment, FIN_GEOMETRY,
+        program = frame.shaders.program(self.vertex, SHADOW_CASTER_FRAGMENT, FIN_GEOMETRY,
                                         defines={**material.defines(obj),
-                                                 **SHADOW_CASTER_DEFINES, **defines,
-                                                 "FUR_FINS": "1"})
+                                                 **SHADOW_CASTER_DEFINES, "FUR_FINS": "1"})
         frame.bind(program, {**vertex_constants(obj), "u_shell_depth": 0.0,
-                             "u_fin_band": material.params.fin_band},
+                             "u_fin_band": material.params.fin_band, "u_root_shell": False,
+                             "u_shell_weight": 1.0},
                    self.textures(frame, obj),
-                   # the depth caster's switch of the skin (the opacity caster has none)
-                   offered={**frame.object_uniforms(obj), **view.camera_uniforms,
-                            "u_root_shell": False, "u_shell_weight": 1.0},
+                   offered={**frame.object_uniforms(obj), **view.camera_uniforms},
                    material=frame.material_inputs(material))
         draw_fins(frame, obj.mesh, program)
 
@@ -157,5 +156,3 @@ class FurShadow(ShadowCaster):
             if k:
                 frame.set_uniforms(program, {"u_shell_depth": depth})
             frame.draw_mesh(obj.mesh, program)
-        if stage != "first" and material.params.fins:
-            self._draw_fins(frame, obj, view, OPACITY_FRAGMENT, {"OPACITY_CASTER": "1"})
