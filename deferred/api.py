@@ -8,10 +8,10 @@ A plugin (the built-in materials, lights and effects, and the example package in
   and the parts it is composed of: its passes, :class:`Technique` (:class:`SurfacePasses`, the
   :class:`GBufferPass` and :class:`ForwardLitPass` every material has by default;
   :class:`PhasePasses`), its shadows, :class:`ShadowCaster` (:class:`NoShadow`,
-  :class:`ShadowView`, ``SHADOW_CASTER_DEFINES``), :class:`Motion` (:class:`ReachMotion`) and
-  :class:`Simulation`; :class:`ShadingModel`, :class:`GBufferData`, :class:`Light`
-  (:class:`LightParams`), :class:`Effect` (:class:`EffectParams`), and the registries to
-  register them with: ``materials``, ``lights``, ``shading_models``, ``effects``.
+  :class:`ShadowView`, ``SHADOW_CASTER_DEFINES``), :class:`Motion` (:class:`ReachMotion`,
+  :class:`MotionOffsets`) and :class:`Simulation`; :class:`ShadingModel`, :class:`GBufferData`,
+  :class:`Light` (:class:`LightParams`), :class:`Effect` (:class:`EffectParams`), and the
+  registries to register them with: ``materials``, ``lights``, ``shading_models``, ``effects``.
 - **passes**: :class:`RenderPass`, :class:`ObjectPass` (with the :class:`PassInput` and
   :class:`Shape` it composes), :class:`FullscreenPass`, :class:`ClearPass`, :func:`copy_pass`,
   compositions of passes (:func:`compose_runs`, ``BEGIN``, ``END``: order-independent
@@ -114,7 +114,7 @@ from deferred.interfaces.shadow_casting import (
     ShadowCaster,
     ShadowView,
 )
-from deferred.interfaces.simulation import Motion, ReachMotion, Simulation
+from deferred.interfaces.simulation import Motion, MotionOffsets, ReachMotion, Simulation
 from deferred.interfaces.techniques import (
     ForwardLitPass,
     GBufferPass,
@@ -198,7 +198,8 @@ __all__ = [
     "BlinnPhongParams", "ClearPass", "Effect", "EffectParams", "ForwardLitPass", "Frame",
     "FullscreenPass", "GBufferData", "GBufferPass", "GpuMesh", "InputError", "Light",
     "LightParams", "LightPath", "LightVolume", "Material", "MaterialParams", "MeshData",
-    "MeshPrimitives", "Motion", "NoShadow", "SHADOW_CASTER_DEFINES", "ShadowCaster",
+    "MeshPrimitives", "Motion", "MotionOffsets", "NoShadow", "SHADOW_CASTER_DEFINES",
+    "ShadowCaster",
     "ShadowParams", "ShadowProjection", "ShadowView",
     "NonZeroVec3", "ObjectPass", "Order", "Params", "PassInput", "Phase", "PhasePasses",
     "Per", "Pipeline", "Radiance", "ReachMotion",

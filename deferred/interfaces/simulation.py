@@ -11,6 +11,7 @@ the passes, the shadow casters and the inputs read it through :meth:`Simulation.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from deferred.errors import DeferredError, RenderError, gl_error
@@ -25,14 +26,30 @@ if TYPE_CHECKING:
 SIMULATED = "simulated"  # a frame's blackboard: (key, node) -> the state brought to its time
 
 
+@dataclass(frozen=True)
+class MotionOffsets:
+    """Where what a material draws at its reach moves on its own (a simulated strand tip in the
+    wind): per-vertex object-space offsets, this frame's and the last frame's, in RGBA32F
+    textures holding vertex i's at texel ``stride * i`` (rows of the texture's width)."""
+
+    current: moderngl.Texture
+    previous: moderngl.Texture
+    stride: int = 1
+
+
 class Motion:
     """How far, in object units along the mesh's normals, what a material draws for an object
     reaches beyond the mesh (fur shells and fins, hair): motion vectors are drawn over the mesh
     pushed out that far (``deferred.effects.taa``), so the pixels of those layers move with
-    the object. By default nothing: the material draws its mesh."""
+    the object. By default nothing: the material draws its mesh. :meth:`offsets` adds where
+    that reach moves by itself between frames (wind), else the layers move with the mesh."""
 
     def extent(self, obj: SceneObjectLike) -> float:
         return 0.0
+
+    def offsets(self, frame: Frame, obj: SceneObjectLike) -> MotionOffsets | None:
+        """This frame's and the last frame's offsets of the reach, or ``None``: none."""
+        return None
 
 
 class ReachMotion(Motion):

@@ -50,7 +50,7 @@ from ..techniques.wetness import read_mask_image
 from .color import pattern_texture
 from .params import NOT_UNIFORMS, ShellFurParams, layers_uniform
 from .passes import CHORD, FUR_VERTEX, STATE, FurLayers
-from .state import SIMULATION
+from .state import SIMULATION, StrandMotion
 
 if TYPE_CHECKING:
     from deferred.api import Frame, SceneObject
@@ -90,6 +90,7 @@ class ShellFurMaterial(FurMaterial):
                   FurLayers(fur_light="shell_fur_light", material="shell_fur"))
     shadow = FurShadow(FUR_VERTEX, inputs=(STATE,))
     simulation = SIMULATION
+    motion = StrandMotion("fur_length")  # the tips' own motion too (wind)
 
     def __init__(self, params: ShellFurParams | None = None, base_dir: Path | None = None):
         super().__init__(params, base_dir)

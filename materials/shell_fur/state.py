@@ -14,7 +14,17 @@ from typing import TYPE_CHECKING
 import moderngl
 import numpy as np
 
-from deferred.api import InputError, Per, RenderWork, Simulation, Work, WorkObject, counted
+from deferred.api import (
+    InputError,
+    MotionOffsets,
+    Per,
+    ReachMotion,
+    RenderWork,
+    Simulation,
+    Work,
+    WorkObject,
+    counted,
+)
 
 from ..techniques.strands import (
     StrandForces,
@@ -132,17 +142,34 @@ class ShellFurState:
         self.strand_data[1:3 * vertices:3, :3] = curl_u
         self.strand_data[2:3 * vertices:3, :3] = curl_v
         self.tips_texture = _float_texture(ctx, TIPS_WIDTH, len(self.strand_data) // TIPS_WIDTH)
+        # the tip deflections the frame before showed, in the same layout (motion vectors:
+        # StrandMotion); this frame's on a first frame
+        self.previous_data = np.zeros_like(self.strand_data)
+        self.previous_texture = _float_texture(ctx, TIPS_WIDTH,
+                                               len(self.strand_data) // TIPS_WIDTH)
         self.step: int | None = None  # steps taken since t = 0
         self.mask = dry_mask(self.size)  # Algorithm 1's, drying included
         self.shown = self.mask.copy()  # what the shaders see: the mask as it soaks in (_soak)
         self.fallen = 0
         self._uploaded: int | None = None
+        self._first_previous = True
 
     def params_at(self, time: float) -> ShellFurParams:
         return _params_at(self.obj, time)
 
     def advance(self, time: float) -> None:
-        """Bring the state to ``time`` (seconds) and upload it if it changed."""
+        """Bring the state to ``time`` (seconds) and upload it if it changed; what the frame
+        before showed becomes the previous tips (once a frame: the simulation's advance)."""
+        rows = slice(0, 3 * self.obj.mesh.vertex_count, 3)
+        shown = self.strand_data[rows].copy() if self._uploaded is not None else None
+        self._advance(time)
+        previous = self.strand_data[rows] if shown is None else shown
+        if not np.array_equal(previous, self.previous_data[rows]) or self._first_previous:
+            self.previous_data[rows] = previous
+            self.previous_texture.write(self.previous_data.tobytes())
+            self._first_previous = False
+
+    def _advance(self, time: float) -> None:
         target = int(math.floor(time / self.dt + 1e-9))
         if self.step is None or target < self.step:
             self._start()
@@ -235,6 +262,7 @@ class ShellFurState:
     def release(self) -> None:
         self.mask_texture.release()
         self.tips_texture.release()
+        self.previous_texture.release()
 
 
 class ShellFurSimulation(Simulation):
@@ -303,3 +331,13 @@ def fur_state(frame: Frame, obj: SceneObject) -> ShellFurState:
     """``obj``'s state in the frame's renderer at the frame's time (``obj``: a scene object
     or its state in the frame)."""
     return SIMULATION.state(frame, frame.scene.object_state(obj.node))
+
+
+class StrandMotion(ReachMotion):
+    """shell_fur's reach in the motion vectors: ``fur_length`` along the normals, moved by each
+    vertex's simulated tip deflection (gravity, gusting wind) of this frame and of the frame
+    before, so the tips' own motion is in the vectors (a still camera in the wind)."""
+
+    def offsets(self, frame: Frame, obj: SceneObject) -> MotionOffsets:
+        state = fur_state(frame, obj)
+        return MotionOffsets(state.tips_texture, state.previous_texture, stride=3)

@@ -120,12 +120,20 @@ class MotionObjectsPass(RenderPass):
                         depth_offset=(-1.0, -4.0))
         for obj in frame.scene.objects:
             # a skinned mesh's motion reads its surface of the frame before too
-            defines = {"SKINNED_MOTION": "1"} if obj.skin_matrices is not None else None
+            defines = {"SKINNED_MOTION": "1"} if obj.skin_matrices is not None else {}
+            motion = obj.material.motion
+            offsets = motion.offsets(frame, obj)  # the reach moving on its own (wind)
+            uniforms: dict[str, Any] = {"u_motion_extent": float(motion.extent(obj))}
+            textures = {}
+            if offsets is not None:
+                defines = {**defines, "MOTION_OFFSETS": "1"}
+                uniforms["u_motion_offset_stride"] = int(offsets.stride)
+                textures = {"u_motion_offsets": offsets.current,
+                            "u_previous_motion_offsets": offsets.previous}
             program = frame.shaders.program("effects/taa/motion_objects.vert",
-                                            "effects/taa/motion_objects.frag", defines=defines)
-            extent = obj.material.motion.extent(obj)
-            frame.bind(program, {"u_motion_extent": float(extent)},
-                       offered=frame.object_uniforms(obj))
+                                            "effects/taa/motion_objects.frag",
+                                            defines=defines or None)
+            frame.bind(program, uniforms, textures, offered=frame.object_uniforms(obj))
             frame.draw_mesh(obj.mesh, program)
 
 
