@@ -86,8 +86,9 @@ Surface strand_surface(vec3 position, bool rim) {
 }
 
 #ifdef FUR_RIM
-// The back-lit rim (Revie 2.3.2, Listing 2.3) of this fragment, every light evaluated here with
-// the rim-bent normal, as the forward shells take it (the brighter of it and the grain's light).
+// The back-lit rim (Revie 2.3.2, Listing 2.3) of this fragment where the frame has volume lights
+// (point, spot): every light evaluated here with the rim-bent normal, as the forward shells take
+// it (the brighter of it and the grain's light).
 // The stipple samples carry the rim of the outer shell only, and at a silhouette of leaning fur
 // the shells showing there stand on base points whose normals are edge-on while the outer
 // shell's samples in front face the viewer: lit from behind they stayed dark. Evaluated only
@@ -99,7 +100,9 @@ vec3 rim_light(float gamma) {
     float weight = u_rim_strength * pow(1.0 - clamp(dot(normalize(v_normal), V), 0.0, 1.0),
                                         u_rim_falloff);
     float fade = smoothstep(RIM_BAND.x, RIM_BAND.y, weight);
-    if (fade <= 0.0) return vec3(0.0);
+    // without a volume light the samples' light, moved to the shell (fur_relight.glsl), holds
+    // the full-screen lights' rim already
+    if (fade <= 0.0 || u_light_count <= u_global_light_count) return vec3(0.0);
     Surface rim = strand_surface(v_position, true);
 #if defined(SHADOWS) && defined(OPACITY_SHADOWS) && defined(OPACITY_RECEIVER)
     // as the forward shells: a shadowed light through the fur in front (the opacity maps),
