@@ -63,20 +63,24 @@ struct Sample {
     float depth;
 };
 
-Sample sample_at(ivec2 p) {
+Sample sample_of(ivec2 p, float depth, vec4 normal_id, vec2 strand) {
     Sample s;
     bool inside = all(greaterThanEqual(p, ivec2(0))) && all(lessThan(p, g_size));
-    vec4 normal_id = normal_id_at(p);
-    s.depth = depth_at(p);
-    s.covered = inside && s.depth > 0.0;
+    s.depth = depth;
+    s.covered = inside && depth > 0.0;
     s.id = normal_id.w;
     s.normal = octahedral_decode(normal_id.xy);
-#ifdef STRAND_IDS
-    s.strand = strand_at(p).r;
-#else
-    s.strand = 0.0;
-#endif
+    s.strand = strand.r;
     return s;
+}
+
+Sample sample_at(ivec2 p) {
+#ifdef STRAND_IDS
+    vec2 strand = strand_at(p);
+#else
+    vec2 strand = vec2(0.0);
+#endif
+    return sample_of(p, depth_at(p), normal_id_at(p), strand);
 }
 
 bool one_surface(Sample a, Sample b) {
@@ -87,6 +91,11 @@ float turn(Sample a, Sample b) {
     return acos(clamp(dot(a.normal, b.normal), -1.0, 1.0));
 }
 
+// The 3x3 neighbourhood's index of the offset o (each of x, y in -1..1).
+int at3(ivec2 o) {
+    return (o.y + 1) * 3 + o.x + 1;
+}
+
 void main() {
     g_size = textureSize(u_linear_depth, 0);
     ivec2 p = ivec2(gl_FragCoord.xy);
@@ -95,21 +104,39 @@ void main() {
         out_edge = 0.0;
         return;
     }
-    float id = normal_id_at(p).w;
-    float edge = 0.0;
+    // The 3x3 neighbourhood's depths and strands and the 4-neighbours' normals and ids, each
+    // fetched once for the three tests below (clamped to the image, as depth_at has them).
+    float depths[9];
+    vec2 strands[9];
+    for (int y = -1; y <= 1; ++y) {
+        for (int x = -1; x <= 1; ++x) {
+            ivec2 o = ivec2(x, y);
+            depths[at3(o)] = depth_at(p + o);
+#ifdef STRAND_IDS
+            strands[at3(o)] = strand_at(p + o);
+#else
+            strands[at3(o)] = vec2(0.0);
+#endif
+        }
+    }
     const ivec2 sides[4] = ivec2[](ivec2(1, 0), ivec2(-1, 0), ivec2(0, 1), ivec2(0, -1));
+    Sample here = sample_of(p, d, normal_id_at(p), strands[4]);
+    Sample around[4];  // around[k ^ 1] is opposite around[k]
+    for (int k = 0; k < 4; ++k) {
+        around[k] = sample_of(p + sides[k], depths[at3(sides[k])], normal_id_at(p + sides[k]),
+                              strands[at3(sides[k])]);
+    }
+    float id = here.id;
+    float edge = 0.0;
 
     // Ids: a different surface (or clump) beside this one, farther away or background.
     if (u_ids) {
-#ifdef STRAND_IDS
-        float clump = strand_at(p).g;
-#endif
         for (int k = 0; k < 4; ++k) {
-            float other_depth = depth_at(p + sides[k]);
-            bool other = !same_surface(normal_id_at(p + sides[k]).w, id);
+            float other_depth = around[k].depth;
+            bool other = !same_surface(around[k].id, id);
 #ifdef STRAND_IDS
             // another clump of the same surface (cartoon hair: one colour, many clumps)
-            other = other || abs(strand_at(p + sides[k]).g - clump) > 0.5;
+            other = other || abs(strands[at3(sides[k])].g - strands[4].g) > 0.5;
 #endif
             if (other && (other_depth <= 0.0 || other_depth > d)) edge = 1.0;
         }
@@ -117,14 +144,13 @@ void main() {
 
     // Creases: one large turn of the normal between this pixel and a neighbour no farther
     // away (the near side; ties to the right and up), with no comparable turn either side.
-    Sample here = sample_at(p);
     for (int k = 0; k < 4; ++k) {
-        Sample next = sample_at(p + sides[k]);
+        Sample next = around[k];
         if (!one_surface(here, next) || dot(here.normal, next.normal) >= u_crease_cosine) continue;
         bool near_side = d < next.depth || (d == next.depth && k % 2 == 0);
         if (!near_side) continue;
         float step_turn = turn(here, next);
-        Sample before = sample_at(p - sides[k]);
+        Sample before = around[k ^ 1];
         Sample after = sample_at(p + 2 * sides[k]);
         // a crease has surface beside it to compare with: a tube one or two pixels across,
         // whose normal turns by up to 90 degrees a pixel, has none
@@ -141,12 +167,12 @@ void main() {
     const ivec2 axes[4] = ivec2[](ivec2(1, 0), ivec2(0, 1), ivec2(1, 1), ivec2(1, -1));
     for (int k = 0; k < 4; ++k) {
 #ifdef STRAND_IDS
-        float clump_here = strand_at(p).g;
-        if (clump_here > 0.5 && abs(strand_at(p + axes[k]).g - clump_here) < 0.5 &&
-                abs(strand_at(p - axes[k]).g - clump_here) < 0.5) continue;
+        float clump_here = strands[4].g;
+        if (clump_here > 0.5 && abs(strands[at3(axes[k])].g - clump_here) < 0.5 &&
+                abs(strands[at3(-axes[k])].g - clump_here) < 0.5) continue;
 #endif
-        float a = depth_at(p + axes[k]);
-        float b = depth_at(p - axes[k]);
+        float a = depths[at3(axes[k])];
+        float b = depths[at3(-axes[k])];
         float inverse_a = a > 0.0 ? 1.0 / a : 0.0;
         float inverse_b = b > 0.0 ? 1.0 / b : 0.0;
         float second = (inverse_a + inverse_b - 2.0 / d) * d;
