@@ -55,6 +55,8 @@ def print_params(entries: list[dict[str, Any]], as_json: bool) -> None:
         for row in entry["params"]:
             table.add_row(*cells(row))
         console.print(table if entry["params"] else f"{title}\n  (no parameters)")
+        for line in data_lines(entry):
+            console.print(line)
 
 
 def plain_lines(entries: list[dict[str, Any]]) -> list[str]:
@@ -70,13 +72,25 @@ def plain_lines(entries: list[dict[str, Any]]) -> list[str]:
             lines.append(f"  {entry['summary']}")
         if not entry["params"]:
             lines.append("  (no parameters)")
-            continue
-        rows = [cells(row) for row in entry["params"]]
-        widths = [max(len(r[i]) for r in [COLUMNS, *rows]) for i in range(4)]
-        for row in [COLUMNS, *rows]:
-            aligned = [cell.ljust(width) for cell, width in zip(row[:4], widths, strict=True)]
-            lines.append(("  " + "  ".join([*aligned, row[4]])).rstrip())
+        else:
+            rows = [cells(row) for row in entry["params"]]
+            widths = [max(len(r[i]) for r in [COLUMNS, *rows]) for i in range(4)]
+            for row in [COLUMNS, *rows]:
+                aligned = [cell.ljust(width) for cell, width in zip(row[:4], widths,
+                                                                     strict=True)]
+                lines.append(("  " + "  ".join([*aligned, row[4]])).rstrip())
+        lines += data_lines(entry)
     return lines
+
+
+def data_lines(entry: dict[str, Any]) -> list[str]:
+    """A light type's own data (``Light.data``): a line per vec4 after the record's four."""
+    data = entry.get("data") or []
+    if not data:
+        return []
+    width = max(len(datum["name"]) for datum in data)
+    return ["  record data (a vec4 each, after color, position, direction, extra):",
+            *(f"    {datum['name'].ljust(width)}  {datum['description']}" for datum in data)]
 
 
 def cells(row: dict[str, Any]) -> tuple[str, str, str, str, str]:

@@ -71,6 +71,9 @@ def describe_type(kind: str, name: str, cls: type) -> dict[str, Any]:
     if kind == "light":
         volume = getattr(cls, "volume", None)
         entry["volume"] = volume.value if isinstance(volume, Enum) else volume
+        # the type's own vec4s after its record's four (Light.data)
+        entry["data"] = [{"name": datum.name, "description": datum.description}
+                         for datum in getattr(cls, "data", ())]
     if kind == "effect":
         entry["pipelines"] = [str(getattr(p, "value", p)) for p in getattr(cls, "pipelines", ())]
     if kind == "shading_model":

@@ -10,14 +10,22 @@ pass reads it per instance, the forward pass loops over all records per fragment
 ``"sphere"`` (the record's ``position.xyz`` is the centre and ``position.w`` the radius), so that
 cost follows the pixels a light touches.
 
-A type whose GLSL reads textures (an environment's maps) gives them from :meth:`Light.textures`,
-bound wherever lights are evaluated, as a shading model's are; a light naming files checks them
-in :meth:`Light.check_files` (paths relative to the scene file's folder, ``base_dir``).
+A type with more data than the record's type-specific slots declares it: ``data``, a tuple of
+:class:`LightDatum`, each one more ``vec4`` of the record after its four. Its GLSL reads them by
+name through a struct generated for the type (``<glsl_function>_data(light)``,
+:mod:`deferred.lighting.dispatch`), so no value hides in another field's spare components and
+nothing reads past what the type declares; ``deferred params light`` lists them.
+
+A type whose GLSL reads textures (an environment's maps, an area light's LTC tables) gives
+them from :meth:`Light.textures`, bound wherever lights are evaluated, as a shading model's
+are; a light naming files checks them in :meth:`Light.check_files` (paths relative to the
+scene file's folder, ``base_dir``).
 """
 
 from __future__ import annotations
 
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar, Literal
 
@@ -40,6 +48,35 @@ if TYPE_CHECKING:
     from deferred.core.frame import Frame
 
 Vec3 = tuple[float, float, float]
+RECORD_VEC4S = 4  # color, position, direction, extra: every light's
+
+
+@dataclass(frozen=True)
+class LightDatum:
+    """One ``vec4`` of a light type's own data, stored after the record's four: ``name`` is
+    its field in the type's generated GLSL struct (an identifier), ``description`` what its
+    components hold (``deferred params light`` shows it)."""
+
+    name: str
+    description: str
+
+    def __post_init__(self) -> None:
+        if not (isinstance(self.name, str) and self.name.isidentifier() and self.name.isascii()):
+            raise ValueError(f"light datum name {self.name!r} is not a GLSL identifier")
+
+
+def check_light_data(cls: type) -> str | None:
+    """What is wrong with a light type's ``data`` declaration (said after "which"), or None."""
+    data = getattr(cls, "data", ())
+    if not isinstance(data, tuple) or not all(isinstance(d, LightDatum) for d in data):
+        return "has a data that is not a tuple of deferred.api.LightDatum"
+    names = [d.name for d in data]
+    if len(set(names)) != len(names):
+        return f"declares the light datum names {names}, some twice"
+    if data and not (isinstance(cls.glsl_function, str) and cls.glsl_function.isidentifier()):
+        return "declares data but its glsl_function is not an identifier"
+    return None
+
 
 class LightParams(Params):
     """Base of every light's parameter model: a colour and its intensity."""
@@ -98,6 +135,10 @@ class Light(Revisioned):
     # how its shadow maps are made, where its Params are ShadowParams (None: it casts none)
     shadow_projection: ClassVar[ShadowProjection | None] = None
     shader_root: ClassVar[Traversable | Path | None] = None
+    # the type's own vec4s after the record's four (read in GLSL through a generated struct)
+    data: ClassVar[tuple[LightDatum, ...]] = ()
+    # an area light: its GLSL calls shade_area (the shading models' area answers are compiled)
+    area: ClassVar[bool] = False
     type_id: ClassVar[int] = 0  # set by the registry
     # a node of the scene graph (or its label) whose space position and direction are in;
     # None: the world (each frame's state holds the light placed in the world)
@@ -129,6 +170,11 @@ class Light(Revisioned):
         wherever lights are evaluated; none by default."""
         return {}
 
+    def emitter_radius(self) -> float:
+        """The radius of the disc the light emits from (0: a point); an area light's sizes its
+        soft shadows (``shadow_filter = "pcss"``)."""
+        return 0.0
+
     @property
     def casts_shadows(self) -> bool:
         """Whether this light asks for shadow maps (``shadows = true`` on a type that has a
@@ -138,19 +184,27 @@ class Light(Revisioned):
     def radiance(self) -> np.ndarray:
         return np.asarray(self.params.color, dtype=np.float64) * self.params.intensity
 
+    @classmethod
+    def record_vec4s(cls) -> int:
+        """``vec4``s of one record: the four every light has and the type's ``data``."""
+        return RECORD_VEC4S + len(cls.data)
+
     def record(self, view: np.ndarray) -> np.ndarray:
-        """(4, 4) float32: color, position, direction, extra (view space). See lighting.glsl.
-        A function of ``params`` and ``view`` alone: the light buffer packs the records again
-        only when one of them changes (``LightBuffer.upload``)."""
+        """(4 + len(data), 4) float32: color, position, direction, extra (view space; see
+        lighting.glsl), then the type's data in its declared order. A function of ``params``
+        and ``view`` alone: the light buffer packs the records again only when one of them
+        changes (``LightBuffer.upload``)."""
         raise NotImplementedError
 
     @classmethod
     def records(cls, lights: list[Light], view: np.ndarray) -> np.ndarray:
-        """``(len(lights), 4, 4)`` float32: :meth:`record` of each light of this type. A type
-        with many lights a frame (point, spot) overrides it with numpy over all of them (a
-        ``record`` call per light is slow at a thousand lights: benchmarks/README.md)."""
-        return np.stack([np.asarray(light.record(view), dtype=np.float32).reshape(4, 4)
-                         for light in lights]) if lights else np.zeros((0, 4, 4), np.float32)
+        """``(len(lights), 4 + len(data), 4)`` float32: :meth:`record` of each light of this
+        type. A type with many lights a frame (point, spot) overrides it with numpy over all of
+        them (a ``record`` call per light is slow at a thousand lights:
+        benchmarks/README.md)."""
+        width = cls.record_vec4s()
+        return np.stack([np.asarray(light.record(view), dtype=np.float32).reshape(width, 4)
+                         for light in lights]) if lights else np.zeros((0, width, 4), np.float32)
 
 
 def view_point(view: np.ndarray, point) -> np.ndarray:

@@ -60,11 +60,14 @@ class Registry(Generic[T]):
     dict of name to ``"module:Class"`` in the order of their type ids (none: no built-ins).
     ``interface``: ``"module:Class"``, the base every plugin's class derives from, and
     ``requires`` the class attributes a plugin's class must have (none: anything with a
-    ``name`` registers)."""
+    ``name`` registers); ``check``: ``"module:function"`` saying what else is wrong with a
+    class (after "which"), or None."""
 
     def __init__(self, what: str, group: str, catalogue: str, max_id: int | None = None,
-                 interface: str | None = None, requires: tuple[str, ...] = ()):
+                 interface: str | None = None, requires: tuple[str, ...] = (),
+                 check: str | None = None):
         self.what = what
+        self.check = check
         self.group = group
         self.catalogue = catalogue
         self.max_id = max_id  # ids are stored in the G-buffer for some registries
@@ -88,6 +91,9 @@ class Registry(Generic[T]):
             raise ValueError(f"{self.what} '{name}' is already registered by "
                              f"{existing.__module__}.{existing.__qualname__}")
         if existing is None:
+            problem = self.class_problem(cls)
+            if problem is not None:
+                raise TypeError(f"{self.what} class {cls.__qualname__} {problem}")
             cls.type_id = self._ids[name] = self._new_id(cls, name)
             self._classes[name] = cls
         return cls
@@ -188,7 +194,15 @@ class Registry(Generic[T]):
             return f"has a Params that is not a deferred.api.Params subclass ({loaded.Params!r})"
         if "from_dict" in self.requires and not callable(loaded.from_dict):
             return "has a from_dict that cannot be called"
-        return None
+        return self.class_problem(loaded)
+
+    def class_problem(self, cls: type) -> str | None:
+        """What this registry's ``check`` finds wrong with ``cls`` (None: nothing, or no
+        check)."""
+        if self.check is None:
+            return None
+        module, _, attribute = self.check.partition(":")
+        return getattr(importlib.import_module(module), attribute)(cls)
 
     def interface_class(self) -> type:
         """The interface's class, imported on first use (it imports this module)."""
@@ -316,7 +330,8 @@ materials: Registry = Registry("material", "deferred.materials", "deferred.mater
                                requires=_FROM_A_SCENE)
 # a listed light's colour texel holds its type id in w's low 8 bits (lighting/light_lists.glsl)
 lights: Registry = Registry("light", "deferred.lights", "deferred.lights", max_id=255,
-                            interface="deferred.interfaces.light:Light", requires=_FROM_A_SCENE)
+                            interface="deferred.interfaces.light:Light", requires=_FROM_A_SCENE,
+                            check="deferred.interfaces.light:check_light_data")
 shading_models: Registry = Registry("shading model", "deferred.shading_models",
                                     "deferred.materials:SHADING_MODELS",
                                     max_id=MAX_SHADING_MODEL_ID,

@@ -1,6 +1,8 @@
 """All lights of a frame packed into one GPU buffer, read by both pipelines.
 
-Each light is four vec4s (``Light.record``), its type id stored in ``color.w``. Full-screen lights
+Each light is four vec4s (``Light.record``), its type id stored in ``color.w``, then the vec4s
+of its type's own data (``Light.data``): a row is as wide as the widest type of the scene
+needs, so a scene whose types declare no data keeps rows of four. Full-screen lights
 (ambient, directional) come first, then volume lights, each group by type, so each deferred
 lighting pass draws one contiguous range and the tiled paths loop ``[0, global_count)`` for the
 lights every pixel gets. Volume lights whose sphere lies outside the view frustum are dropped on
@@ -19,8 +21,8 @@ from typing import TYPE_CHECKING, Any
 import moderngl
 import numpy as np
 
-from deferred.errors import InputError
-from deferred.interfaces.light import Light
+from deferred.errors import InputError, RenderError
+from deferred.interfaces.light import RECORD_VEC4S, Light
 from deferred.lighting.dispatch import (
     FULLSCREEN_LIGHT_CAPACITY,
     FULLSCREEN_UNIFORM,
@@ -32,7 +34,6 @@ if TYPE_CHECKING:
     from deferred.gl.uniforms import ProgramUniforms
 
 LIGHT_BUFFER = "light_buffer"  # its name on a frame's blackboard
-RECORD_VEC4S = 4
 
 
 def visible_spheres(records: np.ndarray, projection: np.ndarray) -> np.ndarray:
@@ -52,6 +53,26 @@ def visible_spheres(records: np.ndarray, projection: np.ndarray) -> np.ndarray:
 def fullscreen_overflow(count: int) -> str:
     return (f"{count} full-screen (ambient, directional) lights; a frame holds at most "
             f"{FULLSCREEN_LIGHT_CAPACITY}")
+
+
+def row_vec4s(light_types) -> int:
+    """``vec4``s a row of the buffer holds for lights of ``light_types``: the widest record."""
+    return max([RECORD_VEC4S, *(cls.record_vec4s() for cls in light_types)])
+
+
+def type_records(light_type: type[Light], lights: list[Light], view: np.ndarray) -> np.ndarray:
+    """``light_type.records``, checked against the type's declaration: ``(n, 4 + len(data),
+    4)`` finite numbers (a wrong shape would shift every later light's record)."""
+    records = np.asarray(light_type.records(lights, view), dtype=np.float32)
+    want = (len(lights), light_type.record_vec4s(), 4)
+    if records.shape != want:
+        data = f" and its {len(light_type.data)} data vec4s" if light_type.data else ""
+        raise RenderError(f"light type '{light_type.name}': records() gave an array of shape "
+                          f"{records.shape}; its four vec4s{data} make {want}")
+    if not np.isfinite(records).all():
+        raise RenderError(f"light type '{light_type.name}': records() gave a value that is not "
+                          "a finite number")
+    return records
 
 
 class LightBuffer:
@@ -78,11 +99,13 @@ class LightBuffer:
         (deferred.lighting.shadows), the others 0."""
         ordered = sorted(lights, key=lambda light: (light.volume != LightVolume.FULLSCREEN,
                                                     light.type_id))  # stable: scene order kept
-        records = np.zeros((len(ordered), RECORD_VEC4S, 4), dtype=np.float32)
+        width = row_vec4s({type(light) for light in lights})
+        records = np.zeros((len(ordered), width, 4), dtype=np.float32)
         start = 0
         for light_type, run in itertools.groupby(ordered, key=type):  # a run per type
             run = list(run)
-            records[start:start + len(run)] = light_type.records(run, view)
+            records[start:start + len(run), :light_type.record_vec4s()] = \
+                type_records(light_type, run, view)
             records[start:start + len(run), 0, 3] = float(light_type.type_id)
             records[start:start + len(run), 3, 3] = [float((shadow_slots or {}).get(id(light), 0))
                                                      for light in run]
@@ -92,7 +115,7 @@ class LightBuffer:
         if projection is not None and volumes.any():
             keep[volumes] = visible_spheres(records[volumes], projection)
         ordered = [light for light, kept in zip(ordered, keep, strict=True) if kept]
-        records = records[keep] if keep.any() else np.zeros((1, RECORD_VEC4S, 4), np.float32)
+        records = records[keep] if keep.any() else np.zeros((1, width, 4), np.float32)
         ranges: dict[type[Light], tuple[int, int]] = {}
         for index, light in enumerate(ordered):
             start, count = ranges.get(type(light), (index, 0))
@@ -139,16 +162,17 @@ class LightBuffer:
                                 **{light_range_uniform(light_type): span
                                    for light_type, span in self.ranges.items()}}
         fullscreen = np.zeros((FULLSCREEN_LIGHT_CAPACITY, RECORD_VEC4S, 4), np.float32)
-        fullscreen[:self.global_count] = records[:self.global_count]
+        fullscreen[:self.global_count] = records[:self.global_count, :RECORD_VEC4S]
         self._uniforms = {"u_light_count": self.count, "u_global_light_count": self.global_count,
                           FULLSCREEN_UNIFORM: fullscreen.tobytes(), **self._range_uniforms}
         self.culled = len(lights) - self.count
-        if rows > self._capacity:
+        width = records.shape[1]
+        if rows > self._capacity or self._texture is None or self._texture.width != width:
             self._release_storage()
             self._capacity = min(max(rows, 16), limit)
-            self._texture = self.ctx.texture((RECORD_VEC4S, self._capacity), 4, dtype="f4")
+            self._texture = self.ctx.texture((width, self._capacity), 4, dtype="f4")
             self._texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
-        self._texture.write(records.tobytes(), viewport=(0, 0, RECORD_VEC4S, rows))
+        self._texture.write(records.tobytes(), viewport=(0, 0, width, rows))
 
     def range(self, light_type: type[Light]) -> tuple[int, int]:
         return self.ranges.get(light_type, (0, 0))

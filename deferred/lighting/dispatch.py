@@ -25,9 +25,25 @@ def light_range_uniform(light_type: type[Light]) -> str:
     return f"{RANGE_UNIFORM_PREFIX}{light_type.type_id}"
 
 
+def light_data_glsl(light_type: type[Light]) -> list[str]:
+    """GLSL of a type's own data (``Light.data``): ``struct <glsl_function>_Data`` with a
+    ``vec4`` field per datum, and ``<glsl_function>_data(light)`` reading them from the light
+    buffer (``light_datum``, common/light_buffer.glsl). None for a type without data."""
+    if not light_type.data:
+        return []
+    name = light_type.glsl_function
+    fields = [f"    vec4 {datum.name};  // {datum.description}" for datum in light_type.data]
+    reads = ", ".join(f"light_datum(light, {k})" for k in range(len(light_type.data)))
+    return [f"struct {name}_Data {{", *fields, "};",
+            f"{name}_Data {name}_data(LightRecord light) {{",
+            f"    return {name}_Data({reads});", "}"]
+
+
 def light_dispatch_glsl(light_types: list[type[Light]]) -> str:
     """GLSL of the light dispatch (and the shading models' dispatch, which the lights call):
 
+    - each type's data struct and reader, where it declares data (:func:`light_data_glsl`),
+      before its file;
     - ``LIGHT_RANGE_<name>``: each type's range uniform (first record, count), defined for
       the scene's types whose name is an identifier;
     - ``evaluate_light``: one light of any type, a switch on its type id;
@@ -42,7 +58,10 @@ def light_dispatch_glsl(light_types: list[type[Light]]) -> str:
     lines = [f'#include "{SHADING_DISPATCH_FILE}"',
              f"#define FULLSCREEN_LIGHT_CAPACITY {FULLSCREEN_LIGHT_CAPACITY}",
              f'#include "{FULLSCREEN_LIGHTS_FILE}"']
-    lines += [f'#include "{cls.glsl_file}"' for cls in light_types]
+    if any(cls.data for cls in light_types):
+        lines.append('#include "common/light_buffer.glsl"')  # light_datum
+    for cls in light_types:
+        lines += [*light_data_glsl(cls), f'#include "{cls.glsl_file}"']
     lines += [f"uniform ivec2 {light_range_uniform(cls)};" for cls in light_types]
     # a type's range by its name, where the name is a GLSL identifier: `#ifdef LIGHT_RANGE_x`
     # holds where the scene has lights of type x (a material's own loop over one type)

@@ -161,7 +161,7 @@ def check_light_radii(light_path: str, lights: list, where: str = "light") -> No
     for index, light in enumerate(lights):
         if light.volume == LightVolume.FULLSCREEN:
             continue
-        radius = float(np.asarray(light.record(np.eye(4)), dtype=np.float64).reshape(4, 4)[1, 3])
+        radius = float(np.asarray(type(light).records([light], np.eye(4)), np.float64)[0, 1, 3])
         if radius > MAX_LISTED_RADIUS:
             raise InputError(f"a radius of {radius:g} is more than the light lists hold "
                              f"({MAX_LISTED_RADIUS:g}, a half float): use the volumes path",

@@ -6,5 +6,6 @@ uniform vec4 u_fullscreen_lights[4 * FULLSCREEN_LIGHT_CAPACITY];
 
 LightRecord fullscreen_light(int index) {
     return LightRecord(u_fullscreen_lights[4 * index], u_fullscreen_lights[4 * index + 1],
-                       u_fullscreen_lights[4 * index + 2], u_fullscreen_lights[4 * index + 3]);
+                       u_fullscreen_lights[4 * index + 2], u_fullscreen_lights[4 * index + 3],
+                       index);
 }

@@ -15,5 +15,11 @@ LightRecord fetch_light(int index) {
     return LightRecord(texelFetch(u_lights, ivec2(0, index), 0),
                        texelFetch(u_lights, ivec2(1, index), 0),
                        texelFetch(u_lights, ivec2(2, index), 0),
-                       texelFetch(u_lights, ivec2(3, index), 0));
+                       texelFetch(u_lights, ivec2(3, index), 0), index);
+}
+
+// The k-th vec4 of the light's type's own data (Light.data), after the record's four: read
+// through the type's generated struct (deferred.lighting.dispatch), which names each one.
+vec4 light_datum(LightRecord light, int k) {
+    return texelFetch(u_lights, ivec2(4 + k, light.index), 0);
 }

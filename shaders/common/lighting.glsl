@@ -8,11 +8,14 @@
 //   direction xyz = direction the light travels, w = type-specific (spot: cos outer angle)
 //   extra     type-specific (spot: x = cos inner angle; ambient: rgb = ground colour); w = the
 //             shadow slot, written by the framework (lighting/shadows.glsl; 0: no shadow)
+// and the light's row in the light buffer, where a type with data of its own (Light.data) reads
+// it: through <glsl_function>_data(light), a struct generated with the type's dispatch.
 struct LightRecord {
     vec4 color;
     vec4 position;
     vec4 direction;
     vec4 extra;
+    int index;
 };
 
 // The surface's shading model answers a light (generated dispatch, deferred.interfaces.shading):
