@@ -10,8 +10,11 @@ A plugin (the built-in materials, lights and effects, and the example package in
   :class:`PhasePasses`), its shadows, :class:`ShadowCaster` (:class:`NoShadow`,
   :class:`ShadowView`, ``SHADOW_CASTER_DEFINES``), :class:`Motion` (:class:`ReachMotion`,
   :class:`MotionOffsets`) and :class:`Simulation`; :class:`ShadingModel`, :class:`GBufferData`,
-  :class:`Light` (:class:`LightParams`), :class:`Effect` (:class:`EffectParams`), and the
-  registries to register them with: ``materials``, ``lights``, ``shading_models``, ``effects``.
+  :class:`Light` (:class:`LightParams`, :class:`LightDatum` for a type's own data;
+  :class:`AreaLight` and :class:`AreaLightParams`, the base of polygonal area lights, with
+  ``ltc_textures``, ``area_light_frame`` and ``disc_polygon_radius``), :class:`Effect`
+  (:class:`EffectParams`), and the registries to register them with: ``materials``,
+  ``lights``, ``shading_models``, ``effects``.
 - **passes**: :class:`RenderPass`, :class:`ObjectPass` (with the :class:`PassInput` and
   :class:`Shape` it composes), :class:`FullscreenPass`, :class:`ClearPass`, :func:`copy_pass`,
   compositions of passes (:func:`compose_runs`, ``BEGIN``, ``END``: order-independent
@@ -87,6 +90,15 @@ from deferred.gl.targets import (
     LIGHT_ACCUMULATION,
     LIGHT_ACCUMULATION_SPEC,
 )
+from deferred.interfaces.area import (
+    AreaLight,
+    AreaLightParams,
+    disc_polygon_radius,
+    ltc_textures,
+)
+from deferred.interfaces.area import (
+    light_frame as area_light_frame,
+)
 from deferred.interfaces.effect import (
     AMBIENT_OCCLUSION,
     Effect,
@@ -96,6 +108,7 @@ from deferred.interfaces.effect import (
 )
 from deferred.interfaces.light import (
     Light,
+    LightDatum,
     LightParams,
     ShadowParams,
     radiances,
@@ -159,6 +172,11 @@ GLSL_INCLUDES: dict[str, str] = {
                             "through the whole volume beyond its back for any other surface",
     "common/forward_lighting.glsl": "every light of the frame at one surface point (forward "
                                     "passes)",
+    "lighting/area.glsl": "struct AreaLight and shade_area (an area light's GLSL); a shading "
+                          "model's area function's integrals: the polygon's clipped cosine "
+                          "integral (area_irradiance), a GGX lobe's share by linearly "
+                          "transformed cosines (area_ggx), the light as a point light "
+                          "(area_as_point_light)",
     "lighting/environment.glsl": "struct Environment and the image-based light's lookups: "
                                  "irradiance (9 spherical harmonics) and GGX-prefiltered "
                                  "radiance by roughness (a shading model's environment "
@@ -189,8 +207,9 @@ GLSL_INCLUDES: dict[str, str] = {
 }
 
 __all__ = [
-    "ALBEDO_SPECULAR", "AMBIENT_OCCLUSION", "BEGIN", "COMPOSITE", "COMPOSITE_SPEC", "DEPTH",
-    "END", "FINAL",
+    "ALBEDO_SPECULAR", "AMBIENT_OCCLUSION", "AreaLight", "AreaLightParams", "BEGIN",
+    "LightDatum", "area_light_frame", "disc_polygon_radius", "ltc_textures",
+    "COMPOSITE", "COMPOSITE_SPEC", "DEPTH", "END", "FINAL",
     "FINAL_SPEC", "FrameMoment", "GBUFFER_COLOR_TARGETS", "GLSL_INCLUDES", "LIGHT_ACCUMULATION",
     "LIGHT_ACCUMULATION_SPEC", "LINEAR_DEPTH", "MAX_COORDINATE", "MOTION", "MOTION_SPEC",
     "NORMAL_EXPONENT_ID",

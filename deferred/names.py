@@ -72,3 +72,4 @@ class ShadowFilter(NameEnum):
 
     PCF = "pcf"  # 3x3 bilinear hardware comparisons (4x4 texels)
     SOFT = "soft"  # a 16-tap Poisson disk of radius ``shadow_softness`` texels
+    PCSS = "pcss"  # percentage-closer soft shadows sized by an area light's emitter

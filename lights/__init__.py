@@ -12,4 +12,6 @@ BUILTINS = {
     "point": "deferred.lights.point:PointLight",
     "spot": "deferred.lights.spot:SpotLight",
     "environment": "deferred.lights.environment:EnvironmentLight",
+    "rect": "deferred.lights.rect:RectLight",
+    "disc": "deferred.lights.disc:DiscLight",
 }

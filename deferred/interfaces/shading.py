@@ -10,9 +10,13 @@ shading-model id, the forward pass in its loop over the lights. An optional
 ``albedo * irradiance``), and an optional ``vec3 <environment_function>(Surface s, vec3 V,
 Environment e)`` the image-based light (``lighting/environment.glsl``: its irradiance and its
 prefiltered radiance by roughness; default: the ambient answer to its irradiance at the
-normal, times the surface's occlusion). Register with
-``@deferred.api.shading_models.register`` or the entry-point group ``deferred.shading_models``;
-only the models a scene uses are compiled.
+normal, times the surface's occlusion). An optional ``vec3 <area_function>(Surface s, vec3 V,
+AreaLight a)`` in its own ``area_file`` answers area lights (``lighting/area.glsl``: the
+polygon's clipped cosine integral, a GGX lobe's share of it by linearly transformed cosines);
+default: the light taken as a point light along its vector irradiance
+(``area_as_point_light``). The area answers are compiled only into scenes with area lights.
+Register with ``@deferred.api.shading_models.register`` or the entry-point group
+``deferred.shading_models``; only the models a scene uses are compiled.
 
 **G-buffer data** is extra per-pixel data (a strand tangent, a toon ramp row) in a render target
 of its own. A material declares it (``Material.gbuffer_data``) and so may a shading model (what it
@@ -49,6 +53,9 @@ class ShadingModel:
     glsl_function: ClassVar[str] = ""
     ambient_function: ClassVar[str | None] = None
     environment_function: ClassVar[str | None] = None
+    # the area-light answer and its file (compiled only where the scene has area lights)
+    area_function: ClassVar[str | None] = None
+    area_file: ClassVar[str | None] = None
     # the most bytes a pixel the model's surfaces may take in the G-buffer (the core and its
     # data): `deferred info` states it, and a model's data over it is refused (None: no budget)
     gbuffer_budget: ClassVar[int | None] = None
@@ -63,11 +70,12 @@ class ShadingModel:
 
 
 ENVIRONMENT_GLSL = "lighting/environment.glsl"
+AREA_GLSL = "lighting/area.glsl"
 
 
-def shading_dispatch_glsl(models: list[type[ShadingModel]]) -> str:
+def shading_dispatch_glsl(models: list[type[ShadingModel]], area: bool = False) -> str:
     """GLSL of ``shade_light``, ``shade_ambient`` and ``shade_environment``: the scene's
-    models, by id."""
+    models, by id; with ``area`` (the scene has area lights), ``shade_area`` too."""
     lines = [f'#include "{ENVIRONMENT_GLSL}"']
     lines += [f'#include "{cls.glsl_file}"' for cls in models]
     lines.append("vec3 shade_light(Surface s, vec3 L, vec3 V, vec3 radiance) {")
@@ -85,4 +93,13 @@ def shading_dispatch_glsl(models: list[type[ShadingModel]]) -> str:
               for cls in models if cls.environment_function]
     lines += ["    return shade_ambient(s, environment_irradiance(e, s.normal) * s.occlusion);",
               "}"]
+    if area:
+        lines.append(f'#include "{AREA_GLSL}"')
+        lines += [f'#include "{cls.area_file}"' for cls in models
+                  if cls.area_function and cls.area_file]
+        lines.append("vec3 shade_area(Surface s, vec3 V, AreaLight a) {")
+        lines += [f"    if (s.shading_model == {cls.type_id}) "
+                  f"return {cls.area_function}(s, V, a);"
+                  for cls in models if cls.area_function]
+        lines += ["    return area_as_point_light(s, V, a);", "}"]
     return "\n".join(lines) + "\n"

@@ -35,7 +35,8 @@ def generated_glsl(light_types: list[type[Light]], shading_models: list[type[Sha
     files = {
         DISPATCH_FILE: light_dispatch_glsl(light_types),
         LISTED_DISPATCH_FILE: listed_dispatch_glsl(light_types),
-        SHADING_DISPATCH_FILE: shading_dispatch_glsl(shading_models),
+        SHADING_DISPATCH_FILE: shading_dispatch_glsl(
+            shading_models, area=any(cls.area for cls in light_types)),
         DATA_STRUCT_FILE: data_struct_glsl(names),
         DATA_FETCH_FILE: data_fetch_glsl(names),
         data_write_file([]): data_write_glsl([]),

@@ -26,7 +26,12 @@ from deferred.lighting.lists import (
     check_light_radii,
 )
 from deferred.lighting.paths import resolve_light_path
-from deferred.lighting.shadows.atlas import SHADOW_ATLAS, SHADOWS_DEFINE, ShadowAtlas
+from deferred.lighting.shadows.atlas import (
+    PCSS_DEFINE,
+    SHADOW_ATLAS,
+    SHADOWS_DEFINE,
+    ShadowAtlas,
+)
 from deferred.lighting.shadows.opacity import (
     OPACITY_SHADOWS_DEFINE,
     opacity_extent,
@@ -122,6 +127,9 @@ class RenderSetup:
         defines = dict(self.pipeline.shader_defines())
         if scene_casts_shadows(state.lights):
             defines[SHADOWS_DEFINE] = "1"
+            if any(light.casts_shadows and light.params.shadow_filter == "pcss"
+                   for light in state.lights):
+                defines[PCSS_DEFINE] = "1"
         if scene_has_opacity(state, plan.pipeline_name):
             defines[OPACITY_SHADOWS_DEFINE] = "1"
         self.shaders = ShaderLibrary(ctx, features.glsl_version(), defines)

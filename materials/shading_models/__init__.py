@@ -1,7 +1,9 @@
 """Built-in shading models (see :mod:`deferred.interfaces.shading`); importing this module
 registers them.
 
-- ``blinn_phong``: the standard model (albedo, specular intensity and exponent).
+- ``blinn_phong``: the standard model (albedo, specular intensity and exponent); area lights
+  by the polygon's irradiance and, for the highlight, GGX's LTC of the same width
+  (``blinn_phong_area.glsl``).
 - ``kajiya_kay``: strands (Silva et al. Eq. 6; Kajiya and Kay 1989): diffuse |T x L|, specular
   ((T.L)(T.E) + |T x L||T x E|)^p along the strand tangent T, stored as G-buffer data.
 - ``marschner``: hair (Marschner et al. 2003 in Karis's 2016 real-time form): R, TT and TRT
@@ -19,7 +21,13 @@ registers them.
   light between the lobes by the same table. The G-buffer carries the base colour as the
   albedo, metallic as the specular intensity, the perceptual roughness as the specular exponent
   and the material's ambient occlusion in the datum ``pbr_occlusion``: 21 bytes a pixel,
-  within the model's budget of :data:`PBR_GBUFFER_BUDGET`.
+  within the model's budget of :data:`PBR_GBUFFER_BUDGET`. Area lights by linearly transformed
+  cosines (``pbr_area.glsl``).
+
+``kajiya_kay``, ``marschner`` and ``toon`` have no area answer: an area light reaches them as a
+point light along its vector irradiance bringing that irradiance (``area_as_point_light`` in
+``lighting/area.glsl``): a strand's lobes are not cosine lobes an LTC fits, and a toon ramp
+wants one light direction.
 """
 
 from __future__ import annotations
@@ -52,6 +60,8 @@ class BlinnPhong(ShadingModel):
     name = "blinn_phong"
     glsl_file = "materials/shading_models/blinn_phong.glsl"
     glsl_function = "blinn_phong"
+    area_file = "materials/shading_models/blinn_phong_area.glsl"
+    area_function = "blinn_phong_area"
 
 
 @shading_models.register
@@ -173,6 +183,8 @@ class Pbr(ShadingModel):
     glsl_function = "pbr"
     ambient_function = "pbr_ambient"
     environment_function = "pbr_environment"
+    area_file = "materials/shading_models/pbr_area.glsl"
+    area_function = "pbr_area"
     gbuffer_data = (PBR_OCCLUSION,)
     gbuffer_budget = PBR_GBUFFER_BUDGET
 

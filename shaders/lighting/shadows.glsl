@@ -3,8 +3,10 @@
 // lookup is a 2x2 PCF). A light's record holds its shadow slot in extra.w (0: no shadow);
 // slot k is row k - 1 of u_shadow_records, an RGBA32F texture of RECORD_TEXELS (40) texels
 // a row:
-//   0: projection (1 cascades, 2 perspective, 3 cube), tiles, filter (0 pcf, 1 soft), softness
-//   1: depth bias, normal bias (texels), cascade blend band (fraction of a cascade), -
+//   0: projection (1 cascades, 2 perspective, 3 cube), tiles, filter (0 pcf, 1 soft, 2 pcss),
+//      softness
+//   1: depth bias, normal bias (texels), cascade blend band (fraction of a cascade), the
+//      light's emitter radius (pcss: an area light's equivalent disc)
 //   2: the cascades' far view depths
 //   3: -
 //   4 + 6 i .. 9 + 6 i, tile i: the view-space -> atlas (u, v, depth) matrix's columns, the
@@ -13,6 +15,14 @@
 //      distances (z, w: a depth back to the light's view depth)
 // Without SHADOWS (no light of the scene casts shadows) the light_shadow_* functions are 1 and
 // read nothing.
+//
+// Percentage-closer soft shadows (SHADOW_PCSS: a light of the scene filters so; Fernando 2005)
+// on perspective tiles: blockers are searched for over the part of the map the cone from the
+// point to the light's disc crosses (u_shadow_depths: the atlas's raw depths), and the
+// comparisons are filtered over the penumbra their mean depth gives, r (1 / z_blocker - 1 /
+// z_receiver) / (2 tan(half the tile's angle)) of the tile for an emitter of radius r. Both
+// reaches are capped at PCSS_MAX_REACH of the tile; the disk turns with the pixel (interleaved
+// gradient noise, Jimenez 2014), so a wide penumbra is grain rather than bands.
 //
 // Deep opacity maps (OPACITY_SHADOWS: a volume such as fur draws them; Yuksel and Keyser 2008):
 // over the atlas's square its lights' maps take (atlas coordinates times u_opacity_from_atlas),
@@ -79,12 +89,7 @@ const vec2 SHADOW_POISSON[16] = vec2[](
     vec2(-0.2419, 0.9971), vec2(-0.8141, 0.9144), vec2(0.1998, 0.7864),
     vec2(0.1438, -0.1410));
 
-#ifdef OPACITY_SHADOWS
-uniform sampler2D u_opacity_first;  // RG32F: light-view depth of the volume's front, - its back
-uniform sampler2D u_opacity;        // RGBA16F: optical depth up to each layer's far end
-uniform vec4 u_opacity_layers;      // the layers' far ends behind the front, world units
-uniform float u_opacity_from_atlas; // atlas -> opacity-map coordinates (their square's scale)
-
+#if defined(OPACITY_SHADOWS) || defined(SHADOW_PCSS)
 // The light-view depth of a depth-buffer value of a tile (near, far; perspective or not).
 float shadow_view_depth(float window_z, vec4 size) {
     float n = size.z, f = size.w;
@@ -92,6 +97,14 @@ float shadow_view_depth(float window_z, vec4 size) {
     return 2.0 * n * f / (f + n - (2.0 * window_z - 1.0) * (f - n));
 }
 #endif
+
+#ifdef OPACITY_SHADOWS
+uniform sampler2D u_opacity_first;  // RG32F: light-view depth of the volume's front, - its back
+uniform sampler2D u_opacity;        // RGBA16F: optical depth up to each layer's far end
+uniform vec4 u_opacity_layers;      // the layers' far ends behind the front, world units
+uniform float u_opacity_from_atlas; // atlas -> opacity-map coordinates (their square's scale)
+#endif
+
 
 #ifdef OPACITY_SHADOWS
 // The light a surface other than the volume's own keeps at view-space P: the transmittance
@@ -189,6 +202,89 @@ float shadow_compare(vec3 uvz, vec4 rect) {
                                            uvz.z), 0.0);
 }
 
+#ifdef SHADOW_PCSS
+uniform sampler2D u_shadow_depths;  // the atlas's depths, read without comparison
+const float PCSS_MAX_REACH = 0.25;  // of a tile: the widest search and filter
+const int PCSS_SEARCH_TAPS = 16;
+const int PCSS_FILTER_TAPS = 24;
+
+// The disk of the soft filter (SHADOW_POISSON, 16 taps) and its mirror turned a little, for
+// 32 taps, rotated by the pixel's angle
+vec2 pcss_tap(int k, mat2 turn) {
+    vec2 tap = SHADOW_POISSON[k & 15];
+    if (k >= 16) tap = vec2(-tap.y, tap.x) * 0.7;
+    return turn * tap;
+}
+
+mat2 pcss_turn() {
+    float noise = fract(52.9829189 * fract(dot(gl_FragCoord.xy, vec2(0.06711056, 0.00583715))));
+    float angle = 6.28318530718 * noise;
+    return mat2(cos(angle), sin(angle), -sin(angle), cos(angle));
+}
+
+// The lit fraction at uvz (a perspective tile: rect, size as shadow_tile reads them) of a light
+// of emitter radius r (world units); slope: the receiver's plane's depth per atlas unit, so a
+// tap far from the centre compares the plane's own depth there, not the centre's (a wide
+// filter on a plane at a slant to the light would shadow the plane by itself)
+float shadow_pcss(vec3 uvz, vec4 rect, vec4 size, float r, vec2 slope) {
+    float tile = rect.z - rect.x;  // atlas units across the tile
+    float tan_half = 0.5 * size.x * tile / u_shadow_atlas_texel;
+    float receiver = shadow_view_depth(uvz.z, size);
+    float to_atlas = r * tile / (2.0 * tan_half);  // per unit of inverse depth
+    float search = min(to_atlas * (1.0 / size.z - 1.0 / receiver), PCSS_MAX_REACH * tile);
+    mat2 turn = pcss_turn();
+    // a texel's value is the depth at its centre: the plane's own texels may lie up to a texel's
+    // slope nearer than the plane at the tap
+    float slack = length(slope) * 1.5 * u_shadow_atlas_texel;
+    float blockers = 0.0;
+    float found = 0.0;
+    // taps past the tile's edge see another face's part of the scene: left out, not clamped
+    vec2 low = rect.xy + vec2(0.5 * u_shadow_atlas_texel);
+    vec2 high = rect.zw - vec2(0.5 * u_shadow_atlas_texel);
+    for (int k = 0; k < PCSS_SEARCH_TAPS; ++k) {
+        vec2 offset = pcss_tap(k, turn) * search;
+        vec2 uv = uvz.xy + offset;
+        if (any(lessThan(uv, low)) || any(greaterThan(uv, high))) continue;
+        float depth = textureLod(u_shadow_depths, uv, 0.0).r;
+        // nearer than the receiver's plane there, and than the receiver (the plane carried
+        // far past the point may pass behind the far plane, where the map holds nothing)
+        if (depth < min(uvz.z + dot(slope, offset) - slack, uvz.z)) {
+            blockers += shadow_view_depth(depth, size);
+            found += 1.0;
+        }
+    }
+    if (found == 0.0) return 1.0;
+    float blocker = blockers / found;
+    float width = clamp(to_atlas * (1.0 / blocker - 1.0 / receiver), u_shadow_atlas_texel,
+                        PCSS_MAX_REACH * tile);
+    float lit = 0.0;
+    float taps = 0.0;
+    for (int k = 0; k < PCSS_FILTER_TAPS; ++k) {
+        vec2 offset = pcss_tap(k, turn) * width;
+        vec2 uv = uvz.xy + offset;
+        if (any(lessThan(uv, low)) || any(greaterThan(uv, high))) continue;
+        lit += shadow_compare(vec3(uvz.xy + offset,
+                                   min(uvz.z + dot(slope, offset) - slack, 1.0)), rect);
+        taps += 1.0;
+    }
+    return taps > 0.0 ? lit / taps : 1.0;
+}
+
+// The depth slope of the plane through view-space Q of normal N, per atlas unit
+vec2 pcss_slope(mat4 to_atlas, vec3 Q, vec3 N, float step) {
+    vec3 T1 = normalize(cross(N, abs(N.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0)));
+    vec3 T2 = cross(N, T1);
+    vec4 a = to_atlas * vec4(Q, 1.0), b = to_atlas * vec4(Q + T1 * step, 1.0),
+         c = to_atlas * vec4(Q + T2 * step, 1.0);
+    vec3 A = a.xyz / a.w, B = b.xyz / b.w, C = c.xyz / c.w;
+    mat2 across = mat2(B.xy - A.xy, C.xy - A.xy);  // columns: each step's atlas offset
+    float det = determinant(across);
+    if (abs(det) < 1e-12) return vec2(0.0);
+    // the gradient g with dot(g, offset) = the depth change of each step
+    return inverse(transpose(across)) * vec2(B.z - A.z, C.z - A.z);
+}
+#endif
+
 // The lit fraction of a point at atlas coordinates uvz in tile rect: one loop whichever the
 // filter (pcf: SHADOW_GRID, a texel apart; soft: SHADOW_POISSON, header.w texels wide), so a
 // light pays for its own filter's taps only (where a shader runs as masked SIMD lanes, as on
@@ -204,6 +300,17 @@ float shadow_filter(vec3 uvz, vec4 rect, vec4 header) {
         lit += shadow_compare(uvz + vec3(offset * scale, 0.0), rect);
     } while (++k < taps);
     return lit / float(taps);
+}
+
+// The tile's filter at uvz: shadow_filter's, or PCSS's where the light asks for it (its emitter
+// radius in biases.w; Q the biased point and N its normal, for the receiver's plane)
+float shadow_lookup(vec3 uvz, vec4 rect, vec4 header, vec4 size, vec4 biases, mat4 to_atlas,
+                    vec3 Q, vec3 N, float texel) {
+#ifdef SHADOW_PCSS
+    if (header.z > 1.5)
+        return shadow_pcss(uvz, rect, size, biases.w, pcss_slope(to_atlas, Q, N, 8.0 * texel));
+#endif
+    return shadow_filter(uvz, rect, header);
 }
 
 // One tile's lit fraction at view-space P (normal N, unit L toward the light, distance to it).
@@ -228,13 +335,14 @@ float shadow_tile(int row, int tile, vec4 header, vec4 biases, vec3 P, vec3 N, v
 #if defined(OPACITY_RECEIVER) && defined(OPACITY_SHADOWS)
     float transmittance = opacity_transmittance(to_atlas, rect, size, P);
     opacity_last = transmittance;
-    float lit = shadow_filter(uvz, rect, header);
+    float lit = shadow_lookup(uvz, rect, header, size, biases, to_atlas, Q, N, texel);
     if (opacity_as_light_pass) return lit * opacity_beyond(to_atlas, rect, size, P);
     return lit * (opacity_split ? 1.0 : transmittance);
 #elif defined(OPACITY_SHADOWS)
-    return shadow_filter(uvz, rect, header) * opacity_beyond(to_atlas, rect, size, P);
+    return shadow_lookup(uvz, rect, header, size, biases, to_atlas, Q, N, texel) *
+           opacity_beyond(to_atlas, rect, size, P);
 #else
-    return shadow_filter(uvz, rect, header);
+    return shadow_lookup(uvz, rect, header, size, biases, to_atlas, Q, N, texel);
 #endif
 }
 

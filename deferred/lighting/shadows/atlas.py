@@ -32,6 +32,8 @@ from deferred.scene.scene import Scene
 
 SHADOW_ATLAS = "shadow_atlas"  # its name on a frame's blackboard
 SHADOWS_DEFINE = "SHADOWS"
+PCSS_DEFINE = "SHADOW_PCSS"  # a light of the scene filters its shadows by its size
+FILTER_IDS = {"pcf": 0.0, "soft": 1.0, "pcss": 2.0}  # lighting/shadows.glsl's header.z
 RECORD_TEXELS = 40  # texels a slot's row: 4 + 6 tiles x 6 (lighting/shadows.glsl)
 CASCADE_BLEND = 0.1  # the fraction of a cascade blended into the next at its far end
 PROJECTION_IDS = {ShadowProjection.CASCADES: 1, ShadowProjection.PERSPECTIVE: 2,
@@ -87,6 +89,10 @@ class ShadowAtlas:
         self.texture.compare_func = "<="
         self.texture.filter = (moderngl.LINEAR, moderngl.LINEAR)
         self.texture.repeat_x = self.texture.repeat_y = False
+        # the same depths read as numbers (PCSS's blocker search): a sampler without comparison
+        self.depth_sampler = ctx.sampler(texture=self.texture, compare_func="",
+                                         filter=(moderngl.NEAREST, moderngl.NEAREST),
+                                         repeat_x=False, repeat_y=False)
         self.framebuffer = ctx.framebuffer(depth_attachment=self.texture)
         self.framebuffer.clear(depth=1.0)  # tiles no light holds read as lit, and show so
         self.records = ctx.texture((RECORD_TEXELS, max_lights), 4, dtype="f4")
@@ -149,9 +155,12 @@ class ShadowAtlas:
                 if not visible_spheres(sphere, projection)[0]:
                     continue
             row = records[slot - 1]
-            row[0] = (PROJECTION_IDS[kind], len(squares),
-                      0.0 if params.shadow_filter == "pcf" else 1.0, params.shadow_softness)
-            row[1] = (params.shadow_bias, params.normal_bias, CASCADE_BLEND, 0.0)
+            pcss = params.shadow_filter == "pcss"
+            # pcss: the normal offset's reach is pcf's (the plane's slope covers the rest)
+            row[0] = (PROJECTION_IDS[kind], len(squares), FILTER_IDS[params.shadow_filter],
+                      1.5 if pcss else params.shadow_softness)
+            row[1] = (params.shadow_bias, params.normal_bias, CASCADE_BLEND,
+                      light.emitter_radius() if pcss else 0.0)
             if kind == ShadowProjection.CASCADES:
                 if bounds is None:
                     bounds = world_bounds(scene)
@@ -226,6 +235,10 @@ class ShadowAtlas:
             self.records.use(location=texture_unit + 1)
             uniforms.set_one("u_shadow_records", texture_unit + 1)
             texture_unit += 2
+            if "u_shadow_depths" in uniforms.members:
+                self.depth_sampler.use(location=texture_unit)
+                uniforms.set_one("u_shadow_depths", texture_unit)
+                texture_unit += 1
         if self.opacity is None:
             return texture_unit
         for name, texture in (("u_opacity_first", self.opacity_first),
@@ -262,7 +275,7 @@ class ShadowAtlas:
         return -first.reshape(side, side, 2)[..., 1]
 
     def release(self) -> None:
-        parts = [self.framebuffer, self.texture, self.records]
+        parts = [self.framebuffer, self.depth_sampler, self.texture, self.records]
         if self.opacity is not None:
             parts += [self.first_framebuffer, self.front_framebuffer, self.opacity_framebuffer,
                       self.opacity_drawn, self.opacity_first, self.opacity]

@@ -60,7 +60,8 @@ def perspective(tan_half: float, near: float, far: float) -> np.ndarray:
 
 def filter_margin(params: Any) -> float:
     """Texels a lookup's filter reaches from its centre (PCF: a texel, plus bilinear)."""
-    return 2.0 if params.shadow_filter == "pcf" else math.ceil(params.shadow_softness) + 1.0
+    return 2.0 if params.shadow_filter in ("pcf", "pcss") else \
+        math.ceil(params.shadow_softness) + 1.0
 
 
 def light_up(direction: np.ndarray) -> np.ndarray:
