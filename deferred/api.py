@@ -26,7 +26,8 @@ A plugin (the built-in materials, lights and effects, and the example package in
   :class:`TargetSpec` for the targets a pass creates.
 - **targets by name**: the G-buffer's (``ALBEDO_SPECULAR``, ``NORMAL_EXPONENT_ID``,
   ``LINEAR_DEPTH``, ``DEPTH``, ``GBUFFER_COLOR_TARGETS``) and the frame's
-  (``LIGHT_ACCUMULATION``, ``COMPOSITE``, ``FINAL`` and their specs).
+  (``LIGHT_ACCUMULATION``, ``DIFFUSE_LIGHT`` where the scene splits its light, ``COMPOSITE``,
+  ``FINAL`` and their specs).
 - **parameters**: the validated types (:data:`Albedo`, :data:`Radiance`, :data:`NonZeroVec3`),
   :class:`Params` and ``UniformOverrides``; ``require_regular_file`` for file parameters,
   ``number_too_long`` for a file whose parser refuses an integer of too many digits.
@@ -85,6 +86,8 @@ from deferred.gl.target_spec import TargetSpec
 from deferred.gl.targets import (
     COMPOSITE,
     COMPOSITE_SPEC,
+    DIFFUSE_LIGHT,
+    DIFFUSE_LIGHT_SPEC,
     FINAL,
     FINAL_SPEC,
     LIGHT_ACCUMULATION,
@@ -209,7 +212,7 @@ GLSL_INCLUDES: dict[str, str] = {
 __all__ = [
     "ALBEDO_SPECULAR", "AMBIENT_OCCLUSION", "AreaLight", "AreaLightParams", "BEGIN",
     "LightDatum", "area_light_frame", "disc_polygon_radius", "ltc_textures",
-    "COMPOSITE", "COMPOSITE_SPEC", "DEPTH", "END", "FINAL",
+    "COMPOSITE", "COMPOSITE_SPEC", "DEPTH", "DIFFUSE_LIGHT", "DIFFUSE_LIGHT_SPEC", "END", "FINAL",
     "FINAL_SPEC", "FrameMoment", "GBUFFER_COLOR_TARGETS", "GLSL_INCLUDES", "LIGHT_ACCUMULATION",
     "LIGHT_ACCUMULATION_SPEC", "LINEAR_DEPTH", "MAX_COORDINATE", "MOTION", "MOTION_SPEC",
     "NORMAL_EXPONENT_ID",

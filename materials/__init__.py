@@ -14,6 +14,7 @@ BUILTINS = {
     "stipple_glass": "deferred.materials.stipple_glass:StippleGlassMaterial",
     "pbr": "deferred.materials.pbr:PbrMaterial",
     "glass": "deferred.materials.glass:GlassMaterial",
+    "subsurface": "deferred.materials.subsurface:SubsurfaceMaterial",
 }
 
 # One package for them all: small classes sharing G-buffer data (the strand tangent), loaded
@@ -25,4 +26,5 @@ SHADING_MODELS = {
     "marschner": "deferred.materials.shading_models:Marschner",
     "pbr": "deferred.materials.shading_models:Pbr",
     "toon_strands": "deferred.materials.shading_models:ToonStrands",
+    "subsurface": "deferred.materials.shading_models:Subsurface",
 }

@@ -14,10 +14,13 @@ import numpy as np
 from deferred.gl.target_spec import TargetSpec
 
 LIGHT_ACCUMULATION = "light_accumulation"
+DIFFUSE_LIGHT = "diffuse_light"  # where the scene splits its light (SPLIT_LIGHTING)
 COMPOSITE = "composite"
 FINAL = "final"
 
 LIGHT_ACCUMULATION_SPEC = TargetSpec(4, "f2", "linear HDR light accumulated by every light")
+DIFFUSE_LIGHT_SPEC = TargetSpec(4, "f2", "the diffuse part of the light accumulation, of the "
+                                "shading models that split their light")
 COMPOSITE_SPEC = TargetSpec(4, "f2", "composition buffer: light accumulation + material phase")
 FINAL_SPEC = TargetSpec(4, "f1", "tone mapped, sRGB encoded")
 

@@ -15,6 +15,8 @@ from deferred.gbuffer.layout import LINEAR_DEPTH
 from deferred.gl.targets import (
     COMPOSITE,
     COMPOSITE_SPEC,
+    DIFFUSE_LIGHT,
+    DIFFUSE_LIGHT_SPEC,
     LIGHT_ACCUMULATION,
     LIGHT_ACCUMULATION_SPEC,
 )
@@ -116,12 +118,13 @@ def pixel_to_view(projection: np.ndarray, width: int, height: int) -> tuple[floa
 
 def list_shading_pass(name: str, clustered: bool, gbuffer: tuple[str, ...],
                       occlusion: str | None, background: tuple[float, float, float],
-                      composite: bool = False) -> FullscreenPass:
+                      composite: bool = False, split: bool = False) -> FullscreenPass:
     """The deferred lighting of every light from the lists: one full-screen pass, which creates
     the light accumulation (the scene's background where the G-buffer holds no surface, alpha
     0; the lights' sum on surfaces, alpha 1), so no pass has to lay the background down first.
     With ``composite`` it creates the composition buffer too, the same values (a frame with
-    no material pass: the copy between them would be all the material phase did).
+    no material pass: the copy between them would be all the material phase did); with
+    ``split`` (the scene splits its light) the diffuse light beside it.
 
     It runs on surfaces only (:func:`deferred.lighting.volumes.surface_pass`; measured in
     benchmarks/README.md)."""
@@ -136,4 +139,6 @@ def list_shading_pass(name: str, clustered: bool, gbuffer: tuple[str, ...],
     if composite:
         creates[COMPOSITE] = COMPOSITE_SPEC
         defines["WRITE_COMPOSITE"] = "1"
+    if split:
+        creates[DIFFUSE_LIGHT] = DIFFUSE_LIGHT_SPEC
     return surface_pass(name, "lighting/list_shading.frag", inputs, creates, background, defines)

@@ -15,7 +15,7 @@ from deferred.gbuffer.layout import DEPTH, GBUFFER_COLOR_TARGETS
 from deferred.gl.context import GL_DEPTH_CLAMP
 from deferred.gl.meshes import MeshData
 from deferred.gl.target_spec import TargetSpec
-from deferred.gl.targets import LIGHT_ACCUMULATION
+from deferred.gl.targets import DIFFUSE_LIGHT, LIGHT_ACCUMULATION
 from deferred.interfaces.light import Light
 from deferred.lighting.buffer import LIGHT_BUFFER
 from deferred.names import LightVolume
@@ -64,19 +64,20 @@ class LightTypePass(RenderPass):
     """Deferred lighting of every light of one type, instanced, added into light accumulation.
 
     It reads the G-buffer, including the scene's declared data (``gbuffer``, the colour targets
-    of the scene's layout), so every shading model finds what it reads."""
+    of the scene's layout), so every shading model finds what it reads. With ``split`` (the
+    scene splits its light) it adds the diffuse part into the diffuse light too."""
 
     phase = Phase.LIGHTING
-    writes = (LIGHT_ACCUMULATION,)
 
     def __init__(self, light_type: type[Light], occlusion: str | None = None,
-                 gbuffer: tuple[str, ...] = GBUFFER_COLOR_TARGETS):
+                 gbuffer: tuple[str, ...] = GBUFFER_COLOR_TARGETS, split: bool = False):
         self.light_type = light_type
+        self.writes = (LIGHT_ACCUMULATION, DIFFUSE_LIGHT) if split else (LIGHT_ACCUMULATION,)
         self.name = f"lighting.{light_type.name}"
         self.occlusion = occlusion  # target holding ambient occlusion (SSAO), if any
         self.gbuffer = gbuffer
         self.samples = (*gbuffer, *((occlusion,) if occlusion else ()))
-        self.reads = (*self.samples, DEPTH, LIGHT_ACCUMULATION)
+        self.reads = (*self.samples, DEPTH, *self.writes)
 
     def execute(self, frame: Frame) -> None:
         offset, count = frame.blackboard[LIGHT_BUFFER].range(self.light_type)
@@ -90,7 +91,7 @@ class LightTypePass(RenderPass):
         if not sphere:
             defines["FULLSCREEN_AT_FAR"] = "1"
         program = frame.shaders.program(vertex, "lighting/accumulate.frag", defines=defines)
-        frame.use_framebuffer((LIGHT_ACCUMULATION,), DEPTH, depth_write=False)
+        frame.use_framebuffer(self.writes, DEPTH, depth_write=False)
         textures = frame.target_samplers(self.gbuffer)
         if self.occlusion:
             textures["u_ssao"] = frame.target(self.occlusion)

@@ -45,12 +45,15 @@ from deferred.gbuffer.layout import (
 from deferred.gl.targets import (
     COMPOSITE,
     COMPOSITE_SPEC,
+    DIFFUSE_LIGHT,
+    DIFFUSE_LIGHT_SPEC,
     FINAL,
     FINAL_SPEC,
     LIGHT_ACCUMULATION,
     LIGHT_ACCUMULATION_SPEC,
 )
 from deferred.interfaces.effect import AMBIENT_OCCLUSION
+from deferred.interfaces.shading import scene_splits_light
 from deferred.interfaces.techniques import ForwardLitPass
 from deferred.lighting.culling import LightCullPass, list_shading_pass
 from deferred.lighting.shadows.caster_pass import ShadowPass
@@ -237,6 +240,7 @@ class DeferredPipeline(Pipeline):
             else None
         folded = False  # the composition made by the lighting pass (below)
         environment = scene.background == ENVIRONMENT_BACKGROUND
+        split = scene_splits_light(scene.shading_models())
         if self.light_path == names.LightPath.VOLUMES:
             # the light accumulation starts as 0 on surfaces and the background elsewhere
             # (its clear); each light type's pass adds into it
@@ -244,15 +248,19 @@ class DeferredPipeline(Pipeline):
                                       {"u_normal_exponent_id": NORMAL_EXPONENT_ID},
                                       {LIGHT_ACCUMULATION: LIGHT_ACCUMULATION_SPEC},
                                       clear_colour(scene))
-            lights = [background, *(LightTypePass(cls, occlusion, layout.color_targets)
+            lights = [background, *(LightTypePass(cls, occlusion, layout.color_targets, split)
                                     for cls in scene.light_types())]
+            if split:
+                lights.insert(0, ClearPass("lighting.diffuse_clear", Phase.LIGHTING, {
+                    DIFFUSE_LIGHT: replace(DIFFUSE_LIGHT_SPEC, clear=(0.0, 0.0, 0.0, 0.0))}))
         else:
             # One pass shades every light and writes the background where there is no surface.
             # Where no other pass writes the light accumulation and the material phase has no
             # pass, the composition is the light accumulation: the same pass writes both, and
             # there is nothing to copy.
             clustered = self.light_path == names.LightPath.CLUSTERED
-            folded = not environment and not phase_passes(scene, Phase.MATERIAL, [], wide) \
+            folded = not environment and not split and \
+                not phase_passes(scene, Phase.MATERIAL, [], wide) \
                 and not any(
                 LIGHT_ACCUMULATION in p.writes
                 for p in phase_passes(scene, Phase.LIGHTING, [], wide))
@@ -260,7 +268,7 @@ class DeferredPipeline(Pipeline):
                                     Phase.LIGHTING, clustered),
                       list_shading_pass(f"lighting.{self.light_path}", clustered,
                                         layout.color_targets, occlusion,
-                                        clear_colour(scene), composite=folded)]
+                                        clear_colour(scene), composite=folded, split=split)]
         if environment:  # behind the lit surfaces, after every light
             lights.append(environment_background_pass(Phase.LIGHTING, LIGHT_ACCUMULATION,
                                                       Order.LAST))

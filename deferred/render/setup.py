@@ -18,6 +18,12 @@ from deferred.gl.context import Features, GLContext
 from deferred.gl.resources import Resources
 from deferred.gl.shaderlib import ShaderLibrary
 from deferred.gl.targets import FrameTargets
+from deferred.interfaces.shading import (
+    SPLIT_DEFINE,
+    TRANSMISSION_DEFINE,
+    scene_splits_light,
+    scene_transmits,
+)
 from deferred.lighting.buffer import LIGHT_BUFFER, LightBuffer
 from deferred.lighting.lists import (
     LIGHT_LISTS,
@@ -125,6 +131,10 @@ class RenderSetup:
         if self.light_path != plan.provisional:
             self.graph = check_passes(self.pipeline.build(state))
         defines = dict(self.pipeline.shader_defines())
+        if scene_splits_light(plan.shading_models):
+            defines[SPLIT_DEFINE] = "1"
+        if scene_transmits(plan.shading_models):
+            defines[TRANSMISSION_DEFINE] = "1"
         if scene_casts_shadows(state.lights):
             defines[SHADOWS_DEFINE] = "1"
             if any(light.casts_shadows and light.params.shadow_filter == "pcss"

@@ -14,5 +14,11 @@ vec3 directional_radiance(LightRecord light, vec3 P, vec3 N, out vec3 L) {
 vec3 directional_light(LightRecord light, Surface s, vec3 P, vec3 V) {
     vec3 L;
     vec3 radiance = directional_radiance(light, P, s.normal, L);
+#ifdef SURFACE_TRANSMISSION
+    return shade_light(s, L, V, radiance) +
+           shade_transmission(s, L, V, light.color.rgb,
+                              light_thickness_cascades(light, P, s.normal));
+#else
     return shade_light(s, L, V, radiance);
+#endif
 }

@@ -9,6 +9,13 @@ vec3 point_light(LightRecord light, Surface s, vec3 P, vec3 V) {
     float falloff = distance_falloff(d, light.position.w);
     if (falloff <= 0.0) return vec3(0.0);
     vec3 L = to_light / d;
+#ifdef SURFACE_TRANSMISSION
+    vec3 through = shade_transmission(s, L, V, light.color.rgb * falloff,
+                                      light_thickness_cube(light, P, s.normal));
+    falloff *= light_shadow_cube(light, P, s.normal, L);
+    return shade_light(s, L, V, light.color.rgb * falloff) + through;
+#else
     falloff *= light_shadow_cube(light, P, s.normal, L);
     return shade_light(s, L, V, light.color.rgb * falloff);
+#endif
 }

@@ -18,7 +18,16 @@ vec3 rect_light(LightRecord light, Surface s, vec3 P, vec3 V) {
     area.corners[1] = centre + x - y;
     area.corners[2] = centre + x + y;
     area.corners[3] = centre - x + y;
-    area.radiance = light.color.rgb * window *
-                    light_shadow_cube(light, P, s.normal, normalize(centre));
+    area.radiance = light.color.rgb * window;
+#ifdef SURFACE_TRANSMISSION
+    vec3 J = area_vector_irradiance(area);  // the light as one direction, for the light through
+    vec3 through = shade_transmission(s, normalize(J), V, area.radiance * length(J),
+                                      light_thickness_cube(light, P, s.normal));
+#endif
+    area.radiance *= light_shadow_cube(light, P, s.normal, normalize(centre));
+#ifdef SURFACE_TRANSMISSION
+    return shade_area(s, V, area) + through;
+#else
     return shade_area(s, V, area);
+#endif
 }

@@ -11,6 +11,13 @@ vec3 spot_light(LightRecord light, Surface s, vec3 P, vec3 V) {
     float cone = cone_falloff(dot(-L, light.direction.xyz), light.direction.w, light.extra.x);
     float falloff = distance_falloff(d, light.position.w) * cone;
     if (falloff <= 0.0) return vec3(0.0);
+#ifdef SURFACE_TRANSMISSION
+    vec3 through = shade_transmission(s, L, V, light.color.rgb * falloff,
+                                      light_thickness_perspective(light, P, s.normal));
+    falloff *= light_shadow_perspective(light, P, s.normal, L);
+    return shade_light(s, L, V, light.color.rgb * falloff) + through;
+#else
     falloff *= light_shadow_perspective(light, P, s.normal, L);
     return shade_light(s, L, V, light.color.rgb * falloff);
+#endif
 }

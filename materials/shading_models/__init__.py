@@ -24,6 +24,12 @@ registers them.
   within the model's budget of :data:`PBR_GBUFFER_BUDGET`. Area lights by linearly transformed
   cosines (``pbr_area.glsl``).
 
+- ``subsurface``: a Lambertian diffuse part and Blinn-Phong's highlight, split (the lighting
+  writes the diffuse part apart, which the subsurface material's screen-space blur scatters),
+  and light through thin parts by the profile's transmittance at the shadow maps' thickness.
+  The datum ``subsurface_profile`` (R8) holds the pixel's row of the scene's profile table
+  (``u_subsurface_profiles``: :func:`subsurface_rows`).
+
 ``kajiya_kay``, ``marschner`` and ``toon`` have no area answer: an area light reaches them as a
 point light along its vector irradiance bringing that irradiance (``area_as_point_light`` in
 ``lighting/area.glsl``): a strand's lobes are not cosine lobes an LTC fits, and a toon ramp
@@ -39,6 +45,8 @@ import numpy as np
 
 from deferred.api import GBufferData, ShadingModel, shading_models
 
+from ..techniques.subsurface_profile import TAPS as SUBSURFACE_TAPS
+from ..techniques.subsurface_profile import kernel as subsurface_kernel
 from ..techniques.xtoon import RAMP_HEIGHT, RAMP_WIDTH, XToonRamp, ramp_layer, scene_ramps
 from .dfg import dfg_table
 
@@ -49,6 +57,8 @@ STRAND_TANGENT = GBufferData(
     "strand_tangent", "RG16F", ("u", "v"),
     "strand tangent, view space, octahedral (kajiya_kay: materials/techniques/strand_tangent.glsl)")
 TOON_RAMP = GBufferData("toon_ramp", "R8", ("row",), "row of the toon ramp texture / 255")
+SUBSURFACE_PROFILE = GBufferData("subsurface_profile", "R8", ("row",),
+                                 "row of the scene's subsurface profile table / 255")
 PBR_OCCLUSION = GBufferData("pbr_occlusion", "R8", ("occlusion",),
                             "pbr: the material's ambient occlusion (its map, by strength)")
 # bytes a pixel the pbr model's surfaces may take: the 20-byte core and 4 of its own
@@ -200,3 +210,54 @@ class Pbr(ShadingModel):
             return texture
 
         return {"u_pbr_dfg": frame.resources.texture("pbr_dfg", create)}
+
+
+def subsurface_rows(scene) -> list[tuple]:
+    """The scene's distinct subsurface profiles, in scene order: each object's material's
+    ``subsurface_profile()`` (shape d per channel, transmission), one row of the table each."""
+    rows: list[tuple] = []
+    for obj in scene.objects:
+        answer = getattr(obj.material, "subsurface_profile", None)
+        if answer is not None and answer() not in rows:
+            rows.append(answer())
+    return rows
+
+
+def subsurface_table(rows: list[tuple]) -> np.ndarray:
+    """``(rows, 1 + SUBSURFACE_TAPS, 4)`` float32: a row per profile, texel 0 its shape and
+    transmission, then its blur taps (offset, weights per channel)."""
+    table = np.zeros((max(len(rows), 1), 1 + SUBSURFACE_TAPS, 4), np.float32)
+    for index, (shape, transmission) in enumerate(rows):
+        offsets, weights = subsurface_kernel(tuple(float(d) for d in shape))
+        table[index, 0] = (*shape, transmission)
+        table[index, 1:, 0] = offsets
+        table[index, 1:, 1:] = weights
+    return table
+
+
+@shading_models.register
+class Subsurface(ShadingModel):
+    name = "subsurface"
+    glsl_file = "materials/shading_models/subsurface.glsl"
+    glsl_function = "subsurface"
+    diffuse_function = "subsurface_diffuse"
+    specular_function = "subsurface_specular"
+    transmission_function = "subsurface_transmission"
+    area_file = "materials/shading_models/subsurface_area.glsl"
+    area_function = "subsurface_area"
+    gbuffer_data = (SUBSURFACE_PROFILE,)
+
+    @classmethod
+    def textures(cls, frame: Frame) -> dict[str, moderngl.Texture]:
+        rows = subsurface_rows(frame.scene)
+        key = tuple(rows)
+
+        def create(ctx: moderngl.Context) -> moderngl.Texture:
+            table = subsurface_table(rows)
+            texture = ctx.texture((table.shape[1], table.shape[0]), 4, table.tobytes(),
+                                  dtype="f4")
+            texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            return texture
+
+        return {"u_subsurface_profiles": frame.resources.current("subsurface_profiles", key,
+                                                                 create)}

@@ -14,14 +14,18 @@ float blinn_phong_lobe_total(float n) {
     return 8.0 * AREA_PI * (a - b);
 }
 
-vec3 blinn_phong_area(Surface s, vec3 V, AreaLight a) {
-    vec3 diffuse = s.albedo * area_irradiance(a, s.normal);
-    if (s.specular_intensity <= 0.0) return a.radiance * diffuse;
+// The highlight's share of the light: what multiplies the radiance
+float blinn_phong_area_specular(Surface s, vec3 V, AreaLight a) {
+    if (s.specular_intensity <= 0.0) return 0.0;
     float n = max(s.specular_exponent, 0.0);
     float roughness = sqrt(sqrt(2.0 / (n + 2.0)));  // the tables' sqrt(alpha)
     vec3 lobe = area_ggx(a, s.normal, V, roughness);
     float head_on = texture(u_ltc_amplitude, ltc_uv(roughness, 1.0)).x;
-    float specular = s.specular_intensity * blinn_phong_lobe_total(n) * lobe.x *
-                     lobe.y / max(head_on, 1e-4);
-    return a.radiance * (diffuse + vec3(specular));
+    return s.specular_intensity * blinn_phong_lobe_total(n) * lobe.x * lobe.y /
+           max(head_on, 1e-4);
+}
+
+vec3 blinn_phong_area(Surface s, vec3 V, AreaLight a) {
+    vec3 diffuse = s.albedo * area_irradiance(a, s.normal);
+    return a.radiance * (diffuse + vec3(blinn_phong_area_specular(s, V, a)));
 }

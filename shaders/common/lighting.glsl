@@ -26,6 +26,17 @@ vec3 shade_ambient(Surface s, vec3 irradiance);
 // ... and the image-based light (default: shade_ambient of its irradiance at the normal).
 vec3 shade_environment(Surface s, vec3 V, Environment e);
 
+#ifdef SPLIT_LIGHTING
+// the diffuse part of the light answered so far at this point by a model that splits it
+// (deferred.interfaces.shading): the lighting passes write it beside the whole
+vec3 split_light_diffuse = vec3(0.0);
+#endif
+#ifdef SURFACE_TRANSMISSION
+// light through the surface from a light behind it (a model's transmission function; 0 for the
+// others): radiance unshadowed, thickness from the light's shadow maps
+vec3 shade_transmission(Surface s, vec3 L, vec3 V, vec3 radiance, float thickness);
+#endif
+
 // Inverse-square falloff windowed to reach exactly 0 at the radius:
 //   (clamp(1 - (d/r)^4, 0, 1))^2 / (d^2 + 1)
 float distance_falloff(float d, float radius) {

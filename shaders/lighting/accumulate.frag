@@ -10,7 +10,11 @@ uniform vec2 u_resolution;
 uniform mat4 u_inverse_projection;
 
 flat in int v_light_index;
-out vec4 out_light;
+layout(location = 0) out vec4 out_light;
+#ifdef SPLIT_LIGHTING
+// the diffuse part of the light (deferred.interfaces.shading: models that split their light)
+layout(location = 1) out vec4 out_diffuse;
+#endif
 
 void main() {
     GBufferSample g = gbuffer_fetch(ivec2(gl_FragCoord.xy));
@@ -26,5 +30,8 @@ void main() {
     out_light = vec4(LIGHT_FUNCTION(fetch_light(v_light_index), g.surface, P, V), 0.0);
 #else
     out_light = vec4(evaluate_light(fetch_light(v_light_index), g.surface, P, V), 0.0);
+#endif
+#ifdef SPLIT_LIGHTING
+    out_diffuse = vec4(split_light_diffuse, 0.0);
 #endif
 }

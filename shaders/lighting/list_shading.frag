@@ -20,11 +20,18 @@ layout(location = 0) out vec4 out_light;
 // the composition buffer, where the frame has no material pass (deferred.lighting.culling)
 layout(location = 1) out vec4 out_composite;
 #endif
+#ifdef SPLIT_LIGHTING
+// the diffuse part of the light (deferred.interfaces.shading: models that split their light)
+layout(location = 1) out vec4 out_diffuse;
+#endif
 
 void write_light(vec4 light) {
     out_light = light;
 #ifdef WRITE_COMPOSITE
     out_composite = light;
+#endif
+#ifdef SPLIT_LIGHTING
+    out_diffuse = vec4(split_light_diffuse, light.a);
 #endif
 }
 

@@ -89,7 +89,7 @@ const vec2 SHADOW_POISSON[16] = vec2[](
     vec2(-0.2419, 0.9971), vec2(-0.8141, 0.9144), vec2(0.1998, 0.7864),
     vec2(0.1438, -0.1410));
 
-#if defined(OPACITY_SHADOWS) || defined(SHADOW_PCSS)
+#if defined(OPACITY_SHADOWS) || defined(SHADOW_PCSS) || defined(SURFACE_TRANSMISSION)
 // The light-view depth of a depth-buffer value of a tile (near, far; perspective or not).
 float shadow_view_depth(float window_z, vec4 size) {
     float n = size.z, f = size.w;
@@ -202,8 +202,11 @@ float shadow_compare(vec3 uvz, vec4 rect) {
                                            uvz.z), 0.0);
 }
 
-#ifdef SHADOW_PCSS
+#if defined(SHADOW_PCSS) || defined(SURFACE_TRANSMISSION)
 uniform sampler2D u_shadow_depths;  // the atlas's depths, read without comparison
+#endif
+
+#ifdef SHADOW_PCSS
 const float PCSS_MAX_REACH = 0.25;  // of a tile: the widest search and filter
 const int PCSS_SEARCH_TAPS = 16;
 const int PCSS_FILTER_TAPS = 24;
@@ -397,6 +400,59 @@ float light_shadow_cube(LightRecord light, vec3 P, vec3 N, vec3 L) {
     return shadow_tile(row, face, shadow_texel(row, 0), shadow_texel(row, 1), P, N, L,
                        length(d));
 }
+#ifdef SURFACE_TRANSMISSION
+// The distance the light travels inside a surface to reach view-space P (normal N): P's depth
+// from the light less the depth of the first surface the map saw along the same ray (Jimenez et
+// al. 2010), P moved a little inside first, so a point at an edge the light grazes reads its own
+// body's front, not its own depth. Along the ray for a perspective tile (its depth is along the
+// tile's axis). 1e30 where P lies outside the tile: no light through.
+float shadow_tile_thickness(int row, int tile, vec3 P, vec3 N, float distance) {
+    int base = 4 + 6 * tile;
+    mat4 to_atlas = mat4(shadow_texel(row, base), shadow_texel(row, base + 1),
+                         shadow_texel(row, base + 2), shadow_texel(row, base + 3));
+    vec4 rect = shadow_texel(row, base + 4);
+    vec4 size = shadow_texel(row, base + 5);
+    float texel = size.x * (size.y > 0.5 ? distance : 1.0);
+    vec4 clip = to_atlas * vec4(P - N * (2.0 * texel), 1.0);
+    vec3 uvz = clip.xyz / clip.w;
+    if (any(lessThan(uvz.xy, rect.xy)) || any(greaterThan(uvz.xy, rect.zw)) || uvz.z >= 1.0)
+        return 1e30;
+    float receiver = shadow_view_depth(uvz.z, size);
+    float first = shadow_view_depth(textureLod(u_shadow_depths, uvz.xy, 0.0).r, size);
+    float along = size.y > 0.5 ? distance / max(receiver, 1e-6) : 1.0;
+    return max(receiver - first, 0.0) * along;
+}
+
+float light_thickness_cascades(LightRecord light, vec3 P, vec3 N) {
+    int slot = int(light.extra.w + 0.5);
+    if (slot <= 0) return 1e30;
+    int row = slot - 1;
+    vec4 splits = shadow_texel(row, 2);
+    int count = int(shadow_texel(row, 0).y + 0.5);
+    float depth = -P.z;
+    if (depth > splits[count - 1]) return 1e30;
+    int i = 0;
+    for (int k = 0; k < 3; ++k)
+        if (k + 1 < count && depth > splits[k]) i = k + 1;
+    return shadow_tile_thickness(row, i, P, N, 1.0);
+}
+
+float light_thickness_perspective(LightRecord light, vec3 P, vec3 N) {
+    int slot = int(light.extra.w + 0.5);
+    if (slot <= 0) return 1e30;
+    return shadow_tile_thickness(slot - 1, 0, P, N, length(P - light.position.xyz));
+}
+
+float light_thickness_cube(LightRecord light, vec3 P, vec3 N) {
+    int slot = int(light.extra.w + 0.5);
+    if (slot <= 0) return 1e30;
+    vec3 d = u_shadow_world_from_view * (P - light.position.xyz);
+    vec3 a = abs(d);
+    int face = a.x >= a.y && a.x >= a.z ? (d.x >= 0.0 ? 0 : 1)
+             : a.y >= a.z ? (d.y >= 0.0 ? 2 : 3) : (d.z >= 0.0 ? 4 : 5);
+    return shadow_tile_thickness(slot - 1, face, P, N, length(d));
+}
+#endif
 #else
 float light_shadow_cascades(LightRecord light, vec3 P, vec3 N, vec3 L) {
     return SHADOW_UNSHADOWED;
@@ -409,4 +465,9 @@ float light_shadow_perspective(LightRecord light, vec3 P, vec3 N, vec3 L) {
 float light_shadow_cube(LightRecord light, vec3 P, vec3 N, vec3 L) {
     return SHADOW_UNSHADOWED;
 }
+#ifdef SURFACE_TRANSMISSION
+float light_thickness_cascades(LightRecord light, vec3 P, vec3 N) { return 1e30; }
+float light_thickness_perspective(LightRecord light, vec3 P, vec3 N) { return 1e30; }
+float light_thickness_cube(LightRecord light, vec3 P, vec3 N) { return 1e30; }
+#endif
 #endif

@@ -77,11 +77,11 @@ def test_an_unknown_name_with_a_newline_stays_on_one_line():
 # light's record hold them, so they never change, whatever loads first.
 BUILTIN_IDS = {
     "materials": {"cartoon_hair": 1, "revie_fur": 2, "shell_fur": 3, "standard": 4,
-                  "stipple_glass": 5, "pbr": 6, "glass": 7},
+                  "stipple_glass": 5, "pbr": 6, "glass": 7, "subsurface": 8},
     "lights": {"ambient": 1, "directional": 2, "point": 3, "spot": 4, "environment": 5,
                "rect": 6, "disc": 7},
     "shading_models": {"blinn_phong": 1, "kajiya_kay": 2, "toon": 3, "marschner": 4, "pbr": 5,
-                       "toon_strands": 6},
+                       "toon_strands": 6, "subsurface": 7},
     "effects": {"edges": 1, "fxaa": 2, "ssao": 3, "taa": 4},
 }
 
