@@ -108,11 +108,17 @@ def scene_transmits(models) -> bool:
     return any(cls.transmission_function for cls in models)
 
 
+def _counted(name: str) -> list[str]:
+    # under the define the scene compiles with where it has such a model (a program built
+    # from every model without it, as a test of the shader files does, leaves it out)
+    return [f"#ifdef {SPLIT_DEFINE}", f"        split_light_diffuse += {name};", "#endif"]
+
+
 def _light_answer(cls: type[ShadingModel], split: bool) -> list[str]:
     if split and cls.splits_light():
         return [f"    if (s.shading_model == {cls.type_id}) {{",
                 f"        vec3 diffuse = {cls.diffuse_function}(s, L, V, radiance);",
-                "        split_light_diffuse += diffuse;",
+                *_counted("diffuse"),
                 f"        return diffuse + {cls.specular_function}(s, L, V, radiance);",
                 "    }"]
     return [f"    if (s.shading_model == {cls.type_id}) "
@@ -125,7 +131,7 @@ def _ambient_answer(cls: type[ShadingModel], split: bool) -> list[str]:
     if split and cls.splits_light():  # all of it diffuse
         return [f"    if (s.shading_model == {cls.type_id}) {{",
                 f"        vec3 ambient = {call};",
-                "        split_light_diffuse += ambient;",
+                *_counted("ambient"),
                 "        return ambient;",
                 "    }"]
     if not cls.ambient_function:

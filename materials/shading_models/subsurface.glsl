@@ -40,6 +40,8 @@ vec3 subsurface_transmission(Surface s, vec3 L, vec3 V, vec3 radiance, float thi
     vec3 through = 0.25 * exp(-thickness / d) + 0.75 * exp(-thickness / (3.0 * d));
     vec3 light = profile.a * s.albedo * through * radiance *
                  clamp(0.3 - dot(s.normal, L), 0.0, 1.0);
+#ifdef SPLIT_LIGHTING  // always, where a scene has the model
     split_light_diffuse += light;
+#endif
     return light;
 }

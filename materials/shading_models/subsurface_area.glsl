@@ -5,6 +5,8 @@
 
 vec3 subsurface_area(Surface s, vec3 V, AreaLight a) {
     vec3 diffuse = a.radiance * s.albedo * area_irradiance(a, s.normal);
+#ifdef SPLIT_LIGHTING  // always, where a scene has the model
     split_light_diffuse += diffuse;
+#endif
     return diffuse + a.radiance * blinn_phong_area_specular(s, V, a);
 }
