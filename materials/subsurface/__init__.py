@@ -34,10 +34,15 @@ from deferred.api import (
     Material,
     ObjectPass,
     Order,
+    Per,
     Phase,
+    RenderWork,
     SurfacePasses,
     TargetSpec,
     Technique,
+    Work,
+    WorkObject,
+    counted,
     materials,
     shading_models,
 )
@@ -51,6 +56,10 @@ if TYPE_CHECKING:
 BLUR = "subsurface_blur"  # the diffuse light blurred across
 SURFACE = "subsurface_surface"  # forward: (view depth, profile row + 1) where it is seen
 DATUM = "subsurface_profile"  # the G-buffer datum of the profile's row
+# seconds a pixel of the material's takes each of the blur's two passes (TAPS taps, each
+# reading the light and where it falls): measured on the reference machine, benchmarks/README.md
+# ("Area lights and subsurface scattering")
+BLUR_PIXEL_SECONDS = 1.5e-6
 
 
 class SubsurfaceParams(BlinnPhongParams):
@@ -141,6 +150,16 @@ class SubsurfaceMaterial(Material):
     shading_model = "subsurface"
     techniques = (SurfacePasses(forward=SubsurfaceForwardPass), SubsurfaceScattering())
     uniform_overrides = {"radius": None, "falloff": None, "transmission": None}
+
+    def work(self, obj: WorkObject, job: RenderWork) -> list[Work]:
+        """Its mesh (forward: drawn again by the mask pass), and the blur's two passes over the
+        pixels it covers, once its bounds are known."""
+        works = [obj.surface_work(2.0 if job.pipeline == "forward" else 1.0)]
+        pixels = obj.covered_pixels(job)
+        if pixels is not None:
+            works.append(Work(f"{obj.label}: the subsurface blur over {counted(pixels)} pixels",
+                              2.0 * pixels, BLUR_PIXEL_SECONDS, obj.key("radius"), Per.SAMPLE))
+        return works
 
     def subsurface_profile(self) -> tuple:
         """(the profile's shape d per channel, the transmission's strength): a row of the

@@ -217,3 +217,19 @@ def test_forward_and_deferred_agree(gl, light_path):
     forward = render(gl, scene, "forward", "tiled" if light_path != "volumes" else "naive")
     peak = float(deferred.max())
     assert psnr(np.clip(deferred / peak, 0, 1), np.clip(forward / peak, 0, 1)) >= 40.0
+
+
+def test_the_cost_model_counts_the_blur_over_the_pixels_covered():
+    from deferred.interfaces.work import RenderWork, Screen, WorkObject
+    from deferred.materials.subsurface import BLUR_PIXEL_SECONDS, SubsurfaceMaterial
+
+    material = SubsurfaceMaterial()
+    unseen = WorkObject(material, 1000, "bunny", "s.toml: object[0]")
+    assert len(material.work(unseen, RenderWork((640, 360)))) == 1  # bounds not known yet
+    screen = Screen(distance=10.0, radius=10.0, focal_pixels=500.0)  # the camera inside it
+    seen = WorkObject(material, 1000, "bunny", "s.toml: object[0]", screen=screen)
+    deferred, blur = material.work(seen, RenderWork((640, 360)))
+    assert blur.seconds == pytest.approx(2 * 640 * 360 * BLUR_PIXEL_SECONDS)
+    assert blur.where == "s.toml: object[0].params.radius"
+    forward, _ = material.work(seen, RenderWork((640, 360), pipeline="forward"))
+    assert forward.units == 2 * deferred.units  # the mask pass draws the mesh again
