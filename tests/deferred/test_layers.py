@@ -18,7 +18,8 @@ from locations import ROOT
 # packages of plugins: they import deferred.api, their own modules and nothing else of deferred
 PLUGIN_FOLDERS = {"materials": "deferred.materials", "lights": "deferred.lights",
                   "deferred/effects": "deferred.effects",
-                  "examples/plugins/deferred-velvet/deferred_velvet": "deferred_velvet"}
+                  "examples/plugins/deferred-velvet/deferred_velvet": "deferred_velvet",
+                  "examples/plugins/deferred-wax/deferred_wax": "deferred_wax"}
 
 
 def contract_layers() -> list[grimp.Layer]:
