@@ -237,13 +237,24 @@ class FullscreenPass(RenderPass):
             frame.draw_fullscreen(program, instances=count)
 
 
+class CopyPass(FullscreenPass):
+    """A pass creating ``target`` as a copy of ``source`` (a snapshot a later pass reads while it
+    writes ``source``: GL forbids reading a texture while rendering into it). A pipeline may
+    fold it into the pass that makes ``source`` (a second output of that pass)."""
+
+    def __init__(self, name: str, phase: Phase, source: str, target: str, spec: TargetSpec,
+                 order: int = Order.OPAQUE, brackets: tuple[str, str] | None = None):
+        super().__init__(name, phase, "post/copy.frag", {"u_source": source}, (target,),
+                         creates={target: spec}, order=order, brackets=brackets)
+        self.source = source
+        self.target = target
+
+
 def copy_pass(name: str, phase: Phase, source: str, target: str, spec: TargetSpec,
               order: int = Order.OPAQUE,
-              brackets: tuple[str, str] | None = None) -> FullscreenPass:
-    """A pass creating ``target`` as a copy of ``source`` (a snapshot a later pass reads while it
-    writes ``source``: GL forbids reading a texture while rendering into it)."""
-    return FullscreenPass(name, phase, "post/copy.frag", {"u_source": source}, (target,),
-                          creates={target: spec}, order=order, brackets=brackets)
+              brackets: tuple[str, str] | None = None) -> CopyPass:
+    """A :class:`CopyPass` of ``source`` into ``target``."""
+    return CopyPass(name, phase, source, target, spec, order, brackets)
 
 
 class PassInput:

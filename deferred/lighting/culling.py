@@ -34,6 +34,7 @@ from deferred.lighting.volumes import surface_pass
 
 if TYPE_CHECKING:
     from deferred.core.frame import Frame
+    from deferred.gl.target_spec import TargetSpec
 
 class LightCullPass(RenderPass):
     """Fill the light lists with a compute shader (tiles or clusters)."""
@@ -118,13 +119,16 @@ def pixel_to_view(projection: np.ndarray, width: int, height: int) -> tuple[floa
 
 def list_shading_pass(name: str, clustered: bool, gbuffer: tuple[str, ...],
                       occlusion: str | None, background: tuple[float, float, float],
-                      composite: bool = False, split: bool = False) -> FullscreenPass:
+                      composite: bool = False, split: bool = False,
+                      snapshots: dict[str, TargetSpec] | None = None) -> FullscreenPass:
     """The deferred lighting of every light from the lists: one full-screen pass, which creates
     the light accumulation (the scene's background where the G-buffer holds no surface, alpha
     0; the lights' sum on surfaces, alpha 1), so no pass has to lay the background down first.
-    With ``composite`` it creates the composition buffer too, the same values (a frame with
-    no material pass: the copy between them would be all the material phase did); with
-    ``split`` (the scene splits its light) the diffuse light beside it.
+    With ``composite`` it creates the composition buffer too, the same values (the copy the
+    material phase would start with: one full-screen pass fewer); ``snapshots`` (at most one
+    target) are copies of the composition the material phase takes before anything writes
+    it, made here as a third output instead of a pass of their own; with ``split`` (the scene
+    splits its light) the diffuse light beside it.
 
     It runs on surfaces only (:func:`deferred.lighting.volumes.surface_pass`; measured in
     benchmarks/README.md)."""
@@ -141,4 +145,9 @@ def list_shading_pass(name: str, clustered: bool, gbuffer: tuple[str, ...],
         defines["WRITE_COMPOSITE"] = "1"
     if split:
         creates[DIFFUSE_LIGHT] = DIFFUSE_LIGHT_SPEC
+    if snapshots:
+        if not composite or len(snapshots) != 1:
+            raise ValueError("the list shading makes one snapshot, with the composition")
+        creates.update(snapshots)
+        defines["WRITE_SNAPSHOT"] = "1"
     return surface_pass(name, "lighting/list_shading.frag", inputs, creates, background, defines)

@@ -24,6 +24,7 @@ from deferred.core.frame import OfferedUniforms
 from deferred.core.graph import PassGraph, compile_graph
 from deferred.core.passes import (
     ClearPass,
+    CopyPass,
     FullscreenPass,
     ObjectPass,
     Order,
@@ -177,6 +178,18 @@ def sort_blended(passes: list[RenderPass], scene: FrameState) -> list[RenderPass
     return passes if same_passes(out, passes) else out
 
 
+def leading_snapshots(material: list[RenderPass]) -> list[CopyPass]:
+    """The copies of the composition among ``material`` (the material phase's passes, in
+    order) that run before any pass writes it: the composition as the lighting made it."""
+    found = []
+    for render_pass in material:
+        if isinstance(render_pass, CopyPass) and render_pass.source == COMPOSITE:
+            found.append(render_pass)
+        elif COMPOSITE in render_pass.writes:
+            break
+    return found
+
+
 def _blended_object_pass(render_pass: RenderPass) -> bool:
     return render_pass.order >= Order.VOLUME and render_pass.order != Order.LAST and \
         getattr(render_pass, "node", None) is not None
@@ -238,9 +251,10 @@ class DeferredPipeline(Pipeline):
         passes += phase_passes(scene, Phase.STIPPLE, [], wide)
         occlusion = AMBIENT_OCCLUSION if any(AMBIENT_OCCLUSION in p.creates for p in passes) \
             else None
-        folded = False  # the composition made by the lighting pass (below)
         environment = scene.background == ENVIRONMENT_BACKGROUND
         split = scene_splits_light(scene.shading_models())
+        material = phase_passes(scene, Phase.MATERIAL, [], wide)
+        folded: list[CopyPass] = []  # the material phase's copies the lighting pass makes
         if self.light_path == names.LightPath.VOLUMES:
             # the light accumulation starts as 0 on surfaces and the background elsewhere
             # (its clear); each light type's pass adds into it
@@ -253,31 +267,35 @@ class DeferredPipeline(Pipeline):
             if split:
                 lights.insert(0, ClearPass("lighting.diffuse_clear", Phase.LIGHTING, {
                     DIFFUSE_LIGHT: replace(DIFFUSE_LIGHT_SPEC, clear=(0.0, 0.0, 0.0, 0.0))}))
+            composite = False
         else:
             # One pass shades every light and writes the background where there is no surface.
-            # Where no other pass writes the light accumulation and the material phase has no
-            # pass, the composition is the light accumulation: the same pass writes both, and
-            # there is nothing to copy.
+            # Where no other pass writes the light accumulation, the composition starts as the
+            # light accumulation: the same pass writes both (no copy pass), and the snapshot
+            # of the composition the material phase takes before its first write to it.
             clustered = self.light_path == names.LightPath.CLUSTERED
-            folded = not environment and not split and \
-                not phase_passes(scene, Phase.MATERIAL, [], wide) \
-                and not any(
+            composite = not environment and not split and not any(
                 LIGHT_ACCUMULATION in p.writes
                 for p in phase_passes(scene, Phase.LIGHTING, [], wide))
+            if composite:
+                folded = leading_snapshots(material)[:1]
             lights = [LightCullPass(f"lighting.cull_{'clusters' if clustered else 'tiles'}",
                                     Phase.LIGHTING, clustered),
                       list_shading_pass(f"lighting.{self.light_path}", clustered,
                                         layout.color_targets, occlusion,
-                                        clear_colour(scene), composite=folded, split=split)]
+                                        clear_colour(scene), composite=composite,
+                                        split=split,
+                                        snapshots={p.target: p.creates[p.target]
+                                                   for p in folded})]
         if environment:  # behind the lit surfaces, after every light
             lights.append(environment_background_pass(Phase.LIGHTING, LIGHT_ACCUMULATION,
                                                       Order.LAST))
         passes += phase_passes(scene, Phase.LIGHTING, lights, wide)
-        if not folded:
-            composite = copy_pass("material.composite_copy", Phase.MATERIAL,
-                                  LIGHT_ACCUMULATION, COMPOSITE, COMPOSITE_SPEC,
-                                  order=Order.FIRST)
-            passes += phase_passes(scene, Phase.MATERIAL, [composite], wide)
+        if not composite:
+            material = phase_passes(scene, Phase.MATERIAL, [copy_pass(
+                "material.composite_copy", Phase.MATERIAL, LIGHT_ACCUMULATION, COMPOSITE,
+                COMPOSITE_SPEC, order=Order.FIRST)], wide)
+        passes += [p for p in material if not any(p is f for f in folded)]
         passes += phase_passes(scene, Phase.POST, [tonemap_pass(scene)], wide)
         return passes
 

@@ -17,12 +17,16 @@ uniform vec3 u_background;  // where the G-buffer holds no surface (alpha 0: cov
 
 layout(location = 0) out vec4 out_light;
 #ifdef WRITE_COMPOSITE
-// the composition buffer, where the frame has no material pass (deferred.lighting.culling)
+// the composition buffer, which the material phase starts from (deferred.lighting.culling)
 layout(location = 1) out vec4 out_composite;
 #endif
 #ifdef SPLIT_LIGHTING
 // the diffuse part of the light (deferred.interfaces.shading: models that split their light)
 layout(location = 1) out vec4 out_diffuse;
+#endif
+#ifdef WRITE_SNAPSHOT
+// a snapshot of the composition the material phase takes before its first write to it
+layout(location = 2) out vec4 out_snapshot;
 #endif
 
 void write_light(vec4 light) {
@@ -32,6 +36,9 @@ void write_light(vec4 light) {
 #endif
 #ifdef SPLIT_LIGHTING
     out_diffuse = vec4(split_light_diffuse, light.a);
+#endif
+#ifdef WRITE_SNAPSHOT
+    out_snapshot = light;
 #endif
 }
 

@@ -439,8 +439,9 @@ def test_a_renderer_follows_a_light_and_the_camera_changed_between_frames(gl, pi
 
 @pytest.mark.parametrize("path", ["tiled", "clustered"])
 def test_the_list_shading_makes_the_composition_where_the_material_phase_has_no_pass(gl, path):
-    """With no material pass the list shading writes the composition buffer too (there is no
-    copy); a material with passes of its own (Revie's fur) keeps the copy that starts them."""
+    """The list shading writes the composition buffer too (there is no copy), and with
+    Revie's fur the stipple snapshot the material phase takes before its first write to the
+    composition (no pass of its own either): the same values as the light accumulation."""
     if not gl.features.compute_shaders:
         pytest.skip("the driver has no compute shaders")
     with Renderer(scene_with(16), "deferred", gl=gl, light_path=path) as renderer:
@@ -451,9 +452,19 @@ def test_the_list_shading_makes_the_composition_where_the_material_phase_has_no_
         np.testing.assert_array_equal(renderer.targets.read("composite"),
                                       renderer.targets.read("light_accumulation"))
     with Renderer(load_scene(), "deferred", (96, 64), gl=gl, light_path=path) as renderer:
-        assert renderer.graph.creators["composite"] == "material.composite_copy"
+        names = [p.name for p in renderer.passes]
+        assert "material.composite_copy" not in names
+        assert "material.stipple_snapshot" not in names
         shading = renderer.passes[renderer.graph.index(f"lighting.{path}")]
-        assert set(shading.creates) == {"light_accumulation"}
+        assert set(shading.creates) == {"light_accumulation", "composite", "composite_snapshot"}
+        snapshots = []
+        renderer.render(on_pass=lambda p, frame: snapshots.append(
+            frame.targets.read("composite_snapshot")) if p is shading else None)
+        np.testing.assert_array_equal(snapshots[0], renderer.targets.read("light_accumulation"))
+        np.testing.assert_array_equal(snapshots[0], renderer.targets.read("composite_snapshot"))
+    with Renderer(load_scene(), "deferred", (96, 64), gl=gl, light_path="volumes") as renderer:
+        names = [p.name for p in renderer.passes]
+        assert names.index("material.composite_copy") < names.index("material.stipple_snapshot")
 
 
 def test_several_full_screen_lights_of_a_type_each_light_the_list_and_forward_paths(gl):
