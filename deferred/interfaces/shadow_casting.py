@@ -15,6 +15,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 if TYPE_CHECKING:
+    from collections.abc import Hashable
+
     from deferred.core.frame import Frame
     from deferred.core.protocols import SceneObjectLike
 
@@ -79,6 +81,14 @@ class ShadowCaster:
         program = frame.shaders.program(SHADOW_CASTER_VERTEX, SHADOW_CASTER_FRAGMENT)
         frame.bind(program, view.uniforms, offered=frame.object_uniforms(obj))
         frame.draw_mesh(obj.mesh, program)
+
+    def cache_key(self, frame: Frame, obj: SceneObjectLike) -> Hashable:
+        """What :meth:`draw` and :meth:`draw_opacity` of ``obj`` depend on this frame beyond
+        the object's state and the map (the framework keys a map's depths on its light,
+        square and each caster's ``ObjectState.version``, and keeps them while those hold):
+        a caster drawing what the camera decides (a level of detail) returns it. By default
+        nothing."""
+        return ()
 
     def opacity_shadows(self, obj: SceneObjectLike) -> bool:
         """Whether ``obj`` is a volume drawn into the deep opacity maps."""

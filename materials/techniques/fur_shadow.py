@@ -115,6 +115,10 @@ class FurShadow(ShadowCaster):
                    material=frame.material_inputs(material))
         draw_fins(frame, obj.mesh, program)
 
+    def cache_key(self, frame: Frame, obj: SceneObject) -> int:
+        """The shells the fur draws into the deep opacity maps: they follow the camera."""
+        return self.opacity_shells(frame, obj) if self.opacity_shadows(obj) else 0
+
     def opacity_layer(self, obj: SceneObject) -> float:
         """The fur's world thickness: a strand's length."""
         return float(obj.material.params.fur_length * object_scale(obj).max())

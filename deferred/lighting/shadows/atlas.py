@@ -74,6 +74,28 @@ class ShadowTile:
     # the light's reach (centre, radius) for culling casters; None: every object
     reach: tuple[np.ndarray, float] | None = None
 
+    def casts(self, centre: np.ndarray, radius: float) -> bool:
+        """Whether a caster bounded by the sphere (``centre``, ``radius``: world) may draw into
+        this map: within the light's reach and not wholly outside the side or far planes of
+        the map's frustum (the near plane is not tested: a cascade's reaches back to the
+        scene's casters, a spot's is a sliver at the light)."""
+        if self.reach is not None and \
+                np.linalg.norm(centre - self.reach[0]) > radius + self.reach[1]:
+            return False
+        point = np.append(centre, 1.0)
+        for plane in frustum_planes(self.view_projection):
+            if plane @ point < -radius:
+                return False
+        return True
+
+
+def frustum_planes(view_projection: np.ndarray) -> np.ndarray:
+    """The left, right, bottom, top and far planes of a clip transform (Gribb and Hartmann),
+    each (a, b, c, d) with (a, b, c) of unit length, positive inside."""
+    m = np.asarray(view_projection, np.float64)
+    planes = np.array([m[3] + m[0], m[3] - m[0], m[3] + m[1], m[3] - m[1], m[3] - m[2]])
+    return planes / np.linalg.norm(planes[:, :3], axis=1, keepdims=True)
+
 
 class ShadowAtlas:
     """The shadow atlas, its records texture and this frame's tiles (a binding source)."""
@@ -101,6 +123,9 @@ class ShadowAtlas:
         self.slots: dict[int, int] = {}  # id(light) -> slot (1-based)
         self.splits: dict[int, np.ndarray] = {}  # id(light) -> its cascades' far depths
         self._plan_key: tuple | None = None
+        # (x, y, size) of a tile -> what it was last drawn with (deferred.lighting.shadows
+        # .caster_pass): its depths stay in the atlas from frame to frame
+        self.drawn: dict[tuple[int, int, int], tuple] = {}
         self._plan: dict = {}
         self._uniforms: dict[str, Any] = {}
         self.opacity = None
@@ -188,6 +213,7 @@ class ShadowAtlas:
         if key != self._plan_key:
             self._plan, left_out = plan_atlas(scene.lights, self.size, self.max_lights)
             self._plan_key = key
+            self.drawn.clear()  # the squares may overlap those drawn before
             if left_out:  # stacklevel: update's caller
                 warnings.warn(left_out_warning(scene.source, left_out), stacklevel=3)
 

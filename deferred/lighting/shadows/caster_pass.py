@@ -1,12 +1,12 @@
 """The shadow pass: each shadowed light's tiles of the atlas cleared and the casters it reaches
 drawn into them by their materials; then, where the scene has them, the volumes' deep opacity
-maps."""
+maps. A tile drawn before with the same light, square and casters, each as it was, is not drawn
+again (the atlas keeps its depths from frame to frame): a still light and still casters cost
+nothing after their first frame, whatever the camera does (but for cascades, which follow it)."""
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
-
-import numpy as np
 
 from deferred.core.passes import Order, Phase, RenderPass
 from deferred.lighting.shadows.atlas import SHADOW_ATLAS, ShadowAtlas, ShadowTile
@@ -15,6 +15,16 @@ from deferred.lighting.shadows.opacity import OPACITY_FAR, OPACITY_FRONT_FRAGMEN
 
 if TYPE_CHECKING:
     from deferred.core.frame import Frame
+
+def caster_key(frame: Frame, obj) -> tuple:
+    """What ``obj``'s drawing into a shadow map depends on besides the map: its state's
+    version (mesh, material parameters, world matrix, joints), the frame's time where its
+    material simulates (its state follows the time), and what its caster adds
+    (:meth:`~deferred.interfaces.shadow_casting.ShadowCaster.cache_key`)."""
+    material = obj.material
+    return (obj.version, frame.time if material.simulation is not None else None,
+            material.shadow.cache_key(frame, obj))
+
 
 # the caster pass's slope-scaled depth offset (glPolygonOffset factor, units): with the
 # lookup's normal offset and depth bias (texels), no acne down to grazing light
@@ -37,41 +47,54 @@ class ShadowPass(RenderPass):
         atlas: ShadowAtlas = frame.blackboard[SHADOW_ATLAS]
         if not atlas.tiles:
             return
-        fbo = atlas.framebuffer
-        frame.gl_call(fbo.use)
-        fbo.depth_mask = True
-        frame.set_state(depth_test=True, depth_func="less", cull=None,
-                        depth_offset=CASTER_DEPTH_OFFSET)
         objects = frame.scene.objects
         spheres = [object_sphere(obj) for obj in objects]
 
         def reached(tile: ShadowTile) -> list:
             return [obj for obj, (centre, radius) in zip(objects, spheres, strict=True)
-                    if tile.reach is None or
-                    np.linalg.norm(centre - tile.reach[0]) <= radius + tile.reach[1]]
+                    if tile.casts(centre, radius)]
 
+        # a tile whose light, square and casters (each as it draws: caster_key) are those it
+        # was last drawn with holds their depths still: it is not drawn again
+        drawn = []
+        for tile in atlas.tiles:
+            casters = reached(tile)
+            key = (tile.slot, tile.view_projection.tobytes(), atlas.opacity_layer,
+                   tuple(caster_key(frame, obj) for obj in casters))
+            rect = (tile.x, tile.y, tile.size)
+            if atlas.drawn.get(rect) != key:
+                atlas.drawn[rect] = key
+                drawn.append((tile, casters))
+        if not drawn:
+            return
+        fbo = atlas.framebuffer
+        frame.gl_call(fbo.use)
+        fbo.depth_mask = True
+        frame.set_state(depth_test=True, depth_func="less", cull=None,
+                        depth_offset=CASTER_DEPTH_OFFSET)
         try:
-            for tile in atlas.tiles:
+            for tile, casters in drawn:
                 rect = (tile.x, tile.y, tile.size, tile.size)
                 fbo.viewport = rect
                 frame.gl_call(lambda rect=rect: fbo.clear(depth=1.0, viewport=rect))
-                for obj in reached(tile):  # beyond the light's reach: casts nothing it lights
+                for obj in casters:  # outside the map's frustum: casts nothing into it
                     obj.material.shadow.draw(frame, obj, tile.view)
         finally:
             fbo.viewport = (0, 0, atlas.size, atlas.size)
         if atlas.opacity is not None:
-            self._opacity(frame, atlas, reached)
+            self._opacity(frame, atlas, drawn)
 
     @staticmethod
-    def _opacity(frame: Frame, atlas: ShadowAtlas, reached) -> None:
-        """The deep opacity maps of each tile: the volume's first and last depths (min blending
-        of the depth and its negative), grown by a texel (``shadows/opacity_front.frag``), then
-        its optical depth added into the layers behind the first (Yuksel and Keyser 2008,
-        3.1-3.2)."""
+    def _opacity(frame: Frame, atlas: ShadowAtlas,
+                 drawn: list[tuple[ShadowTile, list]]) -> None:
+        """The deep opacity maps of each tile ``drawn`` (with its casters): the volume's first
+        and last depths (min blending of the depth and its negative), grown by a texel
+        (``shadows/opacity_front.frag``), then its optical depth added into the layers behind
+        the first (Yuksel and Keyser 2008, 3.1-3.2)."""
         scale = atlas.opacity_scale
         tiles = [(tile, tuple(round(v * scale) for v in (tile.x, tile.y, tile.size, tile.size)),
-                  [obj for obj in reached(tile) if obj.material.shadow.opacity_shadows(obj)])
-                 for tile in atlas.tiles]
+                  [obj for obj in casters if obj.material.shadow.opacity_shadows(obj)])
+                 for tile, casters in drawn]
         stages = ((atlas.first_framebuffer, "first", dict(depth_test=False, blend="min")),
                   (atlas.front_framebuffer, "front", {}),
                   (atlas.opacity_framebuffer, "density", dict(depth_test=False, blend="add")))
