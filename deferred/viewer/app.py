@@ -37,7 +37,7 @@ from deferred.viewer.buffers import (
 )
 from deferred.viewer.compare import psnr
 from deferred.viewer.display import FrameSlot, Rect, Viewport
-from deferred.viewer.imgui_gl import ImguiRenderer
+from deferred.viewer.imgui_gl import ImguiRenderer, PanelLayer
 from deferred.viewer.input import ViewerInput
 from deferred.viewer.inspector import inspect_pixel
 from deferred.viewer.panels import PANEL_WIDTH
@@ -55,6 +55,7 @@ INTERACTIVE_BUDGET_MS = 45.0
 # At most this many frames of an unchanged state are drawn (a temporal history converging)
 STILL_FRAMES = 256
 BACKGROUND = (0.11, 0.11, 0.12)
+RATES_SECONDS = 0.5  # how often the panel's frame rate and frame time change
 
 
 @dataclass
@@ -110,6 +111,7 @@ class Viewer:
         self.io.config_error_recovery = True
         self.io.config_error_recovery_enable_assert = False
         self.imgui = ImguiRenderer(self.ctx)
+        self.panel_layer = PanelLayer(self.ctx, self.imgui)
         # what the panels show
         self.render_error: str | None = None
         self.render_exception: Exception | None = None
@@ -137,6 +139,8 @@ class Viewer:
         self._last_tick = self.now()
         self.still_frames = 0  # frames drawn again for an unchanged state (a history converging)
         self._frame_times: list[float] = []
+        self.shown_rates = (0.0, 0.0)  # (fps, frame ms) as the panel shows them
+        self._rates_at = -math.inf
         self.input = ViewerInput(self, window)  # attaches the window's events
 
     # -- layout ----------------------------------------------------------------------------------
@@ -362,6 +366,10 @@ class Viewer:
         now = clock.perf_counter()
         self._frame_times = [t for t in self._frame_times if now - t < 1.0] + [now]
         self.fps = len(self._frame_times) - 1 if len(self._frame_times) > 1 else 0.0
+        if now - self._rates_at >= RATES_SECONDS or not self.running:
+            # the panel's figures change twice a second, not every frame: unchanged panels
+            # are not drawn again (PanelLayer)
+            self.shown_rates, self._rates_at = (self.fps, self.frame_ms), now
         self.pool.gl.make_current()
         fbo = self.wnd.fbo
         fbo.use()
@@ -384,7 +392,9 @@ class Viewer:
             except Exception as exc:  # noqa: BLE001 - a panel's failure is shown, not fatal
                 self.note(f"panel failed: {type(exc).__name__}: {exc}")
             imgui.render()
-            self.imgui.render(imgui.get_draw_data(), fbo)
+            data = imgui.get_draw_data()
+            if not self.panel_layer.draw(data, fbo, PANEL_WIDTH, fbo.size[1], BACKGROUND):
+                self.imgui.render(data, fbo)
 
     def resize(self, width: int, height: int) -> None:
         """A real window's viewport follows the window (the panels keep their width)."""
@@ -402,6 +412,7 @@ class Viewer:
         self.main.release()
         self.other.release()
         self.viewport.release()
+        self.panel_layer.release()
         self.imgui.release()
         imgui.destroy_context(self._imgui_context)
 

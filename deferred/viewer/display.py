@@ -79,14 +79,25 @@ class FrameSlot:
 
 
 class Viewport:
-    """Draws the slots into the window's framebuffer at ``rect``."""
+    """Draws the slots into the window's framebuffer at ``rect``: a program for each view and
+    for whether the images are the viewport's size (``shaders/viewer/viewport.frag``)."""
 
     def __init__(self, ctx: moderngl.Context):
         self.ctx = ctx
-        self.program = viewer_program(ctx, "viewport.vert", "viewport.frag")
-        self.vao = ctx.vertex_array(self.program, [])
-        self.program["u_left"].value = 0
-        self.program["u_right"].value = 1
+        self.programs: dict[tuple[str, bool], moderngl.Program] = {}
+        self.vaos: dict[tuple[str, bool], moderngl.VertexArray] = {}
+
+    def _program(self, mode: str, exact: bool) -> tuple[moderngl.Program,
+                                                          moderngl.VertexArray]:
+        key = (mode, exact)
+        if key not in self.programs:
+            defines = {"MODE": str(MODES[mode]), **({"EXACT": "1"} if exact else {})}
+            program = viewer_program(self.ctx, "viewport.vert", "viewport.frag", defines)
+            for name, unit in (("u_left", 0), ("u_right", 1)):
+                if name in program:
+                    program[name].value = unit
+            self.programs[key], self.vaos[key] = program, self.ctx.vertex_array(program, [])
+        return self.programs[key], self.vaos[key]
 
     def draw(self, framebuffer: moderngl.Framebuffer, window_height: int, rect: Rect,
              left: FrameSlot, right: FrameSlot | None = None, mode: str = "single",
@@ -103,14 +114,15 @@ class Viewport:
         other.texture.use(1)
         if mode != "single" and other is left:
             mode = "single"
-        self.program["u_mode"].value = MODES[mode]
-        self.program["u_split"].value = float(split)
-        self.program["u_gain"].value = float(gain)
-        self.program["u_exact"].value = left.texture.size == (rect.width, rect.height)
-        self.program["u_origin"].value = tuple(float(v) for v in origin)
-        self.program["u_width"].value = float(rect.width)
-        self.vao.render(moderngl.TRIANGLES, vertices=3)
+        program, vao = self._program(mode, left.texture.size == (rect.width, rect.height))
+        for name, value in (("u_split", float(split)), ("u_gain", float(gain)),
+                            ("u_origin", tuple(float(v) for v in origin)),
+                            ("u_width", float(rect.width))):
+            if name in program:
+                program[name].value = value
+        vao.render(moderngl.TRIANGLES, vertices=3)
 
     def release(self) -> None:
-        self.vao.release()
-        self.program.release()
+        for key in list(self.programs):
+            self.vaos.pop(key).release()
+            self.programs.pop(key).release()

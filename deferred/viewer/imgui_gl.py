@@ -8,6 +8,8 @@ imgui texture.
 
 from __future__ import annotations
 
+import struct
+
 import moderngl
 import numpy as np
 from imgui_bundle import imgui
@@ -35,8 +37,14 @@ class ImguiRenderer:
             int(ctx.info["GL_MAX_TEXTURE_SIZE"])
 
     # -- textures --------------------------------------------------------------------------------
-    def _update_textures(self) -> None:
+    def update_textures(self) -> bool:
+        """imgui's texture requests carried out; whether any texture changed."""
+        changed = False
         for tex in imgui.get_platform_io().textures:
+            if tex.status in (imgui.ImTextureStatus.want_create,
+                              imgui.ImTextureStatus.want_updates,
+                              imgui.ImTextureStatus.want_destroy):
+                changed = True
             status = tex.status
             if status == imgui.ImTextureStatus.want_create:
                 texture = self.ctx.texture((tex.width, tex.height), 4,
@@ -60,10 +68,11 @@ class ImguiRenderer:
                     texture.release()
                 tex.set_tex_id(0)
                 tex.status = imgui.ImTextureStatus.destroyed
+        return changed
 
     # -- drawing ---------------------------------------------------------------------------------
     def render(self, draw_data: imgui.ImDrawData, framebuffer: moderngl.Framebuffer) -> None:
-        self._update_textures()
+        self.update_textures()
         width, height = self.io.display_size
         if width <= 0 or height <= 0:
             return
@@ -111,6 +120,73 @@ class ImguiRenderer:
         self.textures.clear()
         for item in (self.vao, self.vertices, self.indices, self.program):
             item.release()
+
+
+class PanelLayer:
+    """The panels drawn into a texture of their own and copied onto the window, their
+    triangles drawn again only when imgui's draw data (vertices, indices, commands) or its
+    textures differ from those last drawn: a window frame whose panels did not change (the
+    camera orbiting, say) costs a copy of their pixels, not their triangles."""
+
+    def __init__(self, ctx: moderngl.Context, renderer: ImguiRenderer):
+        self.ctx = ctx
+        self.renderer = renderer
+        self.texture: moderngl.Texture | None = None
+        self.framebuffer: moderngl.Framebuffer | None = None
+        self.signature: bytes | None = None
+        self.drawn = 0  # times the triangles were drawn (tests, benchmarks)
+
+    def draw(self, draw_data: imgui.ImDrawData, window: moderngl.Framebuffer, width: int,
+             height: int, background: tuple[float, float, float]) -> bool:
+        """The panels, all within the window's first ``width`` columns, onto ``window``
+        (the same pixels as :meth:`ImguiRenderer.render` over the ``background``); False,
+        drawing nothing, where imgui draws beyond those columns (a popup over the viewport)."""
+        signature = draw_signature(draw_data, width)
+        if signature is None:
+            return False
+        changed = self.renderer.update_textures()
+        if self.texture is None or self.texture.size != (width, height):
+            self.release()
+            self.texture = self.ctx.texture((width, height), 4)
+            self.framebuffer = self.ctx.framebuffer(color_attachments=[self.texture])
+        if changed or signature != self.signature:
+            self.framebuffer.use()
+            self.framebuffer.clear(*background, 1.0)
+            self.renderer.render(draw_data, self.framebuffer)
+            self.signature = signature
+            self.drawn += 1
+        self.ctx.copy_framebuffer(window, self.framebuffer)
+        return True
+
+    def release(self) -> None:
+        for item in (self.framebuffer, self.texture):
+            if item is not None:
+                item.release()
+        self.texture = self.framebuffer = self.signature = None
+
+
+def draw_signature(draw_data: imgui.ImDrawData, width: int) -> bytes | None:
+    """What imgui draws, as bytes (equal bytes: the same pixels); None where it draws beyond
+    the first ``width`` columns (a vertex there, unclipped)."""
+    parts = []
+    for commands in draw_data.cmd_lists:
+        vertices = _bytes_at(commands.vtx_buffer.data_address(),
+                             commands.vtx_buffer.size() * imgui.VERTEX_SIZE)
+        # the vertices' x: the first float of each (position, uv, colour)
+        right = float(np.frombuffer(vertices, np.float32)[::imgui.VERTEX_SIZE // 4].max()) \
+            if vertices else 0.0
+        parts.append(vertices)
+        parts.append(_bytes_at(commands.idx_buffer.data_address(),
+                               commands.idx_buffer.size() * imgui.INDEX_SIZE))
+        for command in commands.cmd_buffer:
+            if command.elem_count == 0:
+                continue
+            x0, y0, x1, y1 = command.clip_rect
+            if min(x1, right) > width:
+                return None
+            parts.append(struct.pack("4f3Q", x0, y0, x1, y1, command.tex_ref.get_tex_id(),
+                                     command.elem_count, command.idx_offset))
+    return b"".join(parts)
 
 
 def _bytes_at(address: int, size: int) -> bytes:

@@ -108,8 +108,9 @@ def _status(viewer: Viewer, shown: list[str]) -> None:
     width, height = viewer.size
     reduced = "  (reduced)" if viewer.shown_reduced else ""
     imgui.text(f"{viewer.session.scene.source}  {width}x{height}  {viewer.pipeline}{reduced}")
-    rate = f"{viewer.fps:4.0f} fps  " if viewer.running else ""
-    imgui.text(f"{rate}frame {viewer.frame_ms:.1f} ms  t = {viewer.timeline.time:.3f} s")
+    fps, frame_ms = viewer.shown_rates
+    rate = f"{fps:4.0f} fps  " if viewer.running else ""
+    imgui.text(f"{rate}frame {frame_ms:.1f} ms  t = {viewer.timeline.time:.3f} s")
     if viewer.render_error:
         _error(viewer.render_error, shown)
     if viewer.session.scene_error:

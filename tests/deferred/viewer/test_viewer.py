@@ -507,3 +507,29 @@ def test_real_window_under_xvfb(scene_file, tmp_path):
     window = np.rint(read_image(out) * 255).astype(np.uint8)
     assert window.shape[:2] == (640, 560)
     assert window[:SIZE[1], 400:].std() > 5
+
+
+def test_unchanged_panels_are_copied_not_drawn_again(scene_file, make_viewer, monkeypatch):
+    """The panels' layer (deferred.viewer.imgui_gl.PanelLayer): the window is the same image
+    whether the panels are drawn or copied from the last drawing; an edit the panels show
+    draws them again."""
+    from deferred.viewer import app
+
+    viewer = make_viewer(scene_file)
+    viewer.update(force_full=True)
+    viewer.draw()
+    viewer.draw()  # imgui settles its layout over the first frames
+    drawn = viewer.panel_layer.drawn
+    viewer.draw()
+    assert viewer.panel_layer.drawn == drawn  # nothing changed: copied
+    copied = viewer.window_image()
+    # the same window, imgui's triangles drawn straight into it
+    monkeypatch.setattr(app.PanelLayer, "draw", lambda self, *args: False)
+    viewer.draw()
+    np.testing.assert_array_equal(viewer.window_image(), copied)
+    monkeypatch.undo()
+    viewer.timeline.scrub(0.5)  # the panel's time changes
+    viewer.update(force_full=True)
+    viewer.draw()
+    assert viewer.panel_layer.drawn == drawn + 1
+    assert not np.array_equal(viewer.window_image()[:, :400], copied[:, :400])
