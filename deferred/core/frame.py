@@ -106,7 +106,8 @@ class Frame:
                  checked_framebuffers: dict[tuple, Any] | None = None,
                  jitter: tuple[float, float] = (0.0, 0.0), sample_index: int = 0,
                  history_kept: bool = False,
-                 previous_view_projection: np.ndarray | None = None):
+                 previous_view_projection: np.ndarray | None = None,
+                 kept_camera_values: dict[str, Any] | None = None):
         self.gl = gl
         self.ctx = gl.ctx
         self.time = float(time)  # seconds: the scene's timeline is applied at this time
@@ -151,9 +152,11 @@ class Frame:
             projection[1, 2] -= 2.0 * jitter[1] / self.height
             self.projection = projection
             self.inverse_projection = np.linalg.inv(projection)
-        # the camera's uniforms as GL takes them: one dict for every pass of the frame
-        self.camera_values = {name: gl_value(value)
-                              for name, value in self.camera_uniforms().items()}
+        # the camera's uniforms as GL takes them: one dict for every pass of the frame; the
+        # last frame's dict where they are the same (``kept_camera_values``), which a program
+        # still holding it is not even looked through for (ProgramUniforms.set_shared)
+        values = {name: gl_value(value) for name, value in self.camera_uniforms().items()}
+        self.camera_values = kept_camera_values if kept_camera_values == values else values
         self.device = device = Device(gl.ctx, targets, resources, time_gl_calls)
         self.stats = device.stats
         self.set_state = device.set_state

@@ -145,6 +145,9 @@ class ShaderLibrary:
         self._labels: dict[int, str] = {}  # program glo -> its files, for messages
         # program glo -> its active uniforms and the values last written to them
         self._uniforms: dict[int, ProgramUniforms] = {}
+        # between start_frame and end_frame; whether a program was looked up outside them
+        self._in_frame = False
+        self._looked_up_outside = True
         self._virtual_key: tuple[str, ...] = ()  # the virtual files' names, in program keys
         # counts the times programs were released: a program looked up before is still valid
         # while it is unchanged
@@ -236,6 +239,8 @@ class ShaderLibrary:
     def program(self, vertex: str, fragment: str | None = None, geometry: str | None = None,
                 defines: dict[str, str] | None = None) -> moderngl.Program:
         """Compile (or return the cached) program of these files with these defines."""
+        if not self._in_frame:
+            self._looked_up_outside = True  # its uniforms may be written directly
         defines = defines or {}
         # a frozenset of the defines: hashing it is cheaper than sorting them on every lookup
         key = (vertex, fragment, geometry, frozenset(defines.items()), self._virtual_key)
@@ -322,6 +327,19 @@ class ShaderLibrary:
             uniforms = self._uniforms[program.glo] = ProgramUniforms(program)
         return uniforms
 
+    def start_frame(self, forget: bool = False) -> None:
+        """A frame starts: what each program holds is forgotten where code outside a frame may
+        have written its uniforms (a program was looked up between frames), or with
+        ``forget`` (strict mode, whose check of unset uniforms counts a frame's writes); else
+        the values stay known, and a frame writes only those that changed since the last."""
+        if forget or self._looked_up_outside:
+            self.forget_uniform_values()
+        self._looked_up_outside = False
+        self._in_frame = True
+
+    def end_frame(self) -> None:
+        self._in_frame = False
+
     def forget_uniform_values(self) -> None:
         """Forget what each program holds (a frame starts: code between frames may have
         written uniforms directly)."""
@@ -333,6 +351,8 @@ class ShaderLibrary:
 
     def compute(self, name: str, defines: dict[str, str] | None = None) -> moderngl.ComputeShader:
         """Compile (or return the cached) compute shader of this file with these defines."""
+        if not self._in_frame:
+            self._looked_up_outside = True
         defines = defines or {}
         key = ("compute", name, frozenset(defines.items()), self._virtual_key)
         cached = self._programs.get(key)

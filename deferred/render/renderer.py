@@ -135,6 +135,7 @@ class Renderer:
             raise
         self._start_over()
         self._frame_number = 0
+        self._camera_values: dict | None = None  # the last frame's (Frame: kept_camera_values)
         self._pending_hdr: weakref.ref[RenderResult] | None = None
         self._note_built(self.state)
 
@@ -293,12 +294,16 @@ class Renderer:
         stale = self.gl.ctx.error  # reading clears it: errors from here on are this frame's
         if stale != "GL_NO_ERROR":
             warnings.warn(f"GL error {stale} left by code outside the renderer", stacklevel=2)
-        frame, history = self._begin_frame(state, time, jitter, sample_index, time_gl_calls)
-        advance_simulations(frame)
-        prepare_passes(frame, self.passes)
-        self.gl.park()  # whatever framebuffer was bound may have been released since
-        self._setup.skinning.run(state)  # draws (captured): needs a complete framebuffer
-        run_passes(frame, sort_blended(self.passes, state), before_pass, on_pass)
+        try:
+            frame, history = self._begin_frame(state, time, jitter, sample_index,
+                                               time_gl_calls)
+            advance_simulations(frame)
+            prepare_passes(frame, self.passes)
+            self.gl.park()  # whatever framebuffer was bound may have been released since
+            self._setup.skinning.run(state)  # draws (captured): needs a complete framebuffer
+            run_passes(frame, sort_blended(self.passes, state), before_pass, on_pass)
+        finally:
+            self.shaders.end_frame()
         if self.strict:
             frame.inputs.check_material_uniforms()
         self.last_frame, self.state = frame, state
@@ -313,13 +318,16 @@ class Renderer:
         self._check_alive()
         state = self.state_at(_frame_time(time))
         self.gl.make_current()
-        advance_simulations(self._begin_frame(state, time, None, None, False)[0])
+        try:
+            advance_simulations(self._begin_frame(state, time, None, None, False)[0])
+        finally:
+            self.shaders.end_frame()
 
     def _begin_frame(self, state: FrameState, time: float,
                      jitter: tuple[float, float] | None, sample_index: int | None,
                      time_gl_calls: bool):
         """The frame of ``state``, its place in the temporal history, the lights uploaded."""
-        self.shaders.forget_uniform_values()  # code between frames may have written them
+        self.shaders.start_frame(forget=self.strict)  # ended by _end_frame
         self.kept_inputs.start_frame(state)
         history = self.temporal.begin(state, time, self.size[0] / self.size[1])
         effect = temporal_effect(state)
@@ -338,7 +346,9 @@ class Renderer:
                       checked_framebuffers=setup.checked_framebuffers,
                       jitter=(float(jitter[0]), float(jitter[1])), sample_index=sample_index,
                       history_kept=history.kept,
-                      previous_view_projection=history.previous_view_projection)
+                      previous_view_projection=history.previous_view_projection,
+                      kept_camera_values=self._camera_values)
+        self._camera_values = frame.camera_values
         # the shading models' and the light types' samplers
         shading = ShadingTextures.of(setup.shading_models, frame, setup.plan.light_types)
         if shading is not None:
