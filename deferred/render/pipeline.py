@@ -180,10 +180,12 @@ def sort_blended(passes: list[RenderPass], scene: FrameState) -> list[RenderPass
 
 def leading_snapshots(material: list[RenderPass]) -> list[CopyPass]:
     """The copies of the composition among ``material`` (the material phase's passes, in
-    order) that run before any pass writes it: the composition as the lighting made it."""
+    order) that run before any pass writes it: the composition as the lighting made it (a
+    composition's own copy, ``brackets``, runs where its members are: never one)."""
     found = []
     for render_pass in material:
-        if isinstance(render_pass, CopyPass) and render_pass.source == COMPOSITE:
+        if isinstance(render_pass, CopyPass) and render_pass.source == COMPOSITE and \
+                render_pass.brackets is None:
             found.append(render_pass)
         elif COMPOSITE in render_pass.writes:
             break
