@@ -97,14 +97,30 @@ def environment_background_pass(phase: Phase, target: str, order: int) -> Render
                           depth_func="lequal", order=order)
 
 
-def tonemap_pass(scene: FrameState) -> RenderPass:
+def tonemap_pass(scene: FrameState, snapshot: CopyPass | None = None) -> RenderPass:
     """Exposure, the scene's tone mapping operator (fixed when the passes are built, as the
-    background is) and sRGB encoding."""
+    background is) and sRGB encoding; with ``snapshot`` (a copy of the final image the post
+    phase takes before anything writes it: FXAA's source) that copy too, as a second output."""
+    creates = {FINAL: FINAL_SPEC}
+    defines = {"TONEMAP": str(TONEMAPS[scene.tonemap])}
+    if snapshot is not None:
+        creates[snapshot.target] = snapshot.creates[snapshot.target]
+        defines["WRITE_SNAPSHOT"] = "1"
     return FullscreenPass(
-        "post.tonemap", Phase.POST, "post/tonemap.frag", {"u_source": COMPOSITE}, (FINAL,),
-        creates={FINAL: FINAL_SPEC}, order=Order.FIRST,
-        defines={"TONEMAP": str(TONEMAPS[scene.tonemap])},
+        "post.tonemap", Phase.POST, "post/tonemap.frag", {"u_source": COMPOSITE},
+        tuple(creates), creates=creates, order=Order.FIRST, defines=defines,
         uniforms=lambda frame: {"u_exposure": frame.scene.exposure})
+
+
+def post_passes(scene: FrameState, wide: list[RenderPass]) -> list[RenderPass]:
+    """The post phase: the tone mapping first, which makes the first copy of the final image
+    the phase takes before any other pass writes it (one full-screen pass fewer)."""
+    post = phase_passes(scene, Phase.POST, [tonemap_pass(scene)], wide)
+    folded = leading_snapshots(post[1:], FINAL)[:1]
+    if not folded:
+        return post
+    return [tonemap_pass(scene, folded[0]),
+            *(p for p in post[1:] if not any(p is f for f in folded))]
 
 
 def scene_passes(scene: FrameState, pipeline: str) -> list[RenderPass]:
@@ -178,16 +194,16 @@ def sort_blended(passes: list[RenderPass], scene: FrameState) -> list[RenderPass
     return passes if same_passes(out, passes) else out
 
 
-def leading_snapshots(material: list[RenderPass]) -> list[CopyPass]:
-    """The copies of the composition among ``material`` (the material phase's passes, in
-    order) that run before any pass writes it: the composition as the lighting made it (a
-    composition's own copy, ``brackets``, runs where its members are: never one)."""
+def leading_snapshots(passes: list[RenderPass], source: str = COMPOSITE) -> list[CopyPass]:
+    """The copies of ``source`` among ``passes`` (in order) that run before any of them writes
+    it: ``source`` as the pass before them made it (a composition's own copy, ``brackets``,
+    runs where its members are: never one)."""
     found = []
-    for render_pass in material:
-        if isinstance(render_pass, CopyPass) and render_pass.source == COMPOSITE and \
+    for render_pass in passes:
+        if isinstance(render_pass, CopyPass) and render_pass.source == source and \
                 render_pass.brackets is None:
             found.append(render_pass)
-        elif COMPOSITE in render_pass.writes:
+        elif source in render_pass.writes:
             break
     return found
 
@@ -298,7 +314,7 @@ class DeferredPipeline(Pipeline):
                 "material.composite_copy", Phase.MATERIAL, LIGHT_ACCUMULATION, COMPOSITE,
                 COMPOSITE_SPEC, order=Order.FIRST)], wide)
         passes += [p for p in material if not any(p is f for f in folded)]
-        passes += phase_passes(scene, Phase.POST, [tonemap_pass(scene)], wide)
+        passes += post_passes(scene, wide)
         return passes
 
 
@@ -323,7 +339,7 @@ class ForwardPipeline(Pipeline):
         if scene.background == ENVIRONMENT_BACKGROUND:  # after the opaque surfaces
             fixed.append(environment_background_pass(Phase.FORWARD, COMPOSITE, Order.OPAQUE + 1))
         passes = phase_passes(scene, Phase.FORWARD, [*shadows, clear, *fixed], wide)
-        passes += phase_passes(scene, Phase.POST, [tonemap_pass(scene)], wide)
+        passes += post_passes(scene, wide)
         return passes
 
     def shader_defines(self) -> dict[str, str]:

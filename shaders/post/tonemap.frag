@@ -9,7 +9,11 @@ uniform float u_exposure;
 #define TONEMAP 2  // the scenes' default
 #endif
 
-out vec4 out_color;
+layout(location = 0) out vec4 out_color;
+#ifdef WRITE_SNAPSHOT
+// a copy of the final image a later post pass reads while it writes the final image (FXAA's)
+layout(location = 1) out vec4 out_snapshot;
+#endif
 
 vec3 aces_fit(vec3 x) {
     return clamp((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0);
@@ -23,4 +27,7 @@ void main() {
     color = aces_fit(color);
 #endif
     out_color = vec4(srgb_encode(color), 1.0);
+#ifdef WRITE_SNAPSHOT
+    out_snapshot = out_color;
+#endif
 }
