@@ -328,10 +328,9 @@ class ShaderLibrary:
         return uniforms
 
     def start_frame(self, forget: bool = False) -> None:
-        """A frame starts: what each program holds is forgotten where code outside a frame may
-        have written its uniforms (a program was looked up between frames), or with
-        ``forget`` (strict mode, whose check of unset uniforms counts a frame's writes); else
-        the values stay known, and a frame writes only those that changed since the last."""
+        """A frame starts: what programs hold is forgotten where code outside a frame may have
+        written it (a program looked up between frames), or with ``forget`` (strict mode counts
+        a frame's writes); else a frame writes only the values changed since the last."""
         if forget or self._looked_up_outside:
             self.forget_uniform_values()
         self._looked_up_outside = False
