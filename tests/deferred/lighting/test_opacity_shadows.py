@@ -80,7 +80,8 @@ FRONT = [0.0, 0.0, -1.0]  # from the camera: depth into the fur along the light 
 
 
 def fur_scene(material: str, density: float, shell_range=(0.0, 1.0), shadows: bool = True,
-              direction=SIDE, distance: float = 2.0, opacity_scale: float = 0.25, **extra):
+              direction=SIDE, distance: float = 2.0, opacity_scale: float = 0.25,
+              shadow_distance: float = 8.0, **extra):
     params = {**FUR[material], "self_shadow_density": density,
               "shell_range": list(shell_range), **extra}
     return scene_from_dict({
@@ -91,7 +92,7 @@ def fur_scene(material: str, density: float, shell_range=(0.0, 1.0), shadows: bo
                     "params": params}],
         "light": [AMBIENT, {"type": "directional", "direction": direction,
                             "intensity": 2.0, "cascades": 1, "shadows": shadows,
-                            "shadow_resolution": 1024, "shadow_distance": 8.0}]})
+                            "shadow_resolution": 1024, "shadow_distance": shadow_distance}]})
 
 
 def luminance(gl, scene, pipeline="forward"):
@@ -382,8 +383,9 @@ def test_far_fur_draws_fewer_opacity_shells(gl, monkeypatch):
     draws = {}
     for distance in (2.0, 40.0):
         counts.clear()
-        with Renderer(fur_scene("shell_fur", 0.5, distance=distance), "forward",
-                      gl=gl) as renderer:
+        # the cascade reaches the far fur (a caster outside every map is not drawn)
+        with Renderer(fur_scene("shell_fur", 0.5, distance=distance, shadow_distance=50.0),
+                      "forward", gl=gl) as renderer:
             renderer.render()
             draws[distance] = renderer.last_frame.stats.draws_by_pass["shadows"]
         assert len(set(counts)) == 1  # the same count in both stages
