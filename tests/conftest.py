@@ -62,7 +62,12 @@ def local_ray():
     the ray extra; skipped without it), stopped after them: its processes do not load the
     tests after. Here, not in a conftest of the farm tests' own: a second module named
     conftest would shadow this one for the test modules that import ``psnr`` from it."""
+    import signal
+
     ray = pytest.importorskip("ray")
+    handlers = {signum: signal.getsignal(signum) for signum in (signal.SIGINT, signal.SIGTERM)}
     ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
     yield ray
     ray.shutdown()
+    for signum, handler in handlers.items():  # ray.init made SIGTERM a sys.exit
+        signal.signal(signum, handler)

@@ -13,6 +13,8 @@ node) is restarted by Ray and the frames it was asked for are asked again
 from __future__ import annotations
 
 import os
+import signal
+import threading
 from collections import deque
 from collections.abc import Iterator
 from typing import Any
@@ -58,7 +60,13 @@ def _connect(address: str | None) -> bool:
 
     if ray.is_initialized():
         return False
+    # ray.init makes SIGTERM a sys.exit(15) in the driver: the command's own handlers stay
+    # (SIGTERM unwinds as Terminated, exit 143, as without Ray)
+    handlers = {signum: signal.getsignal(signum) for signum in (signal.SIGINT, signal.SIGTERM)}
     ray.init(address=address, include_dashboard=False, log_to_driver=False)
+    for signum, handler in handlers.items():
+        if handler is not None and threading.current_thread() is threading.main_thread():
+            signal.signal(signum, handler)
     return True
 
 
