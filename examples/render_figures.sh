@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Render every example scene into docs/figures/ (the images in the README).
+# Render every example scene into docs/figures/ (the images of the README and the site).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 mkdir -p docs/figures
@@ -28,3 +28,6 @@ deferred render examples/cartoon_hair/anchored_head.toml --frames 48 --fps 24 \
 # glTF files (#35): the sample models of ../shared/assets in both pipelines, the helmet with fur on
 # its crest, a skinned animation, in docs/figures/gltf/
 python examples/gltf/figures.py
+# the documentation site's materials gallery: each registered material on the same ball, in
+# docs/figures/materials/
+python docs/material_figures.py
