@@ -459,7 +459,7 @@ def test_cli_dump_writes_the_folder(tmp_path, capsys):
     lists = {"light_lists.exr"} if "light_lists" in manifest["files"] else set()  # tiled paths
     assert {p.name for p in out.iterdir()} == {"gbuffer.exr", "light.exr", "final.exr",
                                                "final.png", "contact.png", "manifest.json",
-                                               "passes", *lists}
+                                               "index.html", "passes", *lists}
     assert manifest["scene"] == "builtin:demo.toml" and manifest["size"] == [96, 64]
     # a file for every pass that writes a target (light culling fills a buffer, no target)
     assert len(list((out / "passes").glob("*.exr"))) == \
