@@ -1,4 +1,4 @@
-"""Error types the command line maps to exit codes (README.md, "Command line")."""
+"""Error types the command line maps to exit codes (docs/guide/command-line.md)."""
 
 from __future__ import annotations
 

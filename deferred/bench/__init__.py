@@ -1,4 +1,4 @@
-"""The benchmark harness (``deferred bench``, README.md "Benchmarks"): the sweep and its runner
+"""The benchmark harness (``deferred bench``, docs/guide/bench.md): the sweep and its runner
 (:mod:`~deferred.bench.harness`), the scene variants it renders (:mod:`~deferred.bench.scenes`),
 how a frame is timed (:mod:`~deferred.bench.timing`) and what is written of the results
 (:mod:`~deferred.bench.report`)."""

@@ -1,4 +1,4 @@
-"""The ``deferred`` command line (README.md, "Command line"): a module per command, the options
+"""The ``deferred`` command line (docs/guide/command-line.md): a module per command, the options
 several share in :mod:`~deferred.cli.options`, ``--view BUFFER`` in
 :mod:`~deferred.cli.view_option`, exit statuses and error lines in :mod:`~deferred.cli.exits`.
 

@@ -38,7 +38,7 @@ def dump(scene: str | None, output: str | None, pipeline: str, size: str | None,
          passes: str | None, pixel: str | None, light_path: str | None, strict: bool,
          compare: tuple[str, str] | None) -> None:
     """Write every buffer of every pass of one frame of SCENE as EXR, plus a contact sheet and
-    a manifest.json (README.md, "Debugging a frame", lists the files).
+    a manifest.json (docs/guide/dump.md lists the files).
 
     With --compare DIR_A DIR_B: print each buffer's max and mean difference, write difference
     images, and exit 0 when the dumps are the same, 1 when they differ (as diff does)."""

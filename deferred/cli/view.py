@@ -1,4 +1,4 @@
-"""``deferred view``: the interactive viewer (README.md, "The viewer"), or its window drawn once
+"""``deferred view``: the interactive viewer (docs/guide/view.md), or its window drawn once
 offscreen (``--headless``)."""
 
 from __future__ import annotations
@@ -46,7 +46,7 @@ def view_command(scene: str | None, pipeline: str, light_path: str | None, size:
                  screenshot: str | None, no_panels: bool, reduce: int | None) -> None:
     """Interactive viewer of SCENE (the built-in demo when omitted): orbit camera, live
     parameters, buffer views, split deferred / forward, pixel inspector, timeline, hot reload
-    of GLSL and scene files, screenshots and recordings (README.md, "The viewer")."""
+    of GLSL and scene files, screenshots and recordings (docs/guide/view.md)."""
     try:
         from deferred.viewer.app import ViewerOptions
         from deferred.viewer.session import Session

@@ -1,4 +1,4 @@
-"""Writing a dump folder (``deferred dump``; README.md, "Debugging a frame"): every buffer of
+"""Writing a dump folder (``deferred dump``; docs/guide/dump.md): every buffer of
 every pass of a captured frame as float EXR with named channels, the frame's decoded buffers, a
 contact sheet and a manifest; :func:`write_dump` describes the files.
 """

@@ -1,4 +1,4 @@
-"""Scene files: TOML (README.md, "Scene files") or a dict, validated into a
+"""Scene files: TOML (docs/reference/scene-files.md) or a dict, validated into a
 :class:`~deferred.scene.scene.Scene`; ``deferred render`` with no scene loads the built-in demo.
 
 Validation names the file, the key and the problem in one line

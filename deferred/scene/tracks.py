@@ -1,5 +1,5 @@
 """Keyframe tracks: the camera, a light or an object's transform moving over time, and the
-turntable (README.md, "Animation").
+turntable (docs/guide/animation.md).
 
 A track animates one target (``camera``, ``object:NAME``, ``light:INDEX`` or ``light:NAME``)
 through keys, each at a time and setting some of the target's properties:

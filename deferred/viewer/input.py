@@ -1,6 +1,6 @@
 """The viewer's input: the window's mouse, keyboard and text events go to imgui over the panels,
 and over the viewport to the camera controller, the clock and the viewer's actions; the keys
-(README.md, "The viewer")."""
+(docs/guide/view.md)."""
 
 from __future__ import annotations
 
@@ -107,7 +107,7 @@ class ViewerInput:
         self.shortcut(key, ctrl)
 
     def shortcut(self, key: Any, ctrl: bool = False) -> None:
-        """The keys (README.md, "The viewer")."""
+        """The keys (docs/guide/view.md)."""
         keys = self.keys
         viewer = self.viewer
         if ctrl and key == keys.S:
