@@ -90,3 +90,13 @@ def test_readme_block_runs(page, line, code, tmp_path):
     done = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env,
                           capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, f"{page} line {line}:\n{done.stderr[-3000:]}"
+
+
+def test_the_readmes_scene_loads():
+    from deferred.scene.loader import scene_from_toml
+
+    blocks = re.findall(r"^```toml\n(.*?)^```", README.read_text(encoding="utf-8"), re.M | re.S)
+    assert blocks
+    for block in blocks:
+        scene = scene_from_toml(block, "README.md")
+        assert scene.objects and scene.lights
