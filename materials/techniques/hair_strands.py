@@ -455,10 +455,12 @@ def unit_vectors(v: np.ndarray) -> np.ndarray:
 def _nearest(points: np.ndarray, centres: np.ndarray, block: int = 4096) -> np.ndarray:
     """Index of the nearest centre of each point, in blocks of points (bounded memory)."""
     out = np.empty(len(points), dtype=np.int64)
+    squared = (centres ** 2).sum(axis=1)
     for start in range(0, len(points), block):
         part = points[start:start + block]
-        distance = ((part[:, None, :] - centres[None, :, :]) ** 2).sum(axis=2)
-        out[start:start + block] = distance.argmin(axis=1)
+        # |p - c|^2 = |p|^2 - 2 p.c + |c|^2, |p|^2 the same for all of a point's centres: one
+        # matrix product a block rather than a (block, centres, 3) array of differences
+        out[start:start + block] = (squared[None, :] - 2.0 * (part @ centres.T)).argmin(axis=1)
     return out
 
 
