@@ -1,10 +1,12 @@
 """How a material's objects cast shadows: a :class:`ShadowCaster`, the material's ``shadow``.
 
 The shadow pass (``deferred.lighting.shadows``) asks each object's material's caster to draw
-the object into a shadow map (:meth:`ShadowCaster.draw`, the mesh's depth by default) and, for a
-volume that shadows itself (fur), into the deep opacity maps
-(:meth:`ShadowCaster.draw_opacity`). A material whose look is not its mesh gives a caster of its
-own; one that casts nothing gives :class:`NoShadow`.
+the object into a shadow map (:meth:`ShadowCaster.draw`, the mesh's depth by default), for a
+volume that shadows itself (fur) into the deep opacity maps
+(:meth:`ShadowCaster.draw_opacity`) and, for a surface that lets coloured light through
+(glass), into the transmittance maps (:meth:`ShadowCaster.draw_transmittance`). A material
+whose look is not its mesh gives a caster of its own; one that casts nothing gives
+:class:`NoShadow`.
 """
 
 from __future__ import annotations
@@ -108,6 +110,21 @@ class ShadowCaster:
         texel; "density", its optical depth times the volume's density factor (what lies behind
         it keeps exp(-the layers' sum) of the light), added into the four layers behind that
         front (``u_opacity_first``, ``u_opacity_layers``), blended additively."""
+
+
+    def transmits(self, obj: SceneObjectLike) -> bool:
+        """Whether ``obj`` lets light through, coloured (glass): it then draws no depth
+        (:meth:`draw` draws nothing for it) and draws its transmittance instead
+        (:meth:`draw_transmittance`)."""
+        return False
+
+    def draw_transmittance(self, frame: Frame, obj: SceneObjectLike, view: ShadowView) -> None:
+        """Draw ``obj`` into the transmittance maps of ``view`` (where :meth:`transmits`):
+        two outputs, its transmittance (RGB; multiplied into what the texel holds) and its
+        depth along the light (``gl_FragCoord.z``; the nearest kept), depth-tested against
+        the opaque casters. The framework has bound the maps' tile, cleared it and set that
+        state (``deferred.lighting.shadows.transmittance``); ``shadows/caster.vert`` with
+        ``view.uniforms`` draws the mesh."""
 
 
 class NoShadow(ShadowCaster):

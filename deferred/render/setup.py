@@ -45,6 +45,7 @@ from deferred.lighting.shadows.opacity import (
     scene_has_opacity,
 )
 from deferred.lighting.shadows.plan import scene_casts_shadows
+from deferred.lighting.shadows.transmittance import TRANSMITTANCE_DEFINE, scene_transmits
 from deferred.names import LightVolume
 from deferred.render.budget import check_target_memory, renderer_holdings
 from deferred.render.generated import generated_glsl
@@ -60,13 +61,14 @@ def structure_key(state: FrameState, pipeline: str, light_path_arg: str | None,
     """What the passes, targets and programs are built from, apart from parameters: which
     objects (their meshes, their materials' types), which lights and effects, whether a
     light casts shadows, whether a material draws opacity maps and their size (with the
-    lights' shadow resolutions) and the shadow budget (the shadow pass, the atlas and the
-    SHADOWS and OPACITY_SHADOWS defines), the clear colour, the tone mapping operator, the
+    lights' shadow resolutions), whether a caster draws transmittance maps, and the shadow
+    budget (the shadow pass, the atlas and the SHADOWS, OPACITY_SHADOWS and
+    SHADOW_TRANSMITTANCE defines), the clear colour, the tone mapping operator, the
     light path and the size asked for. Membership is by identity: which objects are there."""
     return (tuple((obj.node, id(obj.mesh), type(obj.material), obj.label)
                   for obj in state.objects),
             tuple(map(type, state.lights)), scene_casts_shadows(state.lights),
-            opacity_size(state, pipeline), state.shadow_budget,
+            opacity_size(state, pipeline), scene_transmits(state), state.shadow_budget,
             tuple(map(id, state.effects)),
             state.background if isinstance(state.background, str) else tuple(state.background),
             state.tonemap,
@@ -142,6 +144,8 @@ class RenderSetup:
                 defines[PCSS_DEFINE] = "1"
         if scene_has_opacity(state, plan.pipeline_name):
             defines[OPACITY_SHADOWS_DEFINE] = "1"
+        if scene_transmits(state):
+            defines[TRANSMITTANCE_DEFINE] = "1"
         self.shaders = ShaderLibrary(ctx, features.glsl_version(), defines)
         for root in plan.roots:
             self.shaders.add_root(root)
@@ -156,7 +160,8 @@ class RenderSetup:
         budget = state.shadow_budget
         self.shadow_atlas = ShadowAtlas(
             ctx, budget.atlas_size, budget.max_shadowed_lights,
-            opacity_size(state, plan.pipeline_name), opacity_extent(state)) \
+            opacity_size(state, plan.pipeline_name), opacity_extent(state),
+            opacity_extent(state) if scene_transmits(state) else 0) \
             if scene_casts_shadows(state.lights) else None
         # The per-frame GPU resources every frame is given: by name on its blackboard (for the
         # passes that fill or read them), and those that bind themselves to every program as

@@ -14,10 +14,10 @@ vec3 spot_light(LightRecord light, Surface s, vec3 P, vec3 V) {
 #ifdef SURFACE_TRANSMISSION
     vec3 through = shade_transmission(s, L, V, light.color.rgb * falloff,
                                       light_thickness_perspective(light, P, s.normal));
-    falloff *= light_shadow_perspective(light, P, s.normal, L);
-    return shade_light(s, L, V, light.color.rgb * falloff) + through;
+    vec3 lit = light_shadow_perspective(light, P, s.normal, L);  // coloured through glass
+    return shade_light(s, L, V, light.color.rgb * (falloff * lit)) + through;
 #else
-    falloff *= light_shadow_perspective(light, P, s.normal, L);
-    return shade_light(s, L, V, light.color.rgb * falloff);
+    vec3 lit = light_shadow_perspective(light, P, s.normal, L);  // coloured through glass
+    return shade_light(s, L, V, light.color.rgb * (falloff * lit));
 #endif
 }

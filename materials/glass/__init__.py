@@ -46,12 +46,12 @@ from deferred.api import (
     FullscreenPass,
     InputError,
     Material,
-    NoShadow,
     ObjectPass,
     Order,
     Phase,
     RenderError,
     RenderPass,
+    ShadowCaster,
     TargetSpec,
     Technique,
     copy_pass,
@@ -59,7 +59,7 @@ from deferred.api import (
 )
 
 if TYPE_CHECKING:
-    from deferred.api import Frame, SceneObject
+    from deferred.api import Frame, SceneObject, ShadowView
 
 COMPOSITION = "glass"
 ACCUM = "glass_accum"
@@ -249,12 +249,32 @@ class GlassPasses(Technique):
                                brackets=(COMPOSITION, END))]
 
 
+class GlassShadow(ShadowCaster):
+    """Glass hides nothing from a light: it draws no depth, only its transmittance
+    (``transmittance.frag``), so what lies behind it is lit through its colour."""
+
+    def draw(self, frame: Frame, obj: SceneObject, view: ShadowView) -> None:
+        pass
+
+    def transmits(self, obj: SceneObject) -> bool:
+        return True
+
+    def draw_transmittance(self, frame: Frame, obj: SceneObject, view: ShadowView) -> None:
+        program = frame.shaders.program("shadows/caster.vert",
+                                        "materials/glass/transmittance.frag")
+        frame.bind(program, view.uniforms, offered=frame.object_uniforms(obj),
+                   material=frame.material_inputs(obj.material))
+        frame.draw_mesh(obj.mesh, program)
+
+
 @materials.register
 class GlassMaterial(Material):
     name = "glass"
     Params = GlassParams
     surface_shader = "materials/glass/surface.glsl"
     techniques = (GlassPasses(),)
-    shadow = NoShadow()
+    shadow = GlassShadow()
     inputs_from_params = True
-    uniform_overrides = {"mode": None, "layers": None}
+    # u_opacity is the deep opacity maps' sampler (lighting/shadows.glsl) where fur casts them
+    uniform_overrides = {"mode": None, "layers": None,
+                         "opacity": lambda value: {"u_glass_opacity": value}}

@@ -31,7 +31,7 @@ GlassLayer glass_layer() {
     float fresnel = GLASS_F0 + (1.0 - GLASS_F0) * pow(1.0 - cos_view, 5.0);
     GlassLayer g;
     g.emitted = forward_lighting(s, i.position, V);
-    g.coverage = 1.0 - (1.0 - u_opacity) * (1.0 - fresnel) * u_color;
+    g.coverage = 1.0 - (1.0 - u_glass_opacity) * (1.0 - fresnel) * u_color;
     g.offset = -i.normal.xy * u_refraction;
     g.depth = -i.position.z;
     return g;

@@ -4,13 +4,13 @@
 #include "common/surface.glsl"
 
 uniform vec3 u_color;
-uniform float u_opacity;
+uniform float u_glass_opacity;
 uniform float u_specular_intensity;
 uniform float u_specular_exponent;
 
 Surface material_surface(SurfaceInput i) {
     Surface s;
-    s.albedo = u_color * u_opacity;
+    s.albedo = u_color * u_glass_opacity;
     s.specular_intensity = u_specular_intensity;
     s.specular_exponent = u_specular_exponent;
     s.normal = gl_FrontFacing ? i.normal : -i.normal;

@@ -13,8 +13,17 @@
 //      tile's rectangle in the atlas (u0, v0, u1, v1), a texel's world size (x; per unit of
 //      distance from the light where y = 1: a perspective tile), the tile's near and far
 //      distances (z, w: a depth back to the light's view depth)
-// Without SHADOWS (no light of the scene casts shadows) the light_shadow_* functions are 1 and
-// read nothing.
+// The light_shadow_* functions return the fraction of the light reaching a point per channel
+// (a light's GLSL multiplies its radiance by it): grey from the depth maps, coloured where a
+// transparent caster lies between (SHADOW_TRANSMITTANCE below). Without SHADOWS (no light of
+// the scene casts shadows) they are 1 and read nothing.
+//
+// Transmittance maps (SHADOW_TRANSMITTANCE: a transparent caster such as glass draws them;
+// deferred.lighting.shadows.transmittance): over the atlas's square its lights' maps take,
+// texel for texel (atlas coordinates times u_transmittance_from_atlas),
+// u_shadow_transmittance holds the product of the transparent casters' transmittances each
+// texel sees and u_shadow_transparent_depth the depth of the nearest of them. A point beyond
+// that depth takes the colour, filtered bilinearly.
 //
 // Percentage-closer soft shadows (SHADOW_PCSS: a light of the scene filters so; Fernando 2005)
 // on perspective tiles: blockers are searched for over the part of the map the cone from the
@@ -95,6 +104,34 @@ float shadow_view_depth(float window_z, vec4 size) {
     float n = size.z, f = size.w;
     if (size.y < 0.5) return n + window_z * (f - n);
     return 2.0 * n * f / (f + n - (2.0 * window_z - 1.0) * (f - n));
+}
+#endif
+
+#ifdef SHADOW_TRANSMITTANCE
+uniform sampler2D u_shadow_transmittance;      // RGBA8: product of the transmittances
+uniform sampler2D u_shadow_transparent_depth;  // R32F: the nearest transparent caster's depth
+uniform float u_transmittance_from_atlas;      // atlas -> transmittance-map coordinates
+
+// The colour of the light reaching atlas coordinates uvz of tile rect through the transparent
+// casters before it: bilinear over the four texels around it, each its transmittance where
+// uvz lies beyond its nearest transparent caster and white where it does not (that caster's
+// own surface, a surface in front of it).
+vec3 shadow_transmittance(vec3 uvz, vec4 rect) {
+    vec2 size = vec2(textureSize(u_shadow_transmittance, 0));
+    vec2 st = uvz.xy * u_transmittance_from_atlas * size - 0.5;
+    ivec2 corner = ivec2(floor(st));
+    vec2 f = st - vec2(corner);
+    ivec2 low = ivec2(rect.xy * u_transmittance_from_atlas * size + 0.5);
+    ivec2 high = ivec2(rect.zw * u_transmittance_from_atlas * size - 0.5);
+    vec3 sum = vec3(0.0);
+    for (int k = 0; k < 4; ++k) {
+        ivec2 o = ivec2(k & 1, k >> 1);
+        ivec2 texel = clamp(corner + o, low, high);
+        float w = mix(1.0 - f.x, f.x, float(o.x)) * mix(1.0 - f.y, f.y, float(o.y));
+        bool beyond = uvz.z > texelFetch(u_shadow_transparent_depth, texel, 0).r;
+        sum += w * (beyond ? texelFetch(u_shadow_transmittance, texel, 0).rgb : vec3(1.0));
+    }
+    return sum;
 }
 #endif
 
@@ -316,9 +353,20 @@ float shadow_lookup(vec3 uvz, vec4 rect, vec4 header, vec4 size, vec4 biases, ma
     return shadow_filter(uvz, rect, header);
 }
 
-// One tile's lit fraction at view-space P (normal N, unit L toward the light, distance to it).
-float shadow_tile(int row, int tile, vec4 header, vec4 biases, vec3 P, vec3 N, vec3 L,
-                  float distance) {
+// The lit fraction of a tile's depth maps as a colour: times the transmittance of the
+// transparent casters before the point where the scene has them.
+vec3 shadow_tint(float lit, vec3 uvz, vec4 rect) {
+#ifdef SHADOW_TRANSMITTANCE
+    return lit * shadow_transmittance(uvz, rect);
+#else
+    return vec3(lit);
+#endif
+}
+
+// One tile's lit fraction at view-space P (normal N, unit L toward the light, distance to it),
+// per channel.
+vec3 shadow_tile(int row, int tile, vec4 header, vec4 biases, vec3 P, vec3 N, vec3 L,
+                 float distance) {
     int base = 4 + 6 * tile;
     mat4 to_atlas = mat4(shadow_texel(row, base), shadow_texel(row, base + 1),
                          shadow_texel(row, base + 2), shadow_texel(row, base + 3));
@@ -334,34 +382,36 @@ float shadow_tile(int row, int tile, vec4 header, vec4 biases, vec3 P, vec3 N, v
     vec3 Q = P + N * (biases.y * texel * (0.5 + reach * grazing)) + L * (biases.x * texel);
     vec4 clip = to_atlas * vec4(Q, 1.0);
     vec3 uvz = clip.xyz / clip.w;
-    if (uvz.z >= 1.0) return 1.0;  // beyond the map's far plane
+    if (uvz.z >= 1.0) return vec3(1.0);  // beyond the map's far plane
 #if defined(OPACITY_RECEIVER) && defined(OPACITY_SHADOWS)
     float transmittance = opacity_transmittance(to_atlas, rect, size, P);
     opacity_last = transmittance;
     float lit = shadow_lookup(uvz, rect, header, size, biases, to_atlas, Q, N, texel);
-    if (opacity_as_light_pass) return lit * opacity_beyond(to_atlas, rect, size, P);
-    return lit * (opacity_split ? 1.0 : transmittance);
+    if (opacity_as_light_pass) return shadow_tint(lit * opacity_beyond(to_atlas, rect, size, P),
+                                                  uvz, rect);
+    return shadow_tint(lit * (opacity_split ? 1.0 : transmittance), uvz, rect);
 #elif defined(OPACITY_SHADOWS)
-    return shadow_lookup(uvz, rect, header, size, biases, to_atlas, Q, N, texel) *
-           opacity_beyond(to_atlas, rect, size, P);
+    return shadow_tint(shadow_lookup(uvz, rect, header, size, biases, to_atlas, Q, N, texel) *
+                       opacity_beyond(to_atlas, rect, size, P), uvz, rect);
 #else
-    return shadow_lookup(uvz, rect, header, size, biases, to_atlas, Q, N, texel);
+    return shadow_tint(shadow_lookup(uvz, rect, header, size, biases, to_atlas, Q, N, texel),
+                       uvz, rect);
 #endif
 }
 
 // The fraction of a light reaching view-space P on a surface of normal N (1: lit, 0: shadow),
-// L unit toward the light: one function per projection (deferred.names.ShadowProjection), which
+// per channel, L unit toward the light: one function per projection (deferred.names.ShadowProjection), which
 // a light type's GLSL calls for its own, so no light runs another projection's code.
-float light_shadow_cascades(LightRecord light, vec3 P, vec3 N, vec3 L) {
+vec3 light_shadow_cascades(LightRecord light, vec3 P, vec3 N, vec3 L) {
     int slot = int(light.extra.w + 0.5);
-    if (slot <= 0) return SHADOW_UNSHADOWED;
+    if (slot <= 0) return vec3(SHADOW_UNSHADOWED);
     int row = slot - 1;
     vec4 header = shadow_texel(row, 0);
     vec4 biases = shadow_texel(row, 1);
     vec4 splits = shadow_texel(row, 2);
     int count = int(header.y + 0.5);
     float depth = -P.z;
-    if (depth > splits[count - 1]) return SHADOW_UNSHADOWED;  // beyond the shadow distance
+    if (depth > splits[count - 1]) return vec3(SHADOW_UNSHADOWED);  // beyond the shadow distance
     // the first cascade whose far depth lies beyond P (a cheap loop, then one lookup)
     int i = 0;
     float near = 0.0;
@@ -372,7 +422,7 @@ float light_shadow_cascades(LightRecord light, vec3 P, vec3 N, vec3 L) {
         }
     }
     float far = splits[i];
-    float lit = shadow_tile(row, i, header, biases, P, N, L, 1.0);
+    vec3 lit = shadow_tile(row, i, header, biases, P, N, L, 1.0);
     // blended into the next over the last CASCADE_BLEND of its depth range: no seam
     float band = biases.z * (far - near);
     float t = i + 1 < count ? smoothstep(far - band, far, depth) : 0.0;
@@ -380,17 +430,17 @@ float light_shadow_cascades(LightRecord light, vec3 P, vec3 N, vec3 L) {
     return lit;
 }
 
-float light_shadow_perspective(LightRecord light, vec3 P, vec3 N, vec3 L) {
+vec3 light_shadow_perspective(LightRecord light, vec3 P, vec3 N, vec3 L) {
     int slot = int(light.extra.w + 0.5);
-    if (slot <= 0) return SHADOW_UNSHADOWED;
+    if (slot <= 0) return vec3(SHADOW_UNSHADOWED);
     int row = slot - 1;
     return shadow_tile(row, 0, shadow_texel(row, 0), shadow_texel(row, 1), P, N, L,
                        length(P - light.position.xyz));
 }
 
-float light_shadow_cube(LightRecord light, vec3 P, vec3 N, vec3 L) {
+vec3 light_shadow_cube(LightRecord light, vec3 P, vec3 N, vec3 L) {
     int slot = int(light.extra.w + 0.5);
-    if (slot <= 0) return SHADOW_UNSHADOWED;
+    if (slot <= 0) return vec3(SHADOW_UNSHADOWED);
     int row = slot - 1;
     // the face of the direction's major axis in world space (+X, -X, +Y, -Y, +Z, -Z)
     vec3 d = u_shadow_world_from_view * (P - light.position.xyz);
@@ -454,16 +504,16 @@ float light_thickness_cube(LightRecord light, vec3 P, vec3 N) {
 }
 #endif
 #else
-float light_shadow_cascades(LightRecord light, vec3 P, vec3 N, vec3 L) {
-    return SHADOW_UNSHADOWED;
+vec3 light_shadow_cascades(LightRecord light, vec3 P, vec3 N, vec3 L) {
+    return vec3(SHADOW_UNSHADOWED);
 }
 
-float light_shadow_perspective(LightRecord light, vec3 P, vec3 N, vec3 L) {
-    return SHADOW_UNSHADOWED;
+vec3 light_shadow_perspective(LightRecord light, vec3 P, vec3 N, vec3 L) {
+    return vec3(SHADOW_UNSHADOWED);
 }
 
-float light_shadow_cube(LightRecord light, vec3 P, vec3 N, vec3 L) {
-    return SHADOW_UNSHADOWED;
+vec3 light_shadow_cube(LightRecord light, vec3 P, vec3 N, vec3 L) {
+    return vec3(SHADOW_UNSHADOWED);
 }
 #ifdef SURFACE_TRANSMISSION
 float light_thickness_cascades(LightRecord light, vec3 P, vec3 N) { return 1e30; }

@@ -24,6 +24,7 @@ from deferred.lighting.shadows.frusta import (
 )
 from deferred.lighting.shadows.opacity import OPACITY_FAR, OPACITY_LAYERS
 from deferred.lighting.shadows.plan import left_out_warning, plan_atlas
+from deferred.lighting.shadows.transmittance import TRANSMITTANCE_BYTES
 from deferred.names import ShadowProjection
 
 if TYPE_CHECKING:
@@ -40,16 +41,21 @@ PROJECTION_IDS = {ShadowProjection.CASCADES: 1, ShadowProjection.PERSPECTIVE: 2,
                   ShadowProjection.CUBE: 3}
 
 
-def atlas_memory(budget: Any, opacity_size: int = 0) -> dict[str, int]:
+def atlas_memory(budget: Any, opacity_size: int = 0,
+                 transmittance_size: int = 0) -> dict[str, int]:
     """What the shadow atlas of a scene's budget holds, for the memory budget: its depths
     (4 bytes a texel) and its records; with an ``opacity_size``
     (:func:`~deferred.lighting.shadows.opacity.opacity_size`), the opacity maps (the front and
-    back depths as drawn 8 + grown 8 + four half-float layers 8 bytes a texel)."""
+    back depths as drawn 8 + grown 8 + four half-float layers 8 bytes a texel); with a
+    ``transmittance_size``, the transmittance maps (8 bytes a texel)."""
     size = budget.atlas_size
     held = {f"shadow atlas {size}^2": size * size * 4 +
             RECORD_TEXELS * 16 * budget.max_shadowed_lights}
     if opacity_size:
         held[f"opacity shadow maps {opacity_size}^2"] = opacity_size * opacity_size * 24
+    if transmittance_size:
+        held[f"transmittance shadow maps {transmittance_size}^2"] = \
+            transmittance_size * transmittance_size * TRANSMITTANCE_BYTES
     return held
 
 
@@ -101,9 +107,11 @@ class ShadowAtlas:
     """The shadow atlas, its records texture and this frame's tiles (a binding source)."""
 
     def __init__(self, ctx: moderngl.Context, atlas_size: int, max_lights: int,
-                 opacity_size: int = 0, opacity_extent: int = 0):
+                 opacity_size: int = 0, opacity_extent: int = 0, transmittance_size: int = 0):
         """``opacity_size``: texels on a side of the deep opacity maps (0: none), covering the
-        atlas's square of ``opacity_extent`` texels from its corner."""
+        atlas's square of ``opacity_extent`` texels from its corner; ``transmittance_size``:
+        texels on a side of the transmittance maps (0: none), texel for texel with the atlas
+        from its corner (``deferred.lighting.shadows.transmittance``)."""
         self.ctx = ctx
         self.size = atlas_size
         self.max_lights = max_lights
@@ -151,6 +159,17 @@ class ShadowAtlas:
             self.first_framebuffer.clear(OPACITY_FAR, OPACITY_FAR, 0.0, 0.0)
             self.front_framebuffer.clear(OPACITY_FAR, OPACITY_FAR, 0.0, 0.0)
             self.opacity_framebuffer.clear(0.0, 0.0, 0.0, 0.0)
+        self.transmittance = None
+        if transmittance_size:
+            side = transmittance_size
+            self.transmittance = ctx.texture((side, side), 4, dtype="f1")
+            self.transparent_depth = ctx.texture((side, side), 1, dtype="f4")
+            for texture in (self.transmittance, self.transparent_depth):
+                texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+                texture.repeat_x = texture.repeat_y = False
+            self.transmittance_framebuffer = ctx.framebuffer(
+                [self.transmittance, self.transparent_depth])
+            self.transmittance_framebuffer.clear(1.0, 1.0, 1.0, 1.0)
 
 
     # -- per frame ---------------------------------------------------------------------------
@@ -249,6 +268,9 @@ class ShadowAtlas:
             self._uniforms["u_opacity_layers"] = tuple(b * self.opacity_layer
                                                        for b in OPACITY_LAYERS)
             self._uniforms["u_opacity_from_atlas"] = self.size / self.opacity_extent
+        if self.transmittance is not None:
+            self._uniforms["u_transmittance_from_atlas"] = \
+                self.size / self.transmittance.size[0]
 
     # -- binding source ----------------------------------------------------------------------
     def bind(self, uniforms: ProgramUniforms, texture_unit: int) -> int:
@@ -265,6 +287,14 @@ class ShadowAtlas:
                 self.depth_sampler.use(location=texture_unit)
                 uniforms.set_one("u_shadow_depths", texture_unit)
                 texture_unit += 1
+        if self.transmittance is not None and "u_shadow_transmittance" in uniforms.members:
+            for name, texture in (("u_shadow_transmittance", self.transmittance),
+                                  ("u_shadow_transparent_depth", self.transparent_depth)):
+                texture.use(location=texture_unit)
+                uniforms.set_one(name, texture_unit)
+                texture_unit += 1
+            uniforms.set_one("u_transmittance_from_atlas",
+                             self._uniforms["u_transmittance_from_atlas"])
         if self.opacity is None:
             return texture_unit
         for name, texture in (("u_opacity_first", self.opacity_first),
@@ -300,8 +330,19 @@ class ShadowAtlas:
         first = np.frombuffer(self.opacity_first.read(alignment=1), dtype=np.float32)
         return -first.reshape(side, side, 2)[..., 1]
 
+    def read_transmittance(self) -> tuple[np.ndarray, np.ndarray]:
+        """The transmittance maps: the transmittance (side, side, 3) and the nearest
+        transparent caster's depth (side, side), float32, rows bottom-up."""
+        side = self.transmittance.size[0]
+        colour = np.frombuffer(self.transmittance.read(alignment=1), dtype=np.uint8)
+        depth = np.frombuffer(self.transparent_depth.read(alignment=1), dtype=np.float32)
+        return colour.reshape(side, side, 4)[..., :3] / 255.0, depth.reshape(side, side)
+
     def release(self) -> None:
         parts = [self.framebuffer, self.depth_sampler, self.texture, self.records]
+        if self.transmittance is not None:
+            parts = [self.transmittance_framebuffer, self.transmittance,
+                     self.transparent_depth, *parts]
         if self.opacity is not None:
             parts += [self.first_framebuffer, self.front_framebuffer, self.opacity_framebuffer,
                       self.opacity_drawn, self.opacity_first, self.opacity]

@@ -1,8 +1,9 @@
 """The shadow pass: each shadowed light's tiles of the atlas cleared and the casters it reaches
-drawn into them by their materials; then, where the scene has them, the volumes' deep opacity
-maps. A tile drawn before with the same light, square and casters, each as it was, is not drawn
-again (the atlas keeps its depths from frame to frame): a still light and still casters cost
-nothing after their first frame, whatever the camera does (but for cascades, which follow it)."""
+drawn into them by their materials; then, where the scene has them, the transparent casters'
+transmittance maps and the volumes' deep opacity maps. A tile drawn before with the same light,
+square and casters, each as it was, is not drawn again (the atlas keeps its depths and
+transmittances from frame to frame): a still light and still casters cost nothing after their
+first frame, whatever the camera does (but for cascades, which follow it)."""
 
 from __future__ import annotations
 
@@ -12,9 +13,11 @@ from deferred.core.passes import Order, Phase, RenderPass
 from deferred.lighting.shadows.atlas import SHADOW_ATLAS, ShadowAtlas, ShadowTile
 from deferred.lighting.shadows.bounds import object_sphere
 from deferred.lighting.shadows.opacity import OPACITY_FAR, OPACITY_FRONT_FRAGMENT
+from deferred.lighting.shadows.transmittance import TRANSMITTANCE_BLEND
 
 if TYPE_CHECKING:
     from deferred.core.frame import Frame
+
 
 def caster_key(frame: Frame, obj) -> tuple:
     """What ``obj``'s drawing into a shadow map depends on besides the map: its state's
@@ -81,8 +84,31 @@ class ShadowPass(RenderPass):
                     obj.material.shadow.draw(frame, obj, tile.view)
         finally:
             fbo.viewport = (0, 0, atlas.size, atlas.size)
+        if atlas.transmittance is not None:
+            self._transmittance(frame, atlas, drawn)
         if atlas.opacity is not None:
             self._opacity(frame, atlas, drawn)
+
+    @staticmethod
+    def _transmittance(frame: Frame, atlas: ShadowAtlas,
+                       drawn: list[tuple[ShadowTile, list]]) -> None:
+        """The transmittance maps of each tile ``drawn`` (with its casters;
+        ``deferred.lighting.shadows.transmittance``): the transparent casters' transmittance
+        multiplied in and their nearest depth kept."""
+        fbo = atlas.transmittance_framebuffer
+        frame.gl_call(fbo.use)
+        frame.set_state(depth_test=False, cull=None, blend=TRANSMITTANCE_BLEND,
+                        depth_offset=CASTER_DEPTH_OFFSET)
+        try:
+            for tile, casters in drawn:
+                rect = (tile.x, tile.y, tile.size, tile.size)
+                fbo.viewport = rect
+                frame.gl_call(lambda rect=rect: fbo.clear(1.0, 1.0, 1.0, 1.0, viewport=rect))
+                for obj in casters:
+                    if obj.material.shadow.transmits(obj):
+                        obj.material.shadow.draw_transmittance(frame, obj, tile.view)
+        finally:
+            fbo.viewport = (0, 0, *atlas.transmittance.size)
 
     @staticmethod
     def _opacity(frame: Frame, atlas: ShadowAtlas,
