@@ -13,7 +13,8 @@ A plugin (the built-in materials, lights and effects, and the example package in
   :class:`Light` (:class:`LightParams`, :class:`LightDatum` for a type's own data;
   :class:`AreaLight` and :class:`AreaLightParams`, the base of polygonal area lights, with
   ``ltc_textures``, ``area_light_frame`` and ``disc_polygon_radius``), :class:`Effect`
-  (:class:`EffectParams`), and the registries to register them with: ``materials``,
+  (:class:`EffectParams`, :class:`GBufferEffectParams` for an effect reading the G-buffer that
+  may run in the forward pipeline), and the registries to register them with: ``materials``,
   ``lights``, ``shading_models``, ``effects``.
 - **passes**: :class:`RenderPass`, :class:`ObjectPass` (with the :class:`PassInput` and
   :class:`Shape` it composes), :class:`FullscreenPass`, :class:`ClearPass`, :func:`copy_pass`,
@@ -107,6 +108,7 @@ from deferred.interfaces.effect import (
     Effect,
     EffectParams,
     FrameMoment,
+    GBufferEffectParams,
     halton,
 )
 from deferred.interfaces.light import (
@@ -168,8 +170,9 @@ GLSL_INCLUDES: dict[str, str] = {
     "common/lighting.glsl": "struct LightRecord and the shading-model interface (a light's "
                             "GLSL function)",
     "lighting/shadows.glsl": "light_shadow_cascades, _perspective, _cube: the lit fraction of "
-                            "a shadowed light at a point (a light's GLSL function multiplies "
-                            "by its projection's); with deep opacity maps "
+                            "a shadowed light at a point, per channel (a light's GLSL "
+                            "function multiplies by its projection's), coloured through "
+                            "transparent casters (SHADOW_TRANSMITTANCE); with deep opacity maps "
                             "(OPACITY_SHADOWS), times the transmittance through them: at the "
                             "point's depth for an OPACITY_RECEIVER (the volume's own shading), "
                             "through the whole volume beyond its back for any other surface",
@@ -218,6 +221,7 @@ __all__ = [
     "NORMAL_EXPONENT_ID",
     "Albedo", "Blend",
     "BlinnPhongParams", "ClearPass", "Effect", "EffectParams", "ForwardLitPass", "Frame",
+    "GBufferEffectParams",
     "FullscreenPass", "GBufferData", "GBufferPass", "GpuMesh", "InputError", "Light",
     "LightParams", "LightPath", "LightVolume", "Material", "MaterialParams", "MeshData",
     "MeshPrimitives", "Motion", "MotionOffsets", "NoShadow", "SHADOW_CASTER_DEFINES",

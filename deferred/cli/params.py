@@ -106,7 +106,8 @@ def heading(entry: dict[str, Any]) -> str:
     if entry.get("volume"):
         details.append(f"volume {entry['volume']}")
     if entry.get("pipelines") is not None and len(entry["pipelines"]) == 1:
-        details.append(f"{entry['pipelines'][0]} pipeline only")
+        forward = "; forward with forward = true" if entry.get("reads_gbuffer") else " only"
+        details.append(f"{entry['pipelines'][0]} pipeline{forward}")
     if entry.get("glsl_file"):
         details.append(entry["glsl_file"])
     if "materials" in entry:

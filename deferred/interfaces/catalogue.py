@@ -76,6 +76,7 @@ def describe_type(kind: str, name: str, cls: type) -> dict[str, Any]:
                          for datum in getattr(cls, "data", ())]
     if kind == "effect":
         entry["pipelines"] = [str(getattr(p, "value", p)) for p in getattr(cls, "pipelines", ())]
+        entry["reads_gbuffer"] = bool(getattr(cls, "reads_gbuffer", False))
     if kind == "shading_model":
         entry["glsl_file"] = getattr(cls, "glsl_file", None)
         entry["materials"] = [material for material, owner in registry.materials.items()

@@ -21,6 +21,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
 
+from pydantic import Field
+
 from deferred.core.frame import OfferedUniforms
 from deferred.interfaces.work import EFFECT_PIXEL_SECONDS, Per, RenderWork, Work, counted
 from deferred.names import Pipeline
@@ -67,6 +69,14 @@ class EffectParams(Params):
     """Base of every effect's parameter model."""
 
 
+class GBufferEffectParams(EffectParams):
+    """An effect reading the G-buffer (``Effect.reads_gbuffer``): whether it runs in the
+    forward pipeline too."""
+
+    forward: bool = Field(False, description="run in the forward pipeline too, over a "
+                          "G-buffer its objects' G-buffer passes write first")
+
+
 class Effect(Revisioned):
     """A scene-level effect (``[[effect]]`` in a scene file): a ``name``, a validated
     ``Params`` model and the passes it adds to a pipeline (:meth:`passes`, in any phase).
@@ -76,6 +86,12 @@ class Effect(Revisioned):
     name: ClassVar[str]
     Params: ClassVar[type[EffectParams]] = EffectParams
     pipelines: ClassVar[tuple[str, ...]] = tuple(Pipeline)
+    # Its passes read the G-buffer (depth, normals, surface ids: SSAO, edges). With
+    # GBufferEffectParams' ``forward = true`` it runs in the forward pipeline too, which then
+    # writes the G-buffer first: the objects' G-buffer passes (geometry phase) and the screen
+    # phase run before the lit passes (which then need no depth pre-pass), and a screen
+    # effect's ambient occlusion reaches the opaque lit passes.
+    reads_gbuffer: ClassVar[bool] = False
     shader_root: ClassVar[Traversable | Path | None] = None
     uniform_overrides: ClassVar[UniformOverrides] = {}
     type_id: ClassVar[int] = 0  # set by the registry
@@ -90,6 +106,13 @@ class Effect(Revisioned):
     @classmethod
     def from_dict(cls, values: dict[str, Any], where: str | None = None) -> Effect:
         return cls(validate_params(cls.Params, values, where))
+
+    def applies_to(self, pipeline: str) -> bool:
+        """Whether the effect runs in ``pipeline``: one of its ``pipelines``, or the forward
+        pipeline where it reads the G-buffer and its params say ``forward``."""
+        return pipeline in self.pipelines or (
+            self.reads_gbuffer and pipeline == Pipeline.FORWARD and
+            bool(getattr(self.params, "forward", False)))
 
     def uniforms(self, frame: Frame) -> dict[str, Any]:
         """``u_<field>`` for every parameter that is a uniform, offered to a pass's program

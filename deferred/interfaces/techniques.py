@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 from deferred.core.passes import ObjectPass, PassInput, Phase, RenderPass, Shape
 from deferred.gbuffer.layout import DEPTH
 from deferred.gl.targets import COMPOSITE
+from deferred.interfaces.effect import AMBIENT_OCCLUSION
 
 if TYPE_CHECKING:
     from deferred.core.protocols import SceneObjectLike
@@ -44,6 +45,18 @@ class ForwardLitPass(ObjectPass):
     colors = (COMPOSITE,)
     depth = DEPTH
     depth_func = "lequal"
+
+    def read_occlusion(self) -> None:
+        """Take the ambient occlusion a screen effect found for the surface at each pixel (the
+        target ``ssao``, sampled as ``u_ssao`` by ``common/forward_lighting.glsl`` with
+        ``SCREEN_OCCLUSION``): the forward pipeline's, where it writes the G-buffer first, for
+        its opaque lit passes (the surfaces the occlusion was found for). Called before the
+        pass graph is checked."""
+        self.extra_reads = (*self.extra_reads, AMBIENT_OCCLUSION)
+        self.extra_defines = {**(self.extra_defines or {}), "SCREEN_OCCLUSION": "1"}
+        self.samples = tuple(dict.fromkeys([*self.samples, AMBIENT_OCCLUSION]))
+        self.reads = tuple(dict.fromkeys([*self.reads, AMBIENT_OCCLUSION]))
+        self._plain = False
 
 
 class Technique:

@@ -128,16 +128,22 @@ def scene_passes(scene: FrameState, pipeline: str) -> list[RenderPass]:
     materials' (once per material class, shared names once)."""
     passes: list[RenderPass] = []
     for effect in scene.effects:
-        if pipeline in effect.pipelines:
+        if effect.applies_to(pipeline):
             passes += effect.passes(scene, pipeline)
         else:
+            hint = " (forward = true runs it there, over a G-buffer written first)" \
+                if effect.reads_gbuffer and pipeline == names.Pipeline.FORWARD else ""
             warnings.warn(f"effect {effect.name} applies to the {', '.join(effect.pipelines)} "
-                          f"pipeline only; skipped in the {pipeline} pipeline", stacklevel=2)
+                          f"pipeline only; skipped in the {pipeline} pipeline{hint}",
+                          stacklevel=2)
     by_class: dict[type, list] = {}
     for obj in scene.objects:
         by_class.setdefault(type(obj.material), []).append(obj)
-    phases = [Phase.FORWARD] if pipeline == names.Pipeline.FORWARD else \
-        [Phase.GEOMETRY, Phase.SCREEN, Phase.STIPPLE, Phase.LIGHTING, Phase.MATERIAL]
+    if pipeline == names.Pipeline.FORWARD:
+        phases = [Phase.GEOMETRY, Phase.SCREEN, Phase.FORWARD] if forward_gbuffer(scene) else \
+            [Phase.FORWARD]
+    else:
+        phases = [Phase.GEOMETRY, Phase.SCREEN, Phase.STIPPLE, Phase.LIGHTING, Phase.MATERIAL]
     shared: dict[str, RenderPass] = {}
     for cls, objects in by_class.items():
         for phase in [*phases, Phase.POST]:
@@ -151,6 +157,13 @@ def scene_passes(scene: FrameState, pipeline: str) -> list[RenderPass]:
                     raise InputError(f"two materials add different scene passes named "
                                      f"'{render_pass.name}'", f"material {cls.name}")
     return passes
+
+
+def forward_gbuffer(scene: FrameState) -> bool:
+    """Whether the forward pipeline writes the G-buffer first: an effect reading it runs there
+    (``Effect.reads_gbuffer`` with ``forward``)."""
+    return any(effect.reads_gbuffer and effect.applies_to(names.Pipeline.FORWARD)
+               for effect in scene.effects)
 
 
 def camera_distance(scene: FrameState, obj: ObjectState) -> float:
@@ -324,21 +337,38 @@ class ForwardPipeline(Pipeline):
 
     def build(self, scene: FrameState) -> list[RenderPass]:
         wide = scene_passes(scene, self.name)
-        creates = {COMPOSITE: replace(COMPOSITE_SPEC, clear=(*clear_colour(scene), 0.0)),
-                   DEPTH: GBUFFER_TARGETS[DEPTH]}
+        gbuffer = forward_gbuffer(scene)
+        shadows = [ShadowPass(Phase.GEOMETRY if gbuffer else Phase.FORWARD)] \
+            if scene_casts_shadows(scene.lights) else []
+        creates = {COMPOSITE: replace(COMPOSITE_SPEC, clear=(*clear_colour(scene), 0.0))}
+        passes: list[RenderPass] = []
         fixed: list[RenderPass] = []
+        if gbuffer:
+            # the G-buffer an effect reads (SSAO, edges), written by the objects' G-buffer
+            # passes, then the screen phase: its depth is the lit passes' too
+            clear = ClearPass("gbuffer.clear", Phase.GEOMETRY, scene.gbuffer_layout().targets)
+            passes = phase_passes(scene, Phase.GEOMETRY, [*shadows, clear], wide)
+            passes += phase_passes(scene, Phase.SCREEN, [], wide)
+            shadows = []
+        else:
+            creates[DEPTH] = GBUFFER_TARGETS[DEPTH]
         if self.light_path == names.LightPath.TILED:  # Forward+: depth pre-pass, tiled culling
-            creates[LINEAR_DEPTH] = GBUFFER_TARGETS[LINEAR_DEPTH]
-            fixed += [depth_prepass(p) for obj in scene.objects
-                      for p in obj.material.passes(Phase.FORWARD, obj)
-                      if isinstance(p, ForwardLitPass) and not p.transparent]
+            if not gbuffer:
+                creates[LINEAR_DEPTH] = GBUFFER_TARGETS[LINEAR_DEPTH]
+                fixed += [depth_prepass(p) for obj in scene.objects
+                          for p in obj.material.passes(Phase.FORWARD, obj)
+                          if isinstance(p, ForwardLitPass) and not p.transparent]
             fixed.append(LightCullPass("forward.cull_tiles", Phase.FORWARD, clustered=False,
                                        from_near=True))
         clear = ClearPass("forward.clear", Phase.FORWARD, creates)
-        shadows = [ShadowPass(Phase.FORWARD)] if scene_casts_shadows(scene.lights) else []
         if scene.background == ENVIRONMENT_BACKGROUND:  # after the opaque surfaces
             fixed.append(environment_background_pass(Phase.FORWARD, COMPOSITE, Order.OPAQUE + 1))
-        passes = phase_passes(scene, Phase.FORWARD, [*shadows, clear, *fixed], wide)
+        forward = phase_passes(scene, Phase.FORWARD, [*shadows, clear, *fixed], wide)
+        if any(AMBIENT_OCCLUSION in p.creates for p in passes):
+            for render_pass in forward:  # the opaque surfaces the occlusion was found for
+                if isinstance(render_pass, ForwardLitPass) and not render_pass.transparent:
+                    render_pass.read_occlusion()
+        passes += forward
         passes += post_passes(scene, wide)
         return passes
 

@@ -24,8 +24,8 @@ from deferred.api import (
     NORMAL_EXPONENT_ID,
     Albedo,
     Effect,
-    EffectParams,
     FullscreenPass,
+    GBufferEffectParams,
     Order,
     Phase,
     Pipeline,
@@ -44,7 +44,7 @@ EDGE_ROW_OFFSETS = "edge_row_offsets"
 EDGE_ROW_OFFSETS_SPEC = TargetSpec(1, "f2", "least squared offset to an edge along the row")
 
 
-class EdgesParams(EffectParams):
+class EdgesParams(GBufferEffectParams):
     width: int = Field(1, ge=1, le=16, description="line width in pixels (dilation); with "
                                                    "world_width, the widest a line gets")
     world_width: float | None = Field(None, gt=0.0, le=1000.0,
@@ -65,7 +65,9 @@ class EdgesParams(EffectParams):
 class Edges(Effect):
     name = "edges"
     Params = EdgesParams
-    pipelines = (Pipeline.DEFERRED,)  # reads the G-buffer
+    pipelines = (Pipeline.DEFERRED,)  # and the forward pipeline with forward = true
+    reads_gbuffer = True
+    uniform_overrides = {"forward": None}  # where it runs, not a uniform
 
     def passes(self, scene: Scene, pipeline: str) -> list[RenderPass]:
         inputs = {"u_linear_depth": LINEAR_DEPTH, "u_normal_exponent_id": NORMAL_EXPONENT_ID}

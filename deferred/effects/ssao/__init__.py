@@ -14,8 +14,8 @@ from deferred.api import (
     LINEAR_DEPTH,
     NORMAL_EXPONENT_ID,
     Effect,
-    EffectParams,
     FullscreenPass,
+    GBufferEffectParams,
     Phase,
     Pipeline,
     RenderPass,
@@ -28,7 +28,7 @@ SSAO_RAW = "ssao_raw"
 SSAO_SPEC = TargetSpec(1, "f1", "ambient occlusion (1 = open)")
 
 
-class SSAOParams(EffectParams):
+class SSAOParams(GBufferEffectParams):
     radius: float = Field(0.35, gt=0.0, description="view-space sampling radius")
     strength: float = Field(1.0, ge=0.0, le=4.0, description="how dark full occlusion gets")
     samples: int = Field(16, ge=1, le=128, description="samples per pixel")
@@ -38,7 +38,9 @@ class SSAOParams(EffectParams):
 class SSAO(Effect):
     name = "ssao"
     Params = SSAOParams
-    pipelines = (Pipeline.DEFERRED,)  # the forward pipeline has no G-buffer to sample
+    pipelines = (Pipeline.DEFERRED,)  # and the forward pipeline with forward = true
+    reads_gbuffer = True
+    uniform_overrides = {"forward": None}  # where it runs, not a uniform
 
     def passes(self, scene: Scene, pipeline: str) -> list[RenderPass]:
         """Raw hemisphere SSAO, then a depth-aware blur into the ``ssao`` target."""

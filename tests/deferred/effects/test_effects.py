@@ -141,9 +141,46 @@ def test_edges_width_is_the_line_width_in_pixels(gl, width):
 
 
 def test_g_buffer_effects_are_skipped_in_forward_with_a_warning(gl):
-    with pytest.warns(UserWarning, match="effect edges applies to the deferred pipeline only"):
+    with pytest.warns(UserWarning, match="effect edges applies to the deferred pipeline only; "
+                                         r"skipped in the forward pipeline \(forward = true"):
         _, _, names = render(gl, scene([{"type": "edges"}, {"type": "fxaa"}]), "forward")
     assert "post.fxaa" in names and "screen.edges" not in names
+
+
+def forward_and_deferred_scene(forward):
+    return scene_from_dict({
+        "size": [120, 90], "tonemap": "none",
+        "camera": {"position": [0.0, 1.5, 3.5], "target": [0.0, 0.3, 0.0]},
+        "object": [{"mesh": "builtin:plane", "scale": 3.0},
+                   {"mesh": "builtin:sphere", "position": [0.0, 0.5, 0.0], "scale": 0.5},
+                   {"mesh": "builtin:torus", "material": "pbr", "position": [0.9, 0.3, 0.3],
+                    "scale": 0.4, "params": {"base_color": [0.7, 0.4, 0.3]}}],
+        "light": [{"type": "ambient", "color": [0.6, 0.6, 0.6]},
+                  {"type": "directional", "direction": [0.3, -1.0, -0.4], "intensity": 0.8}],
+        "effect": [{"type": "ssao", "forward": forward, "radius": 0.4},
+                   {"type": "edges", "forward": forward}]})
+
+
+@pytest.mark.parametrize("light_path", ["naive", "tiled"])
+def test_g_buffer_effects_run_in_forward_when_asked_and_agree_with_deferred(gl, light_path):
+    """With forward = true the forward pipeline writes the G-buffer first (the objects'
+    G-buffer passes), runs the screen phase over it, and its opaque lit passes take the
+    ambient occlusion: SSAO and edges as in the deferred pipeline."""
+    with Renderer(forward_and_deferred_scene(True), "deferred", gl=gl, strict=True) as renderer:
+        deferred = renderer.render().image[..., :3] / 255.0
+    with Renderer(forward_and_deferred_scene(True), "forward", gl=gl, strict=True,
+                  light_path=light_path) as renderer:
+        forward = renderer.render().image[..., :3] / 255.0
+        names = [p.name for p in renderer.passes]
+    assert names.index("torus0.gbuffer") < names.index("screen.ssao") < \
+        names.index("torus0.forward") < names.index("post.edges")
+    assert not any(name.endswith("depth_prepass") for name in names)  # the G-buffer's depth
+    assert psnr(forward, deferred) >= 40.0
+    with pytest.warns(UserWarning, match="effect ssao applies"):
+        with Renderer(forward_and_deferred_scene(False), "forward", gl=gl,
+                      light_path=light_path) as renderer:
+            plain = renderer.render().image[..., :3] / 255.0
+    assert psnr(plain, deferred) < 30.0  # no occlusion, no outlines
 
 
 @pytest.mark.parametrize("effect, message", [
