@@ -112,6 +112,16 @@ class ShadowCaster:
         front (``u_opacity_first``, ``u_opacity_layers``), blended additively."""
 
 
+    def draw_with(self, frame: Frame, obj: SceneObjectLike, view: ShadowView,
+                  fragment: str) -> None:
+        """Draw ``obj``'s mesh from the light with the fragment shader ``fragment``, which
+        reads the material's uniforms and textures (a transmittance of the material's
+        colour): ``shadows/caster.vert`` and ``view.uniforms``."""
+        program = frame.shaders.program(SHADOW_CASTER_VERTEX, fragment)
+        frame.bind(program, view.uniforms, offered=frame.object_uniforms(obj),
+                   material=frame.material_inputs(obj.material))
+        frame.draw_mesh(obj.mesh, program)
+
     def transmits(self, obj: SceneObjectLike) -> bool:
         """Whether ``obj`` lets light through, coloured (glass): it then draws no depth
         (:meth:`draw` draws nothing for it) and draws its transmittance instead
@@ -123,8 +133,8 @@ class ShadowCaster:
         two outputs, its transmittance (RGB; multiplied into what the texel holds) and its
         depth along the light (``gl_FragCoord.z``; the nearest kept), depth-tested against
         the opaque casters. The framework has bound the maps' tile, cleared it and set that
-        state (``deferred.lighting.shadows.transmittance``); ``shadows/caster.vert`` with
-        ``view.uniforms`` draws the mesh."""
+        state (``deferred.lighting.shadows.transmittance``); :meth:`draw_with` draws the mesh
+        with a fragment shader of the caster's."""
 
 
 class NoShadow(ShadowCaster):

@@ -260,11 +260,7 @@ class GlassShadow(ShadowCaster):
         return True
 
     def draw_transmittance(self, frame: Frame, obj: SceneObject, view: ShadowView) -> None:
-        program = frame.shaders.program("shadows/caster.vert",
-                                        "materials/glass/transmittance.frag")
-        frame.bind(program, view.uniforms, offered=frame.object_uniforms(obj),
-                   material=frame.material_inputs(obj.material))
-        frame.draw_mesh(obj.mesh, program)
+        self.draw_with(frame, obj, view, "materials/glass/transmittance.frag")
 
 
 @materials.register

@@ -64,10 +64,7 @@ class FilmShadow(ShadowCaster):
         return True
 
     def draw_transmittance(self, frame, obj, view):
-        program = frame.shaders.program("shadows/caster.vert", "film/shadow.frag")
-        frame.bind(program, view.uniforms, offered=frame.object_uniforms(obj),
-                   material=frame.material_inputs(obj.material))
-        frame.draw_mesh(obj.mesh, program)
+        self.draw_with(frame, obj, view, "film/shadow.frag")
 
 
 class FilmMaterial(Material):
