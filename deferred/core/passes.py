@@ -97,12 +97,13 @@ class RenderPass(ABC):
 BEGIN, END = "begin", "end"  # the roles of a composition's own passes (RenderPass.brackets)
 
 
-def compose_runs(passes: list[RenderPass],
-                 brackets: list[RenderPass] | None = None) -> list[RenderPass]:
+def compose_runs(passes: list[RenderPass], brackets: list[RenderPass] | None = None,
+                 split: bool = True) -> list[RenderPass]:
     """``passes`` with each composition's ``begin`` and ``end`` passes (those among
     ``passes``, or among ``brackets`` where given) taken from where they are and put around
     every run of its members (consecutive passes whose ``composition`` is its name): the same
-    list where they already are so.
+    list where they already are so. Without ``split``, once around the span from its first
+    member to its last (the list the pass graph checks: each pass in it once).
 
     A composition is a group of object passes composed together, order-independently
     (weighted blended or per-pixel sorted transparency). Each frame, every run of them that no
@@ -124,12 +125,15 @@ def compose_runs(passes: list[RenderPass],
         return passes
     out: list[RenderPass] = []
     current: str | None = None
-    for render_pass in passes:
+    last = {p.composition: k for k, p in enumerate(passes) if p.composition in roles}
+    for index, render_pass in enumerate(passes):
         if render_pass.brackets is not None:
             continue
         group = render_pass.composition
         if group not in roles:
             group = None  # none of its passes in this list: composed on its own
+        if not split and group is None and current is not None and index < last[current]:
+            group = current  # inside the span: no end yet
         if group != current:
             if current is not None:
                 out += roles[current][END]

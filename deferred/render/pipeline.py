@@ -239,9 +239,11 @@ def phase_passes(scene: FrameState, phase: Phase, fixed: list[RenderPass],
             blended = render_pass.order >= Order.VOLUME
             keyed.append(((render_pass.order, OBJECT_PASS, -distance if blended else 0.0, index),
                           render_pass))
-    # a composition's begin and end passes around the runs of its members
+    # a composition's begin and end passes around its members (once: each frame's order splits
+    # them into runs, sort_blended)
     return compose_runs([render_pass for _, render_pass in sorted(keyed,
-                                                                  key=lambda item: item[0])])
+                                                                  key=lambda item: item[0])],
+                        split=False)
 
 
 class Pipeline:

@@ -31,6 +31,9 @@ def test_begin_and_end_go_around_each_run_of_members():
     assert names(compose_runs([fur, a, b, c], brackets=passes)) == \
         ["fur", "clear", "a", "b", "c", "resolve"]
     assert without_brackets(composed) == [a, b, fur, c, last]
+    # once around the span, for the list the pass graph checks
+    assert names(compose_runs(passes, split=False)) == ["clear", "a", "b", "fur", "c", "resolve",
+                                                        "last"]
 
 
 def test_members_without_their_composition_s_passes_compose_alone():

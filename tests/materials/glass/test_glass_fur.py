@@ -77,3 +77,20 @@ def test_each_frame_puts_the_glass_run_where_its_distance_does(gl):
         return names.index("material.glass_composite") < names.index("sphere0.layers")
 
     assert not glass_first(front) and glass_first(behind)
+
+
+@pytest.mark.parametrize("pipeline", ["deferred", "forward"])
+def test_fur_between_two_panes_splits_the_glass_into_two_runs(gl, pipeline):
+    sc = scene(pane_z=1.0)
+    sc.add_object("builtin:plane", "glass", position=(0.0, 0.0, -1.0),
+                  rotation=(90.0, 0.0, 0.0), scale=1.5,
+                  params={"color": [0.2, 0.2, 1.0], "refraction": 0.0})
+    with Renderer(sc, pipeline, gl=gl, strict=True) as renderer:
+        from deferred.debug.capture import capture_frame
+        names = [p.name for p in capture_frame(renderer).passes]
+    phase = "material" if pipeline == "deferred" else "forward"
+    runs = [k for k, name in enumerate(names) if name == f"{phase}.glass_composite"]
+    fur = next(k for k, name in enumerate(names) if name.startswith("sphere0.") and
+               k > names.index(f"{phase}.glass_clear"))
+    assert len(runs) == 2 and runs[0] < fur < runs[1]
+    assert names.index("plane1.glass") < runs[0] < names.index("plane0.glass") < runs[1]
