@@ -11,7 +11,7 @@ from deferred.io.memory import check_memory
 from deferred.lighting.shadows.atlas import atlas_memory
 from deferred.lighting.shadows.opacity import opacity_extent, opacity_size
 from deferred.lighting.shadows.plan import scene_casts_shadows
-from deferred.lighting.shadows.transmittance import scene_transmits
+from deferred.lighting.shadows.transmittance import scene_has_transparent_casters
 from deferred.scene.state import FrameState
 
 
@@ -64,8 +64,9 @@ def renderer_holdings(scene: FrameState, pipeline: str, size: tuple[int, int]) -
     textures and state, the shadow atlas and opacity maps, the effects' histories."""
     held = held_memory(scene)
     if scene_casts_shadows(scene.lights):
+        transparent = opacity_extent(scene) if scene_has_transparent_casters(scene) else 0
         held.update(atlas_memory(scene.shadow_budget, opacity_size(scene, pipeline),
-                                 opacity_extent(scene) if scene_transmits(scene) else 0))
+                                 transparent))
     for effect in scene.effects:
         held.update(effect.held_memory(size))
     return held

@@ -261,8 +261,8 @@ class Pipeline:
     def build(self, scene: FrameState) -> list[RenderPass]:
         raise NotImplementedError
 
-    def shader_defines(self) -> dict[str, str]:
-        """Defines every program of this pipeline gets (the light path's)."""
+    def shader_defines(self, scene: FrameState) -> dict[str, str]:
+        """Defines every program of this pipeline gets for ``scene`` (the light path's)."""
         return {}
 
     def passes(self, scene: FrameState) -> list[RenderPass]:
@@ -307,13 +307,16 @@ class DeferredPipeline(Pipeline):
             # light accumulation: the same pass writes both (no copy pass), and the snapshot
             # of the composition the material phase takes before its first write to it.
             clustered = self.light_path == names.LightPath.CLUSTERED
+            # lists from the near plane where transparent surfaces in front of the opaque
+            # ones read them too (tiled: the G-buffer's depth bounds would miss them)
+            from_near = lit_transparent(scene)
             composite = not environment and not split and not any(
                 LIGHT_ACCUMULATION in p.writes
                 for p in phase_passes(scene, Phase.LIGHTING, [], wide))
             if composite:
                 folded = leading_snapshots(material)[:1]
             lights = [LightCullPass(f"lighting.cull_{'clusters' if clustered else 'tiles'}",
-                                    Phase.LIGHTING, clustered),
+                                    Phase.LIGHTING, clustered, from_near=from_near),
                       list_shading_pass(f"lighting.{self.light_path}", clustered,
                                         layout.color_targets, occlusion,
                                         clear_colour(scene), composite=composite,
@@ -331,6 +334,24 @@ class DeferredPipeline(Pipeline):
         passes += [p for p in material if not any(p is f for f in folded)]
         passes += post_passes(scene, wide)
         return passes
+
+    def shader_defines(self, scene: FrameState) -> dict[str, str]:
+        """On the tiled and clustered paths, where transparent surfaces are lit after the
+        opaque scene (glass), ``forward_lighting`` loops each point's list (LISTED_LIGHTS)
+        rather than every light of the frame."""
+        if self.light_path == names.LightPath.VOLUMES or not lit_transparent(scene):
+            return {}
+        defines = {"LISTED_LIGHTS": "1"}
+        if self.light_path == names.LightPath.CLUSTERED:
+            defines["LIGHT_LISTS_CLUSTERED"] = "1"
+        return defines
+
+
+def lit_transparent(scene: FrameState) -> bool:
+    """Whether the deferred pipeline lights transparent surfaces in its material phase (a
+    pass marked ``transparent``: glass)."""
+    return any(p.transparent for obj in scene.objects
+               for p in obj.material.passes(Phase.MATERIAL, obj))
 
 
 class ForwardPipeline(Pipeline):
@@ -374,7 +395,7 @@ class ForwardPipeline(Pipeline):
         passes += post_passes(scene, wide)
         return passes
 
-    def shader_defines(self) -> dict[str, str]:
+    def shader_defines(self, scene: FrameState) -> dict[str, str]:
         return {"FORWARD_PLUS": "1"} if self.light_path == names.LightPath.TILED else {}
 
 

@@ -45,7 +45,10 @@ from deferred.lighting.shadows.opacity import (
     scene_has_opacity,
 )
 from deferred.lighting.shadows.plan import scene_casts_shadows
-from deferred.lighting.shadows.transmittance import TRANSMITTANCE_DEFINE, scene_transmits
+from deferred.lighting.shadows.transmittance import (
+    TRANSMITTANCE_DEFINE,
+    scene_has_transparent_casters,
+)
 from deferred.names import LightVolume
 from deferred.render.budget import check_target_memory, renderer_holdings
 from deferred.render.generated import generated_glsl
@@ -68,7 +71,8 @@ def structure_key(state: FrameState, pipeline: str, light_path_arg: str | None,
     return (tuple((obj.node, id(obj.mesh), type(obj.material), obj.label)
                   for obj in state.objects),
             tuple(map(type, state.lights)), scene_casts_shadows(state.lights),
-            opacity_size(state, pipeline), scene_transmits(state), state.shadow_budget,
+            opacity_size(state, pipeline), scene_has_transparent_casters(state),
+            state.shadow_budget,
             tuple(map(id, state.effects)),
             state.background if isinstance(state.background, str) else tuple(state.background),
             state.tonemap,
@@ -132,7 +136,7 @@ class RenderSetup:
         self.pipeline = PIPELINES[plan.pipeline_name](self.light_path)
         if self.light_path != plan.provisional:
             self.graph = check_passes(self.pipeline.build(state))
-        defines = dict(self.pipeline.shader_defines())
+        defines = dict(self.pipeline.shader_defines(state))
         if scene_splits_light(plan.shading_models):
             defines[SPLIT_DEFINE] = "1"
         if scene_transmits(plan.shading_models):
@@ -144,7 +148,7 @@ class RenderSetup:
                 defines[PCSS_DEFINE] = "1"
         if scene_has_opacity(state, plan.pipeline_name):
             defines[OPACITY_SHADOWS_DEFINE] = "1"
-        if scene_transmits(state):
+        if scene_has_transparent_casters(state):
             defines[TRANSMITTANCE_DEFINE] = "1"
         self.shaders = ShaderLibrary(ctx, features.glsl_version(), defines)
         for root in plan.roots:
@@ -161,7 +165,7 @@ class RenderSetup:
         self.shadow_atlas = ShadowAtlas(
             ctx, budget.atlas_size, budget.max_shadowed_lights,
             opacity_size(state, plan.pipeline_name), opacity_extent(state),
-            opacity_extent(state) if scene_transmits(state) else 0) \
+            opacity_extent(state) if scene_has_transparent_casters(state) else 0) \
             if scene_casts_shadows(state.lights) else None
         # The per-frame GPU resources every frame is given: by name on its blackboard (for the
         # passes that fill or read them), and those that bind themselves to every program as

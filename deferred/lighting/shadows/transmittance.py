@@ -30,7 +30,7 @@ TRANSMITTANCE_BYTES = 8  # a texel: RGBA8 transmittance and R32F depth
 TRANSMITTANCE_BLEND = ("multiply", "min")
 
 
-def scene_transmits(scene: Scene) -> bool:
+def scene_has_transparent_casters(scene: Scene) -> bool:
     """Whether a shadowed scene draws transmittance maps: an object's caster lets light
     through (``ShadowCaster.transmits``)."""
     return scene_casts_shadows(scene.lights) and any(
