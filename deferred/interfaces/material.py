@@ -274,6 +274,16 @@ class Material(Revisioned):
         objects share counts once. Files are sized by their headers. By default nothing."""
         return {}
 
+    @classmethod
+    def frame_memory(cls, objects: Sequence[SceneObjectLike],
+                     size: tuple[int, int]) -> dict[str, int]:
+        """Bytes this material's scene-wide resources hold for a frame of ``size`` besides the
+        pass graph's targets (storage buffers sized by the frame: glass's per-pixel lists),
+        for ``objects``, the scene's objects of this material; counted with
+        :meth:`held_memory` against the memory budget before the first frame. By default
+        nothing."""
+        return {}
+
     def work(self, obj: WorkObject, job: RenderWork) -> list[Work]:
         """The work this material's passes do for ``obj`` in a render ``job``, as the cost
         model counts it (:mod:`deferred.interfaces.work`): by default its mesh drawn once a

@@ -61,8 +61,14 @@ def held_memory(scene: FrameState) -> dict[str, int]:
 
 def renderer_holdings(scene: FrameState, pipeline: str, size: tuple[int, int]) -> dict[str, int]:
     """What a renderer of ``scene`` holds besides its pass graph's targets: the materials'
-    textures and state, the shadow atlas and opacity maps, the effects' histories."""
+    textures and state, what their scene-wide passes hold for a frame of ``size``
+    (``Material.frame_memory``), the shadow atlas and opacity maps, the effects' histories."""
     held = held_memory(scene)
+    by_class: dict[type, list] = {}
+    for obj in scene.objects:
+        by_class.setdefault(type(obj.material), []).append(obj)
+    for cls, objects in by_class.items():
+        held.update(cls.frame_memory(objects, size))
     if scene_casts_shadows(scene.lights):
         transparent = opacity_extent(scene) if scene_has_transparent_casters(scene) else 0
         held.update(atlas_memory(scene.shadow_budget, opacity_size(scene, pipeline),

@@ -274,3 +274,12 @@ class GlassMaterial(Material):
     # u_opacity is the deep opacity maps' sampler (lighting/shadows.glsl) where fur casts them
     uniform_overrides = {"mode": None, "layers": None,
                          "opacity": lambda value: {"u_glass_opacity": value}}
+
+    @classmethod
+    def frame_memory(cls, objects, size: tuple[int, int]) -> dict[str, int]:
+        """The exact mode's lists: a head a pixel and ``layers`` nodes a pixel."""
+        if scene_mode(objects) != "exact":
+            return {}
+        layers, pixels = scene_layers(objects), size[0] * size[1]
+        return {f"glass lists ({layers} layers a pixel)":
+                4 * (1 + pixels) + NODE_BYTES * layers * pixels}

@@ -116,3 +116,31 @@ def test_glass_behind_an_opaque_surface_is_hidden(gl, pipeline, mode):
     hidden = render_hdr(gl, panes_scene([0, 1, 2], mode, extra=[wall]), pipeline)
     alone = render_hdr(gl, panes_scene([], mode, extra=[wall]), pipeline)
     np.testing.assert_array_equal(hidden, alone)
+
+
+def test_the_exact_modes_lists_count_against_the_memory_budget(tmp_path, capsys):
+    """The exact mode's per-pixel lists (a head and ``layers`` nodes of 24 bytes a pixel) are
+    counted before the first frame: 32 layers at 4096x4096 (12.9 GB) are refused in one line,
+    while wboit at that size holds none."""
+    from deferred.cli import main
+    from deferred.render.budget import renderer_holdings
+    from deferred.scene.timeline import SceneEvaluator
+
+    state = SceneEvaluator(panes_scene([0, 1], "exact")).evaluate(0.0)
+    pixels = 4096 * 4096
+    assert renderer_holdings(state, "deferred", (4096, 4096))[
+        "glass lists (8 layers a pixel)"] == 4 * (1 + pixels) + 24 * 8 * pixels
+    wboit = SceneEvaluator(panes_scene([0, 1], "wboit")).evaluate(0.0)
+    assert not any("glass" in key for key in renderer_holdings(wboit, "deferred", (4096, 4096)))
+
+    (tmp_path / "s.toml").write_text(
+        '[camera]\nposition = [0.0, 0.0, 4.0]\ntarget = [0.0, 0.0, 0.0]\n'
+        '[[object]]\nmesh = "builtin:plane"\nmaterial = "glass"\n'
+        '[object.params]\nmode = "exact"\nlayers = 32\n'
+        '[[light]]\ntype = "directional"\n')
+    code = main(["render", str(tmp_path / "s.toml"), "-o", str(tmp_path / "out.png"),
+                 "--size", "4096x4096"])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and "glass lists (32 layers a pixel): 12" in err, err
+    assert err.startswith("error: ") and len(err.splitlines()) == 1, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.toml"]
