@@ -111,9 +111,8 @@ class GlassLists:
         self.links = ctx.buffer(reserve=8 * self.capacity)
 
     def clear(self) -> None:
-        """No node taken, every pixel's list empty."""
-        self.heads.clear(chunk=b"\xff\xff\xff\xff")
-        self.heads.write(b"\x00\x00\x00\x00")
+        """No node taken, every pixel's list empty (``lists.glsl``: none is 0)."""
+        self.heads.clear()
 
     def bind(self) -> None:
         for buffer, binding in ((self.heads, LIST_BINDINGS["GLASS_HEADS_BINDING"]),

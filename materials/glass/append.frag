@@ -15,12 +15,12 @@ void main() {
     if (gl_HelperInvocation) return;
 #endif
     GlassLayer g = glass_layer();
-    uint node = atomicAdd(glass_count, 1u);
-    if (node >= uint(u_glass_capacity)) return;
+    uint node = atomicAdd(glass_count, 1u) + 1u;
+    if (node > uint(u_glass_capacity)) return;
     uint pixel = uint(gl_FragCoord.y) * uint(u_glass_width) + uint(gl_FragCoord.x);
-    glass_layers[node] = uvec4(packHalf2x16(g.emitted.rg), packHalf2x16(vec2(g.emitted.b,
-                                                                               g.coverage.r)),
-                               packHalf2x16(g.coverage.gb), floatBitsToUint(g.depth));
+    glass_layers[node - 1u] = uvec4(packHalf2x16(g.emitted.rg),
+                                    packHalf2x16(vec2(g.emitted.b, g.coverage.r)),
+                                    packHalf2x16(g.coverage.gb), floatBitsToUint(g.depth));
     uint next = atomicExchange(glass_heads[pixel], node);
-    glass_links[node] = uvec2(packHalf2x16(g.offset), next);
+    glass_links[node - 1u] = uvec2(packHalf2x16(g.offset), next);
 }

@@ -28,8 +28,8 @@ void main() {
     int count = 0;
     vec2 offset = vec2(0.0);
     for (int guard = 0; node != GLASS_NONE && guard < (1 << 20); ++guard) {
-        uvec4 layer = glass_layers[node];
-        uvec2 link = glass_links[node];
+        uvec4 layer = glass_layers[node - 1u];
+        uvec2 link = glass_links[node - 1u];
         float depth = uintBitsToFloat(layer.w);
         offset += unpackHalf2x16(link.x);
         node = link.y;
