@@ -37,13 +37,16 @@ LIGHTS = {
     "spot": {"type": "spot", "position": [-2.0, 2.5, 0.0], "direction": [1.0, -1.0, 0.0],
              "outer_angle": 40.0, "inner_angle": 30.0, "radius": 10.0, "intensity": 8.0,
              "shadows": True, "shadow_resolution": 1024},
+    # a cube map: the shadow spans its +X and -Y faces
+    "point": {"type": "point", "position": [-2.5, 3.0, 0.0], "radius": 12.0, "intensity": 10.0,
+              "shadows": True, "shadow_resolution": 1024},
 }
 
 
 @pytest.mark.parametrize("pipeline, light_path", [
     ("deferred", "tiled"), ("deferred", "volumes"), ("deferred", "clustered"),
     ("forward", "naive"), ("forward", "tiled")])
-@pytest.mark.parametrize("light", ["directional", "spot"])
+@pytest.mark.parametrize("light", list(LIGHTS))
 def test_a_red_pane_casts_a_shadow_of_its_transmittance(gl, pipeline, light_path, light):
     def render(glass):
         with Renderer(scene(LIGHTS[light], glass), pipeline, gl=gl, strict=True,
@@ -55,7 +58,8 @@ def test_a_red_pane_casts_a_shadow_of_its_transmittance(gl, pipeline, light_path
     row = np.argmin(np.abs(ground[:, SIZE[0] // 2, 2]))
     x = ground[row, :, 0]
     # the pane spans x in [-0.5, 0.5] at height 0.5: the camera sees it over the floor within
-    # 0.57 of the middle; its shadow falls 0.5 further along +x (the spot's a little further)
+    # 0.57 of the middle; its shadow falls 0.5 further along +x (the spot's and the point's a
+    # little further)
     under = (x > 0.62) & (x < 0.95)
     beside = (x > 1.35) & (x < 1.6)
     assert under.sum() >= 5 and beside.sum() >= 3
