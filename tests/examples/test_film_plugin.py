@@ -2,13 +2,11 @@
 user would and rendered through the command line in both pipelines: its films tint what lies
 behind them in any order and cast coloured shadows."""
 
-import shutil
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 from locations import ROOT
+from plugin_packages import deferred, install_plugin
 
 from deferred.io.images import read_image
 
@@ -17,20 +15,7 @@ PLUGIN = ROOT / "examples" / "plugins" / "deferred-film"
 
 @pytest.fixture(scope="module")
 def site(tmp_path_factory):
-    work = tmp_path_factory.mktemp("film")
-    source = work / "source"
-    shutil.copytree(PLUGIN, source, ignore=shutil.ignore_patterns("*.egg-info"))
-    target = work / "site"
-    subprocess.run([sys.executable, "-m", "pip", "install", "--quiet", "--no-deps",
-                    "--no-build-isolation", "--target", str(target), str(source)],
-                   check=True, capture_output=True)
-    return target
-
-
-def deferred(site, *args, cwd):
-    env = {"PYTHONPATH": str(site), "DEFERRED_STRICT": "1", "PATH": "/usr/bin:/bin"}
-    return subprocess.run([sys.executable, "-m", "deferred.cli", *map(str, args)], cwd=cwd,
-                          env=env, capture_output=True, text=True)
+    return install_plugin(PLUGIN, tmp_path_factory.mktemp("film"))
 
 
 def scene_text(films: str) -> str:

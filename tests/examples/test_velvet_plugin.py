@@ -2,13 +2,11 @@
 would and rendered through the command line: its own shading model, G-buffer channel, light
 type and effect, in both pipelines; and what a broken plugin may and may not break."""
 
-import shutil
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 from locations import ROOT
+from plugin_packages import deferred, install_plugin
 
 from deferred.io.images import read_image
 
@@ -19,13 +17,7 @@ FRAMEWORK = [ROOT / "deferred", ROOT / "materials", ROOT / "lights", ROOT / "sha
 @pytest.fixture(scope="module")
 def site(tmp_path_factory):
     """A folder with the plugin installed into it (pip --target), plus a broken plugin."""
-    work = tmp_path_factory.mktemp("plugin")
-    source = work / "source"
-    shutil.copytree(PLUGIN, source)  # pip builds in place: keep the repository clean
-    target = work / "site"
-    subprocess.run([sys.executable, "-m", "pip", "install", "--quiet", "--no-deps",
-                    "--no-build-isolation", "--target", str(target), str(source)],
-                   check=True, capture_output=True)
+    target = install_plugin(PLUGIN, tmp_path_factory.mktemp("plugin"))
     info = target / "broken_plugin-0.1.dist-info"
     info.mkdir()
     (info / "METADATA").write_text("Metadata-Version: 2.1\nName: broken-plugin\nVersion: 0.1\n")
@@ -44,12 +36,6 @@ def site(tmp_path_factory):
     (info / "entry_points.txt").write_text(
         "[deferred.materials]\nold_velvet = old_velvet:OldVelvet\n")
     return target
-
-
-def deferred(site, *args, cwd):
-    env = {"PYTHONPATH": str(site), "DEFERRED_STRICT": "1", "PATH": "/usr/bin:/bin"}
-    return subprocess.run([sys.executable, "-m", "deferred.cli", *map(str, args)], cwd=cwd,
-                          env=env, capture_output=True, text=True)
 
 
 @pytest.mark.slow

@@ -2,13 +2,11 @@
 would and rendered through the command line in both pipelines: its shading model answers the
 diffuse and specular light apart and takes light through thin parts from a shadowed light."""
 
-import shutil
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 from locations import ROOT
+from plugin_packages import deferred, install_plugin
 
 from deferred.io.images import read_image
 
@@ -17,20 +15,7 @@ PLUGIN = ROOT / "examples" / "plugins" / "deferred-wax"
 
 @pytest.fixture(scope="module")
 def site(tmp_path_factory):
-    work = tmp_path_factory.mktemp("wax")
-    source = work / "source"
-    shutil.copytree(PLUGIN, source)  # pip builds in place: keep the repository clean
-    target = work / "site"
-    subprocess.run([sys.executable, "-m", "pip", "install", "--quiet", "--no-deps",
-                    "--no-build-isolation", "--target", str(target), str(source)],
-                   check=True, capture_output=True)
-    return target
-
-
-def deferred(site, *args, cwd):
-    env = {"PYTHONPATH": str(site), "DEFERRED_STRICT": "1", "PATH": "/usr/bin:/bin"}
-    return subprocess.run([sys.executable, "-m", "deferred.cli", *map(str, args)], cwd=cwd,
-                          env=env, capture_output=True, text=True)
+    return install_plugin(PLUGIN, tmp_path_factory.mktemp("wax"))
 
 
 @pytest.mark.slow
