@@ -183,6 +183,9 @@ GLSL_INCLUDES: dict[str, str] = {
                           "integral (area_irradiance), a GGX lobe's share by linearly "
                           "transformed cosines (area_ggx), the light as a point light "
                           "(area_as_point_light)",
+    "lighting/area_light.glsl": "shade_area_light: an area light type's light once it has its "
+                                "polygon (AreaLight): the light through thin parts, the shadow "
+                                "of its cube tiles, the shading models' area answer",
     "lighting/environment.glsl": "struct Environment and the image-based light's lookups: "
                                  "irradiance (9 spherical harmonics) and GGX-prefiltered "
                                  "radiance by roughness (a shading model's environment "

@@ -1,8 +1,6 @@
 // Disc (elliptical) area light (lights/disc): as the rect light, with the ellipse taken as the
 // regular 12-gon of its area (the half axes in its data are that polygon's circumradii).
-#include "common/lighting.glsl"
-#include "lighting/area.glsl"
-#include "lighting/shadows.glsl"
+#include "lighting/area_light.glsl"
 
 vec3 disc_light(LightRecord light, Surface s, vec3 P, vec3 V) {
     disc_light_Data data = disc_light_data(light);
@@ -16,15 +14,5 @@ vec3 disc_light(LightRecord light, Surface s, vec3 P, vec3 V) {
         area.corners[k] = centre + cos(angle) * data.axis_x.xyz + sin(angle) * data.axis_y.xyz;
     }
     area.radiance = light.color.rgb * window;
-#ifdef SURFACE_TRANSMISSION
-    vec3 J = area_vector_irradiance(area);  // the light as one direction, for the light through
-    vec3 through = shade_transmission(s, normalize(J), V, area.radiance * length(J),
-                                      light_thickness_cube(light, P, s.normal));
-#endif
-    area.radiance *= light_shadow_cube(light, P, s.normal, normalize(centre));
-#ifdef SURFACE_TRANSMISSION
-    return shade_area(s, V, area) + through;
-#else
-    return shade_area(s, V, area);
-#endif
+    return shade_area_light(light, s, P, V, area, centre);
 }

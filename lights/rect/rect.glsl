@@ -1,10 +1,8 @@
 // Rectangular area light (lights/rect): its record is a sphere light's (centre and range in
 // position, unit normal in direction, radiance in color) and its data the rectangle's half axes
-// (view space). Lit through the shading models' area answers (shade_area, lighting/area.glsl);
+// (view space). Lit through the shading models' area answers (lighting/area_light.glsl);
 // shadowed through six cube tiles around its centre, filtered by its size (PCSS).
-#include "common/lighting.glsl"
-#include "lighting/area.glsl"
-#include "lighting/shadows.glsl"
+#include "lighting/area_light.glsl"
 
 vec3 rect_light(LightRecord light, Surface s, vec3 P, vec3 V) {
     rect_light_Data data = rect_light_data(light);
@@ -19,15 +17,5 @@ vec3 rect_light(LightRecord light, Surface s, vec3 P, vec3 V) {
     area.corners[2] = centre + x + y;
     area.corners[3] = centre - x + y;
     area.radiance = light.color.rgb * window;
-#ifdef SURFACE_TRANSMISSION
-    vec3 J = area_vector_irradiance(area);  // the light as one direction, for the light through
-    vec3 through = shade_transmission(s, normalize(J), V, area.radiance * length(J),
-                                      light_thickness_cube(light, P, s.normal));
-#endif
-    area.radiance *= light_shadow_cube(light, P, s.normal, normalize(centre));
-#ifdef SURFACE_TRANSMISSION
-    return shade_area(s, V, area) + through;
-#else
-    return shade_area(s, V, area);
-#endif
+    return shade_area_light(light, s, P, V, area, centre);
 }
