@@ -60,6 +60,7 @@ DATUM = "subsurface_profile"  # the G-buffer datum of the profile's row
 # reading the light and where it falls): measured on the reference machine, benchmarks/README.md
 # ("Area lights and subsurface scattering")
 BLUR_PIXEL_SECONDS = 1.5e-6
+SHAPE_FLOOR = 1e-7  # world units: the profile's narrowest shape d, its rounding's step
 
 
 class SubsurfaceParams(BlinnPhongParams):
@@ -166,7 +167,10 @@ class SubsurfaceMaterial(Material):
         scene's profile table."""
         params = self.params
         path = [params.radius * f for f in params.falloff]
-        shape = tuple(round(float(d), 7) for d in profile_shape(path, params.color))
+        # rounded so that equal profiles share a row; never 0 (a radius or falloff too small
+        # to round above it scatters nowhere, where 0 would divide by zero)
+        shape = tuple(max(round(float(d), 7), SHAPE_FLOOR)
+                      for d in profile_shape(path, params.color))
         return shape, float(params.transmission)
 
     def uniforms(self, frame: Frame) -> dict[str, Any]:

@@ -219,6 +219,17 @@ def test_forward_and_deferred_agree(gl, light_path):
     assert psnr(np.clip(deferred / peak, 0, 1), np.clip(forward / peak, 0, 1)) >= 40.0
 
 
+@pytest.mark.parametrize("params", [{"radius": 3e-151}, {"falloff": [1.0, 0.0, 0.0]}])
+def test_a_profile_too_narrow_to_scatter_renders_finite_in_both_pipelines(gl, params):
+    """A mean free path (or a channel's falloff) too small for the profile's rounding scatters
+    nowhere: a finite image, in either pipeline, not a division by zero (found by the schema
+    fuzz test: radius 3e-151 gave NaN pixels)."""
+    scene = edge_scene("subsurface", {**params, "transmission": 1.0}, size=(48, 16))
+    for pipeline in ("deferred", "forward"):
+        image = render(gl, scene, pipeline)
+        assert np.isfinite(image).all() and image.max() > 0.1, pipeline
+
+
 def test_the_cost_model_counts_the_blur_over_the_pixels_covered():
     from deferred.interfaces.work import RenderWork, Screen, WorkObject
     from deferred.materials.subsurface import BLUR_PIXEL_SECONDS, SubsurfaceMaterial
