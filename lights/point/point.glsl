@@ -9,13 +9,11 @@ vec3 point_light(LightRecord light, Surface s, vec3 P, vec3 V) {
     float falloff = distance_falloff(d, light.position.w);
     if (falloff <= 0.0) return vec3(0.0);
     vec3 L = to_light / d;
+    vec3 lit = light_shadow_cube(light, P, s.normal, L);  // coloured through glass
+    vec3 shaded = shade_light(s, L, V, light.color.rgb * (falloff * lit));
 #ifdef SURFACE_TRANSMISSION
-    vec3 through = shade_transmission(s, L, V, light.color.rgb * falloff,
-                                      light_thickness_cube(light, P, s.normal));
-    vec3 lit = light_shadow_cube(light, P, s.normal, L);  // coloured through glass
-    return shade_light(s, L, V, light.color.rgb * (falloff * lit)) + through;
-#else
-    vec3 lit = light_shadow_cube(light, P, s.normal, L);  // coloured through glass
-    return shade_light(s, L, V, light.color.rgb * (falloff * lit));
+    shaded += shade_transmission(s, L, V, light.color.rgb * falloff,
+                                 light_thickness_cube(light, P, s.normal));
 #endif
+    return shaded;
 }

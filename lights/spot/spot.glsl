@@ -11,13 +11,11 @@ vec3 spot_light(LightRecord light, Surface s, vec3 P, vec3 V) {
     float cone = cone_falloff(dot(-L, light.direction.xyz), light.direction.w, light.extra.x);
     float falloff = distance_falloff(d, light.position.w) * cone;
     if (falloff <= 0.0) return vec3(0.0);
+    vec3 lit = light_shadow_perspective(light, P, s.normal, L);  // coloured through glass
+    vec3 shaded = shade_light(s, L, V, light.color.rgb * (falloff * lit));
 #ifdef SURFACE_TRANSMISSION
-    vec3 through = shade_transmission(s, L, V, light.color.rgb * falloff,
-                                      light_thickness_perspective(light, P, s.normal));
-    vec3 lit = light_shadow_perspective(light, P, s.normal, L);  // coloured through glass
-    return shade_light(s, L, V, light.color.rgb * (falloff * lit)) + through;
-#else
-    vec3 lit = light_shadow_perspective(light, P, s.normal, L);  // coloured through glass
-    return shade_light(s, L, V, light.color.rgb * (falloff * lit));
+    shaded += shade_transmission(s, L, V, light.color.rgb * falloff,
+                                 light_thickness_perspective(light, P, s.normal));
 #endif
+    return shaded;
 }
