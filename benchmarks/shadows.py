@@ -4,10 +4,19 @@ lights added, unshadowed against shadowed (1024^2 each; the 4096^2 atlas holds a
 Median wall-clock frame time around ``ctx.finish()``, and the ``shadows`` pass's alone, and
 the frame's CPU time (llvmpipe's threads included). ``--camera orbit`` turns the camera by a
 degree a frame around its target (the cascades follow it; still lights' maps are kept), ``still``
-draws the same frame again. Run from the repository root:
+draws the same frame again.
+
+``--allocation coverage`` sizes the spots' maps by the part of the screen each lights
+(``[shadows] allocation``); ``--allocation both`` times the spots with fixed and with coverage
+maps one after the other and prints, for each, the atlas's texels the maps hold and those the
+timed frames drew a frame (the directional case is left out: its cascades cover the view).
+``--spots receding`` puts the 16 spots over a long floor in four rows going away from the
+camera, a cube under each, so they cover unequal parts of the screen (``ring``: the ring over
+lights.toml's shapes, each lighting most of the view). Run from the repository root:
 
     python benchmarks/shadows.py [--size WxH] [--runs N] [--camera still|orbit]
                                  [--paths deferred:tiled,forward:naive,...]
+                                 [--allocation fixed|coverage|both] [--spots ring|receding]
 """
 
 from __future__ import annotations
@@ -23,7 +32,7 @@ import numpy as np
 from deferred.gl.context import create_context
 from deferred.interfaces import registry
 from deferred.render.renderer import Renderer
-from deferred.scene.loader import load_scene
+from deferred.scene.loader import load_scene, scene_from_dict
 
 PATHS = [("deferred", "volumes"), ("deferred", "tiled"), ("deferred", "clustered"),
          ("forward", "naive"), ("forward", "tiled")]
@@ -45,14 +54,45 @@ def spot_lights(shadows: bool, count: int = 16) -> list:
     return out
 
 
-def scene_for(case: str):
-    scene = load_scene("benchmarks/lights.toml")
-    directional = next(light for light in scene.lights if light.name == "directional")
-    if case == "directional":
-        directional.params = directional.params.model_copy(update={
-            "shadows": True, "cascades": 3, "shadow_resolution": 2048})
-    if case.startswith("spots"):
-        scene.lights.extend(spot_lights(shadows=case == "spots shadowed"))
+PLAIN = {"color": [0.5, 0.48, 0.45], "specular_intensity": 0.2}
+
+
+def receding_scene(shadows: bool, size: tuple[int, int]):
+    """16 spots in four rows of four over a long floor, the rows 5 units apart going away
+    from the camera, each aimed straight down at a cube: the near row lights much of the
+    screen, the far row little."""
+    objects = [{"mesh": "builtin:plane", "scale": 14.0, "position": [0.0, 0.0, -6.0],
+                "params": PLAIN}]
+    lights = [{"type": "ambient", "color": [0.05, 0.05, 0.06]}]
+    for row in range(4):
+        z = 4.0 - 5.0 * row
+        for column in range(4):
+            x = (column - 1.5) * (2.0 + row)
+            objects.append({"mesh": "builtin:cube", "position": [x, 0.3, z], "scale": 0.3,
+                            "rotation": [0.0, 25.0 * column, 0.0], "params": PLAIN})
+            lights.append({"type": "spot", "position": [x + 0.4, 3.0, z + 0.3],
+                           "direction": [-0.15, -1.0, -0.1], "radius": 5.0, "intensity": 8.0,
+                           "inner_angle": 30.0, "outer_angle": 40.0,
+                           "color": [1.0, 0.9, 0.8], "shadows": shadows,
+                           "shadow_resolution": 1024})
+    return scene_from_dict({"size": list(size), "camera": {
+        "position": [0.0, 4.5, 9.0], "target": [0.0, 0.0, -3.0], "fov": 50.0, "far": 60.0},
+        "object": objects, "light": lights}, "receding spots")
+
+
+def scene_for(case: str, spots: str = "ring", allocation: str = "fixed",
+              size: tuple[int, int] = (1280, 720)):
+    if spots == "receding" and case.startswith("spots"):
+        scene = receding_scene(case == "spots shadowed", size)
+    else:
+        scene = load_scene("benchmarks/lights.toml")
+        directional = next(light for light in scene.lights if light.name == "directional")
+        if case == "directional":
+            directional.params = directional.params.model_copy(update={
+                "shadows": True, "cascades": 3, "shadow_resolution": 2048})
+        if case.startswith("spots"):
+            scene.lights.extend(spot_lights(shadows=case == "spots shadowed"))
+    scene.shadow_budget = replace(scene.shadow_budget, allocation=allocation)
     return scene
 
 
@@ -66,11 +106,24 @@ def orbit(renderer: Renderer, degrees: float) -> None:
     renderer.scene.camera = replace(camera, position=tuple(float(v) for v in target + turned))
 
 
-def timed(renderer: Renderer, runs: int, moving: bool) -> tuple[float, float, float]:
-    """(median frame ms, median ms of the shadows pass, median frame CPU ms)."""
+def texels(atlas, before: dict) -> tuple[int, int]:
+    """The atlas's texels this frame's maps hold, and those of the maps its shadow pass drew
+    (the squares whose drawn-with key changed from ``before``)."""
+    if atlas is None:
+        return 0, 0
+    held = sum(tile.size * tile.size for tile in atlas.tiles)
+    return held, sum(rect[2] * rect[2] for rect, key in atlas.drawn.items()
+                     if before.get(rect) != key)
+
+
+def timed(renderer: Renderer, runs: int, moving: bool) -> tuple[float, ...]:
+    """(median frame ms, ms of the shadows pass, median frame CPU ms, atlas texels held,
+    median texels drawn a frame)."""
     ctx = renderer.gl.ctx
-    frames, shadow, cpu = [], [], []
+    frames, shadow, cpu, drawn = [], [], [], []
     started = {}
+    atlas = renderer.shadow_atlas
+    before_drawn: dict = {}
 
     def before(render_pass, frame):
         if render_pass.name == "shadows":
@@ -82,20 +135,57 @@ def timed(renderer: Renderer, runs: int, moving: bool) -> tuple[float, float, fl
             ctx.finish()
             shadow.append((time.perf_counter() - started["t"]) * 1000.0)
 
+    def keep_drawn(render_pass, frame):
+        if render_pass.name == "shadows" and atlas is not None:
+            before_drawn.clear()
+            before_drawn.update(atlas.drawn)
+
     renderer.render(readback=False)  # shaders compile
     for _ in range(runs):
         if moving:
             orbit(renderer, 1.0)
         ctx.finish()
         start, cpu_start = time.perf_counter(), time.process_time()
-        renderer.render(readback=False)
+        renderer.render(readback=False, before_pass=keep_drawn)
         ctx.finish()
         frames.append((time.perf_counter() - start) * 1000.0)
         cpu.append((time.process_time() - cpu_start) * 1000.0)
+        drawn.append(texels(atlas, before_drawn)[1])
     if moving:
         orbit(renderer, 1.0)
     renderer.render(readback=False, before_pass=before, on_pass=after)
-    return statistics.median(frames), (shadow[0] if shadow else 0.0), statistics.median(cpu)
+    return (statistics.median(frames), (shadow[0] if shadow else 0.0), statistics.median(cpu),
+            texels(atlas, before_drawn)[0], statistics.median(drawn))
+
+
+def allocations(args, size, paths, gl) -> None:
+    """The spots unshadowed, then shadowed with fixed and with coverage maps, interleaved by
+    rounds (``--runs`` frames a round, the median of the rounds' medians)."""
+    print(f"camera {args.camera}, {args.spots} spots; each cell: frame ms (shadows pass ms) "
+          "[frame CPU ms] {atlas Mi texels held / Mi texels drawn a frame}")
+    print("| pipeline | light path | 16 spots | shadowed, fixed | ratio | shadowed, coverage "
+          "| ratio |")
+    print("|---|---|---:|---:|---:|---:|---:|")
+    cases = [("spots", "fixed"), ("spots shadowed", "fixed"), ("spots shadowed", "coverage")]
+    for pipeline, path in paths:
+        rounds: dict = {case: [] for case in cases}
+        for _ in range(args.rounds):
+            for case in cases:
+                scene = scene_for(case[0], args.spots, case[1], size)
+                with Renderer(scene, pipeline, size, gl=gl, light_path=path) as renderer:
+                    rounds[case].append(timed(renderer, args.runs, args.camera == "orbit"))
+        ms = {case: [statistics.median(v) for v in zip(*rounds[case], strict=True)]
+              for case in cases}
+        plain = ms[cases[0]]
+
+        def cell(m):
+            return (f"{m[0]:.0f} ({m[1]:.1f}) [{m[2]:.0f}] "
+                    f"{{{m[3] / 2**20:.2f} / {m[4] / 2**20:.2f}}}")
+
+        print(f"| {pipeline} | {path} | {plain[0]:.0f} [{plain[2]:.0f}] | "
+              + " | ".join(f"{cell(ms[case])} | {ms[case][0] / plain[0]:.2f}x "
+                           f"[{ms[case][2] / plain[2]:.2f}x]" for case in cases[1:]) + " |",
+              flush=True)
 
 
 def main() -> None:
@@ -104,10 +194,18 @@ def main() -> None:
     parser.add_argument("--runs", type=int, default=3)
     parser.add_argument("--camera", choices=("still", "orbit"), default="still")
     parser.add_argument("--paths", default=",".join(f"{p}:{q}" for p, q in PATHS))
+    parser.add_argument("--allocation", choices=("fixed", "coverage", "both"),
+                        default="fixed")
+    parser.add_argument("--spots", choices=("ring", "receding"), default="ring")
+    parser.add_argument("--rounds", type=int, default=1,
+                        help="--allocation both: rounds of the three cases, interleaved")
     args = parser.parse_args()
     size = tuple(int(v) for v in args.size.split("x"))
     paths = [tuple(item.split(":")) for item in args.paths.split(",")]
     gl = create_context()
+    if args.allocation == "both":
+        allocations(args, size, paths, gl)
+        return
     cases = ["plain", "directional", "spots", "spots shadowed"]
     print(f"camera {args.camera}; each cell: frame ms (shadows pass ms) [frame CPU ms]")
     print("| pipeline | light path | unshadowed | directional shadowed (3 x 2048^2) | ratio | "
@@ -116,7 +214,8 @@ def main() -> None:
     for pipeline, path in paths:
         ms = {}
         for case in cases:
-            with Renderer(scene_for(case), pipeline, size, gl=gl, light_path=path) as renderer:
+            scene = scene_for(case, args.spots, args.allocation, size)
+            with Renderer(scene, pipeline, size, gl=gl, light_path=path) as renderer:
                 ms[case] = timed(renderer, args.runs, args.camera == "orbit")
         plain, directional = ms["plain"], ms["directional"]
         spots, shadowed = ms["spots"], ms["spots shadowed"]

@@ -67,6 +67,13 @@ class ShadowProjection(NameEnum):
     CUBE = "cube"  # point: six 90-degree perspective tiles of the atlas
 
 
+class ShadowAllocation(NameEnum):
+    """How the shadow atlas sizes a light's maps (``[shadows] allocation``)."""
+
+    FIXED = "fixed"  # each map of its light's shadow_resolution
+    COVERAGE = "coverage"  # by the screen its light's shadowed region covers, at most that
+
+
 class ShadowFilter(NameEnum):
     """A shadow map's filter (``shadow_filter``)."""
 

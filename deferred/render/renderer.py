@@ -98,7 +98,12 @@ class Renderer:
     the background, which is the clear value of targets, the operator, a define), the renderer
     builds its passes, targets and programs again on the same context first (:meth:`render`).
     The renderer never writes to the scene: ``state`` is the scene as its last frame drew it.
+
+    ``hold_shadow_sizes`` (the live viewer's) keeps shadow maps' sizes by coverage within a
+    margin from frame to frame (a frame then depends on those before it: off for renders).
     """
+
+    hold_shadow_sizes = False
 
     def __init__(self, scene: Scene, pipeline: str = Pipeline.DEFERRED,
                  size: tuple[int, int] | None = None, gl: GLContext | None = None,
@@ -356,7 +361,7 @@ class Renderer:
         slots = None
         if setup.shadow_atlas is not None:
             slots = setup.shadow_atlas.update(state, frame.view, frame.width / frame.height,
-                                              frame.projection)
+                                              frame.projection, self.hold_shadow_sizes)
         setup.light_buffer.upload(list(state.lights), frame.view, frame.projection, slots)
         self._check_gl("uploading the lights")
         return frame, history

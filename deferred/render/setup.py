@@ -165,7 +165,8 @@ class RenderSetup:
         self.shadow_atlas = ShadowAtlas(
             ctx, budget.atlas_size, budget.max_shadowed_lights,
             opacity_size(state, plan.pipeline_name), opacity_extent(state),
-            opacity_extent(state) if scene_has_transparent_casters(state) else 0) \
+            opacity_extent(state) if scene_has_transparent_casters(state) else 0,
+            budget.allocation) \
             if scene_casts_shadows(state.lights) else None
         # The per-frame GPU resources every frame is given: by name on its blackboard (for the
         # passes that fill or read them), and those that bind themselves to every program as

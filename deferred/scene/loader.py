@@ -160,7 +160,8 @@ class SceneBuilder:
             tonemap=model.tonemap, light_path=model.light_path, source=name,
             shadow_budget=ShadowBudget(model.shadows.atlas_size,
                                        model.shadows.max_shadowed_lights,
-                                       model.shadows.opacity_scale))
+                                       model.shadows.opacity_scale,
+                                       str(model.shadows.allocation)))
         if c.parent is not None:
             self.children.append((self.scene.camera, f"{name}: camera.parent"))
         self.lights()  # lights and effects first: the objects are weighed with them

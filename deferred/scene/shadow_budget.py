@@ -15,8 +15,11 @@ class ShadowBudget:
     texels on a side holding every shadowed light's maps, for at most ``max_shadowed_lights``
     lights (those beyond, or whose maps do not fit, are drawn unshadowed, with a warning).
     Deep opacity maps (fur) have ``opacity_scale`` of the shadow maps' texels on a side, over
-    the part of the atlas the lights' maps take."""
+    the part of the atlas the lights' maps take. ``allocation`` says how large a light's maps
+    are (``deferred.lighting.shadows.coverage``): ``fixed``, each of its ``shadow_resolution``,
+    or ``coverage``, by the part of the screen its shadowed region covers."""
 
     atlas_size: int = 4096
     max_shadowed_lights: int = 16
     opacity_scale: float = 0.25
+    allocation: str = "fixed"

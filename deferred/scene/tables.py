@@ -9,7 +9,7 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
-from deferred.names import LightPath
+from deferred.names import LightPath, ShadowAllocation
 from deferred.scene.camera import CameraModel
 from deferred.scene.shadow_budget import OPACITY_SCALES
 from deferred.scene.tracks import INTERPOLATIONS
@@ -160,6 +160,10 @@ class ShadowsModel(_Strict):
                                      "in scene order; the rest are unshadowed")
     opacity_scale: float = Field(0.25, description="texels on a side of the fur's deep "
                                  "opacity maps per shadow-map texel (1, 0.5, .. 1/16)")
+    allocation: ShadowAllocation = Field(
+        ShadowAllocation.FIXED, description="how large each spot and point light's maps are: "
+        "fixed (its shadow_resolution) or coverage (by the part of the screen its shadowed "
+        "region covers, at most its shadow_resolution; maps shrink before lights are left out)")
 
     @field_validator("opacity_scale")
     @classmethod

@@ -29,6 +29,7 @@ class RendererPool:
         renderer = self.renderers.get(key)
         if renderer is None:
             renderer = Renderer(scene, pipeline, size, gl=self.gl, light_path=light_path)
+            renderer.hold_shadow_sizes = True  # live: a size's edge costs no redraw a frame
             self.renderers[key] = renderer
             self.scenes[key] = scene  # held: its id stays unique while the key lives
         return renderer

@@ -15,6 +15,12 @@ from deferred.interfaces.light import Light
 from deferred.interfaces.shadow_casting import ShadowView
 from deferred.lighting.buffer import visible_spheres
 from deferred.lighting.shadows.bounds import world_bounds
+from deferred.lighting.shadows.coverage import (
+    fit_sizes,
+    map_size,
+    screen_coverage,
+    shadowed_sphere,
+)
 from deferred.lighting.shadows.frusta import (
     cascade_frusta,
     cube_frusta,
@@ -23,9 +29,9 @@ from deferred.lighting.shadows.frusta import (
     unit,
 )
 from deferred.lighting.shadows.opacity import OPACITY_FAR, OPACITY_LAYERS
-from deferred.lighting.shadows.plan import left_out_warning, plan_atlas
+from deferred.lighting.shadows.plan import left_out_warning, plan_atlas, tile_counts
 from deferred.lighting.shadows.transmittance import TRANSMITTANCE_BYTES
-from deferred.names import ShadowProjection
+from deferred.names import ShadowAllocation, ShadowProjection
 
 if TYPE_CHECKING:
     from deferred.gl.uniforms import ProgramUniforms
@@ -107,14 +113,21 @@ class ShadowAtlas:
     """The shadow atlas, its records texture and this frame's tiles (a binding source)."""
 
     def __init__(self, ctx: moderngl.Context, atlas_size: int, max_lights: int,
-                 opacity_size: int = 0, opacity_extent: int = 0, transmittance_size: int = 0):
+                 opacity_size: int = 0, opacity_extent: int = 0, transmittance_size: int = 0,
+                 allocation: str = ShadowAllocation.FIXED):
         """``opacity_size``: texels on a side of the deep opacity maps (0: none), covering the
         atlas's square of ``opacity_extent`` texels from its corner; ``transmittance_size``:
         texels on a side of the transmittance maps (0: none), texel for texel with the atlas
-        from its corner (``deferred.lighting.shadows.transmittance``)."""
+        from its corner (``deferred.lighting.shadows.transmittance``); ``allocation``: how
+        large the maps are (``deferred.lighting.shadows.coverage``)."""
         self.ctx = ctx
         self.size = atlas_size
         self.max_lights = max_lights
+        self.allocation = ShadowAllocation(allocation)
+        # by coverage the maps are packed where the opacity and transmittance maps reach
+        self.region = opacity_extent if (opacity_size or transmittance_size) else atlas_size
+        self.sizes: dict[int, int] = {}  # id(light) -> this frame's map side (by coverage)
+        self._left_out: list[tuple[int, str]] = []  # the lights last warned of
         self.texture = ctx.depth_texture((atlas_size, atlas_size))
         self.texture.compare_func = "<="
         self.texture.filter = (moderngl.LINEAR, moderngl.LINEAR)
@@ -174,30 +187,30 @@ class ShadowAtlas:
 
     # -- per frame ---------------------------------------------------------------------------
     def update(self, scene: Scene, view: np.ndarray, aspect: float,
-               projection: np.ndarray | None = None) -> dict[int, int]:
+               projection: np.ndarray | None = None, hold_sizes: bool = False
+               ) -> dict[int, int]:
         """This frame's tiles and records for the scene's lights seen through ``view`` (the
         camera's world -> view); the slots by ``id(light)``. A spot or point light whose
         sphere lies outside the frustum of ``projection`` lights nothing in view (the light
-        buffer drops it too): its maps are not drawn this frame."""
-        self._plan_lights(scene)
+        buffer drops it too): its maps are not drawn this frame. By coverage, the maps'
+        sizes follow this frame's view; ``hold_sizes`` (the live viewer) keeps the last
+        frame's sizes within a margin (:func:`~deferred.lighting.shadows.coverage.map_size`),
+        so a frame then depends on the frames before it."""
         view = np.asarray(view, np.float64)
+        seen = self._seen_lights(scene, view, projection)
+        self._plan_lights(scene, self._coverage_sizes(scene, view, projection, seen,
+                                                      hold_sizes))
         inverse_view = np.linalg.inv(view)
         records = np.zeros((self.max_lights, RECORD_TEXELS, 4), np.float32)
         self.tiles, self.slots, self.splits = [], {}, {}
         bounds = None
         for light in scene.lights:
             planned = self._plan.get(id(light))
-            if planned is None:
+            if planned is None or not seen.get(id(light), True):
                 continue
             slot, squares = planned
             params = light.params
             kind = light.shadow_projection
-            if kind != ShadowProjection.CASCADES and projection is not None:
-                centre = view @ np.append(np.asarray(params.position, np.float64), 1.0)
-                sphere = np.zeros((1, 4, 4), np.float32)
-                sphere[0, 1] = (*centre[:3], params.radius)
-                if not visible_spheres(sphere, projection)[0]:
-                    continue
             row = records[slot - 1]
             pcss = params.shadow_filter == "pcss"
             # pcss: the normal offset's reach is pcf's (the plane's slope covers the rest)
@@ -223,18 +236,75 @@ class ShadowAtlas:
         self._set_uniforms(scene, inverse_view)
         return self.slots
 
-    def _plan_lights(self, scene: Scene) -> None:
+    @staticmethod
+    def _seen_lights(scene: Scene, view: np.ndarray,
+                     projection: np.ndarray | None) -> dict[int, bool]:
+        """Whether each shadowed spot or point light's sphere touches the view frustum."""
+        lights = [light for light in scene.lights if light.casts_shadows and
+                  light.shadow_projection != ShadowProjection.CASCADES]
+        if projection is None or not lights:
+            return {}
+        spheres = np.zeros((len(lights), 4, 4), np.float32)
+        for row, light in zip(spheres, lights, strict=True):
+            centre = view @ np.append(np.asarray(light.params.position, np.float64), 1.0)
+            row[1] = (*centre[:3], light.params.radius)
+        return {id(light): bool(seen) for light, seen
+                in zip(lights, visible_spheres(spheres, projection), strict=True)}
+
+    def _coverage_sizes(self, scene: Scene, view: np.ndarray, projection: np.ndarray | None,
+                        seen: dict[int, bool], hold: bool) -> dict[int, int]:
+        """By coverage, each spot and point light's map side this frame (0: out of view),
+        fitted to the region the maps may take; fixed: none (each its resolution)."""
+        if self.allocation != ShadowAllocation.COVERAGE or projection is None:
+            return {}
+        requests = []
+        bounds = world_bounds(scene)
+        for light in scene.lights:
+            if not light.casts_shadows:
+                continue
+            resolution = int(light.params.shadow_resolution)
+            if light.shadow_projection == ShadowProjection.CASCADES:
+                requests.append((id(light), tile_counts(light), resolution, 1.0))
+                continue
+            coverage = 0.0
+            if seen.get(id(light), True):
+                centre, radius = shadowed_sphere(light, bounds)
+                coverage = screen_coverage(centre, radius, view, projection, bounds)
+            previous = self.sizes.get(id(light)) if hold else None
+            requests.append((id(light), tile_counts(light),
+                             map_size(resolution, coverage, previous), coverage))
+        # the lights given slots only: those past max_shadowed_lights take no room
+        sides = fit_sizes([request for request in requests[:self.max_lights] if request[2]],
+                          self.region)
+        self.sizes = {key: sides.get(key, 0) for key, *_ in requests}
+        return self.sizes
+
+    def _plan_lights(self, scene: Scene, sizes: dict[int, int]) -> None:
         """The slots and squares of the scene's lights, planned again when what the plan
-        depends on changed (an animated light's params change every frame)."""
+        depends on changed (an animated light's params change every frame; by coverage, a
+        map's size). Tiles drawn before keep their depths where the new plan puts the same
+        light's same map on the same square (the caster pass forgets a square drawn over)."""
         key = tuple((id(light), light.casts_shadows,
                      getattr(light.params, "shadow_resolution", None),
-                     getattr(light.params, "cascades", None)) for light in scene.lights)
+                     getattr(light.params, "cascades", None), sizes.get(id(light)))
+                    for light in scene.lights)
         if key != self._plan_key:
-            self._plan, left_out = plan_atlas(scene.lights, self.size, self.max_lights)
+            self._plan, left_out = plan_atlas(scene.lights, self.region, self.max_lights,
+                                              sizes) \
+                if sizes else plan_atlas(scene.lights, self.size, self.max_lights)
             self._plan_key = key
-            self.drawn.clear()  # the squares may overlap those drawn before
-            if left_out:  # stacklevel: update's caller
+            if left_out and left_out != self._left_out:  # stacklevel: update's caller
                 warnings.warn(left_out_warning(scene.source, left_out), stacklevel=3)
+            self._left_out = left_out
+
+    def mark_drawn(self, rect: tuple[int, int, int], key: tuple) -> None:
+        """Note that the square ``rect`` (x, y, size) now holds what ``key`` draws: every
+        other square it overlaps no longer holds what it was drawn with."""
+        x, y, size = rect
+        for other in [r for r in self.drawn if r != rect and r[0] < x + size and
+                      x < r[0] + r[2] and r[1] < y + size and y < r[1] + r[2]]:
+            del self.drawn[other]
+        self.drawn[rect] = key
 
     def _add_tiles(self, light: Light, slot: int, squares: list[tuple[int, int, int]],
                    frusta: list[tuple], row: np.ndarray, inverse_view: np.ndarray) -> None:

@@ -66,7 +66,7 @@ class ShadowPass(RenderPass):
                    tuple(caster_key(frame, obj) for obj in casters))
             rect = (tile.x, tile.y, tile.size)
             if atlas.drawn.get(rect) != key:
-                atlas.drawn[rect] = key
+                atlas.mark_drawn(rect, key)
                 drawn.append((tile, casters))
         if not drawn:
             return

@@ -4,7 +4,7 @@ atlas they cover and their size; the layers' depths and the first-depth map's cl
 from __future__ import annotations
 
 from deferred.lighting.shadows.plan import plan_atlas, scene_casts_shadows
-from deferred.names import Pipeline
+from deferred.names import Pipeline, ShadowAllocation
 from deferred.scene.scene import Scene
 
 OPACITY_SHADOWS_DEFINE = "OPACITY_SHADOWS"
@@ -30,9 +30,16 @@ def scene_has_opacity(scene: Scene, pipeline: str) -> bool:
 def opacity_extent(scene: Scene) -> int:
     """Texels on a side of the square, from the atlas's corner, that the maps of the scene's
     shadowed lights take (as :func:`~deferred.lighting.shadows.plan.plan_atlas` places them:
-    largest first, from the corner): the part of the atlas the deep opacity maps cover."""
+    largest first, from the corner): the part of the atlas the deep opacity maps and the
+    transmittance maps cover.
+    By screen coverage (``allocation = "coverage"``) the maps are at most these and packed
+    into this square, or into the whole atlas where these do not all fit (smaller maps let
+    more lights in: :func:`~deferred.lighting.shadows.coverage.fit_sizes`)."""
     budget = scene.shadow_budget
-    plan, _ = plan_atlas(scene.lights, budget.atlas_size, budget.max_shadowed_lights)
+    plan, left_out = plan_atlas(scene.lights, budget.atlas_size, budget.max_shadowed_lights)
+    if budget.allocation == ShadowAllocation.COVERAGE and \
+            any(not why.startswith("max_shadowed_lights") for _, why in left_out):
+        return budget.atlas_size
     return max((max(x, y) + size for _, squares in plan.values() for x, y, size in squares),
                default=1)
 

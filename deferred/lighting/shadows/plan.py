@@ -41,11 +41,11 @@ def tile_counts(light: Light) -> int:
     return MAX_TILES if kind == ShadowProjection.CUBE else 1
 
 
-def _place_tiles(lights: list[Light], atlas_size: int
+def _place_tiles(lights: list[Light], atlas_size: int, sizes: dict[int, int]
                  ) -> tuple[dict[int, list[tuple[int, int, int]]], list[int]]:
     """The squares of each of ``lights`` whose maps all fit, largest maps first, and the
     lights whose maps did not (``id``), the first to run out of room first."""
-    requests = sorted(((light.params.shadow_resolution, order, light)
+    requests = sorted(((sizes.get(id(light), light.params.shadow_resolution), order, light)
                        for order, light in enumerate(lights) for _ in range(tile_counts(light))),
                       key=lambda item: (-item[0], item[1]))
     allocator = QuadtreeAllocator(atlas_size)
@@ -62,33 +62,42 @@ def _place_tiles(lights: list[Light], atlas_size: int
     return {key: squares for key, squares in tiles.items() if key not in failed}, failed
 
 
-def plan_atlas(lights: list[Light], atlas_size: int, max_lights: int
+def plan_atlas(lights: list[Light], atlas_size: int, max_lights: int,
+               sizes: dict[int, int] | None = None
                ) -> tuple[dict[int, tuple[int, list[tuple[int, int, int]]]],
                           list[tuple[int, str]]]:
     """Slots and tiles for the shadowed ``lights`` (scene order): ``{id(light): (slot,
-    [(x, y, size), ...])}``, and each light left out as (its index, why), for the warning."""
+    [(x, y, size), ...])}``, and each light left out as (its index, why), for the warning.
+    ``sizes`` (``id(light)`` -> side) replaces a light's ``shadow_resolution`` (0: the light
+    gets no maps this frame, and is not left out); the squares are packed into the atlas's
+    corner square of ``atlas_size``. A light's slot is its place among the first
+    ``max_lights`` shadowed lights, whichever others are placed."""
+    sizes = sizes or {}
     index_of = {id(light): index for index, light in enumerate(lights)}
     wanted = [light for light in lights if light.casts_shadows]
     left_out = [(index_of[id(light)], f"max_shadowed_lights = {max_lights}")
                 for light in wanted[max_lights:]]
     wanted = wanted[:max_lights]
+    slot_of = {id(light): slot for slot, light in enumerate(wanted, 1)}
+    wanted = [light for light in wanted if sizes.get(id(light)) != 0]
     # Largest maps first packs best; the first light to run out of room is left out and the
     # rest planned again, so the squares it took are not lost to the lights after it.
     failed: set[int] = set()
     while True:
         tiles, missing = _place_tiles([light for light in wanted if id(light) not in failed],
-                                      atlas_size)
+                                      atlas_size, sizes)
         if not missing:
             break
         failed.add(missing[0])
     plan: dict[int, tuple[int, list[tuple[int, int, int]]]] = {}
     for light in wanted:
         if id(light) in failed:
+            size = sizes.get(id(light), light.params.shadow_resolution)
             left_out.append((index_of[id(light)],
-                             f"{tile_counts(light)} map(s) of {light.params.shadow_resolution}^2 "
+                             f"{tile_counts(light)} map(s) of {size}^2 "
                              f"each do not fit the {atlas_size}^2 atlas"))
         else:
-            plan[id(light)] = (len(plan) + 1, tiles[id(light)])
+            plan[id(light)] = (slot_of[id(light)], tiles[id(light)])
     return plan, left_out
 
 

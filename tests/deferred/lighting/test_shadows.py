@@ -360,6 +360,8 @@ def test_a_light_whose_maps_do_not_fit_leaves_its_squares_to_the_others(point_fi
     ('[shadows]\natlas_size = 3000\n', "shadows.atlas_size: must be a power of two"),
     ('[shadows]\nmax_shadowed_lights = 0\n', "shadows.max_shadowed_lights"),
     ('[shadows]\nopacity_scale = 0.3\n', "shadows.opacity_scale: must be 1, 0.5"),
+    ('[shadows]\nallocation = "screen"\n',
+     "shadows.allocation: expected one of 'fixed', 'coverage'"),
 ])
 def test_bad_shadow_parameters_are_one_line_errors(tmp_path, text, expected):
     path = tmp_path / "bad.toml"
