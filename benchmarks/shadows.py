@@ -10,6 +10,8 @@ draws the same frame again.
 (``[shadows] allocation``); ``--allocation both`` times the spots with fixed and with coverage
 maps one after the other and prints, for each, the atlas's texels the maps hold and those the
 timed frames drew a frame (the directional case is left out: its cascades cover the view).
+``--move-spots`` turns the spots a degree a frame about the vertical (every map drawn again
+each frame), ``--hold`` holds the sizes from frame to frame as the live viewer does.
 ``--spots receding`` puts the 16 spots over a long floor in four rows going away from the
 camera, a cube under each, so they cover unequal parts of the screen (``ring``: the ring over
 lights.toml's shapes, each lighting most of the view). Run from the repository root:
@@ -17,6 +19,7 @@ lights.toml's shapes, each lighting most of the view). Run from the repository r
     python benchmarks/shadows.py [--size WxH] [--runs N] [--camera still|orbit]
                                  [--paths deferred:tiled,forward:naive,...]
                                  [--allocation fixed|coverage|both] [--spots ring|receding]
+                                 [--rounds N] [--move-spots] [--hold]
 """
 
 from __future__ import annotations
@@ -116,9 +119,25 @@ def texels(atlas, before: dict) -> tuple[int, int]:
                      if before.get(rect) != key)
 
 
-def timed(renderer: Renderer, runs: int, moving: bool) -> tuple[float, ...]:
+def turn_spots(renderer: Renderer, degrees: float) -> None:
+    """Every spot light turned by ``degrees`` about the vertical through the origin, its
+    direction with it: every spot's map is drawn again."""
+    c, s = math.cos(math.radians(degrees)), math.sin(math.radians(degrees))
+
+    def turned(v):
+        return [c * v[0] + s * v[2], v[1], -s * v[0] + c * v[2]]
+
+    for light in renderer.scene.lights:
+        if light.name == "spot":
+            light.params = light.params.model_copy(update={
+                "position": turned(light.params.position),
+                "direction": turned(light.params.direction)})
+
+
+def timed(renderer: Renderer, runs: int, moving: bool,
+          move_spots: bool = False) -> tuple[float, ...]:
     """(median frame ms, ms of the shadows pass, median frame CPU ms, atlas texels held,
-    median texels drawn a frame)."""
+    median texels drawn a frame, ms of the shadows pass drawing every map)."""
     ctx = renderer.gl.ctx
     frames, shadow, cpu, drawn = [], [], [], []
     started = {}
@@ -140,10 +159,15 @@ def timed(renderer: Renderer, runs: int, moving: bool) -> tuple[float, ...]:
             before_drawn.clear()
             before_drawn.update(atlas.drawn)
 
-    renderer.render(readback=False)  # shaders compile
-    for _ in range(runs):
+    def step():
         if moving:
             orbit(renderer, 1.0)
+        if move_spots:
+            turn_spots(renderer, 1.0)
+
+    renderer.render(readback=False)  # shaders compile
+    for _ in range(runs):
+        step()
         ctx.finish()
         start, cpu_start = time.perf_counter(), time.process_time()
         renderer.render(readback=False, before_pass=keep_drawn)
@@ -151,18 +175,28 @@ def timed(renderer: Renderer, runs: int, moving: bool) -> tuple[float, ...]:
         frames.append((time.perf_counter() - start) * 1000.0)
         cpu.append((time.process_time() - cpu_start) * 1000.0)
         drawn.append(texels(atlas, before_drawn)[1])
-    if moving:
-        orbit(renderer, 1.0)
+    step()
     renderer.render(readback=False, before_pass=before, on_pass=after)
+    held = texels(atlas, before_drawn)[0]
+    if atlas is not None:  # every map drawn again: what a change of every map costs
+        atlas.drawn.clear()
+        renderer.render(readback=False, before_pass=before, on_pass=after)
     return (statistics.median(frames), (shadow[0] if shadow else 0.0), statistics.median(cpu),
-            texels(atlas, before_drawn)[0], statistics.median(drawn))
+            held, statistics.median(drawn), shadow[-1] if shadow else 0.0)
+
+
+def cell(m: list[float], d: list[float]) -> str:
+    """A case's medians ``m`` and spreads ``d`` (max - min over the rounds) as a cell."""
+    return (f"{m[0]:.0f}+-{d[0] / 2:.0f} ({m[1]:.1f}; {m[5]:.0f}) [{m[2]:.0f}] "
+            f"{{{m[3] / 2**20:.2f} / {m[4] / 2**20:.2f}}}")
 
 
 def allocations(args, size, paths, gl) -> None:
     """The spots unshadowed, then shadowed with fixed and with coverage maps, interleaved by
     rounds (``--runs`` frames a round, the median of the rounds' medians)."""
-    print(f"camera {args.camera}, {args.spots} spots; each cell: frame ms (shadows pass ms) "
-          "[frame CPU ms] {atlas Mi texels held / Mi texels drawn a frame}")
+    print(f"camera {args.camera}{', spots turning' if args.move_spots else ''}, {args.spots} "
+          "spots; each cell: frame ms (shadows pass ms; drawing every map ms) [frame CPU ms] "
+          "{atlas Mi texels held / Mi texels drawn a frame}")
     print("| pipeline | light path | 16 spots | shadowed, fixed | ratio | shadowed, coverage "
           "| ratio |")
     print("|---|---|---:|---:|---:|---:|---:|")
@@ -173,17 +207,17 @@ def allocations(args, size, paths, gl) -> None:
             for case in cases:
                 scene = scene_for(case[0], args.spots, case[1], size)
                 with Renderer(scene, pipeline, size, gl=gl, light_path=path) as renderer:
-                    rounds[case].append(timed(renderer, args.runs, args.camera == "orbit"))
+                    renderer.hold_shadow_sizes = args.hold
+                    rounds[case].append(timed(renderer, args.runs, args.camera == "orbit",
+                                              args.move_spots))
         ms = {case: [statistics.median(v) for v in zip(*rounds[case], strict=True)]
               for case in cases}
+        spread = {case: [max(v) - min(v) for v in zip(*rounds[case], strict=True)]
+                  for case in cases}
         plain = ms[cases[0]]
 
-        def cell(m):
-            return (f"{m[0]:.0f} ({m[1]:.1f}) [{m[2]:.0f}] "
-                    f"{{{m[3] / 2**20:.2f} / {m[4] / 2**20:.2f}}}")
-
         print(f"| {pipeline} | {path} | {plain[0]:.0f} [{plain[2]:.0f}] | "
-              + " | ".join(f"{cell(ms[case])} | {ms[case][0] / plain[0]:.2f}x "
+              + " | ".join(f"{cell(ms[case], spread[case])} | {ms[case][0] / plain[0]:.2f}x "
                            f"[{ms[case][2] / plain[2]:.2f}x]" for case in cases[1:]) + " |",
               flush=True)
 
@@ -199,6 +233,10 @@ def main() -> None:
     parser.add_argument("--spots", choices=("ring", "receding"), default="ring")
     parser.add_argument("--rounds", type=int, default=1,
                         help="--allocation both: rounds of the three cases, interleaved")
+    parser.add_argument("--move-spots", action="store_true",
+                        help="--allocation both: the spots turn a degree a frame")
+    parser.add_argument("--hold", action="store_true",
+                        help="--allocation both: sizes held from frame to frame (the viewer's)")
     args = parser.parse_args()
     size = tuple(int(v) for v in args.size.split("x"))
     paths = [tuple(item.split(":")) for item in args.paths.split(",")]

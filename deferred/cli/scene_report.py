@@ -14,6 +14,7 @@ from deferred.gl.target_spec import targets_bytes
 from deferred.io.images import amount, check_image
 from deferred.io.memory import BUDGET_VARIABLE, memory_budget
 from deferred.lighting.shadows.plan import plan_atlas
+from deferred.names import ShadowAllocation
 from deferred.render.budget import renderer_holdings
 from deferred.render.setup import SetupPlan
 from deferred.scene.scene import Scene
@@ -102,6 +103,9 @@ def light_lines(state: FrameState) -> list[str]:
     lines.append(f"shadow maps: {len(placed)} of {len(shadowed)} shadowed lights in an atlas of "
                  f"{budget.atlas_size}x{budget.atlas_size} (max_shadowed_lights = "
                  f"{budget.max_shadowed_lights})")
+    if budget.allocation == ShadowAllocation.COVERAGE:
+        lines.append("  allocation = coverage: each frame's spot and point maps at most these, "
+                     "by the screen each covers; maps shrink before lights are left out")
     index_of = {id(light): index for index, light in enumerate(lights)}
     for light in shadowed[:20]:
         if id(light) in placed:
