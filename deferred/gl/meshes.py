@@ -89,6 +89,8 @@ class MeshData:
 SKINNED_SURFACE = (("position", 3), ("normal", 3), ("tangent", 3), ("binormal", 3))
 # a skinned mesh's previous surface, as the motion vectors read it (the rest skipped)
 PREVIOUS_SURFACE = (("previous_position", 3), ("previous_frame", 9))
+# a moving mesh's previous surface (keeps_previous), as the motion vectors read it
+PREVIOUS_MOVING_SURFACE = (("previous_position", 3), ("previous_normal", 3))
 
 
 @dataclass
@@ -103,12 +105,17 @@ class GpuMesh:
     ``skinned=True`` (a mesh with joints and weights) is a moving mesh whose surface holds
     the tangent frame too, rewritten each frame by the skinning step
     (``deferred.render.skinning``) from :attr:`rest_vbo` (the rest surface, joints and
-    weights); :attr:`previous_vbo` keeps the surface of the frame before (motion vectors)."""
+    weights); :attr:`previous_vbo` keeps the surface of the frame before (motion vectors).
+
+    ``keeps_previous=True`` gives a moving mesh a :attr:`previous_vbo` too, the surface of the
+    frame before as its owner keeps it (:meth:`keep_previous` before each rewrite), for the
+    motion vectors of a surface that moves on its own (simulated hair)."""
 
     ctx: moderngl.Context
     data: MeshData
     moving: bool = False
     skinned: bool = False
+    keeps_previous: bool = False
     vbo: moderngl.Buffer = field(init=False)
     ibo: moderngl.Buffer = field(init=False)
     surface_vbo: moderngl.Buffer | None = field(init=False, default=None)
@@ -130,6 +137,8 @@ class GpuMesh:
             self.vbo = self.ctx.buffer(np.hstack(parts).astype(np.float32).tobytes())
         elif self.moving:
             self.surface_vbo = self.ctx.buffer(self._surface().tobytes())
+            if self.keeps_previous:
+                self.previous_vbo = self.ctx.buffer(self._surface().tobytes())
             parts = [self.data.uvs, self.data.tangents, self.data.binormals, self.data.comb]
             self.vbo = self.ctx.buffer(np.hstack(parts).astype(np.float32).tobytes())
         else:
@@ -145,6 +154,15 @@ class GpuMesh:
         if self.surface_vbo is None:
             raise ValueError(f"{self.data.name}: only a moving mesh rewrites its surface")
         self.surface_vbo.write(self._surface().tobytes())
+
+    def keep_previous(self) -> None:
+        """The surface as it is becomes the frame before's (``keeps_previous`` meshes): called
+        before the surface is rewritten for a new frame, or on a frame that does not move it
+        (no motion)."""
+        if self.previous_vbo is None or self.skinned:
+            raise ValueError(f"{self.data.name}: only a moving mesh made with keeps_previous "
+                             "keeps its previous surface")
+        self.ctx.copy_buffer(self.previous_vbo, self.surface_vbo)
 
     def vertex_buffer(self, program: moderngl.Program) -> tuple:
         """The vertex buffer with the format of the attributes ``program`` reads (moderngl's
@@ -168,6 +186,9 @@ class GpuMesh:
             else:
                 buffers = [self._buffer_format(self.surface_vbo, VERTEX_ATTRIBUTES[:2], program),
                            self._buffer_format(self.vbo, VERTEX_ATTRIBUTES[2:], program)]
+                if self.previous_vbo is not None:
+                    buffers.append(self._buffer_format(self.previous_vbo,
+                                                       PREVIOUS_MOVING_SURFACE, program))
             buffers = [buffer for buffer in buffers if len(buffer) > 2]
         if any(f"in_{name}" in program for name, _ in EXTRA_ATTRIBUTES):
             if self.extra_vbo is None:

@@ -21,6 +21,7 @@ if TYPE_CHECKING:
 
     from deferred.core.frame import Frame
     from deferred.core.protocols import SceneObjectLike
+    from deferred.gl.meshes import GpuMesh
     from deferred.interfaces.work import RenderWork, Work, WorkObject
 
 SIMULATED = "simulated"  # a frame's blackboard: (key, node) -> the state brought to its time
@@ -42,7 +43,9 @@ class Motion:
     reaches beyond the mesh (fur shells and fins, hair): motion vectors are drawn over the mesh
     pushed out that far (``deferred.effects.taa``), so the pixels of those layers move with
     the object. By default nothing: the material draws its mesh. :meth:`offsets` adds where
-    that reach moves by itself between frames (wind), else the layers move with the mesh."""
+    that reach moves by itself between frames (wind), else the layers move with the mesh;
+    :meth:`surfaces` the meshes a material draws besides the object's that move on their own
+    (hair tubes), drawn over it as they are."""
 
     def extent(self, obj: SceneObjectLike) -> float:
         return 0.0
@@ -50,6 +53,14 @@ class Motion:
     def offsets(self, frame: Frame, obj: SceneObjectLike) -> MotionOffsets | None:
         """This frame's and the last frame's offsets of the reach, or ``None``: none."""
         return None
+
+    def surfaces(self, frame: Frame, obj: SceneObjectLike) -> tuple[GpuMesh, ...]:
+        """Meshes the material draws for ``obj`` besides its mesh whose vertices move on their
+        own (simulated hair's tubes), each a moving ``GpuMesh`` with ``keeps_previous``: its
+        motion vectors are each vertex's way from the surface of the frame before
+        (``previous_vbo``, placed by the last frame's model) to this frame's. By default
+        none."""
+        return ()
 
 
 class ReachMotion(Motion):

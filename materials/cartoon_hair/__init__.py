@@ -14,7 +14,9 @@ head) is drawn too, in ``skin_color``.
   the simulation, ``timeline_fixed``, may not), so a frame's hair depends only on its time;
 - tubes (4.3.1-4.3.2): :mod:`.techniques.hair_tubes`, ``hair_samples`` spline samples swept by a
   ``sides``-gon tapered by the quadratic ``taper``, built every frame by compute shaders where
-  the context has them (:class:`.techniques.hair_tubes.GpuTubes`), else by numpy;
+  the context has them (:class:`.techniques.hair_tubes.GpuTubes`), else by numpy; the tubes
+  of the frame before kept beside them give the ``taa`` effect's motion vectors the hair's
+  own motion (:class:`.state.HairMotion`);
 - shading (4.3.3-4.3.6): X-toon (:mod:`.techniques.xtoon`) through the ``toon_strands`` model:
   the hair's specular (the band of ``specular_intensity`` and ``specular_exponent``, or the
   ramp's specular metric) along its strands, Kajiya-Kay's sin(T, H) for N.H, the head's band of
@@ -49,7 +51,6 @@ from deferred.api import (
     GBufferData,
     InputError,
     Material,
-    ReachMotion,
     RenderWork,
     SurfacePasses,
     Work,
@@ -71,7 +72,7 @@ from .params import (
     tube_counts,
 )
 from .passes import TUBES, HairStrokes
-from .state import DYNAMICS, hair_shape
+from .state import DYNAMICS, HairMotion, hair_shape
 
 if TYPE_CHECKING:
     from deferred.api import Frame, SceneObject
@@ -111,7 +112,8 @@ class CartoonHairMaterial(Material):
     # the head's surface, then the tubes' (its second surface), then their strokes
     techniques = (SurfacePasses(), SurfacePasses(name="hair", inputs=(TUBES,), shape=TUBES),
                   HairStrokes())
-    motion = ReachMotion("length")  # the strands reach up to their length beyond the head
+    # the strands reach up to their length beyond the head, and move on their own
+    motion = HairMotion("length")
     simulation = DYNAMICS
 
     def check_files(self, where: str | None) -> None:

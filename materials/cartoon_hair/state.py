@@ -16,6 +16,7 @@ from deferred.api import (
     MeshData,
     MeshPrimitives,
     Per,
+    ReachMotion,
     RenderWork,
     Simulation,
     Work,
@@ -85,7 +86,8 @@ class HairState:
         self.clumps = material.clumps(rest)
         self.mesh = MeshData("cartoon_hair tubes", tubes[0], tubes[1],
                              *self._constant_attributes(tubes[2], self.clumps), tubes[3])
-        self.gpu = GpuMesh(ctx, self.mesh, moving=True)
+        # the tubes of the frame before kept beside them: the motion vectors (HairMotion)
+        self.gpu = GpuMesh(ctx, self.mesh, moving=True, keeps_previous=True)
         self.ctx = ctx
         self._gpu_tubes: GpuTubes | None = None
         self._silhouettes: MeshPrimitives | None = None
@@ -173,6 +175,8 @@ class HairState:
             self.simulation.reset(self.model_at(0.0))
             self._physics.clear()
             self._placed, self.time = placement, None
+        # what the frame before showed (a first frame's or a still one's: this frame's)
+        self.gpu.keep_previous()
         if self.time == time:
             return
         # the roots follow the object's transform at each step (its tracks move it); the
@@ -195,6 +199,8 @@ class HairState:
             positions, normals, _, _ = self._tubes(params)
             self.mesh.positions, self.mesh.normals = positions, normals
             self.gpu.write_surface()
+        if self.time is None:  # a first frame (or the history started over): no motion
+            self.gpu.keep_previous()
         self.time = time
 
     def release(self) -> None:
@@ -299,3 +305,12 @@ def check_steps(params: CartoonHairParams, time: float, strands: int, label: str
 
 
 DYNAMICS = HairDynamics()
+
+
+class HairMotion(ReachMotion):
+    """cartoon_hair in the motion vectors: the head pushed out by the strands' ``length`` (what
+    the hair reaches), and the tubes drawn over it from the frame before's to this frame's
+    (dynamics, wind, anchors: the hair's own motion with a still camera)."""
+
+    def surfaces(self, frame: Frame, obj: SceneObject) -> tuple[GpuMesh, ...]:
+        return (DYNAMICS.state(frame, obj).gpu,)

@@ -10,8 +10,10 @@ Passes:
   moves (from the depth; the background as directions), then every object over it, its mesh
   pushed out by what its material draws beyond it (:meth:`~deferred.api.Motion.extent` of
   its material's ``motion``: fur shells and fins, hair) with this frame's and the last
-  frame's model and view-projection (``common/motion.glsl``). Materials change nothing: the
-  framework sets ``u_previous_model`` and ``u_previous_view_projection``.
+  frame's model and view-projection (``common/motion.glsl``), and the meshes it draws that move
+  on their own (:meth:`~deferred.api.Motion.surfaces`: hair tubes) from their surface of the
+  frame before. Materials change nothing else: the framework sets ``u_previous_model`` and
+  ``u_previous_view_projection``.
 - ``post.taa`` (before tone mapping, on the linear composite): the history reprojected,
   clipped to the current 3x3 neighbourhood in YCoCg and blended (``effects/taa/taa_resolve.frag``);
 - ``post.taa_sharpen``: the result into the composite, optionally sharpened.
@@ -120,7 +122,7 @@ class MotionObjectsPass(RenderPass):
                         depth_offset=(-1.0, -4.0))
         for obj in frame.scene.objects:
             # a skinned mesh's motion reads its surface of the frame before too
-            defines = {"SKINNED_MOTION": "1"} if obj.skin_matrices is not None else {}
+            defines = {"PREVIOUS_SURFACE": "1"} if obj.skin_matrices is not None else {}
             motion = obj.material.motion
             offsets = motion.offsets(frame, obj)  # the reach moving on its own (wind)
             uniforms: dict[str, Any] = {"u_motion_extent": float(motion.extent(obj))}
@@ -135,6 +137,15 @@ class MotionObjectsPass(RenderPass):
                                             defines=defines or None)
             frame.bind(program, uniforms, textures, offered=frame.object_uniforms(obj))
             frame.draw_mesh(obj.mesh, program)
+            surfaces = motion.surfaces(frame, obj)  # drawn as they are, over the reach
+            if surfaces:
+                program = frame.shaders.program("effects/taa/motion_objects.vert",
+                                                "effects/taa/motion_objects.frag",
+                                                defines={"PREVIOUS_SURFACE": "1"})
+                frame.bind(program, {"u_motion_extent": 0.0},
+                           offered=frame.object_uniforms(obj))
+                for surface in surfaces:
+                    surface.render(program)
 
 
 class TAAResolvePass(FullscreenPass):

@@ -1,11 +1,12 @@
 // Motion vectors of an object (deferred.effects.taa): its mesh pushed out along the normals by
 // what its material draws beyond it (Material.motion_extent: fur shells and fins, hair), drawn
 // where it is nearest, with this frame's and the last frame's model and camera (and a skinned
-// mesh's surface of the last frame: deferred.render.skinning).
+// mesh's surface of the last frame, deferred.render.skinning, or a simulated one's,
+// Motion.surfaces: PREVIOUS_SURFACE).
 in vec3 in_position;
 in vec3 in_normal;
-#ifdef SKINNED_MOTION
-in vec3 in_previous_position;  // a skinned mesh's surface in the frame before
+#ifdef PREVIOUS_SURFACE
+in vec3 in_previous_position;  // a skinned or simulated mesh's surface in the frame before
 #endif
 
 #include "common/object_transform.glsl"
@@ -33,7 +34,7 @@ invariant gl_Position;
 
 void main() {
     vec3 p = in_position + normalize(in_normal) * u_motion_extent;
-#ifdef SKINNED_MOTION
+#ifdef PREVIOUS_SURFACE
     vec3 previous = in_previous_position + normalize(in_normal) * u_motion_extent;
 #else
     vec3 previous = p;
