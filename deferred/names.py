@@ -80,3 +80,11 @@ class ShadowFilter(NameEnum):
     PCF = "pcf"  # 3x3 bilinear hardware comparisons (4x4 texels)
     SOFT = "soft"  # a 16-tap Poisson disk of radius ``shadow_softness`` texels
     PCSS = "pcss"  # percentage-closer soft shadows sized by an area light's emitter
+
+
+class CascadeUpdates(NameEnum):
+    """When a directional light's cascades are drawn while the camera moves (``[shadows]
+    cascade_updates``, ``Renderer(cascade_updates=)``; ``deferred.lighting.shadows.stagger``)."""
+
+    EVERY_FRAME = "every_frame"  # every cascade fitted to the frame: frames independent
+    STAGGERED = "staggered"  # the nearest every frame, the farther in turn (the viewer's)

@@ -30,7 +30,8 @@ from deferred.gl.targets import COMPOSITE, FINAL
 from deferred.interfaces.material import Material
 from deferred.interfaces.simulation import advance_simulations
 from deferred.io.safety import raise_if_stop_requested
-from deferred.names import Pipeline
+from deferred.lighting.shadows.stagger import check_cascade_updates
+from deferred.names import CascadeUpdates, Pipeline
 from deferred.render import samples as sampling
 from deferred.render.budget import check_target_memory, held_memory, renderer_holdings
 from deferred.render.caches import (
@@ -88,7 +89,9 @@ class Renderer:
     ``strict`` turns a uniform set by name that a program does not declare into an error
     (default: the ``DEFERRED_STRICT`` environment variable). ``light_path`` chooses how lights
     reach the pixels (:mod:`deferred.lighting.paths`; default: the scene's ``light_path``, else
-    the fastest the context allows).
+    the fastest the context allows). ``cascade_updates``: ``"every_frame"`` or ``"staggered"``
+    (a frame then reads far cascades drawn by the frames before it;
+    :mod:`deferred.lighting.shadows.stagger`); default: the scene's, else every frame.
 
     The scene may change between frames: objects, groups, lights and effects added or removed
     (``Scene.add_object``, ``add_light``, ``remove``), materials' parameters
@@ -107,8 +110,10 @@ class Renderer:
 
     def __init__(self, scene: Scene, pipeline: str = Pipeline.DEFERRED,
                  size: tuple[int, int] | None = None, gl: GLContext | None = None,
-                 strict: bool | None = None, light_path: str | None = None):
+                 strict: bool | None = None, light_path: str | None = None,
+                 cascade_updates: str | None = None):
         self._released = False
+        self.cascade_updates = check_cascade_updates(cascade_updates, "cascade_updates")
         if pipeline not in PIPELINES:
             raise InputError(f"unknown pipeline '{pipeline}' (choose from "
                              f"{', '.join(PIPELINES)})", "pipeline")
@@ -360,8 +365,10 @@ class Renderer:
             frame.binding_sources.insert(0, shading)
         slots = None
         if setup.shadow_atlas is not None:
-            slots = setup.shadow_atlas.update(state, frame.view, frame.width / frame.height,
-                                              frame.projection, self.hold_shadow_sizes)
+            slots = setup.shadow_atlas.update(
+                state, frame.view, frame.width / frame.height, frame.projection,
+                self.hold_shadow_sizes, self.cascade_updates
+                or state.shadow_budget.cascade_updates or CascadeUpdates.EVERY_FRAME)
         setup.light_buffer.upload(list(state.lights), frame.view, frame.projection, slots)
         self._check_gl("uploading the lights")
         return frame, history

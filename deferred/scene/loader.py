@@ -161,7 +161,8 @@ class SceneBuilder:
             shadow_budget=ShadowBudget(model.shadows.atlas_size,
                                        model.shadows.max_shadowed_lights,
                                        model.shadows.opacity_scale,
-                                       str(model.shadows.allocation)))
+                                       str(model.shadows.allocation),
+                                       model.shadows.cascade_updates))
         if c.parent is not None:
             self.children.append((self.scene.camera, f"{name}: camera.parent"))
         self.lights()  # lights and effects first: the objects are weighed with them

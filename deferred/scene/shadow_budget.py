@@ -17,9 +17,13 @@ class ShadowBudget:
     Deep opacity maps (fur) have ``opacity_scale`` of the shadow maps' texels on a side, over
     the part of the atlas the lights' maps take. ``allocation`` says how large a light's maps
     are (``deferred.lighting.shadows.coverage``): ``fixed``, each of its ``shadow_resolution``,
-    or ``coverage``, by the part of the screen its shadowed region covers."""
+    or ``coverage``, by the part of the screen its shadowed region covers.
+    ``cascade_updates``: ``"every_frame"``, ``"staggered"``
+    (``deferred.lighting.shadows.stagger``), or None: the renderer's default (every frame; the
+    viewer's staggered)."""
 
     atlas_size: int = 4096
     max_shadowed_lights: int = 16
     opacity_scale: float = 0.25
     allocation: str = "fixed"
+    cascade_updates: str | None = None

@@ -164,6 +164,11 @@ class ShadowsModel(_Strict):
         ShadowAllocation.FIXED, description="how large each spot and point light's maps are: "
         "fixed (its shadow_resolution) or coverage (by the part of the screen its shadowed "
         "region covers, at most its shadow_resolution; maps shrink before lights are left out)")
+    cascade_updates: Literal["every_frame", "staggered"] | None = Field(
+        None, description="while the camera moves, a directional light's cascades all drawn "
+                          "every frame, or the nearest every frame and the farther in turn "
+                          "(staggered: a frame depends on those before it; not for farm "
+                          "renders); unset: every frame, the viewer staggered")
 
     @field_validator("opacity_scale")
     @classmethod

@@ -11,6 +11,7 @@ import time as clock
 import moderngl
 
 from deferred.gl.context import GLContext, detect_features
+from deferred.names import CascadeUpdates
 from deferred.render.renderer import Renderer
 from deferred.scene.scene import Scene
 
@@ -28,7 +29,11 @@ class RendererPool:
         key = (pipeline, light_path, size, id(scene))
         renderer = self.renderers.get(key)
         if renderer is None:
-            renderer = Renderer(scene, pipeline, size, gl=self.gl, light_path=light_path)
+            # interactive: far cascades drawn in turn while the camera moves, unless the
+            # scene says otherwise (deferred.lighting.shadows.stagger)
+            renderer = Renderer(scene, pipeline, size, gl=self.gl, light_path=light_path,
+                                cascade_updates=scene.shadow_budget.cascade_updates
+                                or CascadeUpdates.STAGGERED)
             renderer.hold_shadow_sizes = True  # live: a size's edge costs no redraw a frame
             self.renderers[key] = renderer
             self.scenes[key] = scene  # held: its id stays unique while the key lives

@@ -22,7 +22,7 @@ from deferred.lighting.shadows.coverage import (
     shadowed_sphere,
 )
 from deferred.lighting.shadows.frusta import (
-    cascade_frusta,
+    cascade_slices,
     cube_frusta,
     near_far,
     spot_frustum,
@@ -30,8 +30,9 @@ from deferred.lighting.shadows.frusta import (
 )
 from deferred.lighting.shadows.opacity import OPACITY_FAR, OPACITY_LAYERS
 from deferred.lighting.shadows.plan import left_out_warning, plan_atlas, tile_counts
+from deferred.lighting.shadows.stagger import StaggeredCascades
 from deferred.lighting.shadows.transmittance import TRANSMITTANCE_BYTES
-from deferred.names import ShadowAllocation, ShadowProjection
+from deferred.names import CascadeUpdates, ShadowAllocation, ShadowProjection
 
 if TYPE_CHECKING:
     from deferred.gl.uniforms import ProgramUniforms
@@ -147,6 +148,7 @@ class ShadowAtlas:
         # (x, y, size) of a tile -> what it was last drawn with (deferred.lighting.shadows
         # .caster_pass): its depths stay in the atlas from frame to frame
         self.drawn: dict[tuple[int, int, int], tuple] = {}
+        self.cascades = StaggeredCascades()  # which cascades are fitted again, those kept
         self._plan: dict = {}
         self._uniforms: dict[str, Any] = {}
         self.opacity = None
@@ -187,16 +189,18 @@ class ShadowAtlas:
 
     # -- per frame ---------------------------------------------------------------------------
     def update(self, scene: Scene, view: np.ndarray, aspect: float,
-               projection: np.ndarray | None = None, hold_sizes: bool = False
-               ) -> dict[int, int]:
+               projection: np.ndarray | None = None, hold_sizes: bool = False,
+               cascade_updates: str = CascadeUpdates.EVERY_FRAME) -> dict[int, int]:
         """This frame's tiles and records for the scene's lights seen through ``view`` (the
         camera's world -> view); the slots by ``id(light)``. A spot or point light whose
         sphere lies outside the frustum of ``projection`` lights nothing in view (the light
         buffer drops it too): its maps are not drawn this frame. By coverage, the maps'
         sizes follow this frame's view; ``hold_sizes`` (the live viewer) keeps the last
         frame's sizes within a margin (:func:`~deferred.lighting.shadows.coverage.map_size`),
-        so a frame then depends on the frames before it."""
+        so a frame then depends on the frames before it. ``cascade_updates``: which cascades
+        are fitted again while the camera moves (:mod:`~deferred.lighting.shadows.stagger`)."""
         view = np.asarray(view, np.float64)
+        self.cascades.start_frame(view)
         seen = self._seen_lights(scene, view, projection)
         self._plan_lights(scene, self._coverage_sizes(scene, view, projection, seen,
                                                       hold_sizes))
@@ -221,9 +225,9 @@ class ShadowAtlas:
             if kind == ShadowProjection.CASCADES:
                 if bounds is None:
                     bounds = world_bounds(scene)
-                frusta = cascade_frusta(light, scene, inverse_view, aspect, bounds,
-                                        squares[0][2])
-                splits = np.array([far for far, *_ in frusta])
+                slices = cascade_slices(light, scene, inverse_view, aspect, bounds)
+                frusta = self.cascades.frusta(light, slices, squares, cascade_updates)
+                splits = np.array([cascade.far for cascade in slices])
                 row[2, :len(splits)] = splits
                 self.splits[id(light)] = splits
             elif kind == ShadowProjection.PERSPECTIVE:

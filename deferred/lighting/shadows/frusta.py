@@ -11,6 +11,7 @@ world size of a texel (per unit depth where ``perspective_texel``), and the ligh
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -74,9 +75,23 @@ def unit(v) -> np.ndarray:
     return v / max(float(np.linalg.norm(v)), 1e-12)
 
 
-def cascade_frusta(light: Light, scene: Scene, inverse_view: np.ndarray, aspect: float,
-                   bounds: tuple[np.ndarray, np.ndarray], resolution: int) -> list[tuple]:
-    """A directional light's cascades over the camera's depth up to ``shadow_distance``."""
+@dataclass(frozen=True)
+class CascadeSlice:
+    """A cascade's slice of the view: its far view depth, the light's world -> view, the
+    slice's bounding sphere in the light's view (``centre``, ``radius``) and ``top``, the
+    light-view z of the scene's bounds nearest the light (casters up to there draw)."""
+
+    far: float
+    light_view: np.ndarray
+    centre: np.ndarray
+    radius: float
+    top: float
+
+
+def cascade_slices(light: Light, scene: Scene, inverse_view: np.ndarray, aspect: float,
+                   bounds: tuple[np.ndarray, np.ndarray]) -> list[CascadeSlice]:
+    """A directional light's cascades' slices of the camera's depth up to
+    ``shadow_distance``."""
     params = light.params
     camera = scene.camera
     near = camera.near
@@ -90,10 +105,10 @@ def cascade_frusta(light: Light, scene: Scene, inverse_view: np.ndarray, aspect:
     low, high = bounds
     corners = np.array([[x, y, z, 1.0] for x in (low[0], high[0]) for y in (low[1], high[1])
                         for z in (low[2], high[2])])
-    scene_z = (light_view @ corners.T)[2]
+    top = float((light_view @ corners.T)[2].max())
     eye = inverse_view[:3, 3]
     forward = -inverse_view[:3, 2]
-    frusta = []
+    slices = []
     start = near
     for end in splits:
         # the slice's bounding sphere: its centre on the view axis, equally far from the
@@ -102,16 +117,25 @@ def cascade_frusta(light: Light, scene: Scene, inverse_view: np.ndarray, aspect:
         centre_depth = min((end + start) * (1.0 + k2) / 2.0, end)
         radius = math.sqrt((end - centre_depth) ** 2 + end * end * k2)
         centre = (light_view @ np.append(eye + forward * centre_depth, 1.0))[:3]
-        texel = 2.0 * radius / resolution
-        # snapped to whole texels: the map moves in steps of a texel (stable edges)
-        cx, cy = (np.floor(centre[:2] / texel) * texel)
-        z_near = -max(centre[2] + radius, float(scene_z.max())) - texel
-        z_far = -(centre[2] - radius) + texel
-        projection = orthographic(cx - radius, cx + radius, cy - radius, cy + radius,
-                                  z_near, z_far)
-        frusta.append((end, light_view, projection, texel, False, None))
+        slices.append(CascadeSlice(float(end), light_view, centre, radius, top))
         start = end
-    return frusta
+    return slices
+
+
+def cascade_frustum(cascade: CascadeSlice, resolution: int, widen: float = 1.0) -> tuple:
+    """A cascade's map over its slice's sphere, its radius times ``widen`` (a map kept for
+    later frames covers the slice as the camera moves on:
+    :mod:`~deferred.lighting.shadows.stagger`)."""
+    radius = cascade.radius * widen
+    texel = 2.0 * radius / resolution
+    centre = cascade.centre
+    # snapped to whole texels: the map moves in steps of a texel (stable edges)
+    cx, cy = (np.floor(centre[:2] / texel) * texel)
+    z_near = -max(centre[2] + radius, cascade.top) - texel
+    z_far = -(centre[2] - radius) + texel
+    projection = orthographic(cx - radius, cx + radius, cy - radius, cy + radius,
+                              z_near, z_far)
+    return (cascade.far, cascade.light_view, projection, texel, False, None)
 
 
 def near_plane(radius: float) -> float:
