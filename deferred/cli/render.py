@@ -32,6 +32,7 @@ from deferred.errors import InputError
 from deferred.io.images import write_image
 from deferred.io.paths import check_output_path
 from deferred.io.progress import Progress
+from deferred.names import CascadeUpdates
 from deferred.scene.loader import load_scene
 
 if TYPE_CHECKING:
@@ -330,6 +331,11 @@ def _render_farmed(job: RenderJob, loaded: Scene, size: tuple[int, int] | None,
     from deferred.farm.worker import FrameJob
     from deferred.scene.timeline import SceneEvaluator
 
+    if loaded.shadow_budget.cascade_updates == CascadeUpdates.STAGGERED:
+        # a frame would read far cascades its worker drew for other frames
+        raise InputError("\"staggered\" makes a frame depend on the frames before it: not "
+                         "with --workers, --ray or --resume (every_frame, or leave it out)",
+                         f"{loaded.source}: shadows.cascade_updates")
     loaded.check_tracks(job.times)  # as the renderer does, before any worker starts
     SceneEvaluator(loaded).check_simulation_times(max(job.times), "--time")
     frames = FrameJob(bundle_scene(job.scene, loaded), job.pipeline, size, job.times, job.fps,

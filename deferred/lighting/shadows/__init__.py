@@ -43,9 +43,11 @@ transmittance through the whole volume where it lies beyond the volume's back
 compiles neither lookup.
 
 One module a part: :mod:`~deferred.lighting.shadows.plan` the slots and squares of the atlas;
-:mod:`~deferred.lighting.shadows.frusta` each map's view and projection (cascades, spot,
-cube faces); :mod:`~deferred.lighting.shadows.bounds` the boxes and spheres of what objects
-draw; :mod:`~deferred.lighting.shadows.opacity` whether and how large the deep opacity maps
-are; :mod:`~deferred.lighting.shadows.atlas` the atlas, its records and opacity maps (the
-binding source); :mod:`~deferred.lighting.shadows.caster_pass` the pass drawing into them.
+:mod:`~deferred.lighting.shadows.frusta` each map's view and projection (cascades, spot, cube
+faces); :mod:`~deferred.lighting.shadows.stagger` which cascades are fitted again each frame
+(``[shadows] cascade_updates``: all, or the far ones in turn while the camera moves);
+:mod:`~deferred.lighting.shadows.bounds` the boxes and spheres of what objects draw;
+:mod:`~deferred.lighting.shadows.opacity` whether and how large the deep opacity maps are;
+:mod:`~deferred.lighting.shadows.atlas` the atlas, its records and opacity maps (the binding
+source); :mod:`~deferred.lighting.shadows.caster_pass` the pass drawing into them.
 """

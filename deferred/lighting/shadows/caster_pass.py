@@ -3,7 +3,8 @@ drawn into them by their materials; then, where the scene has them, the transpar
 transmittance maps and the volumes' deep opacity maps. A tile drawn before with the same light,
 square and casters, each as it was, is not drawn again (the atlas keeps its depths and
 transmittances from frame to frame): a still light and still casters cost nothing after their
-first frame, whatever the camera does (but for cascades, which follow it)."""
+first frame, whatever the camera does (but for cascades, which follow it, each frame or in
+turn: :mod:`~deferred.lighting.shadows.stagger`)."""
 
 from __future__ import annotations
 
