@@ -84,13 +84,17 @@ def pixel_history(renderer: Renderer, x: int, y: int, time: float = 0.0) -> list
     written: set[str] = set()  # targets a pass of this frame wrote so far
     pending: list[tuple[dict[str, np.ndarray], int | None]] = []  # from before to after
 
+    def texel(target: str) -> tuple[int, int, int, int]:
+        """The pixel in ``target`` (in a reduced one, the texel covering it)."""
+        return targets.rect_at((gx, gy, 1, 1), targets[target].size)[:2] + (1, 1)
+
     def read(target: str) -> np.ndarray:
         spec = targets.specs[target]
         if spec.depth:
-            data = targets.framebuffer((), target).read((gx, gy, 1, 1), components=1,
+            data = targets.framebuffer((), target).read(texel(target), components=1,
                                                          attachment=-1, dtype="f4")
             return np.frombuffer(data, np.float32).copy()
-        data = targets.framebuffer((target,)).read((gx, gy, 1, 1), components=spec.components,
+        data = targets.framebuffer((target,)).read(texel(target), components=spec.components,
                                                    dtype=spec.dtype)
         return np.frombuffer(data, {"f1": np.uint8, "f2": np.float16,
                                     "f4": np.float32}[spec.dtype]).copy()
@@ -106,7 +110,7 @@ def pixel_history(renderer: Renderer, x: int, y: int, time: float = 0.0) -> list
             targets.scissor = None
         fragments = None if isinstance(render_pass, ClearPass) else int(query.samples)
         for target, value in values.items():  # undo the probe: the real pass comes next
-            targets[target].write(value.tobytes(), viewport=(gx, gy, 1, 1), alignment=1)
+            targets[target].write(value.tobytes(), viewport=texel(target), alignment=1)
         pending.append((values, fragments))
 
     def after(render_pass: RenderPass, frame) -> None:

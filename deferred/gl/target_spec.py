@@ -56,6 +56,11 @@ class TargetSpec:
         names = {"f1": "8", "f2": "16F", "f4": "32F"}
         return "RGBA"[: self.components] + names[self.dtype]
 
+    def size(self, width: int, height: int) -> tuple[int, int]:
+        """The target's size at a frame of ``width`` x ``height``: rounded up, so that a reduced
+        target's texels cover the whole frame."""
+        return (max(1, math.ceil(width * self.scale)), max(1, math.ceil(height * self.scale)))
+
     def same_format(self, other: TargetSpec) -> bool:
         return (self.components, self.dtype, self.depth, self.scale) == \
             (other.components, other.dtype, other.depth, other.scale)
@@ -63,5 +68,4 @@ class TargetSpec:
 
 def targets_bytes(specs: Iterable[TargetSpec], width: int, height: int) -> int:
     """Bytes of the render targets ``specs`` at a frame of ``width`` x ``height``."""
-    return sum(spec.bytes_per_pixel * max(1, math.ceil(width * spec.scale)) *
-               max(1, math.ceil(height * spec.scale)) for spec in specs)
+    return sum(spec.bytes_per_pixel * math.prod(spec.size(width, height)) for spec in specs)

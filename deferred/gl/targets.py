@@ -8,6 +8,8 @@ image; a material or effect pass may create more.
 
 from __future__ import annotations
 
+import math
+
 import moderngl
 import numpy as np
 
@@ -59,7 +61,7 @@ class FrameTargets:
         return texture
 
     def size_of(self, spec: TargetSpec) -> tuple[int, int]:
-        return (max(1, round(self.width * spec.scale)), max(1, round(self.height * spec.scale)))
+        return spec.size(self.width, self.height)
 
     def clear(self, name: str) -> None:
         """Clear target ``name`` to its declared clear value (scissor applies)."""
@@ -89,8 +91,25 @@ class FrameTargets:
                 color_attachments=[self.textures[c] for c in colors],
                 depth_attachment=self.textures[depth] if depth else None)
             self._framebuffers[key] = fbo
-        fbo.scissor = self.scissor
+        fbo.scissor = self.scissor_at(fbo.size)
         return fbo
+
+    def scissor_at(self, size: tuple[int, int]) -> tuple[int, int, int, int] | None:
+        """The scissor over a target of ``size`` (a reduced one: the texels covering the
+        frame's scissor)."""
+        if self.scissor is None or size == (self.width, self.height):
+            return self.scissor
+        return self.rect_at(self.scissor, size)
+
+    def rect_at(self, rect: tuple[int, int, int, int],
+                size: tuple[int, int]) -> tuple[int, int, int, int]:
+        """The texels of a target of ``size`` that cover ``rect`` (x, y, width, height in the
+        frame's GL pixels)."""
+        x, y, width, height = rect
+        sx, sy = size[0] / self.width, size[1] / self.height
+        x0, y0 = math.floor(x * sx), math.floor(y * sy)
+        x1, y1 = math.ceil((x + width) * sx), math.ceil((y + height) * sy)
+        return (x0, y0, max(1, x1 - x0), max(1, y1 - y0))
 
     def read_raw(self, name: str) -> np.ndarray:
         """Target contents in their stored type (uint8, float16 or float32), (H, W, C), bottom

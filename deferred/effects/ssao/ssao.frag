@@ -1,20 +1,26 @@
 // Screen-space ambient occlusion over the clean G-buffer (screen phase: before any stipple
-// pass, Revie 2.4.2). A normal-oriented hemisphere of samples in view space, rotated per pixel
-// by interleaved gradient noise; a sample counts when the G-buffer surface is in front of it.
+// pass, Revie 2.4.2), on every pixel or, with REDUCED_GRID, on a coarser grid whose texels
+// sample the G-buffer at their sample points (effects/ssao/grid.glsl) and keep that point's
+// depth beside the occlusion for the depth-aware blur and upsample.
 #include "gbuffer/layout.glsl"
+#include "effects/ssao/occlusion.glsl"
 
-uniform sampler2D u_linear_depth;
-uniform sampler2D u_normal_exponent_id;
-uniform vec2 u_resolution;
-uniform mat4 u_projection;
-uniform mat4 u_inverse_projection;
-uniform float u_radius;
-uniform float u_strength;
-uniform int u_samples;
+#ifdef REDUCED_GRID
+#include "effects/ssao/grid.glsl"
 
+uniform vec2 u_grid_size;
+
+out vec2 out_occlusion_depth;
+
+void main() {
+    ivec2 pixel = ssao_sample_pixel(ivec2(gl_FragCoord.xy), u_resolution / u_grid_size);
+    float depth = texelFetch(u_linear_depth, pixel, 0).r;
+    float open = depth > 0.0 ? ssao_occlusion(vec2(pixel) + 0.5, pixel, depth, gl_FragCoord.xy)
+                             : 1.0;
+    out_occlusion_depth = vec2(open, depth);
+}
+#else
 out float out_occlusion;
-
-const float GOLDEN_ANGLE = 2.39996323;
 
 void main() {
     ivec2 pixel = ivec2(gl_FragCoord.xy);
@@ -23,29 +29,6 @@ void main() {
         out_occlusion = 1.0;
         return;
     }
-    vec3 P = view_position(gl_FragCoord.xy, depth, u_resolution, u_inverse_projection);
-    vec3 N = octahedral_decode(texelFetch(u_normal_exponent_id, pixel, 0).xy);
-    float noise = fract(52.9829189 * fract(dot(gl_FragCoord.xy, vec2(0.06711056, 0.00583715))));
-    vec3 helper = abs(N.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0);
-    vec3 T = normalize(cross(helper, N));
-    vec3 B = cross(N, T);
-    float occluded = 0.0;
-    for (int k = 0; k < u_samples; ++k) {
-        // Spiral over the hemisphere, denser near the centre and near the point.
-        float t = (float(k) + 0.5) / float(u_samples);
-        float angle = float(k) * GOLDEN_ANGLE + noise * 6.2831853;
-        float r = sqrt(t);
-        vec3 direction = T * (cos(angle) * r) + B * (sin(angle) * r) + N * sqrt(1.0 - t);
-        float scale = mix(0.1, 1.0, t * t);
-        vec3 Q = P + direction * (u_radius * scale);
-        vec4 clip = u_projection * vec4(Q, 1.0);
-        ivec2 sample_pixel = ivec2(floor((clip.xy / clip.w * 0.5 + 0.5) * u_resolution));
-        if (any(lessThan(sample_pixel, ivec2(0))) ||
-            any(greaterThanEqual(sample_pixel, ivec2(u_resolution)))) continue;
-        float scene_depth = texelFetch(u_linear_depth, sample_pixel, 0).r;
-        if (scene_depth <= 0.0) continue;
-        float range = smoothstep(0.0, 1.0, u_radius / max(abs(depth - scene_depth), 1e-4));
-        occluded += (scene_depth < -Q.z - 0.02 * u_radius ? 1.0 : 0.0) * range;
-    }
-    out_occlusion = clamp(1.0 - u_strength * occluded / float(u_samples), 0.0, 1.0);
+    out_occlusion = ssao_occlusion(gl_FragCoord.xy, pixel, depth, gl_FragCoord.xy);
 }
+#endif
