@@ -29,8 +29,10 @@ from deferred.api import (
     Phase,
     Pipeline,
     RenderPass,
+    RenderWork,
     Scene,
     TargetSpec,
+    Work,
     effects,
 )
 
@@ -41,6 +43,9 @@ SSAO_SPEC = TargetSpec(1, "f1", "ambient occlusion (1 = open)")
 SSAO_GRID_SPEC = TargetSpec(2, "f4", "ambient occlusion on the reduced grid, and the depth of "
                             "each texel's sample point")
 REDUCED_GRID = {"REDUCED_GRID": "1"}
+# the upsample's time a pixel, as a share of the full-resolution passes' (benchmarks/README.md,
+# "SSAO on a reduced grid")
+UPSAMPLE_SHARE = 0.1
 # a grid texel spans two pixels at half resolution: a 3x3 blur there covers about what the 5x5
 # covers at full resolution (a 5x5 on the grid smears contact shadows: 5 dB lower PSNR)
 GRID_BLUR = {**REDUCED_GRID, "BLUR_RADIUS": "1"}
@@ -93,6 +98,15 @@ class SSAO(Effect):
                            {"u_ssao_reduced": SSAO_REDUCED, "u_linear_depth": LINEAR_DEPTH},
                            (AMBIENT_OCCLUSION,), creates={AMBIENT_OCCLUSION: SSAO_SPEC}),
         ]
+
+    def work(self, job: RenderWork) -> list[Work]:
+        """The full-resolution passes' work a pixel, over the grid's share of the pixels and
+        the upsample's."""
+        resolution = self.params.resolution
+        share = 1.0 if resolution == 1.0 else resolution * resolution + UPSAMPLE_SHARE
+        return [replace(work, units=work.units * share,
+                        what=f"{work.what} (resolution {resolution:g})")
+                for work in super().work(job)]
 
     def grid_uniforms(self, grid: TargetSpec) -> Callable[[Frame], dict[str, Any]]:
         """The parameters' uniforms and the size of the reduced grid at the frame's size."""

@@ -154,3 +154,15 @@ def test_a_dump_and_a_pixel_history_take_the_reduced_grid(gl, tmp_path):
         assert occlusion[0] < 0.5  # the darkest pixel
         # the probes leave the frame as it was
         assert np.array_equal(renderer.render().image, capture.image)
+
+
+def test_the_cost_model_counts_the_grid_and_the_upsample():
+    from deferred.effects.ssao import SSAO, UPSAMPLE_SHARE
+    from deferred.interfaces.work import RenderWork
+
+    job = RenderWork((1280, 720))
+    full, = SSAO(SSAO.Params(resolution=1.0)).work(job)
+    half, = SSAO(SSAO.Params()).work(job)
+    assert full.units == 1280 * 720
+    assert half.units == pytest.approx(full.units * (0.25 + UPSAMPLE_SHARE))
+    assert "resolution 0.5" in half.what
