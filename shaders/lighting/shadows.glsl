@@ -85,10 +85,6 @@ vec4 shadow_texel(int row, int texel) {
     return texelFetch(u_shadow_records, ivec2(texel, row), 0);
 }
 
-// The pcf filter's 3x3 offsets, a texel apart (each a bilinear comparison: 4x4 texels, a tent).
-const vec2 SHADOW_GRID[9] = vec2[](
-    vec2(-1.0, -1.0), vec2(0.0, -1.0), vec2(1.0, -1.0), vec2(-1.0, 0.0), vec2(0.0, 0.0),
-    vec2(1.0, 0.0), vec2(-1.0, 1.0), vec2(0.0, 1.0), vec2(1.0, 1.0));
 // The soft filter's 16-tap Poisson disk in the unit circle.
 const vec2 SHADOW_POISSON[16] = vec2[](
     vec2(-0.9420, -0.3991), vec2(0.9456, -0.7689), vec2(-0.0942, -0.9294),
@@ -326,20 +322,35 @@ vec2 pcss_slope(mat4 to_atlas, vec3 Q, vec3 N, float step) {
 #endif
 
 // The lit fraction of a point at atlas coordinates uvz in tile rect: one loop whichever the
-// filter (pcf: SHADOW_GRID, a texel apart; soft: SHADOW_POISSON, header.w texels wide), so a
-// light pays for its own filter's taps only (where a shader runs as masked SIMD lanes, as on
-// llvmpipe, the two branches of an `if` both run).
+// filter, so a light pays for its own filter's taps only (where a shader runs as masked SIMD
+// lanes, as on llvmpipe, the two branches of an `if` both run).
+// - pcf: a 3x3 grid of bilinear comparisons a texel apart weighs the 4x4 texels around uvz by
+//   (1 - f, 1, 1, f) along each axis (f the fraction of uvz between texel centres). Two bilinear
+//   comparisons per axis give the same weights: one over the first two texels, placed
+//   1 / (2 - f) of a texel past the first, of weight 2 - f; one over the last two, f / (1 + f)
+//   past the third, of weight 1 + f. So 2x2 lookups, not 9 (the optimised PCF of shadow
+//   mapping practice; the filter is unchanged).
+// - soft: SHADOW_POISSON, header.w texels wide.
 float shadow_filter(vec3 uvz, vec4 rect, vec4 header) {
     bool soft = header.z > 0.5;
-    int taps = soft ? 16 : 9;
-    float scale = (soft ? header.w : 1.0) * u_shadow_atlas_texel;
+    int taps = soft ? 16 : 4;
+    float scale = header.w * u_shadow_atlas_texel;
+    vec2 st = uvz.xy / u_shadow_atlas_texel - 0.5;  // texel-centre coordinates
+    vec2 first = floor(st);
+    vec2 f = st - first;
+    vec2 w_low = 2.0 - f, w_high = 1.0 + f;
+    vec2 uv_low = (first - 0.5 + 1.0 / w_low) * u_shadow_atlas_texel;
+    vec2 uv_high = (first + 1.5 + f / w_high) * u_shadow_atlas_texel;
     float lit = 0.0;
     int k = 0;
     do {
-        vec2 offset = soft ? SHADOW_POISSON[k] : SHADOW_GRID[min(k, 8)];
-        lit += shadow_compare(uvz + vec3(offset * scale, 0.0), rect);
+        vec2 high = vec2(float(k & 1), float(k >> 1));
+        vec2 uv = soft ? uvz.xy + SHADOW_POISSON[k] * scale : mix(uv_low, uv_high, high);
+        vec2 w = mix(w_low, w_high, high);
+        float weight = soft ? 1.0 / 16.0 : w.x * w.y / 9.0;
+        lit += weight * shadow_compare(vec3(uv, uvz.z), rect);
     } while (++k < taps);
-    return lit / float(taps);
+    return lit;
 }
 
 // The tile's filter at uvz: shadow_filter's, or PCSS's where the light asks for it (its emitter
