@@ -37,6 +37,8 @@ from deferred.lighting.shadows.atlas import (
     SHADOW_ATLAS,
     SHADOWS_DEFINE,
     ShadowAtlas,
+    check_records_fit,
+    records_defines,
 )
 from deferred.lighting.shadows.opacity import (
     OPACITY_SHADOWS_DEFINE,
@@ -143,6 +145,7 @@ class RenderSetup:
             defines[TRANSMISSION_DEFINE] = "1"
         if scene_casts_shadows(state.lights):
             defines[SHADOWS_DEFINE] = "1"
+            defines.update(records_defines(state.shadow_budget.max_shadowed_lights))
             if any(light.casts_shadows and light.params.shadow_filter == "pcss"
                    for light in state.lights):
                 defines[PCSS_DEFINE] = "1"
@@ -162,6 +165,8 @@ class RenderSetup:
         self.light_buffer = LightBuffer(ctx)
         self.light_lists = LightLists(ctx) if features.compute_shaders else None
         budget = state.shadow_budget
+        if scene_casts_shadows(state.lights):
+            check_records_fit(ctx, budget.max_shadowed_lights, f"{state.source}: shadows")
         self.shadow_atlas = ShadowAtlas(
             ctx, budget.atlas_size, budget.max_shadowed_lights,
             opacity_size(state, plan.pipeline_name), opacity_extent(state),

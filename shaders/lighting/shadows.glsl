@@ -1,8 +1,8 @@
 // Shadow maps (deferred.lighting.shadows): every shadowed light's maps are tiles of one depth
 // texture, the shadow atlas, read with hardware comparison (sampler2DShadow, bilinear: each
 // lookup is a 2x2 PCF). A light's record holds its shadow slot in extra.w (0: no shadow);
-// slot k is row k - 1 of u_shadow_records, an RGBA32F texture of RECORD_TEXELS (40) texels
-// a row:
+// slot k is row k - 1 of the ShadowRecords uniform block, SHADOW_RECORD_TEXELS (40) vec4s a
+// row, SHADOW_RECORD_ROWS rows (the scene's max_shadowed_lights):
 //   0: projection (1 cascades, 2 perspective, 3 cube), tiles, filter (0 pcf, 1 soft, 2 pcss),
 //      softness
 //   1: depth bias, normal bias (texels), cascade blend band (fraction of a cascade), the
@@ -77,12 +77,14 @@ bool opacity_as_light_pass = false;
 
 #ifdef SHADOWS
 uniform sampler2DShadow u_shadow_atlas;
-uniform sampler2D u_shadow_records;
+layout(std140) uniform ShadowRecords {
+    vec4 shadow_record_data[SHADOW_RECORD_ROWS * SHADOW_RECORD_TEXELS];
+};
 uniform mat3 u_shadow_world_from_view;  // the camera's rotation, view -> world (cube faces)
 uniform float u_shadow_atlas_texel;     // 1 / the atlas's size
 
 vec4 shadow_texel(int row, int texel) {
-    return texelFetch(u_shadow_records, ivec2(texel, row), 0);
+    return shadow_record_data[row * SHADOW_RECORD_TEXELS + texel];
 }
 
 // The soft filter's 16-tap Poisson disk in the unit circle.

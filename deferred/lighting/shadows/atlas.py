@@ -1,6 +1,7 @@
-"""The shadow atlas: one depth texture holding every shadowed light's maps, the records texture
-of each slot's matrices (``lighting/shadows.glsl`` documents its layout) and, where the scene
-draws them, the deep opacity maps; this frame's tiles. A binding source of the frame."""
+"""The shadow atlas: one depth texture holding every shadowed light's maps, the records (a
+uniform block) of each slot's matrices (``lighting/shadows.glsl`` documents its layout) and,
+where the scene draws them, the deep opacity maps; this frame's tiles. A binding source of the
+frame."""
 
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ from typing import TYPE_CHECKING, Any
 import moderngl
 import numpy as np
 
+from deferred.errors import InputError
 from deferred.interfaces.light import Light
 from deferred.interfaces.shadow_casting import ShadowView
 from deferred.lighting.buffer import visible_spheres
@@ -42,7 +44,27 @@ SHADOW_ATLAS = "shadow_atlas"  # its name on a frame's blackboard
 SHADOWS_DEFINE = "SHADOWS"
 PCSS_DEFINE = "SHADOW_PCSS"  # a light of the scene filters its shadows by its size
 FILTER_IDS = {"pcf": 0.0, "soft": 1.0, "pcss": 2.0}  # lighting/shadows.glsl's header.z
-RECORD_TEXELS = 40  # texels a slot's row: 4 + 6 tiles x 6 (lighting/shadows.glsl)
+RECORD_TEXELS = 40  # vec4s a slot's row: 4 + 6 tiles x 6 (lighting/shadows.glsl)
+# The records are a uniform block, not a texture: a light's lookup reads eight of its vec4s at
+# every pixel it lights, and llvmpipe reads uniform memory several times faster than texels
+# (benchmarks/README.md, "Shadow lookups"). Its size is fixed when the shaders are compiled.
+RECORDS_BLOCK = "ShadowRecords"
+RECORDS_BINDING = 1  # its uniform buffer binding point (the framework's only uniform block)
+
+
+def records_defines(max_lights: int) -> dict[str, str]:
+    """The defines sizing lighting/shadows.glsl's records block for ``max_lights`` slots."""
+    return {"SHADOW_RECORD_ROWS": str(max_lights), "SHADOW_RECORD_TEXELS": str(RECORD_TEXELS)}
+
+
+def check_records_fit(ctx: moderngl.Context, max_lights: int, where: str) -> None:
+    """One line where the GL's uniform blocks cannot hold ``max_lights`` slots' records."""
+    limit = int(ctx.info.get("GL_MAX_UNIFORM_BLOCK_SIZE", 0) or 0)
+    need = RECORD_TEXELS * 16 * max_lights
+    if limit and need > limit:
+        raise InputError(f"max_shadowed_lights = {max_lights} needs {need} bytes of shadow "
+                         f"records; this GL's uniform blocks hold {limit} (at most "
+                         f"{limit // (RECORD_TEXELS * 16)} lights)", where)
 CASCADE_BLEND = 0.1  # the fraction of a cascade blended into the next at its far end
 PROJECTION_IDS = {ShadowProjection.CASCADES: 1, ShadowProjection.PERSPECTIVE: 2,
                   ShadowProjection.CUBE: 3}
@@ -111,7 +133,7 @@ def frustum_planes(view_projection: np.ndarray) -> np.ndarray:
 
 
 class ShadowAtlas:
-    """The shadow atlas, its records texture and this frame's tiles (a binding source)."""
+    """The shadow atlas, its records and this frame's tiles (a binding source)."""
 
     def __init__(self, ctx: moderngl.Context, atlas_size: int, max_lights: int,
                  opacity_size: int = 0, opacity_extent: int = 0, transmittance_size: int = 0,
@@ -139,8 +161,7 @@ class ShadowAtlas:
                                          repeat_x=False, repeat_y=False)
         self.framebuffer = ctx.framebuffer(depth_attachment=self.texture)
         self.framebuffer.clear(depth=1.0)  # tiles no light holds read as lit, and show so
-        self.records = ctx.texture((RECORD_TEXELS, max_lights), 4, dtype="f4")
-        self.records.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        self.records = ctx.buffer(reserve=RECORD_TEXELS * 16 * max_lights)
         self.tiles: list[ShadowTile] = []
         self.slots: dict[int, int] = {}  # id(light) -> slot (1-based)
         self.splits: dict[int, np.ndarray] = {}  # id(light) -> its cascades' far depths
@@ -350,13 +371,13 @@ class ShadowAtlas:
     def bind(self, uniforms: ProgramUniforms, texture_unit: int) -> int:
         """The atlas and records where a program reads them (lighting/shadows.glsl), and the
         opacity maps where it reads those (the opacity stage reads the first depth only)."""
-        if "u_shadow_records" in uniforms.members:
+        if RECORDS_BLOCK in uniforms.members:
             uniforms.set_shared("shadows", self._uniforms)
+            self.records.bind_to_uniform_block(RECORDS_BINDING)
+            uniforms.set_one(RECORDS_BLOCK, RECORDS_BINDING)
             self.texture.use(location=texture_unit)
             uniforms.set_one("u_shadow_atlas", texture_unit)
-            self.records.use(location=texture_unit + 1)
-            uniforms.set_one("u_shadow_records", texture_unit + 1)
-            texture_unit += 2
+            texture_unit += 1
             if "u_shadow_depths" in uniforms.members:
                 self.depth_sampler.use(location=texture_unit)
                 uniforms.set_one("u_shadow_depths", texture_unit)

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from deferred.errors import InputError
-from deferred.lighting.shadows.atlas import SHADOW_ATLAS
+from deferred.lighting.shadows.atlas import SHADOW_ATLAS, check_records_fit
 from deferred.lighting.shadows.frusta import practical_splits
 from deferred.render.renderer import Renderer
 from deferred.scene.loader import scene_from_dict
@@ -374,6 +374,18 @@ def test_bad_shadow_parameters_are_one_line_errors(tmp_path, text, expected):
     assert done.returncode == 2
     assert len(done.stderr.strip().splitlines()) == 1 and expected.split(":")[0] in done.stderr
     assert not (tmp_path / "out.png").exists()
+
+
+def test_records_that_overflow_the_gl_uniform_blocks_are_one_line(gl):
+    class SmallBlocks:  # a GL with the smallest uniform blocks the GL 3.3 spec allows
+        info = {"GL_MAX_UNIFORM_BLOCK_SIZE": 16384}
+
+    check_records_fit(SmallBlocks(), 25, "scene.toml: shadows")  # 25 x 640 bytes fit
+    with pytest.raises(InputError) as error:
+        check_records_fit(SmallBlocks(), 26, "scene.toml: shadows")
+    assert str(error.value).count("\n") == 0
+    assert "max_shadowed_lights = 26" in str(error.value) and "at most 25" in str(error.value)
+    check_records_fit(gl.ctx, 64, "scene.toml: shadows")  # the largest budget fits here
 
 
 @pytest.mark.slow
