@@ -25,5 +25,5 @@ class ShadowBudget:
     atlas_size: int = 4096
     max_shadowed_lights: int = 16
     opacity_scale: float = 0.25
-    allocation: str = "fixed"
+    allocation: str = "coverage"
     cascade_updates: str | None = None

@@ -161,9 +161,10 @@ class ShadowsModel(_Strict):
     opacity_scale: float = Field(0.25, description="texels on a side of the fur's deep "
                                  "opacity maps per shadow-map texel (1, 0.5, .. 1/16)")
     allocation: ShadowAllocation = Field(
-        ShadowAllocation.FIXED, description="how large each spot and point light's maps are: "
-        "fixed (its shadow_resolution) or coverage (by the part of the screen its shadowed "
-        "region covers, at most its shadow_resolution; maps shrink before lights are left out)")
+        ShadowAllocation.COVERAGE, description="how large each spot and point light's maps are: "
+        "coverage (by the part of the screen its shadowed region covers, at most its "
+        "shadow_resolution; maps shrink before lights are left out) or fixed (its "
+        "shadow_resolution)")
     cascade_updates: Literal["every_frame", "staggered"] | None = Field(
         None, description="while the camera moves, a directional light's cascades all drawn "
                           "every frame, or the nearest every frame and the farther in turn "

@@ -3,8 +3,11 @@ casters into it.
 
 A light casts shadows when its type names a ``shadow_projection`` and its params say
 ``shadows = true`` (:class:`deferred.interfaces.light.ShadowParams`). Each such light, in scene
-order up to the scene's ``max_shadowed_lights``, is given a *slot* and square tiles of
-``shadow_resolution`` texels in the atlas (a quadtree of power-of-two squares):
+order up to the scene's ``max_shadowed_lights``, is given a *slot* and square tiles in the
+atlas (a quadtree of power-of-two squares): a spot or point light's as large as the part of the
+screen its shadowed region covers asks, at most its ``shadow_resolution`` (``[shadows]
+allocation = "coverage"``, :mod:`~deferred.lighting.shadows.coverage`; ``"fixed"``: that
+resolution), a directional light's of its ``shadow_resolution``:
 
 - ``cascades`` (directional): ``cascades`` orthographic maps over the camera's depth up to
   ``shadow_distance``, split by the practical split scheme (Zhang et al. 2006, "Parallel-Split
@@ -42,7 +45,8 @@ transmittance through the whole volume where it lies beyond the volume's back
 (``opacity_beyond``). Programs see ``OPACITY_SHADOWS``, so a scene without such a volume
 compiles neither lookup.
 
-One module a part: :mod:`~deferred.lighting.shadows.plan` the slots and squares of the atlas;
+One module a part: :mod:`~deferred.lighting.shadows.coverage` how large each light's maps are;
+:mod:`~deferred.lighting.shadows.plan` the slots and squares of the atlas;
 :mod:`~deferred.lighting.shadows.frusta` each map's view and projection (cascades, spot, cube
 faces); :mod:`~deferred.lighting.shadows.stagger` which cascades are fitted again each frame
 (``[shadows] cascade_updates``: all, or the far ones in turn while the camera moves);

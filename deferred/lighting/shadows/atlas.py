@@ -21,7 +21,7 @@ from deferred.lighting.shadows.coverage import (
     fit_sizes,
     map_size,
     screen_coverage,
-    shadowed_sphere,
+    shadowed_spheres,
 )
 from deferred.lighting.shadows.frusta import (
     cascade_slices,
@@ -137,7 +137,7 @@ class ShadowAtlas:
 
     def __init__(self, ctx: moderngl.Context, atlas_size: int, max_lights: int,
                  opacity_size: int = 0, opacity_extent: int = 0, transmittance_size: int = 0,
-                 allocation: str = ShadowAllocation.FIXED):
+                 allocation: str = ShadowAllocation.COVERAGE):
         """``opacity_size``: texels on a side of the deep opacity maps (0: none), covering the
         atlas's square of ``opacity_extent`` texels from its corner; ``transmittance_size``:
         texels on a side of the transmittance maps (0: none), texel for texel with the atlas
@@ -223,12 +223,15 @@ class ShadowAtlas:
         view = np.asarray(view, np.float64)
         self.cascades.start_frame(view)
         seen = self._seen_lights(scene, view, projection)
-        self._plan_lights(scene, self._coverage_sizes(scene, view, projection, seen,
+        # what receives shadows, where cascades or coverage need it
+        bounds = world_bounds(scene) if self.allocation == ShadowAllocation.COVERAGE or any(
+            light.casts_shadows and light.shadow_projection == ShadowProjection.CASCADES
+            for light in scene.lights) else None
+        self._plan_lights(scene, self._coverage_sizes(scene, view, projection, seen, bounds,
                                                       hold_sizes))
         inverse_view = np.linalg.inv(view)
         records = np.zeros((self.max_lights, RECORD_TEXELS, 4), np.float32)
         self.tiles, self.slots, self.splits = [], {}, {}
-        bounds = None
         for light in scene.lights:
             planned = self._plan.get(id(light))
             if planned is None or not seen.get(id(light), True):
@@ -244,8 +247,6 @@ class ShadowAtlas:
             row[1] = (params.shadow_bias, params.normal_bias, CASCADE_BLEND,
                       light.emitter_radius() if pcss else 0.0)
             if kind == ShadowProjection.CASCADES:
-                if bounds is None:
-                    bounds = world_bounds(scene)
                 slices = cascade_slices(light, scene, inverse_view, aspect, bounds)
                 frusta = self.cascades.frusta(light, slices, squares, cascade_updates)
                 splits = np.array([cascade.far for cascade in slices])
@@ -277,27 +278,28 @@ class ShadowAtlas:
                 in zip(lights, visible_spheres(spheres, projection), strict=True)}
 
     def _coverage_sizes(self, scene: Scene, view: np.ndarray, projection: np.ndarray | None,
-                        seen: dict[int, bool], hold: bool) -> dict[int, int]:
+                        seen: dict[int, bool], bounds: tuple[np.ndarray, np.ndarray] | None,
+                        hold: bool) -> dict[int, int]:
         """By coverage, each spot and point light's map side this frame (0: out of view),
         fitted to the region the maps may take; fixed: none (each its resolution)."""
         if self.allocation != ShadowAllocation.COVERAGE or projection is None:
             return {}
+        shadowed = [light for light in scene.lights if light.casts_shadows]
+        local = [light for light in shadowed
+                 if light.shadow_projection != ShadowProjection.CASCADES and
+                 seen.get(id(light), True)]
+        coverage = dict(zip(map(id, local), screen_coverage(
+            *shadowed_spheres(local, bounds), view, projection, bounds).tolist(), strict=True))
         requests = []
-        bounds = world_bounds(scene)
-        for light in scene.lights:
-            if not light.casts_shadows:
-                continue
+        for light in shadowed:
             resolution = int(light.params.shadow_resolution)
-            if light.shadow_projection == ShadowProjection.CASCADES:
+            if light.shadow_projection == ShadowProjection.CASCADES:  # they cover the view
                 requests.append((id(light), tile_counts(light), resolution, 1.0))
                 continue
-            coverage = 0.0
-            if seen.get(id(light), True):
-                centre, radius = shadowed_sphere(light, bounds)
-                coverage = screen_coverage(centre, radius, view, projection, bounds)
+            covered = coverage.get(id(light), 0.0)
             previous = self.sizes.get(id(light)) if hold else None
             requests.append((id(light), tile_counts(light),
-                             map_size(resolution, coverage, previous), coverage))
+                             map_size(resolution, covered, previous), covered))
         # the lights given slots only: those past max_shadowed_lights take no room
         sides = fit_sizes([request for request in requests[:self.max_lights] if request[2]],
                           self.region)

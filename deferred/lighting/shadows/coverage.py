@@ -36,74 +36,94 @@ MIN_TILE = MIN_SHADOW_RESOLUTION  # texels on a side of the smallest map
 SHRINK_MARGIN = 0.5
 
 
-def shadowed_sphere(light: Light, bounds: tuple[np.ndarray, np.ndarray] | None = None
-                    ) -> tuple[np.ndarray, float]:
-    """The world bounding sphere (centre, radius) of what a spot or point light shadows: a
-    spot's cone of its ``radius`` and outer angle, cut where it leaves the world box
-    ``bounds`` of the scene's objects (nothing beyond receives its light), bounded by the
-    cone's circumsphere where the angle is at most 45 degrees, else the sphere around its base
-    disc; a point light's reach."""
-    params = light.params
-    position = np.asarray(params.position, np.float64)
-    length = float(params.radius)
-    if light.shadow_projection != ShadowProjection.PERSPECTIVE:
-        return position, length
-    direction = np.asarray(params.direction, np.float64)
-    direction = direction / max(float(np.linalg.norm(direction)), 1e-12)
-    if bounds is not None:  # the farthest corner of the box along the axis
-        low, high = bounds
-        reach = float(np.sum(np.maximum(direction * (low - position),
-                                        direction * (high - position))))
-        length = min(length, max(reach, 1e-6))
-    angle = math.radians(params.outer_angle)
-    if angle <= math.pi / 4.0:
-        radius = length / (2.0 * math.cos(angle))
-        return position + direction * radius, radius
-    return position + direction * length * math.cos(angle), length * math.sin(angle)
+# the eight corners of a box, as 0/1 picks of its low and high ends
+CORNERS = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], bool)
 
 
-def _extent(centre: float, depth: float, radius: float, scale: float) -> tuple[float, float]:
-    """The NDC interval along one axis of a sphere at (``centre``, ``depth`` > ``radius``) in
+def shadowed_spheres(lights: list[Light], bounds: tuple[np.ndarray, np.ndarray] | None = None
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """The world bounding spheres (centres (n, 3), radii (n,)) of what spot and point
+    ``lights`` shadow: a spot's cone of its ``radius`` and outer angle, cut where it leaves the
+    world box ``bounds`` of the scene's objects (nothing beyond receives its light), bounded by
+    the cone's circumsphere where the angle is at most 45 degrees, else by the sphere around its
+    base disc; a point light's reach."""
+    params = [light.params for light in lights]
+    centres = np.array([p.position for p in params], np.float64).reshape(-1, 3)
+    radii = np.array([p.radius for p in params], np.float64)
+    spot = np.array([light.shadow_projection == ShadowProjection.PERSPECTIVE
+                     for light in lights], bool)
+    if not spot.any():
+        return centres, radii
+    position = centres[spot]
+    direction = np.array([p.direction for p, is_spot in zip(params, spot, strict=True)
+                          if is_spot], np.float64)
+    direction /= np.maximum(np.linalg.norm(direction, axis=1, keepdims=True), 1e-12)
+    length = radii[spot]
+    if bounds is not None:  # the box's farthest corner along each axis
+        reach = np.maximum(direction * (bounds[0] - position),
+                           direction * (bounds[1] - position)).sum(axis=1)
+        length = np.minimum(length, np.maximum(reach, 1e-6))
+    angle = np.radians([p.outer_angle for p, is_spot in zip(params, spot, strict=True)
+                        if is_spot])
+    narrow = angle <= math.pi / 4.0
+    radius = np.where(narrow, length / (2.0 * np.cos(angle)), length * np.sin(angle))
+    along = np.where(narrow, radius, length * np.cos(angle))
+    centres[spot] = position + direction * along[:, None]
+    radii[spot] = radius
+    return centres, radii
+
+
+def _extent(centre: np.ndarray, depth: np.ndarray, radius: np.ndarray,
+            scale: float) -> tuple[np.ndarray, np.ndarray]:
+    """The NDC interval along one axis of spheres at (``centre``, ``depth`` > ``radius``) in
     that axis's plane with the view axis: the slopes of the two lines from the eye tangent to
-    it, times the projection's ``scale`` (P00 or P11)."""
+    each, times the projection's ``scale`` (P00 or P11)."""
     d2 = depth * depth - radius * radius
-    root = radius * math.sqrt(max(centre * centre + d2, 0.0))
-    low, high = (centre * depth - root) / d2, (centre * depth + root) / d2
-    return max(scale * low, -1.0), min(scale * high, 1.0)
+    root = radius * np.sqrt(np.maximum(centre * centre + d2, 0.0))
+    return np.maximum(scale * (centre * depth - root) / d2, -1.0), \
+        np.minimum(scale * (centre * depth + root) / d2, 1.0)
 
 
-def screen_coverage(centre: np.ndarray, radius: float, view: np.ndarray,
+def screen_coverage(centres: np.ndarray, radii: np.ndarray, view: np.ndarray,
                     projection: np.ndarray,
-                    bounds: tuple[np.ndarray, np.ndarray] | None = None) -> float:
-    """The fraction of the screen covered by the world sphere (``centre``, ``radius``) where it
-    meets the world box ``bounds`` of what can receive its shadow: the rectangle bounding the
-    sphere under ``view`` and the perspective ``projection`` (Mara and McGuire 2013, "2D
-    Polyhedral Bounds of a Clipped, Perspective-Projected 3D Sphere": the planes through each
-    screen axis tangent to it), cut to the rectangle of the box's part within the sphere's
-    box where that lies wholly in front of the eye, and to the view. 1 where the sphere
-    reaches the eye's plane. Sub-pixel offsets of the projection (jitter) are left out."""
-    x, y, z = (float(v) for v in (view @ np.append(centre, 1.0))[:3])
-    depth = -z
-    if depth <= radius:
-        return 1.0
+                    bounds: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
+    """The fraction of the screen covered by each world sphere (``centres`` (n, 3), ``radii``)
+    where it meets the world box ``bounds`` of what can receive its shadow: the rectangle
+    bounding the sphere under ``view`` and the perspective ``projection`` (Mara and McGuire
+    2013, "2D Polyhedral Bounds of a Clipped, Perspective-Projected 3D Sphere": the planes
+    through each screen axis tangent to it), cut to the rectangle of the box's part within the
+    sphere's box where that lies wholly in front of the eye, and to the view. 1 where the
+    sphere reaches the eye's plane. Sub-pixel offsets of the projection (jitter) are left
+    out."""
+    centres = np.asarray(centres, np.float64).reshape(-1, 3)
+    radii = np.asarray(radii, np.float64).reshape(-1)
+    view = np.asarray(view, np.float64)
+    seen = centres @ view[:3, :3].T + view[:3, 3]
+    depth = -seen[:, 2]
+    front = depth > radii
+    safe = np.where(front, depth, radii + 1.0)  # the others' rectangles are not used
     scale = (float(projection[0, 0]), float(projection[1, 1]))
-    x0, x1 = _extent(x, depth, radius, scale[0])
-    y0, y1 = _extent(y, depth, radius, scale[1])
+    x0, x1 = _extent(seen[:, 0], safe, radii, scale[0])
+    y0, y1 = _extent(seen[:, 1], safe, radii, scale[1])
     if bounds is not None:
-        low = np.maximum(bounds[0], centre - radius)
-        high = np.minimum(bounds[1], centre + radius)
-        if np.any(low > high):
-            return 0.0
-        corners = np.array([[cx, cy, cz, 1.0] for cx in (low[0], high[0])
-                            for cy in (low[1], high[1]) for cz in (low[2], high[2])])
-        seen = (view @ corners.T)[:3]
-        if np.all(seen[2] < -1e-6):
-            sx, sy = scale[0] * seen[0] / -seen[2], scale[1] * seen[1] / -seen[2]
-            x0, x1 = max(x0, float(sx.min())), min(x1, float(sx.max()))
-            y0, y1 = max(y0, float(sy.min())), min(y1, float(sy.max()))
-    if x1 <= x0 or y1 <= y0:
-        return 0.0
-    return (x1 - x0) * (y1 - y0) / 4.0
+        low = np.maximum(bounds[0], centres - radii[:, None])
+        high = np.minimum(bounds[1], centres + radii[:, None])
+        empty = np.any(low > high, axis=1)
+        corners = np.where(CORNERS[None], high[:, None], low[:, None])  # (n, 8, 3)
+        points = corners @ view[:3, :3].T + view[:3, 3]
+        ahead = np.all(points[..., 2] < -1e-6, axis=1)
+        w = np.where(ahead[:, None], -points[..., 2], 1.0)
+        sx, sy = scale[0] * points[..., 0] / w, scale[1] * points[..., 1] / w
+        x0 = np.where(ahead, np.maximum(x0, sx.min(axis=1)), x0)
+        x1 = np.where(ahead, np.minimum(x1, sx.max(axis=1)), x1)
+        y0 = np.where(ahead, np.maximum(y0, sy.min(axis=1)), y0)
+        y1 = np.where(ahead, np.minimum(y1, sy.max(axis=1)), y1)
+        front &= ~empty
+        out = empty
+    else:
+        out = np.zeros(len(radii), bool)
+    area = np.maximum(x1 - x0, 0.0) * np.maximum(y1 - y0, 0.0) / 4.0
+    return np.where(front, area, np.where(out, 0.0, 1.0))
 
 
 def needed_log2(resolution: int, coverage: float) -> float:

@@ -77,13 +77,15 @@ def test_screen_coverage_is_the_sampled_spheres_rectangle(centre, radius):
     camera = Camera((0.0, 0.0, 0.0), (0.0, 0.0, -1.0), (0.0, 1.0, 0.0), 50.0, 0.1, 100.0)
     view, projection = camera.view(), camera.projection(16 / 9)
     centre = np.asarray(centre)
-    got = screen_coverage(centre, radius, view, projection)
+    got = screen_coverage(centre[None], np.array([radius]), view, projection)[0]
     want = 1.0 if radius >= -centre[2] else sampled_coverage(centre, radius, view, projection)
     assert got == pytest.approx(want, rel=0.01, abs=1e-4)
-    # a box around only part of the sphere narrows it
-    part = screen_coverage(centre, radius, view, projection,
-                           (centre - radius, centre + (0.0, 0.0, radius)))
+    # a box around only part of the sphere narrows it; one beyond it leaves nothing
+    part = screen_coverage(centre[None], np.array([radius]), view, projection,
+                           (centre - radius, centre + (0.0, 0.0, radius)))[0]
     assert part <= got + 1e-12
+    assert screen_coverage(centre[None], np.array([radius]), view, projection,
+                           (centre + radius + 1.0, centre + radius + 2.0))[0] == 0.0
 
 
 def test_map_sizes_follow_coverage_with_a_margin_before_shrinking():
