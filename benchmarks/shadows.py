@@ -8,10 +8,11 @@ draws the same frame again; ``--cascade-updates staggered`` draws the far cascad
 while the camera moves (``deferred.lighting.shadows.stagger``; the shadows pass's time is then
 the mean of two frames, one of each far cascade's turn).
 
-``--allocation coverage`` sizes the spots' maps by the part of the screen each lights
-(``[shadows] allocation``); ``--allocation both`` times the spots with fixed and with coverage
-maps one after the other and prints, for each, the atlas's texels the maps hold and those the
-timed frames drew a frame (the directional case is left out: its cascades cover the view).
+``--allocation fixed`` gives every spot's map its 1024^2 (``coverage``, the default, sizes
+them by the part of the screen each lights: ``[shadows] allocation``); ``--allocation both``
+times the spots with fixed and with coverage maps one after the other and prints, for each,
+the atlas's texels the maps hold and those the timed frames drew a frame (the directional case
+is left out: its cascades cover the view).
 ``--move-spots`` turns the spots a degree a frame about the vertical (every map drawn again
 each frame), ``--hold`` holds the sizes from frame to frame as the live viewer does.
 ``--spots receding`` puts the 16 spots over a long floor in four rows going away from the
@@ -86,7 +87,7 @@ def receding_scene(shadows: bool, size: tuple[int, int]):
         "object": objects, "light": lights}, "receding spots")
 
 
-def scene_for(case: str, spots: str = "ring", allocation: str = "fixed",
+def scene_for(case: str, spots: str = "ring", allocation: str = "coverage",
               size: tuple[int, int] = (1280, 720)):
     if spots == "receding" and case.startswith("spots"):
         scene = receding_scene(case == "spots shadowed", size)
@@ -240,7 +241,7 @@ def main() -> None:
                         default="every_frame")
     parser.add_argument("--paths", default=",".join(f"{p}:{q}" for p, q in PATHS))
     parser.add_argument("--allocation", choices=("fixed", "coverage", "both"),
-                        default="fixed")
+                        default="coverage")
     parser.add_argument("--spots", choices=("ring", "receding"), default="ring")
     parser.add_argument("--rounds", type=int, default=1,
                         help="--allocation both: rounds of the three cases, interleaved")

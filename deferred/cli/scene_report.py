@@ -13,7 +13,8 @@ from deferred.errors import InputError
 from deferred.gl.target_spec import targets_bytes
 from deferred.io.images import amount, check_image
 from deferred.io.memory import BUDGET_VARIABLE, memory_budget
-from deferred.lighting.shadows.plan import plan_atlas
+from deferred.lighting.shadows.coverage import fit_sizes
+from deferred.lighting.shadows.plan import plan_atlas, tile_counts
 from deferred.names import ShadowAllocation
 from deferred.render.budget import renderer_holdings
 from deferred.render.setup import SetupPlan
@@ -99,13 +100,18 @@ def light_lines(state: FrameState) -> list[str]:
         lines.append("shadow maps: none (no light has shadows = true)")
         return lines
     budget = state.shadow_budget
-    placed, left_out = plan_atlas(lights, budget.atlas_size, budget.max_shadowed_lights)
+    sizes = None
+    if budget.allocation == ShadowAllocation.COVERAGE:  # as if each light covered the view
+        sizes = fit_sizes([(id(light), tile_counts(light), light.params.shadow_resolution, 1.0)
+                           for light in shadowed[:budget.max_shadowed_lights]],
+                          budget.atlas_size)
+    placed, left_out = plan_atlas(lights, budget.atlas_size, budget.max_shadowed_lights, sizes)
     lines.append(f"shadow maps: {len(placed)} of {len(shadowed)} shadowed lights in an atlas of "
                  f"{budget.atlas_size}x{budget.atlas_size} (max_shadowed_lights = "
                  f"{budget.max_shadowed_lights})")
     if budget.allocation == ShadowAllocation.COVERAGE:
-        lines.append("  allocation = coverage: each frame's spot and point maps at most these, "
-                     "by the screen each covers; maps shrink before lights are left out")
+        lines.append("  allocation = coverage: each frame's spot and point maps at most these "
+                     "(every light covering the view), by the screen each covers")
     index_of = {id(light): index for index, light in enumerate(lights)}
     for light in shadowed[:20]:
         if id(light) in placed:

@@ -1,8 +1,9 @@
 """Shadow map sizes by screen coverage (the ``[shadows]`` table's ``allocation = "coverage"``).
 
 A spot or point light's maps are sized by how much of the view its shadowed region covers: the
-bounding sphere of its cone (spot) or of its reach (point), projected to the screen as the
-rectangle of its tangent planes (exact for a sphere in front of the eye), clipped to the view.
+bounding sphere of its cone (spot; the cone cut where it leaves the scene's box) or of its reach
+(point), projected to the screen as the rectangle of its tangent planes (exact for a sphere in
+front of the eye), cut to the rectangle of the scene's box within the sphere and to the view.
 The map's side is its ``shadow_resolution`` times the square root of the covered fraction of the
 screen (texels per pixel across the region held near what the full resolution gives a light
 filling the view), rounded up to a power of two, at least :data:`MIN_TILE` and at most the
@@ -12,8 +13,9 @@ view and keep their resolution.
 Every size is a function of the frame alone (the camera and the light at its time), so a frame
 of ``deferred render`` or a farm's worker is the same whatever came before. The live viewer
 asks for hysteresis (:func:`map_size`'s ``previous``): a map grows as soon as its light needs
-more texels and shrinks only once the light covers half the area its smaller size stands for,
-so a camera moving back and forth about a size's edge does not redraw the map every frame.
+more texels and shrinks only once the light covers half the area the next smaller size
+suffices for, so a camera moving back and forth about a size's edge does not redraw the map
+every frame.
 
 When the maps do not fit the atlas (the sum of their areas: power-of-two squares packed largest
 first fill a power-of-two square exactly), the largest maps are halved, those covering least of

@@ -206,3 +206,22 @@ def test_more_lights_than_fit_at_full_size_all_get_shadows(gl):
     peak = float(full.max())
     psnr = 10.0 * math.log10(peak * peak / float(np.mean((image - full) ** 2)))
     assert psnr > 30.0, psnr
+
+
+def test_info_lists_every_light_that_fits_with_smaller_maps():
+    """``deferred info``'s shadow maps by coverage: as if each light covered the view, the
+    maps halved to fit (fixed: one light placed, the rest unshadowed)."""
+    from deferred.cli.scene_report import light_lines
+    from deferred.scene.timeline import SceneEvaluator
+
+    spots = [{**SMALL, "position": [float(x), 1.5, 0.0]} for x in range(8)]
+    lines = {}
+    for allocation in ("coverage", "fixed"):
+        the_scene = scene(spots, allocation, atlas_size=512)
+        lines[allocation] = light_lines(SceneEvaluator(the_scene).evaluate(0.0))
+    assert "shadow maps: 8 of 8 shadowed lights in an atlas of 512x512 " \
+           "(max_shadowed_lights = 16)" in lines["coverage"]
+    assert not any("unshadowed" in line for line in lines["coverage"])
+    assert "  light[1] spot: 1 tile of 256x256" in lines["coverage"]
+    assert "shadow maps: 1 of 8 shadowed lights in an atlas of 512x512 " \
+           "(max_shadowed_lights = 16)" in lines["fixed"]
