@@ -22,9 +22,9 @@ resolution), a directional light's of its ``shadow_resolution``:
 The light's record carries its slot in ``extra.w`` (the light lists keep a light's index, so
 every light path and both pipelines read the slot with the record); the slot's row of the
 records (a uniform block sized by ``max_shadowed_lights``) holds its matrices from view space
-to the atlas (``lighting/shadows.glsl`` documents the layout). The atlas is one binding source of the frame, bound to every program
-that reads it; programs only read it where the scene has a shadowed light (the define
-``SHADOWS``), so a scene without shadows pays nothing.
+to the atlas (``lighting/shadows.glsl`` documents the layout). The atlas is one binding source
+of the frame, bound to every program that reads it; programs only read it where the scene has
+a shadowed light (the define ``SHADOWS``), so a scene without shadows pays nothing.
 
 **Deep opacity maps** (Yuksel and Keyser 2008), where an object's material draws a volume
 (``ShadowCaster.opacity_shadows``: fur; in the deferred pipeline ``deferred_opacity`` too): beside
