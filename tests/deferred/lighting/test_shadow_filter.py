@@ -4,6 +4,7 @@ lookups the shader spends on it, and the soft filter the mean of its Poisson tap
 
 import moderngl
 import numpy as np
+from glsl_harness import draw_values
 from locations import FIXTURES
 
 from deferred.gbuffer.layout import GBufferLayout
@@ -62,21 +63,13 @@ def glsl_filter(gl, depths, points):
     inputs = ctx.texture((len(points), 1), 4, np.asarray(points, np.float32).tobytes(),
                          dtype="f4")
     inputs.filter = (moderngl.NEAREST, moderngl.NEAREST)
-    target = ctx.texture((len(points), 1), 1, dtype="f4")
-    framebuffer = ctx.framebuffer([target])
-    vao = ctx.vertex_array(program, [])
-    framebuffer.use()
-    ctx.viewport = (0, 0, len(points), 1)
-    ctx.enable_only(moderngl.NOTHING)
     atlas.use(0)
     inputs.use(1)
     program["u_shadow_atlas"] = 0
     program["u_points"] = 1
     program["u_shadow_atlas_texel"] = 1.0 / SIZE
-    vao.render(moderngl.TRIANGLES, vertices=3)
-    values = np.frombuffer(target.read(), np.float32).copy()
-    gl.park()
-    for thing in (vao, framebuffer, target, inputs, atlas):
+    values = draw_values(gl, program, (len(points), 1), 1).ravel()
+    for thing in (inputs, atlas):
         thing.release()
     lib.release()
     return values

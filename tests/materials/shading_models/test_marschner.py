@@ -6,6 +6,7 @@ tips glow)."""
 import moderngl
 import numpy as np
 import pytest
+from glsl_harness import draw_values
 from locations import FIXTURES
 
 from deferred.gl.shaderlib import ShaderLibrary
@@ -75,19 +76,10 @@ def glsl_values(gl, rows):
         data[i, 4, :2] = b, s
     inputs = ctx.texture((5, len(rows)), 4, data.tobytes(), dtype="f4")
     inputs.filter = (moderngl.NEAREST, moderngl.NEAREST)
-    target = ctx.texture((len(rows), 1), 4, dtype="f4")
-    framebuffer = ctx.framebuffer([target])
-    vao = ctx.vertex_array(program, [])
-    framebuffer.use()
-    ctx.viewport = (0, 0, len(rows), 1)
-    ctx.enable_only(moderngl.NOTHING)
     inputs.use(0)
     program["u_inputs"] = 0
-    vao.render(moderngl.TRIANGLES, vertices=3)
-    values = np.frombuffer(target.read(), np.float32).reshape(-1, 4)[:, :3].copy()
-    gl.park()
-    for thing in (vao, framebuffer, target, inputs):
-        thing.release()
+    values = draw_values(gl, program, (len(rows), 1), 4)[0, :, :3]
+    inputs.release()
     lib.release()
     return values
 

@@ -9,6 +9,7 @@ from pathlib import Path
 import moderngl
 import numpy as np
 import pytest
+from glsl_harness import draw_values
 from locations import FIXTURES
 from PIL import Image
 
@@ -275,23 +276,15 @@ def render_ink(gl, tam, tones, uniforms):
     texture = tam_texture(ctx, tam)
     tone_texture = ctx.texture((width, height), 1, tones.astype(np.float32).tobytes(), dtype="f4")
     tone_texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
-    target = ctx.texture((width, height), 1, dtype="f4")
-    fbo = ctx.framebuffer([target])
-    vao = ctx.vertex_array(program, [])
     texture.use(0)
     tone_texture.use(1)
     values = {"u_tam": 0, "u_tones": 1, "u_tam_tones": tam.tones, "u_gutter": tam.gutter,
               **uniforms}
     for name, value in values.items():
         program[name].value = value
-    fbo.use()
-    ctx.viewport = (0, 0, width, height)
-    ctx.enable_only(moderngl.NOTHING)
-    vao.render(moderngl.TRIANGLES, vertices=3)
-    ink = np.frombuffer(target.read(), np.float32).reshape(height, width).astype(np.float64)
+    ink = draw_values(gl, program, (width, height), 1)[..., 0].astype(np.float64)
     levels = [np.frombuffer(texture.read(level=m), np.uint8) for m in range(tam.mips)]
-    gl.park()
-    for thing in (vao, fbo, target, tone_texture, texture):
+    for thing in (tone_texture, texture):
         thing.release()
     lib.release()
     assert ctx.error == "GL_NO_ERROR"
